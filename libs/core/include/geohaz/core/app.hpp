@@ -1,0 +1,48 @@
+#pragma once
+/// \file app.hpp
+/// What every geohaz command-line app shares: the common options (Boost.Program_options), the
+/// exception → exit-code mapping (InputError → 2, anything else → 1), thread setup and the
+/// `--help-config` key reference.
+
+#include <boost/program_options.hpp>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "geohaz/core/config.hpp"
+
+namespace geohaz {
+
+/// Options every app takes.
+struct CommonOptions {
+  std::string config;                ///< --config FILE ("" if none)
+  std::vector<std::string> set;      ///< --set key=value ...
+  std::string out;                   ///< --out DIR
+  int threads = 0;                   ///< --threads N (0: all cores)
+  bool quiet = false;                ///< --quiet
+  bool help_config = false;          ///< --help-config
+};
+
+/// Add --config, --set, --out, --threads, --quiet, --help, --version, --help-config.
+void add_common_options(boost::program_options::options_description& desc, CommonOptions& opts,
+                        const std::string& default_out);
+
+/// Parse argv. Returns false (after printing) when --help or --version was asked for.
+/// Unknown options or bad values → InputError.
+bool parse_command_line(int argc, const char* const* argv, const std::string& app, const std::string& summary,
+                        boost::program_options::options_description& desc,
+                        boost::program_options::positional_options_description* positional = nullptr);
+
+/// Read the config file (or an empty one) and apply the --set overrides.
+ConfigReader load_config(const CommonOptions& opts);
+
+/// Set the OpenMP thread count (0 = all cores); InputError when negative. Returns the count used.
+int setup_threads(int threads);
+
+/// Run an app body, mapping exceptions to messages on stderr and exit codes:
+/// InputError → 2 ("app: input error: ..."), SimulationError → 1 ("app: simulation stopped: ..."),
+/// any other exception → 1 ("app: error: ...").
+int run_main(const std::string& app, const std::function<int()>& body);
+
+}  // namespace geohaz

@@ -1,0 +1,191 @@
+#pragma once
+/// \file particles.hpp
+/// Structure-of-arrays particle store. Every per-particle quantity of a model is a *field*,
+/// declared once as a tag type:
+///
+///     struct Density { using type = double; static constexpr const char* label = "density";
+///                      static constexpr const char* unit = "kg/m^3"; };
+///
+/// The tag names the HDF5 dataset (label) and its unit. A model's store is
+/// `ParticleStore<Position<2>, Velocity<2>, Density, ...>`; each field is one contiguous
+/// std::vector, so hot loops stream through memory. Append, compacting removal and reordering
+/// by a permutation act on every field together, so no field can be forgotten.
+///
+/// Value types must be trivially copyable: arithmetic types or fixed-size Eigen matrices.
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <type_traits>
+#include <vector>
+
+#include "geohaz/core/vec.hpp"
+
+namespace geohaz {
+
+/// How a field value maps to a flat array of scalars (for I/O).
+template <class T, class Enable = void>
+struct FieldTraits;
+
+template <class T>
+struct FieldTraits<T, std::enable_if_t<std::is_arithmetic_v<T>>> {
+  using scalar = T;
+  static constexpr int rows = 1;
+  static constexpr int cols = 1;
+};
+
+template <class S, int R, int C, int O, int MR, int MC>
+struct FieldTraits<Eigen::Matrix<S, R, C, O, MR, MC>> {
+  static_assert(R > 0 && C > 0, "only fixed-size Eigen types can be particle fields");
+  using scalar = S;
+  static constexpr int rows = R;
+  static constexpr int cols = C;
+};
+
+/// Common field tags. Models add their own beside these.
+template <int Dim>
+struct Position {
+  using type = Vec<Dim>;
+  static constexpr const char* label = "position";
+  static constexpr const char* unit = "m";
+};
+template <int Dim>
+struct Velocity {
+  using type = Vec<Dim>;
+  static constexpr const char* label = "velocity";
+  static constexpr const char* unit = "m/s";
+};
+template <int Dim>
+struct Acceleration {
+  using type = Vec<Dim>;
+  static constexpr const char* label = "acceleration";
+  static constexpr const char* unit = "m/s^2";
+};
+struct Mass {
+  using type = double;
+  static constexpr const char* label = "mass";
+  static constexpr const char* unit = "kg";
+};
+/// Stable particle identity, kept through reordering and removal (for tracking and restart).
+struct ParticleId {
+  using type = std::int64_t;
+  static constexpr const char* label = "id";
+  static constexpr const char* unit = "1";
+};
+
+namespace detail {
+template <class Tag, class... Tags>
+struct IndexOf;
+template <class Tag, class... Rest>
+struct IndexOf<Tag, Tag, Rest...> : std::integral_constant<std::size_t, 0> {};
+template <class Tag, class First, class... Rest>
+struct IndexOf<Tag, First, Rest...> : std::integral_constant<std::size_t, 1 + IndexOf<Tag, Rest...>::value> {};
+}  // namespace detail
+
+/// The particle container: one std::vector per field tag.
+template <class... Tags>
+class ParticleStore {
+public:
+  static constexpr std::size_t kFieldCount = sizeof...(Tags);
+
+  /// Number of particles.
+  std::size_t size() const noexcept { return size_; }
+  bool empty() const noexcept { return size_ == 0; }
+
+  /// The array of one field.
+  template <class Tag>
+  std::vector<typename Tag::type>& get() noexcept {
+    return std::get<detail::IndexOf<Tag, Tags...>::value>(fields_);
+  }
+  template <class Tag>
+  const std::vector<typename Tag::type>& get() const noexcept {
+    return std::get<detail::IndexOf<Tag, Tags...>::value>(fields_);
+  }
+  /// Whether the store has a field tag (compile time).
+  template <class Tag>
+  static constexpr bool has() noexcept {
+    return (std::is_same_v<Tag, Tags> || ...);
+  }
+
+  /// Resize every field; new entries are value-initialised (zero for arithmetic and Eigen zero()).
+  void resize(std::size_t n) {
+    (resize_one<Tags>(n), ...);
+    size_ = n;
+  }
+  void reserve(std::size_t n) { (std::get<detail::IndexOf<Tags, Tags...>::value>(fields_).reserve(n), ...); }
+
+  /// Append n zero-initialised particles; returns the index of the first new one.
+  std::size_t append(std::size_t n) {
+    const std::size_t first = size_;
+    resize(size_ + n);
+    return first;
+  }
+
+  /// Remove the particles whose flag is nonzero, keeping the order of the rest (compacting).
+  /// Returns the number removed.
+  std::size_t remove_if(std::span<const std::uint8_t> remove) {
+    if (remove.size() != size_) throw std::invalid_argument("ParticleStore::remove_if: mask size mismatch");
+    std::size_t w = 0;
+    for (std::size_t r = 0; r < size_; ++r) {
+      if (remove[r]) continue;
+      if (w != r) (move_one<Tags>(r, w), ...);
+      ++w;
+    }
+    const std::size_t removed = size_ - w;
+    resize(w);
+    return removed;
+  }
+
+  /// Reorder every field so that new[i] = old[perm[i]]. perm must be a permutation of 0..size-1.
+  /// Uses one scratch buffer per call (not per particle); cheap enough to do every few steps.
+  void reorder(std::span<const std::uint32_t> perm) {
+    if (perm.size() != size_) throw std::invalid_argument("ParticleStore::reorder: permutation size mismatch");
+    (permute_one<Tags>(perm), ...);
+  }
+
+  /// Visit every field as (Tag{}, array) in declaration order: used by writers and readers.
+  template <class F>
+  void for_each_field(F&& f) {
+    (f(Tags{}, get<Tags>()), ...);
+  }
+  template <class F>
+  void for_each_field(F&& f) const {
+    (f(Tags{}, get<Tags>()), ...);
+  }
+
+  /// Bytes of per-particle state (for the memory budget in docs/performance.md).
+  static constexpr std::size_t bytes_per_particle() noexcept { return (sizeof(typename Tags::type) + ...); }
+
+private:
+  template <class Tag>
+  void resize_one(std::size_t n) {
+    auto& v = get<Tag>();
+    using T = typename Tag::type;
+    if constexpr (std::is_arithmetic_v<T>) {
+      v.resize(n, T{});
+    } else {
+      v.resize(n, T::Zero());
+    }
+  }
+  template <class Tag>
+  void move_one(std::size_t from, std::size_t to) {
+    auto& v = get<Tag>();
+    v[to] = v[from];
+  }
+  template <class Tag>
+  void permute_one(std::span<const std::uint32_t> perm) {
+    auto& v = get<Tag>();
+    std::vector<typename Tag::type> tmp(v.size());
+    for (std::size_t i = 0; i < perm.size(); ++i) tmp[i] = v[perm[i]];
+    v.swap(tmp);
+  }
+
+  std::tuple<std::vector<typename Tags::type>...> fields_;
+  std::size_t size_ = 0;
+};
+
+}  // namespace geohaz

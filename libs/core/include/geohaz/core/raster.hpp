@@ -1,0 +1,132 @@
+#pragma once
+/// \file raster.hpp
+/// Terrain and map rasters (GDAL behind this header; only raster.cpp / vector.cpp include GDAL).
+///
+/// Conventions: a Raster is north-up (no rotation terms), stored row-major with row 0 at the top
+/// (north), like GeoTIFF. Cell (col, row) covers [x0 + col·dx, x0 + (col+1)·dx] ×
+/// [y0 − (row+1)·|dy|, y0 − row·|dy|]; values are taken at cell centres. Coordinates are in the
+/// raster's CRS; simulations need a projected (metric) CRS.
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "geohaz/core/vec.hpp"
+
+namespace geohaz {
+
+/// A single-band raster of doubles on a north-up grid.
+struct Raster {
+  int nx = 0, ny = 0;                        ///< columns, rows
+  std::array<double, 6> geotransform{};      ///< GDAL order: x0, dx, 0, y0, 0, dy (dy < 0)
+  std::string crs_wkt;                       ///< WKT of the CRS ("" if none)
+  std::optional<double> nodata;              ///< nodata value, if any
+  std::vector<double> data;                  ///< nx·ny values, row-major, row 0 north
+
+  /// An empty raster on the same grid and CRS, filled with `fill`.
+  Raster like(double fill, std::optional<double> nodata_value = std::nullopt) const;
+  double& at(int col, int row) { return data[static_cast<std::size_t>(row) * nx + col]; }
+  double at(int col, int row) const { return data[static_cast<std::size_t>(row) * nx + col]; }
+  double cell_size_x() const noexcept { return geotransform[1]; }
+  double cell_size_y() const noexcept { return -geotransform[5]; }  ///< positive
+  /// Centre of cell (col, row) in CRS coordinates.
+  Vec2 cell_centre(int col, int row) const noexcept;
+  /// Fractional pixel coordinates (col, row) of a point, centre-based: the centre of cell (0,0) is (0,0).
+  Vec2 to_pixel(const Vec2& p) const noexcept;
+  bool is_nodata(double v) const noexcept;
+  /// Bounding box of the raster extent: (xmin, ymin), (xmax, ymax).
+  std::array<Vec2, 2> extent() const noexcept;
+};
+
+/// How a raster's CRS is to be treated on reading.
+enum class CrsPolicy {
+  RequireProjected,  ///< geographic → InputError suggesting gdalwarp -t_srs; none → warning, metres
+  Any                ///< accept anything
+};
+
+/// Read band 1 of any GDAL raster. InputError (naming the file) when unreadable, rotated
+/// (non-zero rotation terms), or in a geographic CRS under RequireProjected. A missing CRS under
+/// RequireProjected prints a warning to stderr and the units are taken as metres.
+Raster read_raster(const std::filesystem::path& path, CrsPolicy policy = CrsPolicy::RequireProjected);
+
+/// Write a GeoTIFF (Float32 unless `float64`), deflate-compressed, same grid, CRS and nodata.
+/// Written to a temporary name and renamed, so no half-written file is left on failure.
+void write_geotiff(const std::filesystem::path& path, const Raster& r, bool float64 = false);
+
+/// Whether the WKT describes a geographic (degrees) CRS.
+bool crs_is_geographic(const std::string& wkt);
+/// Whether two WKTs describe the same CRS.
+bool crs_equal(const std::string& a, const std::string& b);
+/// Transform points from one CRS to another (traditional x=east, y=north axis order).
+std::vector<Vec2> transform_points(const std::vector<Vec2>& pts, const std::string& from_wkt, const std::string& to_wkt);
+
+/// A bilinear terrain surface over an elevation raster.
+class Terrain {
+public:
+  explicit Terrain(Raster elevation);
+  const Raster& raster() const noexcept { return r_; }
+  /// True when the four cell centres around (x, y) all hold data.
+  bool valid(double x, double y) const noexcept;
+  /// Bilinear elevation (NaN outside or over nodata).
+  double elevation(double x, double y) const noexcept;
+  /// Gradient (∂z/∂x, ∂z/∂y) of the bilinear surface (NaN outside).
+  Vec2 gradient(double x, double y) const noexcept;
+  /// Upward unit normal (−∂z/∂x, −∂z/∂y, 1)/norm.
+  Vec3 normal(double x, double y) const noexcept;
+
+private:
+  Raster r_;
+};
+
+/// A point of an elevation profile: distance along the polyline s, position, elevation.
+struct ProfilePoint {
+  double s, x, y, z;
+};
+
+/// Sample the terrain along a polyline every `spacing` metres (the vertices included).
+/// InputError if the polyline leaves the valid data.
+std::vector<ProfilePoint> extract_profile(const Terrain& terrain, const std::vector<Vec2>& polyline, double spacing);
+
+/// A polygon with holes, and the value of a requested attribute (NaN if not requested/absent).
+struct Polygon {
+  std::vector<Vec2> outer;
+  std::vector<std::vector<Vec2>> holes;
+  double attribute = std::numeric_limits<double>::quiet_NaN();
+  bool contains(const Vec2& p) const noexcept;
+};
+
+/// Read all polygons of the first layer of an OGR data source (Shapefile, GeoJSON, GeoPackage),
+/// reprojected to `target_wkt` when the layer's CRS differs (and target_wkt is not empty).
+/// `attribute` names a numeric field to read per polygon ("" for none).
+/// InputError when unreadable, empty, or without polygons.
+std::vector<Polygon> read_polygons(const std::filesystem::path& path, const std::string& attribute,
+                                   const std::string& target_wkt);
+
+/// Colour ramps for quick-look pictures.
+enum class ColourRamp { Viridis, Magma, Terrain, BlueRed };
+
+/// Write a quick-look PNG: a hillshade of `elevation`, overlaid where `overlay` is present, finite,
+/// not nodata and above `overlay_min` by the colour ramp between vmin and vmax (auto when vmin ≥ vmax).
+/// A colour bar with `label` is drawn along the bottom. Goes through GDAL's PNG driver.
+void write_quicklook_png(const std::filesystem::path& path, const Raster& elevation, const Raster* overlay,
+                         ColourRamp ramp, const std::string& label, double vmin = 0.0, double vmax = 0.0,
+                         double overlay_min = 0.0);
+
+/// A plain RGB image written as PNG through GDAL (for plots the apps draw themselves).
+struct Image {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgb;  ///< width·height·3, row 0 at the top
+  Image(int w, int h, std::array<std::uint8_t, 3> background = {255, 255, 255});
+  void set(int x, int y, std::array<std::uint8_t, 3> c) noexcept;
+  void line(double x0, double y0, double x1, double y1, std::array<std::uint8_t, 3> c) noexcept;
+  void fill_circle(double cx, double cy, double radius, std::array<std::uint8_t, 3> c) noexcept;
+};
+void write_png(const std::filesystem::path& path, const Image& img);
+/// Colour of value t ∈ [0, 1] on a ramp.
+std::array<std::uint8_t, 3> ramp_colour(ColourRamp ramp, double t) noexcept;
+
+}  // namespace geohaz

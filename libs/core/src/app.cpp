@@ -1,0 +1,76 @@
+#include "geohaz/core/app.hpp"
+
+#include <omp.h>
+
+#include <iostream>
+
+#include "geohaz/core/errors.hpp"
+
+namespace po = boost::program_options;
+
+namespace geohaz {
+
+void add_common_options(po::options_description& desc, CommonOptions& o, const std::string& default_out) {
+  desc.add_options()
+    ("help,h", "print this help and exit")
+    ("version", "print the version and exit")
+    ("config,c", po::value<std::string>(&o.config), "scenario configuration file (TOML)")
+    ("set", po::value<std::vector<std::string>>(&o.set)->composing(),
+     "override a config key, e.g. --set material.cohesion=5e3 (repeatable; values in SI units)")
+    ("out,o", po::value<std::string>(&o.out)->default_value(default_out), "output directory")
+    ("threads,j", po::value<int>(&o.threads)->default_value(0), "OpenMP threads (0: all cores)")
+    ("quiet,q", po::bool_switch(&o.quiet), "no progress output")
+    ("help-config", po::bool_switch(&o.help_config), "print every config key with unit, default and range, and exit");
+}
+
+bool parse_command_line(int argc, const char* const* argv, const std::string& app, const std::string& summary,
+                        po::options_description& desc, po::positional_options_description* positional) {
+  po::variables_map vm;
+  try {
+    auto parser = po::command_line_parser(argc, argv).options(desc);
+    if (positional) parser.positional(*positional);
+    po::store(parser.run(), vm);
+    if (vm.count("help")) {
+      std::cout << app << " " << GEOHAZ_VERSION << ": " << summary << "\n\n" << desc << "\n";
+      return false;
+    }
+    if (vm.count("version")) {
+      std::cout << app << " " << GEOHAZ_VERSION << "\n";
+      return false;
+    }
+    po::notify(vm);
+  } catch (const po::error& e) {
+    throw InputError(std::string(e.what()) + " (see " + app + " --help)", "command line");
+  }
+  return true;
+}
+
+ConfigReader load_config(const CommonOptions& opts) {
+  ConfigReader r = opts.config.empty() ? ConfigReader::from_string("", "<no config file>")
+                                       : ConfigReader::from_file(opts.config);
+  for (const auto& s : opts.set) r.apply_override(s);
+  return r;
+}
+
+int setup_threads(int threads) {
+  if (threads < 0) throw InputError("must be ≥ 0 (0 uses all cores)", "command line", "--threads", std::to_string(threads));
+  if (threads > 0) omp_set_num_threads(threads);
+  return omp_get_max_threads();
+}
+
+int run_main(const std::string& app, const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const InputError& e) {
+    std::cerr << app << ": input error: " << e.what() << "\n";
+    return kExitInputError;
+  } catch (const SimulationError& e) {
+    std::cerr << app << ": simulation stopped: " << e.what() << "\n";
+    return kExitFailure;
+  } catch (const std::exception& e) {
+    std::cerr << app << ": error: " << e.what() << "\n";
+    return kExitFailure;
+  }
+}
+
+}  // namespace geohaz

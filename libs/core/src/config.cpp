@@ -1,0 +1,471 @@
+#include "geohaz/core/config.hpp"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "geohaz/core/errors.hpp"
+
+namespace geohaz {
+
+bool Range::contains(double v) const noexcept {
+  if (std::isnan(v)) return false;
+  if (min_open ? !(v > min) : !(v >= min)) return false;
+  if (max_open ? !(v < max) : !(v <= max)) return false;
+  return true;
+}
+
+namespace {
+std::string num(double v) {
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+std::string node_text(const toml::node& n) {
+  std::ostringstream s;
+  if (auto str = n.as_string()) {
+    s << str->get();
+  } else if (n.is_table()) {
+    s << "<table>";
+  } else {
+    n.visit([&](auto&& v) { s << v; });
+  }
+  return s.str();
+}
+
+/// Split "a.b[2].c" into segments {"a", "b[2]", "c"}.
+std::vector<std::string> split_path(std::string_view path) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : path) {
+    if (c == '.') {
+      out.push_back(cur);
+      cur.clear();
+    } else {
+      cur.push_back(c);
+    }
+  }
+  out.push_back(cur);
+  return out;
+}
+
+/// Parse a segment "name[3]" into ("name", 3) or ("name", -1).
+std::pair<std::string, long> parse_segment(const std::string& seg) {
+  const auto lb = seg.find('[');
+  if (lb == std::string::npos || seg.back() != ']') return {seg, -1};
+  return {seg.substr(0, lb), std::stol(seg.substr(lb + 1, seg.size() - lb - 2))};
+}
+
+/// Insert (or replace) the node at a dotted path, creating tables and array-of-table elements.
+void insert_path(toml::table& root, std::string_view path, const toml::node& value, bool create_elements) {
+  const auto segs = split_path(path);
+  toml::table* t = &root;
+  for (std::size_t s = 0; s + 1 < segs.size(); ++s) {
+    auto [name, index] = parse_segment(segs[s]);
+    if (index < 0) {
+      auto* child = t->get(name);
+      if (!child || !child->is_table()) {
+        t->insert_or_assign(name, toml::table{});
+        child = t->get(name);
+      }
+      t = child->as_table();
+    } else {
+      auto* child = t->get(name);
+      if (!child || !child->is_array()) {
+        if (!create_elements) throw InputError("no array of tables named '" + name + "'", {}, std::string(path));
+        t->insert_or_assign(name, toml::array{});
+        child = t->get(name);
+      }
+      auto* arr = child->as_array();
+      if (static_cast<long>(arr->size()) <= index) {
+        if (!create_elements)
+          throw InputError("index out of range: the array has " + std::to_string(arr->size()) + " entries", {},
+                           std::string(path));
+        while (static_cast<long>(arr->size()) <= index) arr->push_back(toml::table{});
+      }
+      auto* elem = arr->get(static_cast<std::size_t>(index));
+      if (!elem->is_table()) throw InputError("not a table", {}, std::string(path));
+      t = elem->as_table();
+    }
+  }
+  value.visit([&](auto&& v) { t->insert_or_assign(segs.back(), v); });
+}
+
+std::string describe_path(std::string p) {
+  // "layers[0].c" -> "layers[].c" for the reference.
+  std::string out;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p[i] == '[') {
+      out += "[]";
+      while (i < p.size() && p[i] != ']') ++i;
+    } else {
+      out.push_back(p[i]);
+    }
+  }
+  return out;
+}
+}  // namespace
+
+struct ConfigReader::State {
+  toml::table root;
+  toml::table resolved;
+  std::string source;
+  std::filesystem::path base;
+  bool describe = false;
+  std::set<std::string> accessed;  // full paths of leaves and arrays of tables read
+  std::vector<KeyReference> refs;
+  std::set<std::string> ref_keys;
+
+  void record(const std::string& full, std::string type, std::string_view unit, std::string def, std::string range,
+              std::string_view help) {
+    const std::string k = describe_path(full);
+    if (ref_keys.insert(k).second)
+      refs.push_back({k, std::move(type), std::string(unit), std::move(def), std::move(range), std::string(help)});
+  }
+};
+
+ConfigReader::ConfigReader(std::shared_ptr<State> state, std::string prefix)
+    : state_(std::move(state)), prefix_(std::move(prefix)) {}
+ConfigReader::ConfigReader(const ConfigReader&) = default;
+ConfigReader& ConfigReader::operator=(const ConfigReader&) = default;
+ConfigReader::ConfigReader(ConfigReader&&) noexcept = default;
+ConfigReader& ConfigReader::operator=(ConfigReader&&) noexcept = default;
+ConfigReader::~ConfigReader() = default;
+
+ConfigReader ConfigReader::from_file(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw InputError("config file not found (or not a regular file)", path.string());
+  std::ifstream in(path);
+  if (!in) throw InputError("config file cannot be opened", path.string());
+  std::stringstream ss;
+  ss << in.rdbuf();
+  auto r = from_string(ss.str(), path.string());
+  r.state_->base = std::filesystem::absolute(path).parent_path();
+  return r;
+}
+
+ConfigReader ConfigReader::from_string(std::string_view text, std::string source) {
+  auto st = std::make_shared<State>();
+  st->source = source;
+  st->base = std::filesystem::current_path();
+  try {
+    st->root = toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream s;
+    s << "TOML syntax error at line " << e.source().begin.line << ", column " << e.source().begin.column << ": "
+      << e.description();
+    throw InputError(s.str(), source);
+  }
+  return ConfigReader(st, "");
+}
+
+ConfigReader ConfigReader::describe() {
+  auto st = std::make_shared<State>();
+  st->describe = true;
+  return ConfigReader(st, "");
+}
+
+void ConfigReader::apply_override(std::string_view assignment) {
+  const auto eq = assignment.find('=');
+  auto trim = [](std::string_view s) {
+    while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
+    while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+    return std::string(s);
+  };
+  if (eq == std::string_view::npos)
+    throw InputError("--set expects key=value", "command line", "", std::string(assignment));
+  const std::string key = trim(assignment.substr(0, eq));
+  const std::string value = trim(assignment.substr(eq + 1));
+  if (key.empty()) throw InputError("--set expects key=value (empty key)", "command line", "", std::string(assignment));
+  toml::table parsed;
+  try {
+    parsed = toml::parse("v = " + value);
+  } catch (const toml::parse_error&) {
+    parsed = toml::table{};
+    parsed.insert("v", value);  // a bare word: take it as a string
+  }
+  try {
+    insert_path(state_->root, key, *parsed.get("v"), false);
+  } catch (const InputError& e) {
+    throw InputError(e.reason(), "command line (--set)", key, value);
+  }
+}
+
+namespace {
+[[noreturn]] void type_error(const std::string& src, const std::string& key, const toml::node& n, const char* want) {
+  throw InputError(std::string("wrong type: expected ") + want, src, key, node_text(n));
+}
+}  // namespace
+
+double ConfigReader::get(std::string_view key, double def, Range range, KeyDoc doc) {
+  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  state_->record(full, "number", doc.unit, num(def), range.str(), doc.help);
+  state_->accessed.insert(full);
+  double v = def;
+  if (!state_->describe) {
+    auto node = state_->root.at_path(full);
+    if (node) {
+      if (auto d = node.value<double>(); d && (node.is_floating_point() || node.is_integer())) {
+        v = *d;
+      } else {
+        type_error(state_->source, full, *node.node(), "a number");
+      }
+      if (!range.contains(v))
+        throw InputError("out of range: allowed " + range.str() + (doc.unit.empty() ? "" : " " + std::string(doc.unit)),
+                         state_->source, full, node_text(*node.node()));
+    }
+  }
+  insert_path(state_->resolved, full, toml::value<double>(v), true);
+  return v;
+}
+
+double ConfigReader::require(std::string_view key, Range range, KeyDoc doc) {
+  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  if (state_->describe) {
+    state_->record(full, "number", doc.unit, "(required)", range.str(), doc.help);
+    state_->accessed.insert(full);
+    double placeholder = std::isfinite(range.min) ? range.min + (range.min_open ? 1.0 : 0.0) : 1.0;
+    if (!range.contains(placeholder)) placeholder = std::isfinite(range.max) ? range.max : 0.0;
+    return placeholder;
+  }
+  if (!state_->root.at_path(full))
+    throw InputError("required key is missing (" + std::string(doc.help) + ", " + std::string(doc.unit) + ", range " +
+                         range.str() + ")",
+                     state_->source, full);
+  const double v = get(key, 0.0, range, doc);
+  state_->refs.back().default_value = "(required)";
+  return v;
+}
+
+std::int64_t ConfigReader::get_int(std::string_view key, std::int64_t def, Range range, KeyDoc doc) {
+  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  state_->record(full, "integer", doc.unit, std::to_string(def), range.str(), doc.help);
+  state_->accessed.insert(full);
+  std::int64_t v = def;
+  if (!state_->describe) {
+    auto node = state_->root.at_path(full);
+    if (node) {
+      if (!node.is_integer()) type_error(state_->source, full, *node.node(), "an integer");
+      v = *node.value<std::int64_t>();
+      if (!range.contains(static_cast<double>(v)))
+        throw InputError("out of range: allowed " + range.str(), state_->source, full, std::to_string(v));
+    }
+  }
+  insert_path(state_->resolved, full, toml::value<std::int64_t>(v), true);
+  return v;
+}
+
+bool ConfigReader::get_bool(std::string_view key, bool def, KeyDoc doc) {
+  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  state_->record(full, "boolean", doc.unit, def ? "true" : "false", "true|false", doc.help);
+  state_->accessed.insert(full);
+  bool v = def;
+  if (!state_->describe) {
+    auto node = state_->root.at_path(full);
+    if (node) {
+      if (!node.is_boolean()) type_error(state_->source, full, *node.node(), "true or false");
+      v = *node.value<bool>();
+    }
+  }
+  insert_path(state_->resolved, full, toml::value<bool>(v), true);
+  return v;
+}
+
+std::string ConfigReader::get_string(std::string_view key, std::string_view def, KeyDoc doc) {
+  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  state_->record(full, "string", doc.unit, "\"" + std::string(def) + "\"", "", doc.help);
+  state_->accessed.insert(full);
+  std::string v(def);
+  if (!state_->describe) {
+    auto node = state_->root.at_path(full);
+    if (node) {
+      if (!node.is_string()) type_error(state_->source, full, *node.node(), "a string");
+      v = *node.value<std::string>();
+    }
+  }
+  insert_path(state_->resolved, full, toml::value<std::string>(v), true);
+  return v;
+}
+
+std::string ConfigReader::require_string(std::string_view key, KeyDoc doc) {
+  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  if (!state_->describe && !state_->root.at_path(full))
+    throw InputError("required key is missing (" + std::string(doc.help) + ")", state_->source, full);
+  auto v = get_string(key, "", doc);
+  state_->refs.back().default_value = "(required)";
+  return v;
+}
+
+std::string ConfigReader::get_choice(std::string_view key, std::string_view def,
+                                     const std::vector<std::string>& choices, KeyDoc doc) {
+  const std::string v = get_string(key, def, doc);
+  std::string list;
+  for (const auto& c : choices) list += (list.empty() ? "" : "|") + c;
+  state_->refs.back().range = list;
+  if (std::find(choices.begin(), choices.end(), v) == choices.end()) {
+    const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+    throw InputError("unknown choice; allowed: " + list, state_->source, full, v);
+  }
+  return v;
+}
+
+std::vector<double> ConfigReader::get_array(std::string_view key, const std::vector<double>& def, Range range,
+                                            KeyDoc doc, std::size_t expected_size) {
+  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  std::string deftext = "[";
+  for (std::size_t i = 0; i < def.size(); ++i) deftext += (i ? ", " : "") + num(def[i]);
+  deftext += "]";
+  state_->record(full, expected_size ? "array[" + std::to_string(expected_size) + "]" : "array", doc.unit, deftext,
+                 range.str(), doc.help);
+  state_->accessed.insert(full);
+  std::vector<double> v = def;
+  if (!state_->describe) {
+    auto node = state_->root.at_path(full);
+    if (node) {
+      auto* arr = node.as_array();
+      if (!arr) type_error(state_->source, full, *node.node(), "an array of numbers");
+      v.clear();
+      for (auto& e : *arr) {
+        auto d = e.value<double>();
+        if (!d || !(e.is_floating_point() || e.is_integer())) type_error(state_->source, full, e, "numbers in the array");
+        if (!range.contains(*d))
+          throw InputError("array element out of range: allowed " + range.str(), state_->source, full, num(*d));
+        v.push_back(*d);
+      }
+      if (expected_size && v.size() != expected_size)
+        throw InputError("expected " + std::to_string(expected_size) + " numbers, got " + std::to_string(v.size()),
+                         state_->source, full, node_text(*node.node()));
+      if (v.empty()) throw InputError("the array is empty", state_->source, full);
+    }
+  }
+  toml::array out;
+  for (double d : v) out.push_back(d);
+  insert_path(state_->resolved, full, out, true);
+  return v;
+}
+
+std::vector<double> ConfigReader::require_array(std::string_view key, Range range, KeyDoc doc,
+                                                std::size_t expected_size) {
+  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  if (state_->describe) {
+    return get_array(key, std::vector<double>(expected_size ? expected_size : 1, 0.0), Range{}, doc, 0);
+  }
+  if (!state_->root.at_path(full))
+    throw InputError("required key is missing (" + std::string(doc.help) + ", " + std::string(doc.unit) + ")",
+                     state_->source, full);
+  auto v = get_array(key, {}, range, doc, expected_size);
+  state_->refs.back().default_value = "(required)";
+  return v;
+}
+
+bool ConfigReader::has(std::string_view key) const {
+  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  return !state_->describe && static_cast<bool>(state_->root.at_path(full));
+}
+
+std::vector<ConfigReader> ConfigReader::tables(std::string_view key, KeyDoc doc) {
+  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  state_->record(full, "array of tables", "", "[]", "", doc.help);
+  state_->accessed.insert(full);
+  std::vector<ConfigReader> out;
+  if (state_->describe) {
+    out.push_back(ConfigReader(state_, full + "[0]"));
+    return out;
+  }
+  auto node = state_->root.at_path(full);
+  if (!node) return out;
+  auto* arr = node.as_array();
+  if (!arr || !arr->is_array_of_tables())
+    type_error(state_->source, full, *node.node(), "an array of tables ([[...]] blocks)");
+  for (std::size_t i = 0; i < arr->size(); ++i) {
+    out.push_back(ConfigReader(state_, full + "[" + std::to_string(i) + "]"));
+    insert_path(state_->resolved, full + "[" + std::to_string(i) + "].__placeholder", toml::value<bool>(true), true);
+    state_->resolved.at_path(full + "[" + std::to_string(i) + "]").as_table()->erase("__placeholder");
+  }
+  return out;
+}
+
+ConfigReader ConfigReader::section(std::string_view key) const {
+  return ConfigReader(state_, prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key));
+}
+
+void ConfigReader::finish() const {
+  if (state_->describe) return;
+  // Walk every leaf of the file; the first one nobody read is unknown.
+  std::function<void(const toml::table&, const std::string&)> walk = [&](const toml::table& t, const std::string& pre) {
+    for (auto&& [k, node] : t) {
+      const std::string path = pre.empty() ? std::string(k.str()) : pre + "." + std::string(k.str());
+      if (auto* sub = node.as_table()) {
+        walk(*sub, path);
+        continue;
+      }
+      if (auto* arr = node.as_array(); arr && arr->is_array_of_tables() && state_->accessed.count(path)) {
+        for (std::size_t i = 0; i < arr->size(); ++i)
+          walk(*arr->get(i)->as_table(), path + "[" + std::to_string(i) + "]");
+        continue;
+      }
+      if (state_->accessed.count(path)) continue;
+      // List the keys that do exist beside it.
+      const auto dot = path.rfind('.');
+      const std::string parent = dot == std::string::npos ? "" : describe_path(path.substr(0, dot));
+      std::string valid;
+      std::set<std::string> seen;
+      for (const auto& r : state_->refs) {
+        const auto rdot = r.key.rfind('.');
+        const std::string rparent = rdot == std::string::npos ? "" : r.key.substr(0, rdot);
+        std::string name = r.key.substr(rdot == std::string::npos ? 0 : rdot + 1);
+        if (rparent == parent && seen.insert(name).second) valid += (valid.empty() ? "" : ", ") + name;
+        // Also offer sub-tables of this level.
+        if (rparent.size() > parent.size() && rparent.rfind(parent.empty() ? "" : parent + ".", 0) == 0) {
+          std::string rest = rparent.substr(parent.empty() ? 0 : parent.size() + 1);
+          rest = rest.substr(0, rest.find('.'));
+          if (rest.size() > 2 && rest.substr(rest.size() - 2) == "[]") rest.resize(rest.size() - 2);
+          if (seen.insert(rest).second) valid += (valid.empty() ? "" : ", ") + rest + ".*";
+        }
+      }
+      throw InputError("unknown key" + std::string(parent.empty() ? "" : " in [" + parent + "]") +
+                           "; valid keys here: " + (valid.empty() ? "(none)" : valid),
+                       state_->source, path);
+    }
+  };
+  walk(state_->root, "");
+}
+
+std::string ConfigReader::resolved() const {
+  std::ostringstream s;
+  s << state_->resolved << "\n";
+  return s.str();
+}
+
+std::vector<KeyReference> ConfigReader::reference() const { return state_->refs; }
+
+std::string ConfigReader::format_reference(const std::vector<KeyReference>& refs) {
+  std::ostringstream s;
+  for (const auto& r : refs) {
+    s << r.key << "  (" << r.type;
+    if (!r.unit.empty()) s << ", " << r.unit;
+    s << ")\n      " << r.help << "\n      default: " << r.default_value;
+    if (!r.range.empty()) s << "   allowed: " << r.range;
+    s << "\n";
+  }
+  return s.str();
+}
+
+const std::string& ConfigReader::source() const { return state_->source; }
+std::filesystem::path ConfigReader::base_dir() const { return state_->base; }
+
+std::string Range::str() const {
+  if (std::isinf(min) && std::isinf(max)) return "any";
+  return std::string(min_open ? "(" : "[") + num(min) + ", " + num(max) + (max_open || std::isinf(max) ? ")" : "]");
+}
+
+}  // namespace geohaz

@@ -1,0 +1,209 @@
+#include "geohaz/core/neighbours.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace geohaz {
+
+template <int Dim>
+void CellList<Dim>::build(std::span<const Vec<Dim>> x, double cell_size, const Periodicity<Dim>& periodic) {
+  if (!(cell_size > 0.0) || !std::isfinite(cell_size))
+    throw std::invalid_argument("CellList: cell size must be positive and finite");
+  periodic_ = periodic;
+  const std::int64_t n = static_cast<std::int64_t>(x.size());
+  if (x.size() >= std::numeric_limits<std::uint32_t>::max())
+    throw std::invalid_argument("CellList: too many particles for 32-bit indices");
+
+  // Bounding box along non-periodic axes (parallel reduction), finite check on the way.
+  Vec<Dim> lo = Vec<Dim>::Constant(std::numeric_limits<double>::max());
+  Vec<Dim> hi = Vec<Dim>::Constant(std::numeric_limits<double>::lowest());
+  std::int64_t bad = -1;
+#pragma omp parallel
+  {
+    Vec<Dim> tlo = lo, thi = hi;
+    std::int64_t tbad = -1;
+#pragma omp for schedule(static) nowait
+    for (std::int64_t i = 0; i < n; ++i) {
+      const Vec<Dim>& p = x[static_cast<std::size_t>(i)];
+      if (!p.allFinite()) {
+        if (tbad < 0) tbad = i;
+        continue;
+      }
+      tlo = tlo.cwiseMin(p);
+      thi = thi.cwiseMax(p);
+    }
+#pragma omp critical
+    {
+      lo = lo.cwiseMin(tlo);
+      hi = hi.cwiseMax(thi);
+      if (tbad >= 0 && (bad < 0 || tbad < bad)) bad = tbad;
+    }
+  }
+  if (bad >= 0) {
+    std::ostringstream s;
+    s << "CellList: particle " << bad << " has a non-finite position";
+    throw std::invalid_argument(s.str());
+  }
+  if (n == 0) {
+    lo.setZero();
+    hi.setZero();
+  }
+
+  // Grid: periodic axes span exactly one period; others the bounding box. Cap the cell count so a
+  // few far-away particles cannot make the grid huge (3D runouts, escaped particles).
+  const double cap = 8.0 * static_cast<double>(n) + 4096.0;
+  double size = cell_size;
+  for (;;) {
+    double total = 1.0;
+    for (int d = 0; d < Dim; ++d) {
+      if (periodic_.axis[d]) {
+        const double L = periodic_.hi[d] - periodic_.lo[d];
+        if (!(L >= 2.0 * cell_size))
+          throw std::invalid_argument("CellList: a periodic axis must be at least twice the cut-off long");
+        origin_[d] = periodic_.lo[d];
+        dims_[d] = std::max(1, static_cast<int>(std::floor(L / size)));
+        edge_[d] = L / dims_[d];
+      } else {
+        origin_[d] = lo[d];
+        const double L = hi[d] - lo[d];
+        dims_[d] = static_cast<int>(std::floor(L / size)) + 1;
+        edge_[d] = size;
+      }
+      total *= dims_[d];
+    }
+    if (total <= cap) break;
+    size *= 1.25;
+  }
+
+  std::size_t ncell = 1;
+  for (int d = 0; d < Dim; ++d) ncell *= static_cast<std::size_t>(dims_[d]);
+
+  cell_of_.resize(x.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) cell_of_[i] = cell_index(x[static_cast<std::size_t>(i)]);
+
+  // Counting sort by cell (stable in particle index).
+  cell_start_.assign(ncell + 1, 0);
+  for (std::uint32_t c : cell_of_) ++cell_start_[c + 1];
+  for (std::size_t c = 0; c < ncell; ++c) cell_start_[c + 1] += cell_start_[c];
+  sorted_.resize(x.size());
+  std::vector<std::uint32_t> fill(cell_start_.begin(), cell_start_.end() - 1);
+  for (std::size_t i = 0; i < x.size(); ++i) sorted_[fill[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+}
+
+template <int Dim>
+std::uint32_t CellList<Dim>::cell_index(const Vec<Dim>& p) const noexcept {
+  std::uint32_t idx = 0;
+  std::uint32_t stride = 1;
+  for (int d = 0; d < Dim; ++d) {
+    double u = (p[d] - origin_[d]) / edge_[d];
+    int c = static_cast<int>(std::floor(u));
+    if (periodic_.axis[d]) {
+      c %= dims_[d];
+      if (c < 0) c += dims_[d];
+    } else {
+      c = std::clamp(c, 0, dims_[d] - 1);
+    }
+    idx += static_cast<std::uint32_t>(c) * stride;
+    stride *= static_cast<std::uint32_t>(dims_[d]);
+  }
+  return idx;
+}
+
+template <int Dim>
+std::array<int, Dim> CellList<Dim>::cell_coords(std::uint32_t c) const noexcept {
+  std::array<int, Dim> out{};
+  for (int d = 0; d < Dim; ++d) {
+    out[d] = static_cast<int>(c % static_cast<std::uint32_t>(dims_[d]));
+    c /= static_cast<std::uint32_t>(dims_[d]);
+  }
+  return out;
+}
+
+template <int Dim>
+void NeighbourList<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const Periodicity<Dim>& periodic) {
+  cells_.build(x, cutoff, periodic);
+  cutoff_ = cutoff;
+  periodic_any_ = periodic.any();
+  const double rc2 = cutoff * cutoff;
+  const std::size_t n = x.size();
+  offsets_.assign(n + 1, 0);
+
+  const auto& dims = cells_.dims();
+  const auto starts = cells_.cell_start();
+  const auto sorted = cells_.sorted();
+  const auto cell_of = cells_.cell_of();
+  const auto& per = cells_.periodicity();
+
+  const int nthreads = omp_get_max_threads();
+  if (thread_buffers_.size() < static_cast<std::size_t>(nthreads)) thread_buffers_.resize(nthreads);
+
+#pragma omp parallel num_threads(nthreads)
+  {
+    const int t = omp_get_thread_num();
+    const int T = omp_get_num_threads();
+    const std::size_t begin = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(T);
+    const std::size_t end = n * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(T);
+    auto& buf = thread_buffers_[t];
+    buf.clear();
+
+    // Distinct neighbour cell coordinates along each axis (handles short periodic axes).
+    std::array<std::array<int, 3>, Dim> cand{};
+    std::array<int, Dim> ncand{};
+    for (std::size_t i = begin; i < end; ++i) {
+      const auto c = cells_.cell_coords(cell_of[i]);
+      for (int d = 0; d < Dim; ++d) {
+        ncand[d] = 0;
+        for (int o = -1; o <= 1; ++o) {
+          int cc = c[d] + o;
+          if (per.axis[d]) {
+            cc = (cc % dims[d] + dims[d]) % dims[d];
+          } else if (cc < 0 || cc >= dims[d]) {
+            continue;
+          }
+          bool seen = false;
+          for (int k = 0; k < ncand[d]; ++k) seen = seen || cand[d][k] == cc;
+          if (!seen) cand[d][ncand[d]++] = cc;
+        }
+      }
+      const Vec<Dim> xi = x[i];
+      const std::size_t before = buf.size();
+      std::array<int, Dim> k{};
+      for (;;) {
+        std::uint32_t cell = 0, stride = 1;
+        for (int d = 0; d < Dim; ++d) {
+          cell += static_cast<std::uint32_t>(cand[d][k[d]]) * stride;
+          stride *= static_cast<std::uint32_t>(dims[d]);
+        }
+        for (std::uint32_t s = starts[cell]; s < starts[cell + 1]; ++s) {
+          const std::uint32_t j = sorted[s];
+          if (j == i) continue;
+          const Vec<Dim> d = periodic_any_ ? per.min_image(xi - x[j]) : Vec<Dim>(xi - x[j]);
+          if (d.squaredNorm() < rc2) buf.push_back(j);
+        }
+        int d = 0;
+        while (d < Dim && ++k[d] == ncand[d]) k[d++] = 0;
+        if (d == Dim) break;
+      }
+      offsets_[i + 1] = static_cast<std::uint32_t>(buf.size() - before);
+    }
+#pragma omp barrier
+#pragma omp single
+    {
+      for (std::size_t i = 0; i < n; ++i) offsets_[i + 1] += offsets_[i];
+      indices_.resize(offsets_[n]);
+    }
+    std::copy(buf.begin(), buf.end(), indices_.begin() + (n > 0 ? offsets_[begin] : 0));
+  }
+}
+
+template class CellList<2>;
+template class CellList<3>;
+template class NeighbourList<2>;
+template class NeighbourList<3>;
+
+}  // namespace geohaz

@@ -1,0 +1,54 @@
+#include "geohaz/core/output.hpp"
+
+#include <stdexcept>
+
+#include "geohaz/core/errors.hpp"
+
+namespace geohaz {
+
+AtomicTextFile::AtomicTextFile(std::filesystem::path final_path)
+    : final_(std::move(final_path)), tmp_(final_.string() + ".partial"), out_(tmp_) {
+  if (!out_) throw std::runtime_error("cannot write " + tmp_.string());
+  out_.precision(10);
+}
+
+AtomicTextFile::~AtomicTextFile() {
+  if (!committed_) {
+    out_.close();
+    std::error_code ec;
+    std::filesystem::remove(tmp_, ec);
+  }
+}
+
+void AtomicTextFile::commit() {
+  out_.flush();
+  const bool ok = static_cast<bool>(out_);
+  out_.close();
+  if (!ok) throw std::runtime_error("write failed: " + final_.string());
+  std::filesystem::rename(tmp_, final_);
+  committed_ = true;
+}
+
+void write_text_file(const std::filesystem::path& path, std::string_view text) {
+  AtomicTextFile f(path);
+  f.stream() << text;
+  f.commit();
+}
+
+void make_output_dir(const std::filesystem::path& dir) {
+  std::error_code ec;
+  if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
+    throw InputError("output path exists and is not a directory", "", "--out", dir.string());
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw InputError("cannot create output directory: " + ec.message(), "", "--out", dir.string());
+}
+
+void remove_partial_files(const std::filesystem::path& dir) {
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) return;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    if (e.path().extension() == ".partial") std::filesystem::remove(e.path(), ec);
+  }
+}
+
+}  // namespace geohaz

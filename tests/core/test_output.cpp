@@ -1,0 +1,96 @@
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "geohaz/core/errors.hpp"
+#include "geohaz/core/output.hpp"
+#include "geohaz/core/progress.hpp"
+
+namespace fs = std::filesystem;
+
+namespace geohaz {
+namespace {
+
+fs::path temp_dir(const std::string& name) {
+  auto d = fs::temp_directory_path() / ("geohaz_test_" + std::to_string(getpid()) + "_" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+TEST(AtomicTextFile, AppearsOnlyOnCommit) {
+  const auto d = temp_dir("atomic");
+  {
+    AtomicTextFile f(d / "a.csv");
+    f << "x,y\n1,2\n";
+    EXPECT_FALSE(fs::exists(d / "a.csv"));
+    f.commit();
+  }
+  EXPECT_TRUE(fs::exists(d / "a.csv"));
+  EXPECT_FALSE(fs::exists(d / "a.csv.partial"));
+  try {
+    AtomicTextFile f(d / "b.csv");
+    f << "half";
+    throw std::runtime_error("failure mid-way");
+  } catch (const std::runtime_error&) {
+  }
+  EXPECT_FALSE(fs::exists(d / "b.csv"));
+  EXPECT_FALSE(fs::exists(d / "b.csv.partial"));  // nothing half-written is left
+  fs::remove_all(d);
+}
+
+TEST(OutputDir, CreatesAndRejectsFiles) {
+  const auto d = temp_dir("outdir");
+  EXPECT_NO_THROW(make_output_dir(d / "x" / "y"));
+  EXPECT_TRUE(fs::is_directory(d / "x" / "y"));
+  write_text_file(d / "file", "not a dir");
+  EXPECT_THROW(make_output_dir(d / "file"), InputError);
+  std::ofstream(d / "z.tif.partial") << "junk";
+  remove_partial_files(d);
+  EXPECT_FALSE(fs::exists(d / "z.tif.partial"));
+  EXPECT_TRUE(fs::exists(d / "file"));
+  fs::remove_all(d);
+}
+
+TEST(Progress, LogModePrintsPlainLinesWithRateAndEta) {
+  std::FILE* f = std::tmpfile();
+  ProgressReporter p("test", 10.0, false, f);
+  p.set_terminal(false);
+  p.set_log_interval(0.0);
+  p.update(0.0, 0, 100);
+  p.update(5.0, 50, 100);
+  EXPECT_NE(p.last_line().find("50.0%"), std::string::npos) << p.last_line();
+  EXPECT_NE(p.last_line().find("ETA"), std::string::npos);
+  EXPECT_NE(p.last_line().find("step 50"), std::string::npos);
+  p.finish(10.0, 100, 100);
+  std::rewind(f);
+  char buf[4096] = {};
+  const std::size_t n = std::fread(buf, 1, sizeof buf - 1, f);
+  std::fclose(f);
+  const std::string out(buf, n);
+  EXPECT_EQ(out.find('\r'), std::string::npos);  // no terminal control in logs
+  EXPECT_NE(out.find("done in"), std::string::npos);
+}
+
+TEST(Progress, QuietPrintsNothing) {
+  std::FILE* f = std::tmpfile();
+  ProgressReporter p("test", 1.0, true, f);
+  p.set_log_interval(0.0);
+  p.update(0.5, 5, 10);
+  p.finish(1.0, 10, 10);
+  EXPECT_EQ(std::ftell(f), 0);
+  std::fclose(f);
+}
+
+TEST(Progress, DurationFormat) {
+  EXPECT_EQ(format_duration(12.34), "12.3s");
+  EXPECT_EQ(format_duration(185), "3m05s");
+  EXPECT_EQ(format_duration(3720), "1h02m");
+  EXPECT_EQ(format_duration(-1), "--");
+}
+
+}  // namespace
+}  // namespace geohaz
