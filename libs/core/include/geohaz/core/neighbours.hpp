@@ -90,7 +90,11 @@ private:
 template <int Dim>
 class NeighbourList {
 public:
+  /// Cells per cut-off length: the grid has cells of edge cutoff/kReach, scanned kReach cells deep.
+  static constexpr int kReach = 2;
+
   /// Find, for every particle, all others closer than cutoff (strictly). Parallel (OpenMP).
+  /// Throws std::invalid_argument if a periodic axis is shorter than 2 × cutoff.
   void build(std::span<const Vec<Dim>> x, double cutoff, const Periodicity<Dim>& periodic = {});
 
   std::size_t size() const noexcept { return offsets_.empty() ? 0 : offsets_.size() - 1; }
@@ -138,7 +142,7 @@ private:
   bool periodic_any_ = false;
   std::vector<std::uint32_t> offsets_, indices_;
   std::vector<std::vector<std::uint32_t>> thread_buffers_;  // reused between builds
-  std::vector<std::uint32_t> thread_counts_;
+  std::vector<Vec<Dim>> sorted_x_;                         // positions in cell order, reused
 };
 
 extern template class CellList<2>;

@@ -1,0 +1,358 @@
+/// \file raster.cpp
+/// Terrain rasters through GDAL (see raster.hpp): reading, GeoTIFF writing, CRS helpers and the
+/// bilinear Terrain surface. GDAL is confined to this file, vector.cpp and png.cpp.
+
+#include "geohaz/core/raster.hpp"
+
+#include <cpl_conv.h>
+#include <cpl_error.h>
+#include <gdal_priv.h>
+#include <ogr_spatialref.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <mutex>
+
+#include "geohaz/core/errors.hpp"
+#include "geohaz/core/raster_extra.hpp"
+
+namespace geohaz {
+
+// Shared with vector.cpp and png.cpp (declared there; no private header to keep GDAL out of ours).
+namespace detail {
+
+void ensure_gdal_registered() {
+  static std::once_flag once;
+  std::call_once(once, [] { GDALAllRegister(); });
+}
+
+/// Silences GDAL's own stderr printing while we turn its failures into InputError messages
+/// (which carry CPLGetLastErrorMsg()).
+class QuietGdalErrors {
+ public:
+  QuietGdalErrors() {
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    CPLErrorReset();
+  }
+  ~QuietGdalErrors() { CPLPopErrorHandler(); }
+  QuietGdalErrors(const QuietGdalErrors&) = delete;
+  QuietGdalErrors& operator=(const QuietGdalErrors&) = delete;
+};
+
+std::string gdal_last_error() {
+  const char* msg = CPLGetLastErrorMsg();
+  return (msg && *msg) ? std::string(" (GDAL: ") + msg + ")" : std::string();
+}
+
+/// Parse a CRS in any form GDAL accepts; false when it cannot.
+bool parse_srs(const std::string& text, OGRSpatialReference& srs) {
+  if (text.empty()) return false;
+  QuietGdalErrors quiet;
+  return srs.SetFromUserInput(text.c_str()) == OGRERR_NONE;
+}
+
+}  // namespace detail
+
+using detail::ensure_gdal_registered;
+using detail::gdal_last_error;
+using detail::QuietGdalErrors;
+
+// ---------------------------------------------------------------------------------------------
+// Raster
+
+Raster Raster::like(double fill, std::optional<double> nodata_value) const {
+  Raster r;
+  r.nx = nx;
+  r.ny = ny;
+  r.geotransform = geotransform;
+  r.crs_wkt = crs_wkt;
+  r.nodata = nodata_value;
+  r.data.assign(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny), fill);
+  return r;
+}
+
+Vec2 Raster::cell_centre(int col, int row) const noexcept {
+  return {geotransform[0] + (col + 0.5) * geotransform[1], geotransform[3] + (row + 0.5) * geotransform[5]};
+}
+
+Vec2 Raster::to_pixel(const Vec2& p) const noexcept {
+  return {(p.x() - geotransform[0]) / geotransform[1] - 0.5, (p.y() - geotransform[3]) / geotransform[5] - 0.5};
+}
+
+bool Raster::is_nodata(double v) const noexcept {
+  // NaN is never data, whatever the declared nodata value.
+  if (std::isnan(v)) return true;
+  return nodata.has_value() && v == *nodata;
+}
+
+std::array<Vec2, 2> Raster::extent() const noexcept {
+  const double x0 = geotransform[0], x1 = geotransform[0] + nx * geotransform[1];
+  const double y0 = geotransform[3], y1 = geotransform[3] + ny * geotransform[5];
+  return {Vec2(std::min(x0, x1), std::min(y0, y1)), Vec2(std::max(x0, x1), std::max(y0, y1))};
+}
+
+// ---------------------------------------------------------------------------------------------
+// CRS helpers
+
+bool crs_is_geographic(const std::string& wkt) {
+  OGRSpatialReference srs;
+  if (!detail::parse_srs(wkt, srs)) return false;
+  return srs.IsGeographic() && !srs.IsProjected();
+}
+
+bool crs_equal(const std::string& a, const std::string& b) {
+  if (a.empty() || b.empty()) return a.empty() && b.empty();
+  if (a == b) return true;
+  OGRSpatialReference sa, sb;
+  if (!detail::parse_srs(a, sa) || !detail::parse_srs(b, sb)) return false;
+  const char* options[] = {"IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES", "CRITERION=EQUIVALENT_EXCEPT_AXIS_ORDER_GEOGCRS",
+                           nullptr};
+  return sa.IsSame(&sb, options);
+}
+
+std::string crs_to_wkt(const std::string& definition) {
+  if (definition.empty()) return {};
+  ensure_gdal_registered();
+  OGRSpatialReference srs;
+  QuietGdalErrors quiet;
+  if (srs.SetFromUserInput(definition.c_str()) != OGRERR_NONE)
+    throw InputError(
+        "not a coordinate reference system GDAL understands (use e.g. EPSG:32632 or WKT)" + gdal_last_error(), "", "",
+        definition);
+  char* out = nullptr;
+  const char* options[] = {"FORMAT=WKT2_2018", nullptr};
+  srs.exportToWkt(&out, options);
+  std::string wkt = out ? out : "";
+  CPLFree(out);
+  return wkt;
+}
+
+std::vector<Vec2> transform_points(const std::vector<Vec2>& pts, const std::string& from_wkt,
+                                   const std::string& to_wkt) {
+  if (from_wkt.empty() || to_wkt.empty() || crs_equal(from_wkt, to_wkt)) return pts;
+  ensure_gdal_registered();
+  OGRSpatialReference from, to;
+  if (!detail::parse_srs(from_wkt, from)) throw InputError("cannot interpret the source CRS", "", "", from_wkt);
+  if (!detail::parse_srs(to_wkt, to)) throw InputError("cannot interpret the target CRS", "", "", to_wkt);
+  from.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  to.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  QuietGdalErrors quiet;
+  std::unique_ptr<OGRCoordinateTransformation> ct(OGRCreateCoordinateTransformation(&from, &to));
+  if (!ct) throw InputError("no coordinate transformation between the two CRS" + gdal_last_error());
+  std::vector<double> x(pts.size()), y(pts.size());
+  std::vector<int> ok(pts.size(), 0);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    x[i] = pts[i].x();
+    y[i] = pts[i].y();
+  }
+  ct->Transform(static_cast<int>(pts.size()), x.data(), y.data(), nullptr, ok.data());
+  std::vector<Vec2> out(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (!ok[i] || !std::isfinite(x[i]) || !std::isfinite(y[i]))
+      throw InputError("point (" + std::to_string(pts[i].x()) + ", " + std::to_string(pts[i].y()) +
+                       ") cannot be transformed to the target CRS" + gdal_last_error());
+    out[i] = Vec2(x[i], y[i]);
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading and writing
+
+Raster read_raster(const std::filesystem::path& path, CrsPolicy policy) {
+  ensure_gdal_registered();
+  const std::string file = path.string();
+  QuietGdalErrors quiet;
+  std::unique_ptr<GDALDataset> ds(
+      GDALDataset::Open(file.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
+  if (!ds) throw InputError("cannot read as a raster" + gdal_last_error(), file);
+  if (ds->GetRasterCount() < 1) throw InputError("the dataset has no raster band", file);
+
+  Raster r;
+  r.nx = ds->GetRasterXSize();
+  r.ny = ds->GetRasterYSize();
+  if (r.nx <= 0 || r.ny <= 0) throw InputError("the raster is empty (0 columns or rows)", file);
+
+  std::array<double, 6> gt{};
+  const bool has_gt = ds->GetGeoTransform(gt.data()) == CE_None;
+  if (!has_gt) {
+    if (policy == CrsPolicy::RequireProjected)
+      throw InputError("the raster has no georeferencing (geotransform); a georeferenced grid is required", file);
+    gt = {0.0, 1.0, 0.0, 0.0, 0.0, -1.0};  // plain pixel grid, row 0 at the top
+  }
+  if (gt[2] != 0.0 || gt[4] != 0.0)
+    throw InputError("rotated geotransform (rotation terms " + std::to_string(gt[2]) + ", " + std::to_string(gt[4]) +
+                         ") is not supported; make it north-up with `gdalwarp in.tif out.tif`",
+                     file);
+  if (!(gt[1] > 0.0) || gt[5] == 0.0 || !std::isfinite(gt[5]))
+    throw InputError("invalid cell size (dx = " + std::to_string(gt[1]) + ", dy = " + std::to_string(gt[5]) + ")",
+                     file);
+
+  if (const OGRSpatialReference* srs = ds->GetSpatialRef(); srs && !srs->IsEmpty()) {
+    char* wkt = nullptr;
+    const char* options[] = {"FORMAT=WKT2_2018", nullptr};
+    srs->exportToWkt(&wkt, options);
+    r.crs_wkt = wkt ? wkt : "";
+    CPLFree(wkt);
+    if (policy == CrsPolicy::RequireProjected && srs->IsGeographic() && !srs->IsProjected()) {
+      // Suggest the UTM zone of the raster's centre (assuming degrees of longitude/latitude).
+      const double lon = gt[0] + 0.5 * r.nx * gt[1], lat = gt[3] + 0.5 * r.ny * gt[5];
+      std::string epsg = "EPSG:32632";
+      if (std::abs(lon) <= 180.0 && std::abs(lat) <= 84.0) {
+        const int zone = std::clamp(static_cast<int>(std::floor((lon + 180.0) / 6.0)) + 1, 1, 60);
+        epsg = "EPSG:" + std::to_string((lat >= 0.0 ? 32600 : 32700) + zone);
+      }
+      throw InputError(
+          "the raster is in a geographic CRS (degrees), but simulations need a projected CRS in metres; "
+          "reproject it first, e.g. `gdalwarp -t_srs " +
+              epsg + " " + file + " projected.tif` (" + epsg +
+              " is the UTM zone of the raster's centre; a local projected CRS works too)",
+          file);
+    }
+  } else if (policy == CrsPolicy::RequireProjected) {
+    std::cerr << "warning: " << file << ": the raster has no CRS; its coordinates are taken as metres\n";
+  }
+
+  GDALRasterBand* band = ds->GetRasterBand(1);
+  int has_nodata = 0;
+  const double nd = band->GetNoDataValue(&has_nodata);
+  if (has_nodata) r.nodata = nd;
+
+  r.data.resize(static_cast<std::size_t>(r.nx) * static_cast<std::size_t>(r.ny));
+  if (band->RasterIO(GF_Read, 0, 0, r.nx, r.ny, r.data.data(), r.nx, r.ny, GDT_Float64, 0, 0, nullptr) != CE_None)
+    throw InputError("cannot read band 1" + gdal_last_error(), file);
+
+  if (gt[5] > 0.0) {
+    // South-up grid (row 0 at the south edge): flip the rows so the Raster is north-up.
+    for (int row = 0; row < r.ny / 2; ++row)
+      std::swap_ranges(r.data.begin() + static_cast<std::ptrdiff_t>(row) * r.nx,
+                       r.data.begin() + static_cast<std::ptrdiff_t>(row + 1) * r.nx,
+                       r.data.begin() + static_cast<std::ptrdiff_t>(r.ny - 1 - row) * r.nx);
+    gt[3] += r.ny * gt[5];
+    gt[5] = -gt[5];
+  }
+  r.geotransform = gt;
+  return r;
+}
+
+void write_geotiff(const std::filesystem::path& path, const Raster& r, bool float64) {
+  const std::string file = path.string();
+  if (r.nx <= 0 || r.ny <= 0 || r.data.size() != static_cast<std::size_t>(r.nx) * static_cast<std::size_t>(r.ny))
+    throw InputError("cannot write an empty or inconsistent raster (" + std::to_string(r.nx) + " x " +
+                         std::to_string(r.ny) + ", " + std::to_string(r.data.size()) + " values)",
+                     file);
+  ensure_gdal_registered();
+  OGRSpatialReference srs;
+  if (!r.crs_wkt.empty() && !detail::parse_srs(r.crs_wkt, srs))
+    throw InputError("the raster's CRS cannot be interpreted", file, "", r.crs_wkt);
+
+  // The GTiff driver does not depend on the extension, so "<name>.partial" (the project-wide
+  // temporary name that remove_partial_files() knows) works.
+  const std::string tmp = file + ".partial";
+  QuietGdalErrors quiet;
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
+  if (!driver) throw std::runtime_error("GDAL has no GTiff driver");
+  const char* options[] = {"COMPRESS=DEFLATE", "PREDICTOR=1", "TILED=NO", nullptr};
+  bool ok = true;
+  {
+    std::unique_ptr<GDALDataset> ds(
+        driver->Create(tmp.c_str(), r.nx, r.ny, 1, float64 ? GDT_Float64 : GDT_Float32, const_cast<char**>(options)));
+    if (!ds) throw InputError("cannot create the GeoTIFF" + gdal_last_error(), file);
+    std::array<double, 6> gt = r.geotransform;
+    ok = ds->SetGeoTransform(gt.data()) == CE_None;
+    if (ok && !r.crs_wkt.empty()) ok = ds->SetSpatialRef(&srs) == CE_None;
+    GDALRasterBand* band = ds->GetRasterBand(1);
+    if (ok && r.nodata) ok = band->SetNoDataValue(*r.nodata) == CE_None;
+    if (ok)
+      ok = band->RasterIO(GF_Write, 0, 0, r.nx, r.ny, const_cast<double*>(r.data.data()), r.nx, r.ny, GDT_Float64, 0, 0,
+                          nullptr) == CE_None;
+    if (ok) ds->FlushCache(true);  // returns void in GDAL 3.6: failures show in the error state
+    ok = ok && CPLGetLastErrorType() != CE_Failure && CPLGetLastErrorType() != CE_Fatal;
+  }  // closes the dataset (writes the rest)
+  ok = ok && CPLGetLastErrorType() != CE_Failure && CPLGetLastErrorType() != CE_Fatal;
+  std::error_code ec;
+  if (!ok) {
+    const std::string msg = gdal_last_error();
+    std::filesystem::remove(tmp, ec);
+    throw InputError("writing the GeoTIFF failed" + msg, file);
+  }
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw InputError("cannot move the GeoTIFF into place: " + ec.message(), file);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Terrain: bilinear surface through the cell centres. These functions are called per particle
+// per step, so they do no allocation and no GDAL calls.
+
+Terrain::Terrain(Raster elevation) : r_(std::move(elevation)) {
+  if (r_.nx < 2 || r_.ny < 2)
+    throw InputError("a terrain needs at least 2 x 2 cells (got " + std::to_string(r_.nx) + " x " +
+                     std::to_string(r_.ny) + ")");
+  if (r_.data.size() != static_cast<std::size_t>(r_.nx) * static_cast<std::size_t>(r_.ny))
+    throw InputError("terrain raster size does not match its data");
+  if (!(r_.geotransform[1] > 0.0) || !(r_.geotransform[5] < 0.0) || r_.geotransform[2] != 0.0 ||
+      r_.geotransform[4] != 0.0)
+    throw InputError("terrain raster must be north-up with dx > 0 and dy < 0");
+}
+
+bool Terrain::valid(double x, double y) const noexcept {
+  TerrainSample s;
+  return sample_terrain(r_, x, y, s);
+}
+
+double Terrain::elevation(double x, double y) const noexcept {
+  TerrainSample s;
+  return sample_terrain(r_, x, y, s) ? s.z : std::numeric_limits<double>::quiet_NaN();
+}
+
+Vec2 Terrain::gradient(double x, double y) const noexcept {
+  TerrainSample s;
+  return sample_terrain(r_, x, y, s) ? s.gradient : Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
+}
+
+Vec3 Terrain::normal(double x, double y) const noexcept {
+  const Vec2 g = gradient(x, y);
+  const Vec3 n(-g.x(), -g.y(), 1.0);
+  return n / n.norm();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Profiles
+
+std::vector<ProfilePoint> extract_profile(const Terrain& terrain, const std::vector<Vec2>& polyline, double spacing) {
+  if (!(spacing > 0.0) || !std::isfinite(spacing))
+    throw InputError("profile spacing must be a positive number of metres", "", "spacing", std::to_string(spacing));
+  if (polyline.size() < 2)
+    throw InputError("a profile needs a polyline of at least 2 vertices (got " + std::to_string(polyline.size()) + ")");
+  std::vector<ProfilePoint> out;
+  double s0 = 0.0;
+  auto add = [&](double s, const Vec2& p) {
+    const double z = terrain.elevation(p.x(), p.y());
+    if (!std::isfinite(z))
+      throw InputError("the profile leaves the terrain data at (" + std::to_string(p.x()) + ", " +
+                       std::to_string(p.y()) + "), s = " + std::to_string(s) + " m");
+    out.push_back({s, p.x(), p.y(), z});
+  };
+  add(0.0, polyline.front());
+  for (std::size_t k = 0; k + 1 < polyline.size(); ++k) {
+    const Vec2 a = polyline[k], b = polyline[k + 1];
+    const double len = (b - a).norm();
+    // Samples every `spacing` from the segment start; the end vertex closes the segment (the last
+    // interval of a segment is ≤ spacing). A sample closer than 1e-9·spacing to the vertex is the vertex.
+    for (int m = 1;; ++m) {
+      const double d = m * spacing;
+      if (d >= len - 1e-9 * spacing) break;
+      add(s0 + d, a + (b - a) * (d / len));
+    }
+    s0 += len;
+    if (len > 0.0) add(s0, b);
+  }
+  return out;
+}
+
+}  // namespace geohaz
