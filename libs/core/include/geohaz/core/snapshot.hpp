@@ -20,6 +20,7 @@
 #include <string_view>
 #include <vector>
 
+#include "geohaz/core/errors.hpp"
 #include "geohaz/core/particles.hpp"
 
 namespace geohaz {
@@ -89,7 +90,8 @@ private:
   std::unique_ptr<Impl> impl_;
 };
 
-/// One field read back: count × components doubles (integers converted), row-major per particle.
+/// One field read back: count × components doubles (integers converted), per particle in the field
+/// type's storage order (column-major for Eigen matrices; symmetric tensors are unaffected).
 struct FieldData {
   std::string unit;
   std::size_t count = 0;
@@ -125,13 +127,15 @@ private:
   std::unique_ptr<Impl> impl_;
 };
 
-/// Copy a field read back into a store's array (sizes must match; throws InputError otherwise).
+/// Copy a field read back into a store's array (sizes must match; throws InputError otherwise, e.g.
+/// when a restart file does not belong to the scenario).
 template <class Tag, class Store>
 void load_field(const FieldData& d, Store& store) {
   using Tr = FieldTraits<typename Tag::type>;
   auto& v = store.template get<Tag>();
   if (d.count != v.size() || d.components() != Tr::rows * Tr::cols)
-    throw std::invalid_argument(std::string("snapshot field '") + Tag::label + "' does not match the store");
+    throw InputError(std::string("snapshot field '") + Tag::label + "' does not match the particle store (" +
+                     std::to_string(d.count) + " particles × " + std::to_string(d.components()) + " components)");
   for (std::size_t i = 0; i < d.count; ++i) {
     if constexpr (Tr::rows * Tr::cols == 1) {
       v[i] = static_cast<typename Tr::scalar>(d.values[i]);
