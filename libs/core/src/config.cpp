@@ -207,7 +207,7 @@ namespace {
 }  // namespace
 
 double ConfigReader::get(std::string_view key, double def, Range range, KeyDoc doc) {
-  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  const std::string full = full_key(key);
   state_->record(full, "number", doc.unit, num(def), range.str(), doc.help);
   state_->accessed.insert(full);
   double v = def;
@@ -229,7 +229,7 @@ double ConfigReader::get(std::string_view key, double def, Range range, KeyDoc d
 }
 
 double ConfigReader::require(std::string_view key, Range range, KeyDoc doc) {
-  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  const std::string full = full_key(key);
   if (state_->describe) {
     state_->record(full, "number", doc.unit, "(required)", range.str(), doc.help);
     state_->accessed.insert(full);
@@ -247,7 +247,7 @@ double ConfigReader::require(std::string_view key, Range range, KeyDoc doc) {
 }
 
 std::int64_t ConfigReader::get_int(std::string_view key, std::int64_t def, Range range, KeyDoc doc) {
-  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  const std::string full = full_key(key);
   state_->record(full, "integer", doc.unit, std::to_string(def), range.str(), doc.help);
   state_->accessed.insert(full);
   std::int64_t v = def;
@@ -265,7 +265,7 @@ std::int64_t ConfigReader::get_int(std::string_view key, std::int64_t def, Range
 }
 
 bool ConfigReader::get_bool(std::string_view key, bool def, KeyDoc doc) {
-  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  const std::string full = full_key(key);
   state_->record(full, "boolean", doc.unit, def ? "true" : "false", "true|false", doc.help);
   state_->accessed.insert(full);
   bool v = def;
@@ -281,7 +281,7 @@ bool ConfigReader::get_bool(std::string_view key, bool def, KeyDoc doc) {
 }
 
 std::string ConfigReader::get_string(std::string_view key, std::string_view def, KeyDoc doc) {
-  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  const std::string full = full_key(key);
   state_->record(full, "string", doc.unit, "\"" + std::string(def) + "\"", "", doc.help);
   state_->accessed.insert(full);
   std::string v(def);
@@ -297,7 +297,7 @@ std::string ConfigReader::get_string(std::string_view key, std::string_view def,
 }
 
 std::string ConfigReader::require_string(std::string_view key, KeyDoc doc) {
-  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  const std::string full = full_key(key);
   if (!state_->describe && !state_->root.at_path(full))
     throw InputError("required key is missing (" + std::string(doc.help) + ")", state_->source, full);
   auto v = get_string(key, "", doc);
@@ -312,7 +312,7 @@ std::string ConfigReader::get_choice(std::string_view key, std::string_view def,
   for (const auto& c : choices) list += (list.empty() ? "" : "|") + c;
   state_->refs.back().range = list;
   if (std::find(choices.begin(), choices.end(), v) == choices.end()) {
-    const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+    const std::string full = full_key(key);
     throw InputError("unknown choice; allowed: " + list, state_->source, full, v);
   }
   return v;
@@ -320,7 +320,7 @@ std::string ConfigReader::get_choice(std::string_view key, std::string_view def,
 
 std::vector<double> ConfigReader::get_array(std::string_view key, const std::vector<double>& def, Range range,
                                             KeyDoc doc, std::size_t expected_size) {
-  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  const std::string full = full_key(key);
   std::string deftext = "[";
   for (std::size_t i = 0; i < def.size(); ++i) deftext += (i ? ", " : "") + num(def[i]);
   deftext += "]";
@@ -355,7 +355,7 @@ std::vector<double> ConfigReader::get_array(std::string_view key, const std::vec
 
 std::vector<double> ConfigReader::require_array(std::string_view key, Range range, KeyDoc doc,
                                                 std::size_t expected_size) {
-  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  const std::string full = full_key(key);
   if (state_->describe) {
     return get_array(key, std::vector<double>(expected_size ? expected_size : 1, 0.0), Range{}, doc, 0);
   }
@@ -368,12 +368,12 @@ std::vector<double> ConfigReader::require_array(std::string_view key, Range rang
 }
 
 bool ConfigReader::has(std::string_view key) const {
-  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  const std::string full = full_key(key);
   return !state_->describe && static_cast<bool>(state_->root.at_path(full));
 }
 
 std::vector<ConfigReader> ConfigReader::tables(std::string_view key, KeyDoc doc) {
-  const std::string full = prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
+  const std::string full = full_key(key);
   state_->record(full, "array of tables", "", "[]", "", doc.help);
   state_->accessed.insert(full);
   std::vector<ConfigReader> out;
@@ -394,8 +394,10 @@ std::vector<ConfigReader> ConfigReader::tables(std::string_view key, KeyDoc doc)
   return out;
 }
 
-ConfigReader ConfigReader::section(std::string_view key) const {
-  return ConfigReader(state_, prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key));
+ConfigReader ConfigReader::section(std::string_view key) const { return ConfigReader(state_, full_key(key)); }
+
+std::string ConfigReader::full_key(std::string_view key) const {
+  return prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
 }
 
 void ConfigReader::finish() const {

@@ -13,13 +13,10 @@
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
 #include "geohaz/core/raster_extra.hpp"
+#include "gdal_common.hpp"
 
 namespace geohaz {
 
-namespace detail {  // defined in raster.cpp
-void ensure_gdal_registered();
-std::string gdal_last_error();
-}  // namespace detail
 
 using Rgb = std::array<std::uint8_t, 3>;
 
@@ -222,11 +219,7 @@ void write_rgb_png(const std::filesystem::path& path, int w, int h, const std::v
   detail::ensure_gdal_registered();
   const std::string file = path.string();
   const std::string tmp = file + ".partial";
-  CPLPushErrorHandler(CPLQuietErrorHandler);
-  struct Pop {
-    ~Pop() { CPLPopErrorHandler(); }
-  } pop;
-  CPLErrorReset();
+  detail::QuietGdalErrors quiet;
   GDALDriver* mem_driver = GetGDALDriverManager()->GetDriverByName("MEM");
   GDALDriver* png_driver = GetGDALDriverManager()->GetDriverByName("PNG");
   if (!mem_driver || !png_driver) throw std::runtime_error("GDAL lacks the MEM or PNG driver");
@@ -270,11 +263,7 @@ void write_png(const std::filesystem::path& path, const Image& img) {
 Image read_image(const std::filesystem::path& path) {
   detail::ensure_gdal_registered();
   const std::string file = path.string();
-  CPLPushErrorHandler(CPLQuietErrorHandler);
-  struct Pop {
-    ~Pop() { CPLPopErrorHandler(); }
-  } pop;
-  CPLErrorReset();
+  detail::QuietGdalErrors quiet;
   std::unique_ptr<GDALDataset> ds(
       GDALDataset::Open(file.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
   if (!ds) throw InputError("cannot read as an image" + detail::gdal_last_error(), file);

@@ -17,10 +17,10 @@
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster_extra.hpp"
+#include "gdal_common.hpp"
 
 namespace geohaz {
 
-// Shared with vector.cpp and png.cpp (declared there; no private header to keep GDAL out of ours).
 namespace detail {
 
 void ensure_gdal_registered() {
@@ -28,25 +28,11 @@ void ensure_gdal_registered() {
   std::call_once(once, [] { GDALAllRegister(); });
 }
 
-/// Silences GDAL's own stderr printing while we turn its failures into InputError messages
-/// (which carry CPLGetLastErrorMsg()).
-class QuietGdalErrors {
- public:
-  QuietGdalErrors() {
-    CPLPushErrorHandler(CPLQuietErrorHandler);
-    CPLErrorReset();
-  }
-  ~QuietGdalErrors() { CPLPopErrorHandler(); }
-  QuietGdalErrors(const QuietGdalErrors&) = delete;
-  QuietGdalErrors& operator=(const QuietGdalErrors&) = delete;
-};
-
 std::string gdal_last_error() {
   const char* msg = CPLGetLastErrorMsg();
   return (msg && *msg) ? std::string(" (GDAL: ") + msg + ")" : std::string();
 }
 
-/// Parse a CRS in any form GDAL accepts; false when it cannot.
 bool parse_srs(const std::string& text, OGRSpatialReference& srs) {
   if (text.empty()) return false;
   QuietGdalErrors quiet;

@@ -11,14 +11,10 @@
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
+#include "gdal_common.hpp"
 
 namespace geohaz {
 
-namespace detail {  // defined in raster.cpp
-void ensure_gdal_registered();
-std::string gdal_last_error();
-bool parse_srs(const std::string& text, OGRSpatialReference& srs);
-}  // namespace detail
 
 namespace {
 
@@ -74,11 +70,7 @@ std::vector<Polygon> read_polygons(const std::filesystem::path& path, const std:
                                    const std::string& target_wkt) {
   detail::ensure_gdal_registered();
   const std::string file = path.string();
-  CPLPushErrorHandler(CPLQuietErrorHandler);
-  struct Pop {
-    ~Pop() { CPLPopErrorHandler(); }
-  } pop;
-  CPLErrorReset();
+  detail::QuietGdalErrors quiet;
 
   std::unique_ptr<GDALDataset> ds(
       GDALDataset::Open(file.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));

@@ -111,6 +111,8 @@ public:
 private:
   struct State;
   ConfigReader(std::shared_ptr<State> state, std::string prefix);
+  /// The dotted path of `key` below this reader's prefix.
+  std::string full_key(std::string_view key) const;
   std::shared_ptr<State> state_;
   std::string prefix_;
 };
