@@ -1,0 +1,119 @@
+// Throughput of the debris-runout solver (issue 4 targets, 2-core machine):
+//  1. particle-steps per second for a 10^5-particle flow on an inclined plane, 1 and 2 threads
+//     (target ≥ 5e6 /s with 2 threads);
+//  2. wall time of the seed's case at the seed's scale: 10 simulated minutes of a ~5000-particle
+//     release (d0 = 5 m, h0 = 1 m, 2 m thick over 300 m × 200 m) on the synthetic 5 km valley DSM of 2000 × 1000 cells
+//     at 2.5 m, n = 0.06, i_cr = 0.15 (target < 10 s), with the hazard maps recorded every step as the app does.
+// Prints rates; never asserts. Usage: bench_runout [particles=100000] [steps=40]
+#include <omp.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+
+#include "geohaz/runout/hazard_maps.hpp"
+#include "geohaz/runout/release.hpp"
+#include "geohaz/runout/solver.hpp"
+#include "geohaz/runout/synthetic_terrain.hpp"
+
+using namespace geohaz;
+using namespace geohaz::runout;
+
+namespace {
+double now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Process CPU time (s): with the machine shared, CPU time per particle-step is the load-independent figure.
+double cpu() {
+  return static_cast<double>(std::clock()) / CLOCKS_PER_SEC;
+}
+
+struct Rate {
+  double wall, cpu;
+};
+
+Rate plane_rate(std::size_t target, int steps, int threads) {
+  omp_set_num_threads(threads);
+  RunoutParameters p;
+  p.d0 = 5.0;
+  p.h0 = 1.0;
+  p.duration = 1e9;
+  p.friction = ModifiedManningFriction{0.06, 0.15, 0.0};
+  InclinedPlane plane;
+  plane.slope = Vec2(-0.3, 0.0);
+  RunoutSolver<InclinedPlane> s(plane, p);
+  const int n = static_cast<int>(std::sqrt(static_cast<double>(target)));
+  const double d = p.d0 / std::sqrt(2.0);  // 2 m thick layer
+  auto& st = s.particles();
+  st.append(static_cast<std::size_t>(n) * n);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j) * n + i;
+      st.get<Position<2>>()[k] = Vec2(i * d, j * d);
+      st.get<Volume>()[k] = p.nominal_volume();
+      st.get<ParticleId>()[k] = static_cast<std::int64_t>(k);
+    }
+  s.initialise();
+  for (int k = 0; k < 5; ++k) s.step();  // warm-up: moving, reordered
+  const double t0 = now(), c0 = cpu();
+  for (int k = 0; k < steps; ++k) s.step();
+  const double wall = now() - t0, c = cpu() - c0;
+  const double ps = static_cast<double>(st.size()) * steps;
+  return {ps / wall, ps / c};
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::size_t n = argc > 1 ? std::strtoul(argv[1], nullptr, 10) : 100000;
+  const int steps = argc > 2 ? std::atoi(argv[2]) : 40;
+  std::printf("bench_runout: %zu particles on a plane, %d steps\n", n, steps);
+  std::fflush(stdout);
+  for (int t : {1, 2}) {
+    const Rate r = plane_rate(n, steps, t);
+    std::printf("  %d thread(s): %.3g particle-steps/s (wall), %.3g per CPU-second\n", t, r.wall, r.cpu);
+    std::fflush(stdout);
+  }
+
+  // The seed's case.
+  omp_set_num_threads(2);
+  const SyntheticValley v;
+  const GridSurface surface = v.surface();
+  const GridGeometry g = v.geometry();
+  std::vector<double> thick(g.cells(), 0.0);
+  const double L = v.length();
+  for (int r = 0; r < g.ny; ++r)
+    for (int c = 0; c < g.nx; ++c) {
+      const Vec2 p = g.centre(c, r);
+      const double s = p.x() - g.x0;
+      if (s > 0.06 * L && s < 0.12 * L && std::abs(p.y() - v.thalweg_y(p.x())) < 0.02 * L) thick[g.index(c, r)] = 2.0;
+    }
+  RunoutParameters p;
+  p.d0 = 5.0;
+  p.h0 = 1.0;
+  p.duration = 600.0;
+  p.friction = ModifiedManningFriction{0.06, 0.15, 0.0};
+  RunoutSolver<GridSurface> s(surface, p);
+  const SeedReport rep = seed_release(g, thick, p.d0, p.h0, s.particles());
+  s.initialise();
+  HazardMaps maps(g, p.d0, p.density);
+  const double t0 = now(), c0 = cpu();
+  std::size_t particle_steps = 0;
+  while (!s.finished()) {
+    s.step();
+    maps.record(s.particles(), s.time());
+    particle_steps += s.particles().size();
+  }
+  const double wall = now() - t0, cpu_s = cpu() - c0;
+  const auto row = series_row(s.particles(), s.budget(), s.time(), s.step_count());
+  std::printf(
+      "seed case: %zu particles (%.0f m^3), 2000 x 1000 DSM at 2.5 m, %.0f s simulated in %lld steps: "
+      "%.2f s wall, %.2f s CPU (2 threads, %.3g particle-steps/s); front travelled %.0f m (seed: 4800 m in 600 s)\n",
+      rep.particles, rep.volume_seeded, s.time(), static_cast<long long>(s.step_count()), wall, cpu_s,
+      static_cast<double>(particle_steps) / wall, row.front_travel);
+  std::printf("memory: %zu bytes per particle; DSM %zu MB\n", RunoutStore::bytes_per_particle(),
+              g.cells() * sizeof(double) / (1024 * 1024));
+  return 0;
+}

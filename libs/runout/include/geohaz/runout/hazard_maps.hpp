@@ -1,0 +1,80 @@
+#pragma once
+/// \file hazard_maps.hpp
+/// Hazard maps on the DSM grid, accumulated during a run, and the statistics of the outputs
+/// (time series rows, end-of-run summary).
+///
+/// Maps: every recorded step each particle paints the cells whose centre lies within
+/// max(d0/2, cell size) of it (its own cell always) with its flow depth, surface speed and dynamic
+/// pressure ρ S² (maxima over time) and, if moving, the arrival time (first time painted).
+/// The final deposit thickness is the cubic-spline kernel sum Σ V_j W(|x_c − x_j|, d0) at the cell
+/// centres, so it integrates to the volume left in the domain.
+
+#include <limits>
+#include <vector>
+
+#include "geohaz/runout/fields.hpp"
+#include "geohaz/runout/solver.hpp"
+#include "geohaz/runout/surface.hpp"
+
+namespace geohaz::runout {
+
+class HazardMaps {
+ public:
+  HazardMaps(GridGeometry grid, double d0, double density);
+
+  /// Paint the current particle state at time t (s).
+  void record(const RunoutStore& store, double t);
+
+  const GridGeometry& grid() const noexcept { return g_; }
+  const std::vector<double>& max_depth() const noexcept { return max_depth_; }        ///< m
+  const std::vector<double>& max_speed() const noexcept { return max_speed_; }        ///< m/s
+  const std::vector<double>& max_pressure() const noexcept { return max_pressure_; }  ///< Pa (ρ S²)
+  const std::vector<double>& arrival_time() const noexcept { return arrival_; }       ///< s, NaN: never
+  /// Area (m²) of the cells reached by the flow (max depth > 0).
+  double affected_area() const;
+
+  /// Final deposit thickness (m) on the grid from the particles left (kernel sum).
+  std::vector<double> deposit(const RunoutStore& store) const;
+
+ private:
+  GridGeometry g_;
+  double d0_, density_, radius_;
+  std::vector<double> max_depth_, max_speed_, max_pressure_, arrival_;
+};
+
+/// One row of the time series.
+struct SeriesRow {
+  double time = 0.0;
+  std::int64_t step = 0;
+  std::size_t particles = 0;
+  Vec2 front = Vec2::Zero();  ///< position of the particle with the longest path (m)
+  double front_travel = 0.0;  ///< its horizontal path length (m)
+  double front_drop = 0.0;    ///< its elevation drop since release (m)
+  double mean_speed = 0.0;    ///< volume-weighted over moving particles (m/s)
+  double max_speed = 0.0;     ///< m/s
+  VolumeBudget volumes;
+};
+SeriesRow series_row(const RunoutStore& store, const VolumeBudget& budget, double t, std::int64_t step);
+
+/// Release top (highest start point), for the fahrböschung.
+struct ReleaseTop {
+  Vec2 position = Vec2::Zero();
+  double elevation = -std::numeric_limits<double>::infinity();
+};
+ReleaseTop release_top(const RunoutStore& store);
+
+/// End-of-run summary figures.
+struct RunoutSummary {
+  double runout_length = 0.0;      ///< longest horizontal path of a particle still in the domain (m)
+  double drop_height = 0.0;        ///< H: top of release − elevation of the toe particle (m)
+  double reach = 0.0;              ///< L: horizontal distance top of release → toe along the path (m)
+  double fahrboeschung = 0.0;      ///< H/L (1)
+  double fahrboeschung_deg = 0.0;  ///< atan(H/L) (degrees)
+  double com_drop = 0.0;           ///< centre-of-mass elevation drop (m)
+  double com_travel = 0.0;         ///< volume-weighted mean path length (m)
+  double com_angle_deg = 0.0;      ///< atan(com_drop/com_travel) (degrees)
+  Vec2 toe = Vec2::Zero();         ///< position of the toe particle (m)
+};
+RunoutSummary summarise(const RunoutStore& store, const ReleaseTop& top);
+
+}  // namespace geohaz::runout

@@ -1,0 +1,146 @@
+#include "geohaz/runout/hazard_maps.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "geohaz/core/kernels.hpp"
+
+namespace geohaz::runout {
+
+HazardMaps::HazardMaps(GridGeometry grid, double d0, double density)
+    : g_(grid),
+      d0_(d0),
+      density_(density),
+      radius_(std::max({0.5 * d0, grid.dx, grid.dy})),
+      max_depth_(grid.cells(), 0.0),
+      max_speed_(grid.cells(), 0.0),
+      max_pressure_(grid.cells(), 0.0),
+      arrival_(grid.cells(), std::numeric_limits<double>::quiet_NaN()) {}
+
+void HazardMaps::record(const RunoutStore& store, double t) {
+  const auto& x = store.get<Position<2>>();
+  const auto& h = store.get<FlowDepth>();
+  const auto& s = store.get<Speed>();
+  const auto& moving = store.get<Moving>();
+  const int rc = static_cast<int>(std::ceil(radius_ / g_.dx)), rr = static_cast<int>(std::ceil(radius_ / g_.dy));
+  const double r2 = radius_ * radius_;
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    int c0, r0;
+    if (!g_.cell_of(x[i], c0, r0)) continue;
+    const double p = density_ * s[i] * s[i];
+    for (int r = std::max(0, r0 - rr); r <= std::min(g_.ny - 1, r0 + rr); ++r)
+      for (int c = std::max(0, c0 - rc); c <= std::min(g_.nx - 1, c0 + rc); ++c) {
+        if ((c != c0 || r != r0) && (g_.centre(c, r) - x[i]).squaredNorm() > r2) continue;
+        const std::size_t k = g_.index(c, r);
+        max_depth_[k] = std::max(max_depth_[k], h[i]);
+        max_speed_[k] = std::max(max_speed_[k], s[i]);
+        max_pressure_[k] = std::max(max_pressure_[k], p);
+        if (std::isnan(arrival_[k]) && (moving[i] || t == 0.0)) arrival_[k] = t;
+      }
+  }
+}
+
+double HazardMaps::affected_area() const {
+  std::size_t n = 0;
+  for (double d : max_depth_)
+    if (d > 0.0) ++n;
+  return static_cast<double>(n) * g_.cell_area();
+}
+
+std::vector<double> HazardMaps::deposit(const RunoutStore& store) const {
+  std::vector<double> t(g_.cells(), 0.0);
+  const auto& x = store.get<Position<2>>();
+  const auto& vol = store.get<Volume>();
+  const double support = 2.0 * d0_;
+  const int rc = static_cast<int>(std::ceil(support / g_.dx)) + 1,
+            rr = static_cast<int>(std::ceil(support / g_.dy)) + 1;
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    const double fc = (x[i].x() - g_.x0) / g_.dx, fr = (g_.y0 - x[i].y()) / g_.dy;
+    const int c0 = static_cast<int>(std::floor(fc)), r0 = static_cast<int>(std::floor(fr));
+    for (int r = std::max(0, r0 - rr); r <= std::min(g_.ny - 1, r0 + rr); ++r)
+      for (int c = std::max(0, c0 - rc); c <= std::min(g_.nx - 1, c0 + rc); ++c) {
+        const double d = (g_.centre(c, r) - x[i]).norm();
+        if (d < support) t[g_.index(c, r)] += vol[i] * CubicSpline<2>::value(d, d0_);
+      }
+  }
+  return t;
+}
+
+SeriesRow series_row(const RunoutStore& store, const VolumeBudget& budget, double t, std::int64_t step) {
+  SeriesRow row;
+  row.time = t;
+  row.step = step;
+  row.particles = store.size();
+  row.volumes = budget;
+  const auto& x = store.get<Position<2>>();
+  const auto& path = store.get<PathLength>();
+  const auto& s = store.get<Speed>();
+  const auto& vol = store.get<Volume>();
+  const auto& moving = store.get<Moving>();
+  const auto& z = store.get<Elevation>();
+  const auto& z0 = store.get<StartElevation>();
+  double sv = 0.0, v = 0.0;
+  std::size_t front = store.size();
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    if (front == store.size() || path[i] > path[front]) front = i;
+    row.max_speed = std::max(row.max_speed, s[i]);
+    if (moving[i]) {
+      sv += vol[i] * s[i];
+      v += vol[i];
+    }
+  }
+  if (v > 0.0) row.mean_speed = sv / v;
+  if (front < store.size()) {
+    row.front = x[front];
+    row.front_travel = path[front];
+    row.front_drop = z0[front] - z[front];
+  }
+  return row;
+}
+
+ReleaseTop release_top(const RunoutStore& store) {
+  ReleaseTop top;
+  const auto& z0 = store.get<StartElevation>();
+  const auto& x0 = store.get<StartPosition>();
+  for (std::size_t i = 0; i < store.size(); ++i)
+    if (z0[i] > top.elevation) {
+      top.elevation = z0[i];
+      top.position = x0[i];
+    }
+  return top;
+}
+
+RunoutSummary summarise(const RunoutStore& store, const ReleaseTop& top) {
+  RunoutSummary s;
+  if (store.empty()) return s;
+  const auto& path = store.get<PathLength>();
+  const auto& x = store.get<Position<2>>();
+  const auto& x0 = store.get<StartPosition>();
+  const auto& z = store.get<Elevation>();
+  const auto& z0 = store.get<StartElevation>();
+  const auto& vol = store.get<Volume>();
+  std::size_t toe = 0;
+  double v = 0.0, zc = 0.0, zc0 = 0.0, pc = 0.0;
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    if (path[i] > path[toe]) toe = i;
+    v += vol[i];
+    zc += vol[i] * z[i];
+    zc0 += vol[i] * z0[i];
+    pc += vol[i] * path[i];
+  }
+  s.runout_length = path[toe];
+  s.toe = x[toe];
+  s.drop_height = top.elevation - z[toe];
+  s.reach = path[toe] + (x0[toe] - top.position).norm();
+  if (s.reach > 0.0) {
+    s.fahrboeschung = s.drop_height / s.reach;
+    s.fahrboeschung_deg = std::atan(s.fahrboeschung) * 180.0 / std::numbers::pi;
+  }
+  s.com_drop = (zc0 - zc) / v;
+  s.com_travel = pc / v;
+  if (s.com_travel > 0.0) s.com_angle_deg = std::atan2(s.com_drop, s.com_travel) * 180.0 / std::numbers::pi;
+  return s;
+}
+
+}  // namespace geohaz::runout

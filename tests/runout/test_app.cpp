@@ -1,0 +1,245 @@
+// Regression tests of the debris-runout app: a tiny synthetic valley run end to end (outputs exist,
+// volumes balance, the flow travels down the valley), and bad inputs (exit code 2, a message naming
+// the input, no output written).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "geohaz/core/raster.hpp"
+#include "geohaz/core/snapshot.hpp"
+#include "geohaz/runout/synthetic_terrain.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int code;
+  std::string output;
+};
+
+// Run the app through the shell, capturing stdout+stderr.
+Result run(const std::string& args) {
+  const std::string cmd = std::string(DEBRIS_RUNOUT_EXE) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
+  const int status = pclose(p);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+fs::path work_dir() {
+  const fs::path d = fs::path(GEOHAZ_BINARY_DIR) / "tests" / "runout" / "app_work";
+  fs::create_directories(d);
+  return d;
+}
+
+// The tiny synthetic valley (0.1 scale: 200 × 100 cells of 2.5 m, 500 m long), made once per run
+// by the app's own generator.
+fs::path tiny_dsm() {
+  const fs::path dsm = work_dir() / "tiny.tif";
+  static bool made = false;
+  if (!made) {
+    made = true;
+    const auto r = run("--make-synthetic-dsm " + dsm.string() + " --synthetic-scale 0.1 --release-depth 3");
+    EXPECT_EQ(r.code, 0) << r.output;
+  }
+  return dsm;
+}
+
+bool dir_has_files(const fs::path& d) {
+  return fs::exists(d) && !fs::is_empty(d);
+}
+
+}  // namespace
+
+TEST(DebrisRunoutApp, HelpAndVersion) {
+  auto r = run("--help");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.output.find("--release-from"), std::string::npos);
+  EXPECT_NE(r.output.find("s/m^(1/3)"), std::string::npos);  // units in --help
+  r = run("--help-config");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.output.find("model.icr"), std::string::npos);
+  EXPECT_EQ(run("--version").code, 0);
+}
+
+TEST(DebrisRunoutApp, TinyValleyRunsAndBalancesVolume) {
+  const fs::path dsm = tiny_dsm();
+  const fs::path out = work_dir() / "tiny_out";
+  fs::remove_all(out);
+  const auto r = run(dsm.string() + " --release " + (work_dir() / "tiny_release.tif").string() +
+                     " --d0 2.5 --h0 0.75 --duration 60 --out " + out.string() + " --quiet --threads 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* f :
+       {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "arrival_time.tif", "particles.h5",
+        "particles.xmf", "series.csv", "summary.json", "config.toml", "deposit.png", "max_speed.png"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  std::ifstream in(out / "summary.json");
+  const auto j = nlohmann::json::parse(in);
+  const double read = j["volumes_m3"]["release_read"], seeded = j["volumes_m3"]["seeded"];
+  // Release: 3 m over the block 30–60 m down-valley, ±10 m across: about 3 × 30 × 20 m³ (cells
+  // whose centres fall inside).
+  EXPECT_NEAR(read, 1800.0, 0.15 * 1800.0);
+  EXPECT_NEAR(seeded, read, 1e-9 * read);
+  EXPECT_LT(std::abs(j["mass_balance_error_relative"].get<double>()), 1e-12);
+  const double dep = j["volumes_m3"]["deposited"], mob = j["volumes_m3"]["mobile"], lost = j["volumes_m3"]["lost"];
+  EXPECT_NEAR(dep + mob + lost, read, 1e-9 * read);
+  // The kernel deposit map integrates to the volume still in the domain (grid quadrature, 2 %).
+  EXPECT_NEAR(j["volumes_m3"]["deposit_raster"].get<double>(), dep + mob, 0.02 * (dep + mob));
+  // Down a ≥ 0.24 gradient channel with i_cr = 0.15 the flow must travel far beyond its release
+  // (≥ 100 m in 60 s), and the fahrböschung must be steeper than the energy line atan(0.15) = 8.5°
+  // and gentler than the head slope atan(0.45) = 24°.
+  EXPECT_GT(j["runout_length_along_path_m"].get<double>(), 100.0);
+  EXPECT_GT(j["fahrboeschung"]["angle_deg"].get<double>(), 8.5);
+  EXPECT_LT(j["fahrboeschung"]["angle_deg"].get<double>(), 24.0);
+  EXPECT_GT(j["max_speed_m_s"].get<double>(), 1.0);
+}
+
+TEST(DebrisRunoutApp, BadInputsExitTwoAndWriteNothing) {
+  const fs::path dsm = tiny_dsm();
+  const std::string rel = (work_dir() / "tiny_release.tif").string();
+  const fs::path out = work_dir() / "bad_out";
+  struct Case {
+    std::string args, expect;
+  };
+  const std::string missing = (work_dir() / "no_such.tif").string();
+  // A release raster in another place: a copy of the DSM grid shifted far away is made by writing a
+  // GeoJSON polygon outside the DSM.
+  const fs::path far = work_dir() / "far.geojson";
+  {
+    std::ofstream f(far);
+    f << R"({"type":"FeatureCollection","crs":{"type":"name","properties":{"name":"urn:ogc:def:crs:EPSG::32654"}},)"
+      << R"("features":[{"type":"Feature","properties":{"thickness":2.0},"geometry":{"type":"Polygon","coordinates":)"
+      << R"([[[100000,100000],[100100,100000],[100100,100100],[100000,100000]]]}}]})";
+  }
+  const fs::path empty_poly = work_dir() / "tiny_empty.geojson";
+  {
+    std::ofstream f(empty_poly);
+    f << R"({"type":"FeatureCollection","crs":{"type":"name","properties":{"name":"urn:ogc:def:crs:EPSG::32654"}},)"
+      << R"("features":[{"type":"Feature","properties":{"thickness":0.0},"geometry":{"type":"Polygon","coordinates":)"
+      << R"([[[480010,4309990],[480020,4309990],[480020,4309980],[480010,4309990]]]}}]})";
+  }
+  // A DSM in a geographic CRS (degrees): the error must suggest gdalwarp.
+  const fs::path geo = work_dir() / "geographic.tif";
+  {
+    geohaz::Raster r;
+    r.nx = r.ny = 10;
+    r.geotransform = {140.0, 0.001, 0.0, 39.0, 0.0, -0.001};
+    r.crs_wkt = R"(GEOGCS["WGS 84",DATUM["WGS_1984",SPHEROID["WGS 84",6378137,298.257223563]],PRIMEM["Greenwich",0],)"
+                R"(UNIT["degree",0.0174532925199433],AUTHORITY["EPSG","4326"]])";
+    r.data.assign(100, 100.0);
+    geohaz::write_geotiff(geo, r);
+  }
+  const std::vector<Case> cases = {
+      {geo.string() + " --release " + rel, "gdalwarp"},
+      {missing + " --release " + rel, "no_such.tif"},
+      {dsm.string() + " --release " + missing, "no_such.tif"},
+      {dsm.string() + " --release " + rel + " --n -1", "model.n"},
+      {dsm.string() + " --release " + rel + " --duration 0", "run.duration"},
+      {dsm.string() + " --release " + rel + " --set model.nonsense=3", "nonsense"},
+      {dsm.string() + " --release " + rel + " --friction magic", "model.friction"},
+      {dsm.string() + " --release " + far.string(), "outside the DSM"},
+      {dsm.string() + " --release " + empty_poly.string(), "empty release"},
+      {dsm.string(), "no release"},
+  };
+  for (const auto& c : cases) {
+    fs::remove_all(out);
+    const auto r = run(c.args + " --out " + out.string() + " --quiet");
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.output;
+    EXPECT_NE(r.output.find(c.expect), std::string::npos) << c.args << "\n" << r.output;
+    EXPECT_FALSE(dir_has_files(out)) << c.args;
+  }
+}
+
+TEST(DebrisRunoutApp, ReleaseFromSphSlopeFileMatchesVolume) {
+  // A release.h5 as sph-slope writes it (handoff spec): one snapshot of 2D map points with
+  // volumes, in the DSM's CRS. The app must report the volume read and seed exactly that volume.
+  const fs::path dsm = tiny_dsm();
+  const fs::path h5 = work_dir() / "release.h5";
+  std::vector<geohaz::Vec2> pos;
+  std::vector<double> vol;
+  double total = 0.0;
+  for (int k = 0; k < 300; ++k) {
+    // Points spread over 20 m × 15 m around (480045, 4309875), volumes 0.5–1.4 m³.
+    pos.emplace_back(480035.0 + 20.0 * ((k * 37) % 100) / 100.0, 4309868.0 + 15.0 * ((k * 61) % 100) / 100.0);
+    vol.push_back(0.5 + 0.1 * (k % 10));
+    total += vol.back();
+  }
+  {
+    geohaz::SnapshotWriter w(h5, "sph-slope-release", 2, "");
+    w.set_attribute("crs_wkt", geohaz::runout::kSyntheticValleyCrsWkt);
+    w.set_attribute("total_volume", total);
+    w.set_attribute("source", "test: displacement > 0.5 m");
+    w.set_attribute("bulking_factor", 1.0);
+    const geohaz::FieldView views[] = {{"position", "m", geohaz::ScalarType::Float64, pos.data(), pos.size(), 2, 1},
+                                       {"volume", "m^3", geohaz::ScalarType::Float64, vol.data(), vol.size(), 1, 1}};
+    w.write(12.5, 100, views);
+  }
+  const fs::path out = work_dir() / "handoff_out";
+  fs::remove_all(out);
+  const auto r = run(dsm.string() + " --release-from " + h5.string() + " --d0 2.5 --h0 0.5 --duration 5 --out " +
+                     out.string() + " --threads 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::ifstream in(out / "summary.json");
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_NEAR(j["volumes_m3"]["release_read"].get<double>(), total, 1e-12 * total);
+  EXPECT_NEAR(j["volumes_m3"]["seeded"].get<double>(), total, 1e-12 * total);
+  EXPECT_NE(r.output.find("m^3 read"), std::string::npos) << r.output;
+  // A point outside the DSM is rejected (exit 2), nothing written.
+  pos.back() = geohaz::Vec2(0.0, 0.0);
+  {
+    geohaz::SnapshotWriter w(h5, "sph-slope-release", 2, "");
+    w.set_attribute("crs_wkt", geohaz::runout::kSyntheticValleyCrsWkt);
+    const geohaz::FieldView views[] = {{"position", "m", geohaz::ScalarType::Float64, pos.data(), pos.size(), 2, 1},
+                                       {"volume", "m^3", geohaz::ScalarType::Float64, vol.data(), vol.size(), 1, 1}};
+    w.write(12.5, 100, views);
+  }
+  fs::remove_all(out);
+  const auto bad = run(dsm.string() + " --release-from " + h5.string() + " --out " + out.string() + " --quiet");
+  EXPECT_EQ(bad.code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("outside the DSM"), std::string::npos) << bad.output;
+  EXPECT_FALSE(dir_has_files(out));
+}
+
+TEST(DebrisRunoutApp, ReleaseInAnotherCrsIsReprojected) {
+  // The same kind of release.h5, but with its points in geographic WGS 84 (lon, lat): the app must
+  // reproject them onto the UTM DSM; the volume is unchanged and the run succeeds.
+  const fs::path dsm = tiny_dsm();
+  const std::string wgs84 =
+      R"(GEOGCS["WGS 84",DATUM["WGS_1984",SPHEROID["WGS 84",6378137,298.257223563]],PRIMEM["Greenwich",0],)"
+      R"(UNIT["degree",0.0174532925199433],AUTHORITY["EPSG","4326"]])";
+  std::vector<geohaz::Vec2> utm;
+  std::vector<double> vol;
+  for (int k = 0; k < 100; ++k) {
+    utm.emplace_back(480040.0 + (k % 10), 4309870.0 + (k / 10));
+    vol.push_back(1.0);
+  }
+  const auto lonlat = geohaz::transform_points(utm, geohaz::runout::kSyntheticValleyCrsWkt, wgs84);
+  ASSERT_GT(lonlat[0].x(), 140.0);  // degrees east: really geographic
+  const fs::path h5 = work_dir() / "release_wgs84.h5";
+  {
+    geohaz::SnapshotWriter w(h5, "sph-slope-release", 2, "");
+    w.set_attribute("crs_wkt", wgs84);
+    const geohaz::FieldView views[] = {
+        {"position", "m", geohaz::ScalarType::Float64, lonlat.data(), lonlat.size(), 2, 1},
+        {"volume", "m^3", geohaz::ScalarType::Float64, vol.data(), vol.size(), 1, 1}};
+    w.write(0.0, 0, views);
+  }
+  const fs::path out = work_dir() / "reproject_out";
+  fs::remove_all(out);
+  const auto r = run(dsm.string() + " --release-from " + h5.string() + " --d0 2.5 --h0 0.5 --duration 2 --out " +
+                     out.string() + " --threads 1 --quiet");
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::ifstream in(out / "summary.json");
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_NEAR(j["volumes_m3"]["seeded"].get<double>(), 100.0, 1e-10);
+}
