@@ -1,0 +1,126 @@
+// Throughput of the bonded-disc DEM (particle-steps per second), 1 and 2 threads:
+//  1. N unbonded discs settling under gravity in a box (contacts only);
+//  2. an N-disc bonded sample (parallel bonds on the regular-triangulation edges) compressed
+//     between platens.
+// Usage: bench_dem [N=100000] [steps=300] [threads=0: both 1 and 2]. Prints rates; never asserts.
+#include <omp.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <random>
+#include <utility>
+
+#include "geohaz/dem/packing.hpp"
+#include "geohaz/dem/solver.hpp"
+#include "geohaz/dem/tessellation.hpp"
+
+using namespace geohaz;
+using namespace geohaz::dem;
+
+namespace {
+
+/// Discs on a triangular lattice (spacing 2 R_max) with radii in [0.8, 1] R_max, nx per row.
+void lattice(DemSolver& s, std::size_t n, double rmax, double fill, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.8, 1.0);
+  const auto nx = static_cast<std::size_t>(std::sqrt(static_cast<double>(n)));
+  const double dx = 2 * rmax / fill, dy = dx * std::sqrt(3.0) / 2;
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t row = k / nx, col = k % nx;
+    add_disc(s.discs, Vec2((col + 0.5 * (row % 2) + 0.5) * dx, (row + 0.5) * dy + rmax), rmax * u(rng), 2650,
+             static_cast<std::int64_t>(k));
+  }
+}
+
+void box(DemSolver& s, double w, double h) {
+  const Vec2 c[4] = {Vec2(0, 0), Vec2(w, 0), Vec2(w, h), Vec2(0, h)};
+  const Vec2 n[4] = {Vec2(0, 1), Vec2(-1, 0), Vec2(0, -1), Vec2(1, 0)};
+  for (int k = 0; k < 4; ++k) {
+    WallSegment wl;
+    const Vec2 d = c[(k + 1) % 4] - c[k];
+    wl.a = c[k] - 0.5 * d;
+    wl.b = c[(k + 1) % 4] + 0.5 * d;
+    wl.servo_normal = n[k];
+    s.walls.push_back(wl);
+  }
+}
+
+/// Particle-steps per wall-clock second, and per CPU second of the process (all threads): on a
+/// shared machine the second tells the per-core cost even when the wall clock is inflated.
+std::pair<double, double> rate(DemSolver& s, int steps) {
+  for (int k = 0; k < 20; ++k) s.step();  // warm-up (first list builds, first sort)
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::clock_t c0 = std::clock();
+  for (int k = 0; k < steps; ++k) s.step();
+  const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
+  const double ps = static_cast<double>(s.discs.size()) * steps;
+  return {ps / dt, ps / cpu};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::size_t n = argc > 1 ? std::strtoull(argv[1], nullptr, 10) : 100000;
+  const int steps = argc > 2 ? std::atoi(argv[2]) : 300;
+  const int only_threads = argc > 3 ? std::atoi(argv[3]) : 0;  // 0: 1 and 2 threads
+  const double rmax = 1e-3;
+  const auto nx = static_cast<std::size_t>(std::sqrt(static_cast<double>(n)));
+  std::printf("bench_dem: %zu discs, %d timed steps\n", n, steps);
+  for (int threads : {1, 2}) {
+    if (only_threads > 0 && threads != only_threads) continue;
+    omp_set_num_threads(threads);
+    {
+      DemSolver s;
+      s.law = LinearSpringCoulomb{1e8, 4e7};
+      s.contact.friction = 0.5;
+      s.contact.restitution = 0.5;
+      // Lattice spacing = mean diameter (radii 0.8–1 R_max): about half the neighbours touch, the rest
+      // close up as the pile settles under gravity.
+      lattice(s, n, rmax, 1.0 / 0.9, 1);
+      const double w = (nx + 1) * 2 * rmax * 0.9;
+      box(s, w, 2 * w);
+      s.initialise();
+      // Let the pile form so contacts exist, then time.
+      for (int k = 0; k < 200; ++k) s.step();
+      const auto [r, rc] = rate(s, steps);
+      std::printf(
+          "  unbonded settling, %d thread(s): %.3g particle-steps/s (%.3g per CPU-second; %zu contacts, dt = %.3g s)\n",
+          threads, r, rc, s.contact_count(), s.time_step());
+    }
+    {
+      DemSolver s;
+      s.settings.gravity = Vec2::Zero();
+      s.settings.local_damping = 0.7;
+      const double Ec = 20e9;
+      s.law = LinearSpringCoulomb{2 * Ec, 2 * Ec / 2.5};
+      s.contact.friction = 0.5;
+      lattice(s, n, rmax, 1.0, 2);
+      const auto& x = s.discs.get<Position<2>>();
+      Vec2 lo = x[0], hi = x[0];
+      for (const auto& p : x) {
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+      }
+      const auto t = tessellate(x, s.discs.get<Radius>(), lo - Vec2::Constant(rmax), hi + Vec2::Constant(rmax));
+      ParallelBondProperties pb;
+      pb.modulus = Ec;
+      pb.tensile_strength = pb.shear_strength = 50e6;
+      pb.tensile_strength_std = pb.shear_strength_std = 10e6;
+      install_parallel_bonds(s.discs, t.edges, pb, 0.5, 3, s.bonds);
+      s.bond_properties = pb;
+      box(s, hi.x() + rmax, hi.y() + rmax);
+      s.walls[0].velocity = Vec2(0, 0.2);   // bottom platen up
+      s.walls[2].velocity = Vec2(0, -0.2);  // top platen down
+      s.initialise();
+      const auto [r, rc] = rate(s, steps);
+      std::printf(
+          "  bonded compression, %d thread(s): %.3g particle-steps/s (%.3g per CPU-second; %zu bonds, %zu broken)\n",
+          threads, r, rc, s.bonds.size(), s.events.size());
+    }
+  }
+  return 0;
+}

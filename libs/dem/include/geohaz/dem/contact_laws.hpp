@@ -1,0 +1,104 @@
+#pragma once
+/// \file contact_laws.hpp
+/// Disc–disc and disc–wall contact laws. Each law is a small value type with an `evaluate`
+/// member inlined into the force loop; the solver picks one with std::visit once per step.
+///
+/// Sign conventions (2D, unit thickness): overlap δ = R_i + R_j − |x_i − x_j| > 0 in contact,
+/// the normal n points from j to i, the tangent t = ẑ × n. The normal force on i is
+/// F_n = f_el(δ) − c_n v_n (v_n = relative normal velocity, > 0 separating). No clamp to F_n ≥ 0 is
+/// applied while δ > 0, so the restitution coefficient e is reproduced exactly by the linear law
+/// (documented in docs/dem.md); the friction limit uses max(F_n, 0).
+
+#include <cmath>
+#include <numbers>
+#include <variant>
+
+namespace geohaz::dem {
+
+/// Normal and tangential response of a contact at overlap δ.
+struct ContactResponse {
+  double fn_elastic;  ///< elastic normal force (N/m), ≥ 0
+  double kn;          ///< tangent normal stiffness (N/m/m) — also enters the critical time step
+  double cn;          ///< normal dashpot coefficient (N·s/m/m)
+  double kt;          ///< tangential stiffness (N/m/m)
+};
+
+/// Damping ratio ζ giving restitution e for a linear spring-dashpot:
+/// e = exp(−ζπ/√(1−ζ²))  ⇔  ζ = −ln e / √(π² + ln² e)   (e.g. Ting & Corkum 1992).
+inline double damping_ratio_from_restitution(double e) {
+  if (e >= 1.0) return 0.0;
+  if (e <= 0.0) return 1.0;
+  const double l = std::log(e);
+  return -l / std::sqrt(std::numbers::pi * std::numbers::pi + l * l);
+}
+
+/// Linear spring–dashpot with Coulomb friction (Cundall & Strack 1979):
+/// F_n = k_n δ − c_n v_n, c_n = 2ζ√(m* k_n); ΔF_t = −k_s Δu_t, |F_t| ≤ μ F_n.
+/// Undamped contact duration t_c = π√(m*/k_n).
+struct LinearSpringCoulomb {
+  double kn = 1e8;  ///< normal stiffness (N/m per m thickness)
+  double ks = 1e8;  ///< shear stiffness (N/m per m thickness)
+
+  /// \param zeta damping ratio from the restitution coefficient (damping_ratio_from_restitution).
+  ContactResponse evaluate(double delta, double meff, double /*reff*/, double /*slice*/, double zeta) const noexcept {
+    return {kn * delta, kn, 2.0 * zeta * std::sqrt(meff * kn), ks};
+  }
+  /// Stiffness used for the critical time step before any contact exists.
+  double reference_kn(double /*radius*/) const noexcept { return kn; }
+  double reference_kt(double /*radius*/) const noexcept { return ks; }
+};
+
+/// Hertz–Mindlin (no-slip) contact of two elastic spheres (Hertz 1882; Mindlin 1949; the usual
+/// DEM form of Tsuji et al. 1992), turned into a force per unit thickness of the discs by taking
+/// the disc as a row of spheres of its diameter: forces and stiffnesses are divided by the slice
+/// length l = R_i + R_j (disc pair) or 2R_i (disc–wall). This is our choice (docs/dem.md): the
+/// plain sphere law gives newtons, not N/m, and is far too soft for mm-size discs.
+///   F_n = 4/3 E* √R* δ^{3/2} / l, S_n = 2E*√(R*δ) / l, S_t = 8G*√(R*δ) / l,
+///   c_n = 2√(5/6) β √(S_n m*), β = −ln e/√(π² + ln² e),
+///   E* = E/(2(1−ν²)), G* = E/(4(2−ν)(1+ν)) for identical materials.
+/// Elastic contact duration t_c = 2.868 (m*² l² /(R* E*² v))^{1/5} (m* per unit thickness).
+struct HertzMindlin {
+  double youngs = 1e9;               ///< particle Young's modulus E (Pa)
+  double poisson = 0.25;             ///< Poisson's ratio ν
+  double reference_overlap = 0.005;  ///< δ/R used for the time step of a disc with no contact yet
+
+  double estar() const noexcept { return youngs / (2.0 * (1.0 - poisson * poisson)); }
+  double gstar() const noexcept { return youngs / (4.0 * (2.0 - poisson) * (1.0 + poisson)); }
+  /// \param slice row-of-spheres length l (m); \param beta damping factor (= damping_ratio_from_restitution(e)).
+  ContactResponse evaluate(double delta, double meff, double reff, double slice, double beta) const noexcept {
+    const double a = std::sqrt(reff * delta);  // contact radius
+    const double Es = estar() / slice;
+    const double sn = 2.0 * Es * a;
+    return {4.0 / 3.0 * Es * a * delta, sn, 2.0 * std::sqrt(5.0 / 6.0) * beta * std::sqrt(sn * meff),
+            8.0 * gstar() / slice * a};
+  }
+  /// Stiffness of a contact of a disc of radius R with an equal disc at the reference overlap.
+  double reference_kn(double radius) const noexcept {
+    return 2.0 * estar() * std::sqrt(0.5 * radius * reference_overlap * radius) / (2.0 * radius);
+  }
+  double reference_kt(double radius) const noexcept {
+    return 8.0 * gstar() * std::sqrt(0.5 * radius * reference_overlap * radius) / (2.0 * radius);
+  }
+};
+
+/// The contact law chosen by the configuration (visited once per step).
+using ContactLaw = std::variant<LinearSpringCoulomb, HertzMindlin>;
+
+/// Parameters shared by the contact laws.
+struct ContactProperties {
+  double friction = 0.5;     ///< Coulomb friction coefficient μ
+  double restitution = 0.5;  ///< normal restitution coefficient e ∈ (0, 1]
+  /// Rolling-resistance coefficient μ_r (elastic–plastic spring-dashpot, Ai et al. 2011 model C,
+  /// also Iwashita & Oda 1998): k_r = 2.25 μ_r² k_n R*², |M_r| ≤ μ_r R* F_n.
+  double rolling_friction = 0.0;
+  /// Rolling viscous damping ratio η_r (of the critical rolling damping 2√(I_r k_r)), applied
+  /// while the rolling spring is not at its plastic limit.
+  double rolling_damping = 0.3;
+};
+
+/// Combined rolling stiffness per Ai et al. (2011), eq. (9).
+inline double rolling_stiffness(double mu_r, double kn, double reff) noexcept {
+  return 2.25 * mu_r * mu_r * kn * reff * reff;
+}
+
+}  // namespace geohaz::dem

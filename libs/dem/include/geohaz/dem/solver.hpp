@@ -1,0 +1,140 @@
+#pragma once
+/// \file solver.hpp
+/// The bonded-disc DEM solver: one step reads top to bottom in DemSolver::step().
+///
+///  1. half kick  v += ½Δt F/m, ω += ½Δt T/I (free discs), drift x += vΔt, θ += ωΔt, walls move;
+///  2. neighbour list (core NeighbourList, cut-off 2R_max + skin) rebuilt when a disc has moved
+///     more than skin/2 since the last build; every few rebuilds the store is sorted by cell;
+///  3. forces: disc–disc contacts (full list, each disc computes its own side, no atomics),
+///     parallel bonds (one loop over bonds, then gathered per disc), walls and terrain, gravity,
+///     Cundall local damping F ← F − α|F| sign(v) (Cundall 1987);
+///  4. second half kick (velocity Verlet), servo walls, next critical time step
+///     Δt = safety · min_i min(√(m_i/k_i), √(I_i/k_i^rot)) from the stiffnesses acting on each disc.
+///
+/// Contact history (shear force, rolling moment) is a per-disc CSR of (partner id, state) laid
+/// out like the neighbour list and rebuilt every step from the previous step's table: lookups go
+/// by partner id, so the history survives sorting and list rebuilds.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "geohaz/core/neighbours.hpp"
+#include "geohaz/dem/bonds.hpp"
+#include "geohaz/dem/contact_laws.hpp"
+#include "geohaz/dem/fields.hpp"
+#include "geohaz/dem/walls.hpp"
+
+namespace geohaz::dem {
+
+/// Numerical settings of a run.
+struct SolverSettings {
+  Vec2 gravity = Vec2(0.0, -9.81);  ///< m/s²
+  double local_damping = 0.0;       ///< Cundall's α ∈ [0, 1): 0.7 quasi-static, 0 dynamic
+  double safety_factor = 0.25;      ///< Δt = safety · critical Δt
+  double fixed_time_step = 0.0;     ///< > 0: use this Δt (s) instead (must be below the critical one)
+  double skin = 0.0;                ///< Verlet skin (m); 0: 0.3 R_min
+  int reorder_interval = 20;        ///< sort the store by cell every this many list rebuilds (0: never)
+  double max_speed = 1e3;           ///< a disc faster than this (m/s) is a blow-up
+  double joint_friction = 0.5;      ///< μ of contacts across a joint (smooth-joint-like)
+};
+
+/// A pair of discs separated by a joint: contact acts along the joint normal with joint friction.
+struct JointPair {
+  std::int64_t id_a, id_b;
+  Vec2 normal;  ///< unit normal of the joint plane
+};
+
+class DemSolver {
+ public:
+  DiscStore discs;
+  BondTable bonds;
+  ParallelBondProperties bond_properties;
+  ContactLaw law = LinearSpringCoulomb{};
+  ContactProperties contact;
+  SolverSettings settings;
+  std::vector<WallSegment> walls;     ///< moving / servo walls (few)
+  TerrainSegments terrain;            ///< static polylines (many)
+  std::vector<AcousticEvent> events;  ///< every bond break so far
+
+  /// Call after discs, bonds, walls, terrain and joints are set (and again whenever any of these is
+  /// changed from outside, e.g. discs added or bonds created): builds the id index, the bond and
+  /// joint lookups, the neighbour list and the first time step.
+  void initialise();
+  /// Set the joint pairs (contacts that slide along a joint plane).
+  void set_joints(std::vector<JointPair> joints);
+  const std::vector<JointPair>& joints() const noexcept { return joints_; }
+
+  /// Advance one step. Throws SimulationError (disc id, position, step) on a blow-up.
+  void step();
+  /// Advance until time t_end (or max_steps).
+  void run_until(double t_end, std::int64_t max_steps = INT64_MAX);
+
+  double time() const noexcept { return time_; }
+  double time_step() const noexcept { return dt_; }
+  std::int64_t step_count() const noexcept { return steps_; }
+  /// Critical time step of the current state (before the safety factor).
+  double critical_time_step() const noexcept { return dt_crit_; }
+
+  /// Translational + rotational kinetic energy (J/m).
+  double kinetic_energy() const;
+  /// Elastic energy in the contact springs (normal and shear) and intact bonds (J/m).
+  double strain_energy() const;
+  /// Gravitational potential energy Σ m g·(−x) relative to the origin (J/m).
+  double potential_energy() const;
+  /// Total linear momentum (kg·m/s/m).
+  Vec2 momentum() const;
+  /// Number of disc–disc contacts (unordered pairs) in the last step.
+  std::size_t contact_count() const;
+  /// Current index of a disc id (valid until the next sort).
+  std::uint32_t index_of(std::int64_t id) const { return index_of_id_[static_cast<std::size_t>(id)]; }
+  /// Sum of forces on the discs whose Kinematic flag equals `group` (N/m), i.e. the reaction on a grip.
+  Vec2 kinematic_group_force(std::uint8_t group) const;
+  /// Largest neighbour-list cut-off used (m).
+  double cutoff() const noexcept { return cutoff_; }
+  /// Number of neighbour-list rebuilds so far.
+  std::int64_t rebuild_count() const noexcept { return rebuilds_; }
+  /// Contact pairs (unordered, by current index) of the last step, for coordination numbers.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> contact_pairs() const;
+
+ private:
+  template <class Law>
+  void compute_forces(const Law& law);
+  template <class Law>
+  void pair_forces(const Law& law);
+  template <class Law>
+  void wall_forces(const Law& law);
+  template <class Law>
+  void finish_step(const Law& law);
+  void bond_forces();
+  void rebuild_neighbours();
+  void reorder();
+  void rebuild_id_index();
+  void rebuild_bond_index();
+  void rebuild_joint_index();
+  void update_time_step();
+  void check_state() const;
+
+  struct PairHistory {
+    std::vector<std::uint32_t> offsets;  ///< per disc, like the neighbour list it was written with
+    std::vector<std::int64_t> partner;   ///< partner id, −1: no contact
+    std::vector<double> shear, roll;     ///< F_s (N/m), M_r (N·m/m)
+  };
+  PairHistory hist_, hist_next_;
+  bool same_layout_ = false;  ///< hist_ was written with the current neighbour list
+
+  NeighbourList<2> list_;
+  double cutoff_ = 0, skin_ = 0, rmax_ = 0;
+  std::int64_t rebuilds_ = 0;
+  std::vector<std::uint32_t> index_of_id_;
+  std::vector<std::uint32_t> bond_offsets_;  ///< per id: CSR into bond_entries_
+  std::vector<std::int64_t> bond_entries_;   ///< bond index, negated−1 for side B
+  std::vector<JointPair> joints_;
+  std::vector<std::uint32_t> joint_offsets_;  ///< per id
+  std::vector<std::uint32_t> joint_entries_;  ///< index into joints_
+  double time_ = 0, dt_ = 0, dt_crit_ = 0;
+  std::int64_t steps_ = 0;
+  std::vector<std::uint32_t> perm_scratch_;
+};
+
+}  // namespace geohaz::dem

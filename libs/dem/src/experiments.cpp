@@ -1,0 +1,549 @@
+#include "geohaz/dem/experiments.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <numeric>
+#include <stdexcept>
+
+#include "geohaz/core/errors.hpp"
+#include "geohaz/dem/tessellation.hpp"
+
+namespace geohaz::dem {
+
+namespace {
+
+constexpr double kDeg = 180.0 / std::numbers::pi;
+
+/// Slope of y against x by least squares over the points with lo ≤ w ≤ hi.
+double ls_slope(const std::vector<double>& x, const std::vector<double>& y) {
+  const std::size_t n = x.size();
+  if (n < 2) return 0.0;
+  const double mx = std::accumulate(x.begin(), x.end(), 0.0) / n, my = std::accumulate(y.begin(), y.end(), 0.0) / n;
+  double sxy = 0, sxx = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    sxy += (x[k] - mx) * (y[k] - my);
+    sxx += (x[k] - mx) * (x[k] - mx);
+  }
+  return sxx > 0 ? sxy / sxx : 0.0;
+}
+
+/// Inclination (degrees, 0–90 from horizontal) of the principal axis of a point cloud.
+double principal_inclination(const std::vector<Vec2>& p) {
+  if (p.size() < 3) return 0.0;
+  Vec2 m = Vec2::Zero();
+  for (const auto& q : p) m += q;
+  m /= static_cast<double>(p.size());
+  Mat2 c = Mat2::Zero();
+  for (const auto& q : p) c += (q - m) * (q - m).transpose();
+  Eigen::SelfAdjointEigenSolver<Mat2> es(c);
+  const Vec2 d = es.eigenvectors().col(1);
+  double a = std::atan2(d.y(), d.x()) * kDeg;
+  a = std::fmod(a + 360.0, 180.0);
+  return a > 90 ? 180 - a : a;
+}
+
+double polygon_area(const std::vector<Vec2>& p) {
+  double a = 0;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const Vec2& u = p[k];
+    const Vec2& v = p[(k + 1) % p.size()];
+    a += u.x() * v.y() - v.x() * u.y();
+  }
+  return 0.5 * std::abs(a);
+}
+
+bool inside_polygon(const std::vector<Vec2>& poly, const Vec2& q) {
+  bool in = false;
+  for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+    const Vec2 &a = poly[i], &b = poly[j];
+    if (((a.y() > q.y()) != (b.y() > q.y())) && (q.x() < (b.x() - a.x()) * (q.y() - a.y()) / (b.y() - a.y()) + a.x()))
+      in = !in;
+  }
+  return in;
+}
+
+double distance_to_polyline(const std::vector<Vec2>& pl, const Vec2& q) {
+  double d = std::numeric_limits<double>::max();
+  for (std::size_t k = 0; k + 1 < pl.size(); ++k)
+    d = std::min(d, (q - closest_point_on_segment(pl[k], pl[k + 1], q)).norm());
+  return d;
+}
+
+/// x below which a fraction `f` of the (free-disc) mass lies.
+double mass_quantile_x(const DemSolver& s, double f) {
+  const auto& x = s.discs.get<Position<2>>();
+  const auto& m = s.discs.get<Mass>();
+  std::vector<std::pair<double, double>> v(s.discs.size());
+  double total = 0;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    v[i] = {x[i].x(), m[i]};
+    total += m[i];
+  }
+  std::sort(v.begin(), v.end());
+  double acc = 0;
+  for (const auto& [xx, mm] : v) {
+    acc += mm;
+    if (acc >= f * total) return xx;
+  }
+  return v.empty() ? 0.0 : v.back().first;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+BondedSample build_bonded_sample(const PackingSpec& packing, const MaterialSpec& material) {
+  BondedSample out;
+  out.packed = pack_discs_in_box(packing, material.law);
+  const auto& x = out.packed.discs.get<Position<2>>();
+  const auto& r = out.packed.discs.get<Radius>();
+  const Vec2 lo(0, 0), hi(out.packed.width, out.packed.height);
+  const Tessellation t = tessellate(x, r, lo, hi);
+  install_parallel_bonds(out.packed.discs, t.edges, material.bond, material.bond_gap_tolerance, packing.seed,
+                         out.bonds);
+  out.traces = generate_joint_traces(material.joint_sets, lo, hi, packing.seed);
+  out.traces.insert(out.traces.end(), material.traces.begin(), material.traces.end());
+  out.joints = cut_bonds_by_traces(out.packed.discs, out.bonds, out.traces, &out.discontinuities,
+                                   out.packed.width * out.packed.height);
+  return out;
+}
+
+void load_sample(DemSolver& s, const BondedSample& sample, const MaterialSpec& material) {
+  s.discs = sample.packed.discs;
+  s.bonds = sample.bonds;
+  s.law = material.law;
+  s.contact = material.contact;
+  s.bond_properties = material.bond;
+  s.settings.joint_friction = material.joint_friction;
+  s.set_joints(sample.joints);
+}
+
+LabTestResult run_lab_test(const LabTestSpec& spec, const BondedSample& sample, DemSolver& s,
+                           const RunObserver& observe) {
+  load_sample(s, sample, spec.material);
+  s.settings.gravity = Vec2::Zero();
+  s.settings.local_damping = spec.local_damping;
+  LabTestResult res;
+  res.discs = s.discs.size();
+  res.bonds = s.bonds.intact_count();
+  res.porosity = sample.packed.porosity;
+  const double W0 = sample.packed.width, H0 = sample.packed.height;
+  res.width = W0;
+  res.height = H0;
+  const double v = spec.loading_velocity;
+  const bool tension = spec.test == LabTest::BiaxialTension;
+  const auto& x = s.discs.get<Position<2>>();
+  const auto& R = s.discs.get<Radius>();
+
+  double Wl = W0, Hl = H0, grip_gap = H0;
+  if (!tension) {
+    s.walls = sample.packed.walls;  // bottom, right, top, left; frictionless platens and sides
+    for (auto& w : s.walls) w.friction = 0.0;
+    const bool confined = spec.confining_stress > 0;
+    if (!confined) s.walls[1].active = s.walls[3].active = false;
+    s.initialise();
+    // Consolidation to the isotropic (or lateral-only) stress σ_3.
+    if (confined) {
+      for (auto& w : s.walls) {
+        w.control = WallControl::Servo;
+        w.target_stress = spec.confining_stress;
+        w.servo_gain = 0.05;
+        w.max_speed = 5e-5 * sample.packed.discs.get<Radius>()[0] / s.time_step();
+      }
+      std::array<double, 4> acc{};
+      int nacc = 0;
+      for (int k = 1; k <= 20000; ++k) {
+        const double Wc = s.walls[1].a.x() - s.walls[3].a.x(), Hc = s.walls[2].a.y() - s.walls[0].a.y();
+        for (int q = 0; q < 4; ++q) s.walls[q].loaded_length = (q % 2 == 0) ? Wc : Hc;
+        s.step();
+        for (int q = 0; q < 4; ++q) acc[q] += s.walls[q].normal_stress(s.walls[q].loaded_length);
+        ++nacc;
+        if (k % 250 == 0) {
+          bool ok = true;
+          for (int q = 0; q < 4; ++q) {
+            const double mean = acc[q] / nacc;
+            ok = ok && std::abs(mean - spec.confining_stress) < 0.05 * spec.confining_stress;
+            s.walls[q].target_stress =
+                std::max(0.1 * spec.confining_stress, s.walls[q].target_stress + 0.7 * (spec.confining_stress - mean));
+          }
+          acc = {};
+          nacc = 0;
+          if (observe) observe(s, "consolidation");
+          if (ok) break;
+        }
+      }
+    }
+    // Loading: platens strain-controlled, lateral walls servo on σ_3.
+    for (int q : {0, 2}) {
+      s.walls[q].control = WallControl::Velocity;
+      s.walls[q].velocity = s.walls[q].servo_normal * v;
+    }
+    Wl = s.walls[1].a.x() - s.walls[3].a.x();
+    Hl = s.walls[2].a.y() - s.walls[0].a.y();
+  } else {
+    s.walls.clear();
+    auto& kin = s.discs.get<Kinematic>();
+    auto& vel = s.discs.get<Velocity<2>>();
+    const double g = spec.grip_fraction * H0;
+    double top_in = H0, bottom_in = 0;
+    for (std::size_t i = 0; i < s.discs.size(); ++i) {
+      if (x[i].y() < g) {
+        kin[i] = 1;
+        vel[i] = Vec2(0, -v);
+        bottom_in = std::max(bottom_in, x[i].y());
+      } else if (x[i].y() > H0 - g) {
+        kin[i] = 2;
+        vel[i] = Vec2(0, v);
+        top_in = std::min(top_in, x[i].y());
+      }
+    }
+    grip_gap = top_in - bottom_in;
+    s.initialise();
+  }
+
+  const double W_start = Wl, H_start = Hl;
+  const double t0 = s.time();
+  std::size_t last_events = s.events.size();
+  double peak = 0, peak_strain = 0;
+  std::array<double, 2> acc{};
+  int nacc = 0;
+  const double max_steps = 1e8;
+  for (std::int64_t k = 1; k < max_steps; ++k) {
+    if (!tension) {
+      const double Wc = s.walls[1].active ? s.walls[1].a.x() - s.walls[3].a.x() : Wl;
+      const double Hc = s.walls[2].a.y() - s.walls[0].a.y();
+      for (int q = 0; q < 4; ++q) s.walls[q].loaded_length = (q % 2 == 0) ? Wc : Hc;
+    }
+    s.step();
+    if (!tension && s.walls[1].active) {
+      acc[0] += s.walls[1].normal_stress(s.walls[1].loaded_length);
+      acc[1] += s.walls[3].normal_stress(s.walls[3].loaded_length);
+      ++nacc;
+      if (nacc == 250) {  // integral correction of the lateral servo (as in the consolidation)
+        for (int q : {1, 3}) {
+          const double mean = acc[q == 1 ? 0 : 1] / nacc;
+          s.walls[q].target_stress =
+              std::max(0.1 * spec.confining_stress, s.walls[q].target_stress + 0.5 * (spec.confining_stress - mean));
+        }
+        acc = {};
+        nacc = 0;
+      }
+    }
+    if (k % spec.record_interval != 0) continue;
+    CurvePoint p{};
+    p.time = s.time() - t0;
+    if (!tension) {
+      const double Hc = s.walls[2].a.y() - s.walls[0].a.y();
+      double Wc;
+      if (s.walls[1].active) {
+        Wc = s.walls[1].a.x() - s.walls[3].a.x();
+      } else {  // unconfined: width from the discs' extent
+        double lo = 1e300, hi = -1e300;
+        for (std::size_t i = 0; i < s.discs.size(); ++i) {
+          lo = std::min(lo, x[i].x() - R[i]);
+          hi = std::max(hi, x[i].x() + R[i]);
+        }
+        Wc = hi - lo;
+      }
+      p.axial_strain = (H_start - Hc) / H_start;
+      p.lateral_strain = (W_start - Wc) / W_start;
+      p.axial_stress = 0.5 * (s.walls[0].normal_stress(Wc) + s.walls[2].normal_stress(Wc));
+      p.lateral_stress = s.walls[1].active ? 0.5 * (s.walls[1].normal_stress(Hc) + s.walls[3].normal_stress(Hc)) : 0.0;
+    } else {
+      const Vec2 f1 = s.kinematic_group_force(1), f2 = s.kinematic_group_force(2);
+      p.axial_strain = 2.0 * v * p.time / grip_gap;   // extension positive
+      p.axial_stress = 0.5 * (f1.y() - f2.y()) / W0;  // tension positive
+      p.lateral_strain = 0;
+      p.lateral_stress = 0;
+    }
+    p.volumetric_strain = p.axial_strain + p.lateral_strain;
+    p.ae_count = s.events.size() - last_events;
+    p.ae_energy = 0;
+    for (std::size_t e = last_events; e < s.events.size(); ++e) p.ae_energy += s.events[e].energy;
+    last_events = s.events.size();
+    p.broken_total = s.events.size();
+    res.curve.push_back(p);
+    if (observe) observe(s, "loading");
+    if (p.axial_stress > peak) {
+      peak = p.axial_stress;
+      peak_strain = p.axial_strain;
+    }
+    if (p.axial_strain >= spec.max_axial_strain) break;
+    if (peak > 0 && p.axial_stress < spec.post_peak_stop * peak && p.axial_strain > 1.05 * peak_strain) break;
+  }
+  // Derived numbers.
+  std::size_t ipk = 0;
+  for (std::size_t k = 0; k < res.curve.size(); ++k)
+    if (res.curve[k].axial_stress > res.curve[ipk].axial_stress) ipk = k;
+  if (!res.curve.empty()) {
+    res.peak_stress = res.curve[ipk].axial_stress;
+    res.peak_strain = res.curve[ipk].axial_strain;
+    res.confining_stress = tension ? 0.0 : res.curve[ipk].lateral_stress;
+    const double s3 = tension ? 0.0 : spec.confining_stress;
+    res.deviator_at_peak = res.peak_stress - s3;
+    std::vector<double> ea, q, el;
+    const double dev_pk = res.peak_stress - s3;
+    for (std::size_t k = 0; k <= ipk; ++k) {
+      const double dq = res.curve[k].axial_stress - s3;
+      if (dq >= 0.1 * dev_pk && dq <= 0.5 * dev_pk) {
+        ea.push_back(res.curve[k].axial_strain);
+        q.push_back(dq);
+        el.push_back(res.curve[k].lateral_strain);
+      }
+    }
+    res.youngs_modulus = ls_slope(ea, q);
+    res.poisson_ratio = tension ? 0.0 : -ls_slope(ea, el);
+  }
+  res.events = s.events;
+  std::vector<Vec2> cracks;
+  for (const auto& e : s.events) {
+    (e.mode == FailureMode::Tensile ? res.tensile_breaks : res.shear_breaks) += 1;
+    cracks.push_back(e.position);
+  }
+  res.crack_plane_angle = principal_inclination(cracks);
+  return res;
+}
+
+MohrCoulombFit fit_mohr_coulomb(const std::vector<double>& s3, const std::vector<double>& s1) {
+  MohrCoulombFit f;
+  if (s3.size() < 2 || s3.size() != s1.size()) return f;
+  f.slope = ls_slope(s3, s1);
+  const double m3 = std::accumulate(s3.begin(), s3.end(), 0.0) / s3.size();
+  const double m1 = std::accumulate(s1.begin(), s1.end(), 0.0) / s1.size();
+  f.intercept = m1 - f.slope * m3;
+  if (f.slope <= 1.0) return f;
+  const double sphi = (f.slope - 1) / (f.slope + 1);
+  const double phi = std::asin(sphi);
+  f.friction_angle = phi * kDeg;
+  f.cohesion = f.intercept * (1 - sphi) / (2 * std::cos(phi));
+  f.failure_plane_angle = 45.0 + 0.5 * f.friction_angle;
+  f.valid = true;
+  return f;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+double scheidegger_h_over_l(double volume) {
+  return std::pow(10.0, -0.15666 * std::log10(volume) + 0.62419);
+}
+
+std::vector<std::size_t> label_fragments(DemSolver& s) {
+  const std::size_t n = s.discs.size();
+  std::vector<std::uint32_t> parent(n);
+  std::iota(parent.begin(), parent.end(), 0u);
+  auto find = [&](std::uint32_t a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  for (std::size_t b = 0; b < s.bonds.size(); ++b) {
+    if (s.bonds.state[b] != BondState::Intact) continue;
+    const std::uint32_t a = find(s.index_of(s.bonds.id_a[b])), c = find(s.index_of(s.bonds.id_b[b]));
+    if (a != c) parent[std::max(a, c)] = std::min(a, c);
+  }
+  std::vector<std::size_t> count(n, 0);
+  for (std::size_t i = 0; i < n; ++i) ++count[find(static_cast<std::uint32_t>(i))];
+  // Fragment ids: rank of the root by size (0 = largest).
+  std::vector<std::uint32_t> roots;
+  for (std::size_t i = 0; i < n; ++i)
+    if (count[i] > 0) roots.push_back(static_cast<std::uint32_t>(i));
+  std::stable_sort(roots.begin(), roots.end(), [&](auto a, auto b) { return count[a] > count[b]; });
+  std::vector<std::int32_t> rank(n, -1);
+  std::vector<std::size_t> sizes;
+  for (std::size_t k = 0; k < roots.size(); ++k) {
+    rank[roots[k]] = static_cast<std::int32_t>(k);
+    sizes.push_back(count[roots[k]]);
+  }
+  auto& frag = s.discs.get<Fragment>();
+  for (std::size_t i = 0; i < n; ++i) frag[i] = rank[find(static_cast<std::uint32_t>(i))];
+  return sizes;
+}
+
+void check_avalanche_spec(const AvalancheSpec& spec) {
+  if (spec.source.size() < 3)
+    throw InputError("the source polygon needs at least 3 vertices", "", "avalanche.source_x");
+  if (spec.terrain.size() < 2)
+    throw InputError("the terrain profile needs at least 2 points", "", "avalanche.terrain_x");
+  const double area = polygon_area(spec.source);
+  const double rm = 0.5 * (spec.packing.r_min + spec.packing.r_max);
+  const double n_est = area * (1.0 - spec.packing.porosity) / (std::numbers::pi * rm * rm);
+  if (n_est < 4.0)
+    throw InputError("the source polygon (" + std::to_string(area) + " m²) holds only about " + std::to_string(n_est) +
+                         " discs of the given radii: enlarge it or reduce sample.r_min/r_max",
+                     "", "avalanche.source_x");
+  Vec2 c = Vec2::Zero();
+  for (const auto& p : spec.source) c += p;
+  c /= static_cast<double>(spec.source.size());
+  // Terrain elevation under the centroid (linear interpolation of the profile).
+  for (std::size_t k = 0; k + 1 < spec.terrain.size(); ++k) {
+    const Vec2 &a = spec.terrain[k], &b = spec.terrain[k + 1];
+    if (c.x() < a.x() || c.x() > b.x()) continue;
+    const double z = a.y() + (c.x() - a.x()) / (b.x() - a.x()) * (b.y() - a.y());
+    if (c.y() <= z)
+      throw InputError("the source polygon's centroid (" + std::to_string(c.x()) + ", " + std::to_string(c.y()) +
+                           ") m lies below the terrain (" + std::to_string(z) + " m there)",
+                       "", "avalanche.source_z");
+    break;
+  }
+}
+
+AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const RunObserver& observe) {
+  check_avalanche_spec(spec);
+  AvalancheResult res;
+  Vec2 lo = spec.source[0], hi = spec.source[0];
+  for (const auto& p : spec.source) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  PackingSpec pk = spec.packing;
+  pk.width = hi.x() - lo.x();
+  pk.height = hi.y() - lo.y();
+  PackedSample box = pack_discs_in_box(pk, spec.material.law);
+  // Keep the discs inside the polygon and clear of the terrain.
+  DiscStore kept;
+  {
+    const auto& x = box.discs.get<Position<2>>();
+    const auto& r = box.discs.get<Radius>();
+    std::int64_t id = 0;
+    for (std::size_t i = 0; i < box.discs.size(); ++i) {
+      const Vec2 p = x[i] + lo;
+      if (!inside_polygon(spec.source, p)) continue;
+      if (distance_to_polyline(spec.terrain, p) < 1.02 * r[i]) continue;
+      add_disc(kept, p, r[i], spec.packing.density, id++);
+    }
+  }
+  if (kept.size() < 2)
+    throw InputError("the source polygon holds fewer than 2 discs above the terrain: enlarge it or use smaller radii",
+                     "", "avalanche.source");
+  const Tessellation t = tessellate(kept.get<Position<2>>(), kept.get<Radius>(), lo, hi);
+  BondTable bonds;
+  install_parallel_bonds(kept, t.edges, spec.material.bond, spec.material.bond_gap_tolerance, pk.seed, bonds);
+  std::vector<JointTrace> traces = generate_joint_traces(spec.material.joint_sets, lo, hi, pk.seed);
+  traces.insert(traces.end(), spec.material.traces.begin(), spec.material.traces.end());
+  res.area = polygon_area(spec.source);
+  const auto joints = cut_bonds_by_traces(kept, bonds, traces, &res.discontinuities, res.area);
+  res.joints_cut = joints.size();
+
+  s.discs = std::move(kept);
+  s.bonds = std::move(bonds);
+  s.law = spec.material.law;
+  s.contact = spec.material.contact;
+  s.bond_properties = spec.material.bond;
+  s.settings.joint_friction = spec.material.joint_friction;
+  s.settings.local_damping = spec.settle_damping;
+  s.set_joints(joints);
+  // Terrain with tall end walls so nothing leaves the section.
+  std::vector<Vec2> ter = spec.terrain;
+  const double tall = 10.0 * (hi - lo).norm() + 100.0;
+  ter.insert(ter.begin(), ter.front() + Vec2(0, tall));
+  ter.push_back(ter.back() + Vec2(0, tall));
+  s.terrain = TerrainSegments{};
+  s.terrain.add_polyline(ter, spec.terrain_friction, spec.terrain_restitution);
+  s.walls.clear();
+  if (spec.support.size() == 2) {
+    WallSegment w;
+    w.a = spec.support[0];
+    w.b = spec.support[1];
+    w.friction = spec.terrain_friction;
+    w.restitution = spec.terrain_restitution;
+    s.walls.push_back(w);
+  }
+  s.initialise();
+  res.discs = s.discs.size();
+  res.bonds = s.bonds.intact_count();
+
+  // Settling.
+  while (s.time() < spec.settle_time) {
+    s.step();
+    if (observe && s.step_count() % 200 == 0) observe(s, "settling");
+  }
+  {
+    const auto& x = s.discs.get<Position<2>>();
+    const auto& r = s.discs.get<Radius>();
+    res.crown_z = -1e300;
+    for (std::size_t i = 0; i < s.discs.size(); ++i)
+      if (x[i].y() + r[i] > res.crown_z) {
+        res.crown_z = x[i].y() + r[i];
+        res.crown_x = x[i].x();
+      }
+  }
+  // Release.
+  for (auto& w : s.walls) w.active = false;
+  for (std::size_t b = 0; b < s.bonds.size(); ++b) {
+    s.bonds.tensile_strength[b] *= spec.strength_factor;
+    s.bonds.shear_strength[b] *= spec.strength_factor;
+  }
+  s.settings.local_damping = spec.runout_damping;
+  const Vec2 g0 = s.settings.gravity;
+  const double t_release = s.time();
+  const std::size_t events_before = s.events.size();
+  std::size_t last_events = s.events.size();
+  double next_record = t_release;
+  double prev_front = mass_quantile_x(s, 0.99), prev_t = t_release;
+  while (true) {
+    const double tr = s.time() - t_release;
+    s.settings.gravity = tr < spec.trigger_duration ? Vec2(g0 + spec.trigger_acceleration) : g0;
+    if (s.time() >= next_record - 1e-12) {
+      AvalanchePoint p{};
+      p.time = tr;
+      p.front = mass_quantile_x(s, 0.99);
+      p.front_velocity = s.time() > prev_t ? (p.front - prev_front) / (s.time() - prev_t) : 0.0;
+      prev_front = p.front;
+      prev_t = s.time();
+      p.kinetic_energy = s.kinetic_energy();
+      const auto sizes = label_fragments(s);
+      p.fragments = sizes.size();
+      p.largest_fragment = sizes.empty() ? 0 : sizes.front();
+      p.ae_count = s.events.size() - last_events;
+      p.ae_energy = 0;
+      for (std::size_t e = last_events; e < s.events.size(); ++e) p.ae_energy += s.events[e].energy;
+      last_events = s.events.size();
+      res.series.push_back(p);
+      if (observe) observe(s, "runout");
+      next_record += spec.record_interval;
+    }
+    if (tr >= spec.runout_time) break;
+    s.step();
+  }
+  s.settings.gravity = g0;
+  // Run-out measures: toe = 99 % mass quantile of x at the end, on the terrain.
+  res.toe_x = mass_quantile_x(s, 0.99);
+  res.toe_z = s.terrain.elevation(res.toe_x);
+  res.fall_height = res.crown_z - res.toe_z;
+  res.runout = res.toe_x - res.crown_x;
+  res.h_over_l = res.runout > 0 ? res.fall_height / res.runout : 0.0;
+  const double width = spec.volume_width > 0 ? spec.volume_width : (hi.x() - lo.x());
+  res.volume = res.area * width;
+  res.scheidegger_h_over_l = scheidegger_h_over_l(res.volume);
+  // Deposit profile: thickness above the terrain in bins of 2 R_max.
+  {
+    const auto& x = s.discs.get<Position<2>>();
+    const auto& r = s.discs.get<Radius>();
+    const double rmax = *std::max_element(r.begin(), r.end());
+    double xmin = 1e300, xmax = -1e300;
+    for (const auto& p : x) {
+      xmin = std::min(xmin, p.x());
+      xmax = std::max(xmax, p.x());
+    }
+    const double bw = 2 * rmax;
+    const std::size_t nb = static_cast<std::size_t>((xmax - xmin) / bw) + 1;
+    std::vector<double> top(nb, -1e300);
+    for (std::size_t i = 0; i < s.discs.size(); ++i) {
+      const auto b = static_cast<std::size_t>((x[i].x() - xmin) / bw);
+      top[b] = std::max(top[b], x[i].y() + r[i]);
+    }
+    for (std::size_t b = 0; b < nb; ++b) {
+      const double xc = xmin + (b + 0.5) * bw;
+      const double zt = s.terrain.elevation(xc);
+      res.deposit.emplace_back(xc, top[b] > -1e299 && std::isfinite(zt) ? std::max(0.0, top[b] - zt) : 0.0);
+    }
+  }
+  res.fragment_sizes = label_fragments(s);
+  res.events = s.events;  // settling breaks included (time < release time)
+  res.release_time = t_release;
+  res.events_before_release = events_before;
+  return res;
+}
+
+}  // namespace geohaz::dem

@@ -1,0 +1,175 @@
+#include "geohaz/dem/output.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include "geohaz/core/output.hpp"
+#include "geohaz/core/raster.hpp"
+
+namespace geohaz::dem {
+
+void write_snapshot(SnapshotWriter& w, const DemSolver& s) {
+  const auto& d = s.discs;
+  auto view = [&](auto tag) {
+    using Tag = decltype(tag);
+    using Tr = FieldTraits<typename Tag::type>;
+    const auto& v = d.template get<Tag>();
+    return FieldView{Tag::label, Tag::unit, scalar_type_of<typename Tr::scalar>(), v.data(), v.size(),
+                     Tr::rows,   Tr::cols};
+  };
+  std::vector<FieldView> fields{view(Position<2>{}), view(Velocity<2>{}), view(Rotation{}),   view(AngularVelocity{}),
+                                view(Radius{}),      view(Mass{}),        view(ParticleId{}), view(BrokenBonds{}),
+                                view(IntactBonds{}), view(Fragment{}),    view(Force{})};
+  std::vector<std::uint32_t> lines;
+  for (std::size_t b = 0; b < s.bonds.size(); ++b) {
+    if (s.bonds.state[b] != BondState::Intact) continue;
+    lines.push_back(s.index_of(s.bonds.id_a[b]));
+    lines.push_back(s.index_of(s.bonds.id_b[b]));
+  }
+  w.write(s.time(), s.step_count(), fields, lines);
+}
+
+void write_curve_csv(const std::filesystem::path& path, const std::vector<CurvePoint>& curve) {
+  std::ostringstream o;
+  o << std::setprecision(9);
+  o << "time_s,axial_strain,lateral_strain,volumetric_strain,axial_stress_Pa,lateral_stress_Pa,ae_count,ae_energy_J_"
+       "per_m,"
+       "broken_bonds_total\n";
+  for (const auto& p : curve)
+    o << p.time << ',' << p.axial_strain << ',' << p.lateral_strain << ',' << p.volumetric_strain << ','
+      << p.axial_stress << ',' << p.lateral_stress << ',' << p.ae_count << ',' << p.ae_energy << ',' << p.broken_total
+      << '\n';
+  write_text_file(path, o.str());
+}
+
+void write_ae_csv(const std::filesystem::path& path, const std::vector<AcousticEvent>& events) {
+  std::ostringstream o;
+  o << std::setprecision(9);
+  o << "time_s,x_m,y_m,mode,energy_J_per_m,bond\n";
+  for (const auto& e : events)
+    o << e.time << ',' << e.position.x() << ',' << e.position.y() << ','
+      << (e.mode == FailureMode::Tensile ? "tensile" : "shear") << ',' << e.energy << ',' << e.bond << '\n';
+  write_text_file(path, o.str());
+}
+
+void write_avalanche_csv(const std::filesystem::path& path, const std::vector<AvalanchePoint>& series) {
+  std::ostringstream o;
+  o << std::setprecision(9);
+  o << "time_s,front_m,front_velocity_m_per_s,kinetic_energy_J_per_m,fragments,largest_fragment_discs,ae_count,"
+       "ae_energy_J_per_m\n";
+  for (const auto& p : series)
+    o << p.time << ',' << p.front << ',' << p.front_velocity << ',' << p.kinetic_energy << ',' << p.fragments << ','
+      << p.largest_fragment << ',' << p.ae_count << ',' << p.ae_energy << '\n';
+  write_text_file(path, o.str());
+}
+
+void write_deposit_csv(const std::filesystem::path& path, const std::vector<std::pair<double, double>>& deposit) {
+  std::ostringstream o;
+  o << std::setprecision(9) << "x_m,thickness_m\n";
+  for (const auto& [x, h] : deposit) o << x << ',' << h << '\n';
+  write_text_file(path, o.str());
+}
+
+namespace {
+
+struct Frame {
+  Vec2 lo, hi;
+  int w, h;
+  double scale;
+  double px(double x) const { return (x - lo.x()) * scale; }
+  double py(double y) const { return h - 1 - (y - lo.y()) * scale; }
+};
+
+Frame make_frame(Vec2 lo, Vec2 hi, int width_px) {
+  const Vec2 pad = 0.03 * (hi - lo) + Vec2::Constant(1e-9);
+  lo -= pad;
+  hi += pad;
+  Frame f;
+  f.lo = lo;
+  f.hi = hi;
+  f.w = std::max(16, width_px);
+  f.scale = f.w / (hi.x() - lo.x());
+  f.h = std::clamp(static_cast<int>((hi.y() - lo.y()) * f.scale), 16, 4 * f.w);
+  return f;
+}
+
+}  // namespace
+
+void write_sample_png(const std::filesystem::path& path, const DemSolver& s, int width_px) {
+  const auto& x = s.discs.get<Position<2>>();
+  const auto& R = s.discs.get<Radius>();
+  Vec2 lo = Vec2::Constant(1e300), hi = Vec2::Constant(-1e300);
+  for (std::size_t i = 0; i < s.discs.size(); ++i) {
+    lo = lo.cwiseMin(x[i] - Vec2::Constant(R[i]));
+    hi = hi.cwiseMax(x[i] + Vec2::Constant(R[i]));
+  }
+  const Frame f = make_frame(lo, hi, width_px);
+  Image img(f.w, f.h);
+  for (std::size_t i = 0; i < s.discs.size(); ++i)
+    img.fill_circle(f.px(x[i].x()), f.py(x[i].y()), R[i] * f.scale, {215, 215, 215});
+  for (const auto& w : s.walls)
+    if (w.active) img.line(f.px(w.a.x()), f.py(w.a.y()), f.px(w.b.x()), f.py(w.b.y()), {0, 0, 0});
+  for (std::size_t b = 0; b < s.bonds.size(); ++b) {
+    std::array<std::uint8_t, 3> c{};
+    switch (s.bonds.state[b]) {
+      case BondState::Intact:
+        c = {40, 90, 200};
+        break;
+      case BondState::BrokenTension:
+        c = {220, 30, 30};
+        break;
+      case BondState::BrokenShear:
+        c = {250, 150, 0};
+        break;
+      case BondState::CutByJoint:
+        c = {20, 160, 60};
+        break;
+    }
+    const Vec2& a = x[s.index_of(s.bonds.id_a[b])];
+    const Vec2& bb = x[s.index_of(s.bonds.id_b[b])];
+    if (s.bonds.state[b] == BondState::Intact) {
+      img.line(f.px(a.x()), f.py(a.y()), f.px(bb.x()), f.py(bb.y()), c);
+    } else {  // a crack: mark the bond centre boldly
+      const Vec2 m = 0.5 * (a + bb);
+      img.fill_circle(f.px(m.x()), f.py(m.y()), std::max(1.5, 0.4 * s.bonds.radius[b] * f.scale), c);
+    }
+  }
+  write_png(path, img);
+}
+
+void write_avalanche_png(const std::filesystem::path& path, const DemSolver& s, const std::vector<Vec2>& terrain,
+                         const std::vector<Vec2>& source, int width_px) {
+  Vec2 lo = Vec2::Constant(1e300), hi = Vec2::Constant(-1e300);
+  for (const auto& p : terrain) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  for (const auto& p : source) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const Frame f = make_frame(lo, hi, width_px);
+  Image img(f.w, f.h);
+  for (std::size_t k = 0; k + 1 < terrain.size(); ++k)
+    img.line(f.px(terrain[k].x()), f.py(terrain[k].y()), f.px(terrain[k + 1].x()), f.py(terrain[k + 1].y()),
+             {60, 40, 20});
+  for (std::size_t k = 0; k < source.size(); ++k) {
+    const Vec2& a = source[k];
+    const Vec2& b = source[(k + 1) % source.size()];
+    img.line(f.px(a.x()), f.py(a.y()), f.px(b.x()), f.py(b.y()), {150, 150, 150});
+  }
+  const auto& x = s.discs.get<Position<2>>();
+  const auto& R = s.discs.get<Radius>();
+  const auto& frag = s.discs.get<Fragment>();
+  int maxf = 1;
+  for (auto q : frag) maxf = std::max(maxf, q);
+  for (std::size_t i = 0; i < s.discs.size(); ++i) {
+    const double t = frag[i] <= 0 ? 0.0 : 0.15 + 0.85 * std::fmod(0.618034 * frag[i], 1.0);
+    img.fill_circle(f.px(x[i].x()), f.py(x[i].y()), std::max(0.8, R[i] * f.scale), ramp_colour(ColourRamp::Viridis, t));
+  }
+  write_png(path, img);
+}
+
+}  // namespace geohaz::dem

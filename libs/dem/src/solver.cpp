@@ -1,0 +1,895 @@
+#include "geohaz/dem/solver.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "geohaz/core/errors.hpp"
+
+namespace geohaz::dem {
+
+namespace {
+
+/// Below this many discs (or bonds) a loop runs on one thread: fork/join costs more than it saves.
+constexpr std::int64_t kParallelMin = 2048;
+
+inline Vec2 perp(const Vec2& n) noexcept {
+  return Vec2(-n.y(), n.x());
+}
+inline double sgn(double v) noexcept {
+  return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0);
+}
+
+/// Equivalent rolling inertia of Ai et al. (2011), eq. (12).
+inline double rolling_inertia(double Ii, double mi, double Ri, double Ij, double mj, double Rj) noexcept {
+  return 1.0 / (1.0 / (Ii + mi * Ri * Ri) + 1.0 / (Ij + mj * Rj * Rj));
+}
+
+}  // namespace
+
+std::size_t add_disc(DiscStore& s, const Vec2& x, double r, double rho, std::int64_t id) {
+  const std::size_t i = s.append(1);
+  const double m = rho * std::numbers::pi * r * r;
+  s.get<Position<2>>()[i] = x;
+  s.get<PositionAtBuild>()[i] = x;
+  s.get<Radius>()[i] = r;
+  s.get<Mass>()[i] = m;
+  s.get<Inertia>()[i] = 0.5 * m * r * r;
+  s.get<ParticleId>()[i] = id >= 0 ? id : static_cast<std::int64_t>(i);
+  auto& wc = s.get<WallContacts>()[i];
+  wc.setZero();
+  wc.row(0).setConstant(-1.0);
+  return i;
+}
+
+std::size_t BondTable::intact_count() const noexcept {
+  return static_cast<std::size_t>(std::count(state.begin(), state.end(), BondState::Intact));
+}
+
+void BondTable::add(std::int64_t a, std::int64_t b, double r, double d0, double kn, double ks, double sigma_c,
+                    double tau_c) {
+  id_a.push_back(a);
+  id_b.push_back(b);
+  radius.push_back(r);
+  rest_length.push_back(d0);
+  normal_stiffness.push_back(kn);
+  shear_stiffness.push_back(ks);
+  shear_force.push_back(0.0);
+  moment.push_back(0.0);
+  normal_force.push_back(0.0);
+  tensile_strength.push_back(sigma_c);
+  shear_strength.push_back(tau_c);
+  state.push_back(BondState::Intact);
+  force_on_a.push_back(Vec2::Zero());
+  torque_on_a.push_back(0.0);
+  torque_on_b.push_back(0.0);
+}
+
+double WallSegment::normal_stress(double loaded_length) const noexcept {
+  const double L = loaded_length > 0 ? loaded_length : length();
+  return L > 0 ? -force.dot(servo_normal) / L : 0.0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Setup and indices
+
+void DemSolver::set_joints(std::vector<JointPair> joints) {
+  joints_ = std::move(joints);
+  rebuild_joint_index();
+}
+
+void DemSolver::rebuild_id_index() {
+  const auto& ids = discs.get<ParticleId>();
+  std::int64_t max_id = -1;
+  for (auto id : ids) max_id = std::max(max_id, id);
+  index_of_id_.assign(static_cast<std::size_t>(max_id + 1), std::numeric_limits<std::uint32_t>::max());
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (ids[i] < 0) throw std::invalid_argument("DemSolver: negative disc id");
+    if (index_of_id_[ids[i]] != std::numeric_limits<std::uint32_t>::max())
+      throw std::invalid_argument("DemSolver: duplicate disc id " + std::to_string(ids[i]));
+    index_of_id_[ids[i]] = static_cast<std::uint32_t>(i);
+  }
+}
+
+void DemSolver::rebuild_bond_index() {
+  const std::size_t nid = index_of_id_.size();
+  bond_offsets_.assign(nid + 1, 0);
+  for (std::size_t b = 0; b < bonds.size(); ++b) {
+    if (bonds.id_a[b] < 0 || bonds.id_b[b] < 0 || static_cast<std::size_t>(bonds.id_a[b]) >= nid ||
+        static_cast<std::size_t>(bonds.id_b[b]) >= nid)
+      throw std::invalid_argument("DemSolver: bond " + std::to_string(b) + " names an unknown disc id");
+    ++bond_offsets_[bonds.id_a[b] + 1];
+    ++bond_offsets_[bonds.id_b[b] + 1];
+  }
+  for (std::size_t k = 0; k < nid; ++k) bond_offsets_[k + 1] += bond_offsets_[k];
+  bond_entries_.resize(bond_offsets_[nid]);
+  std::vector<std::uint32_t> fill(bond_offsets_.begin(), bond_offsets_.end() - 1);
+  for (std::size_t b = 0; b < bonds.size(); ++b) {
+    bond_entries_[fill[bonds.id_a[b]]++] = static_cast<std::int64_t>(b);
+    bond_entries_[fill[bonds.id_b[b]]++] = -static_cast<std::int64_t>(b) - 1;
+  }
+  const std::size_t nb = bonds.size();
+  bonds.force_on_a.resize(nb, Vec2::Zero());
+  bonds.torque_on_a.resize(nb, 0.0);
+  bonds.torque_on_b.resize(nb, 0.0);
+  bonds.normal_force.resize(nb, 0.0);
+}
+
+void DemSolver::rebuild_joint_index() {
+  const std::size_t nid = index_of_id_.size();
+  joint_offsets_.assign(nid + 1, 0);
+  for (const auto& j : joints_) {
+    if (j.id_a < 0 || j.id_b < 0 || static_cast<std::size_t>(std::max(j.id_a, j.id_b)) >= nid) continue;
+    ++joint_offsets_[j.id_a + 1];
+    ++joint_offsets_[j.id_b + 1];
+  }
+  for (std::size_t k = 0; k < nid; ++k) joint_offsets_[k + 1] += joint_offsets_[k];
+  joint_entries_.resize(joint_offsets_[nid]);
+  std::vector<std::uint32_t> fill(joint_offsets_.begin(), joint_offsets_.end() - 1);
+  for (std::size_t k = 0; k < joints_.size(); ++k) {
+    const auto& j = joints_[k];
+    if (j.id_a < 0 || j.id_b < 0 || static_cast<std::size_t>(std::max(j.id_a, j.id_b)) >= nid) continue;
+    joint_entries_[fill[j.id_a]++] = static_cast<std::uint32_t>(k);
+    joint_entries_[fill[j.id_b]++] = static_cast<std::uint32_t>(k);
+  }
+}
+
+void DemSolver::initialise() {
+  if (discs.empty()) throw std::invalid_argument("DemSolver: no discs");
+  rebuild_id_index();
+  rebuild_bond_index();
+  rebuild_joint_index();
+  const auto& R = discs.get<Radius>();
+  const double rmax = *std::max_element(R.begin(), R.end());
+  const double rmin = *std::min_element(R.begin(), R.end());
+  rmax_ = rmax;
+  skin_ = settings.skin > 0 ? settings.skin : 0.3 * rmin;
+  cutoff_ = 2.0 * rmax + skin_;
+  double reach = rmax;
+  terrain.build(reach);
+  // Keep the contact history across re-initialisation when the layout is unchanged.
+  if (hist_.offsets.size() != discs.size() + 1) {
+    hist_ = {};
+    hist_.offsets.assign(discs.size() + 1, 0);
+  }
+  rebuild_neighbours();
+  same_layout_ = false;
+  update_time_step();
+}
+
+void DemSolver::rebuild_neighbours() {
+  auto& x = discs.get<Position<2>>();
+  auto& xb = discs.get<PositionAtBuild>();
+  const std::int64_t n = static_cast<std::int64_t>(discs.size());
+  ++rebuilds_;
+  // Small problems build the list on one thread (the core build always forks a team); the guard
+  // restores the thread count even if the build throws.
+  struct ThreadCount {
+    int saved = omp_get_max_threads();
+    bool changed;
+    explicit ThreadCount(bool one) : changed(one) {
+      if (changed) omp_set_num_threads(1);
+    }
+    ~ThreadCount() {
+      if (changed) omp_set_num_threads(saved);
+    }
+  } guard(n <= kParallelMin);
+  if (settings.reorder_interval > 0 && rebuilds_ > 1 && (rebuilds_ - 1) % settings.reorder_interval == 0) {
+    list_.build(x, cutoff_);
+    reorder();
+  }
+  list_.build(x, cutoff_);
+  std::copy(x.begin(), x.end(), xb.begin());
+  same_layout_ = false;
+}
+
+void DemSolver::reorder() {
+  const auto order = list_.cell_order();
+  perm_scratch_.assign(order.begin(), order.end());
+  discs.reorder(perm_scratch_);
+  // Move each disc's history segment with it.
+  const std::size_t n = discs.size();
+  PairHistory h;
+  h.offsets.assign(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t o = perm_scratch_[i];
+    h.offsets[i + 1] = h.offsets[i] + (hist_.offsets[o + 1] - hist_.offsets[o]);
+  }
+  h.partner.resize(h.offsets[n]);
+  h.shear.resize(h.offsets[n]);
+  h.roll.resize(h.offsets[n]);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t o = perm_scratch_[i];
+    std::copy(hist_.partner.begin() + hist_.offsets[o], hist_.partner.begin() + hist_.offsets[o + 1],
+              h.partner.begin() + h.offsets[i]);
+    std::copy(hist_.shear.begin() + hist_.offsets[o], hist_.shear.begin() + hist_.offsets[o + 1],
+              h.shear.begin() + h.offsets[i]);
+    std::copy(hist_.roll.begin() + hist_.offsets[o], hist_.roll.begin() + hist_.offsets[o + 1],
+              h.roll.begin() + h.offsets[i]);
+  }
+  hist_ = std::move(h);
+  rebuild_id_index();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Forces
+
+template <class Law>
+void DemSolver::pair_forces(const Law& law) {
+  const auto& x = discs.get<Position<2>>();
+  const auto& v = discs.get<Velocity<2>>();
+  const auto& w = discs.get<AngularVelocity>();
+  const auto& R = discs.get<Radius>();
+  const auto& m = discs.get<Mass>();
+  const auto& I = discs.get<Inertia>();
+  const auto& id = discs.get<ParticleId>();
+  const auto& kin = discs.get<Kinematic>();
+  auto& F = discs.get<Force>();
+  auto& T = discs.get<Torque>();
+  auto& K = discs.get<StiffnessSum>();
+  const auto off = list_.offsets();
+  const auto nbr = list_.indices();
+  const std::size_t n = discs.size();
+  hist_next_.offsets.assign(off.begin(), off.end());
+  hist_next_.partner.resize(nbr.size());
+  hist_next_.shear.resize(nbr.size());
+  hist_next_.roll.resize(nbr.size());
+  const double dt = dt_;
+  const double mu = contact.friction;
+  const double mu_r = contact.rolling_friction;
+  const double eta_r = contact.rolling_damping;
+  const double zeta = damping_ratio_from_restitution(contact.restitution);
+  const double mu_joint = settings.joint_friction;
+  const bool same = same_layout_ && hist_.offsets.size() == n + 1;
+  const bool any_joints = !joints_.empty();
+
+#pragma omp parallel for schedule(static) if (static_cast <std::int64_t>(n) > kParallelMin)
+  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    const Vec2 xi = x[i];
+    const double Ri = R[i];
+    Vec2 f = Vec2::Zero();
+    double tq = 0.0, ktr = 0.0, krot = 0.0;
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+      const std::uint32_t j = nbr[k];
+      const Vec2 d = xi - x[j];
+      const double r2 = d.squaredNorm();
+      const double Rs = Ri + R[j];
+      if (r2 >= Rs * Rs || r2 == 0.0) {
+        hist_next_.partner[k] = -1;
+        continue;
+      }
+      const double r = std::sqrt(r2);
+      const double delta = Rs - r;
+      Vec2 nrm = d / r;
+      double mu_c = mu, mu_rc = mu_r;
+      if (any_joints) {
+        for (std::uint32_t q = joint_offsets_[id[i]]; q < joint_offsets_[id[i] + 1]; ++q) {
+          const JointPair& jp = joints_[joint_entries_[q]];
+          if (jp.id_a == id[j] || jp.id_b == id[j]) {
+            nrm = jp.normal.dot(nrm) >= 0 ? jp.normal : Vec2(-jp.normal);
+            mu_c = mu_joint;
+            mu_rc = 0.0;
+            break;
+          }
+        }
+      }
+      const Vec2 t = perp(nrm);
+      const double meff = kin[j] ? m[i] : (kin[i] ? m[j] : m[i] * m[j] / (m[i] + m[j]));
+      const double reff = Ri * R[j] / Rs;
+      const ContactResponse c = law.evaluate(delta, meff, reff, Rs, zeta);
+      // Levers to the common contact point (mid-overlap), so the pair of shear forces is a zero
+      // net couple and angular momentum is conserved exactly.
+      const double li = Ri - 0.5 * delta, lj = R[j] - 0.5 * delta;
+      const Vec2 vrel = v[i] - v[j] - (w[i] * li + w[j] * lj) * t;
+      const double vn = vrel.dot(nrm);
+      const double vt = vrel.dot(t);
+      const double fn = c.fn_elastic - c.cn * vn;
+      // History by partner id: same slot when the list is unchanged, else a scan of the old segment.
+      double fs = 0.0, mr = 0.0;
+      const std::int64_t pj = id[j];
+      if (same && hist_.partner[k] == pj) {
+        fs = hist_.shear[k];
+        mr = hist_.roll[k];
+      } else if (!same) {
+        for (std::uint32_t q = hist_.offsets[i]; q < hist_.offsets[i + 1]; ++q)
+          if (hist_.partner[q] == pj) {
+            fs = hist_.shear[q];
+            mr = hist_.roll[q];
+            break;
+          }
+      }
+      fs -= c.kt * vt * dt;
+      const double limit = mu_c * std::max(fn, 0.0);
+      if (std::abs(fs) > limit) fs = sgn(fs) * limit;
+      double mdamp = 0.0, kr = 0.0;
+      if (mu_rc > 0.0) {
+        kr = rolling_stiffness(mu_rc, c.kn, reff);
+        const double wr = w[i] - w[j];
+        mr -= kr * wr * dt;
+        const double mmax = mu_rc * reff * std::max(fn, 0.0);
+        if (std::abs(mr) >= mmax) {
+          mr = sgn(mr) * mmax;
+        } else {
+          const double Ir = rolling_inertia(I[i], m[i], Ri, I[j], m[j], R[j]);
+          mdamp = -eta_r * 2.0 * std::sqrt(Ir * kr) * wr;
+        }
+      } else {
+        mr = 0.0;
+      }
+      f += fn * nrm + fs * t;
+      tq += -li * fs + mr + mdamp;
+      ktr += std::max(c.kn, c.kt);
+      krot += c.kt * Ri * Ri + kr;
+      hist_next_.partner[k] = pj;
+      hist_next_.shear[k] = fs;
+      hist_next_.roll[k] = mr;
+    }
+    F[i] = f;
+    T[i] = tq;
+    K[i] = Eigen::Vector2d(ktr, krot);
+  }
+  std::swap(hist_, hist_next_);
+  same_layout_ = true;
+}
+
+void DemSolver::bond_forces() {
+  const std::size_t nb = bonds.size();
+  if (nb == 0) return;
+  const auto& x = discs.get<Position<2>>();
+  const auto& v = discs.get<Velocity<2>>();
+  const auto& w = discs.get<AngularVelocity>();
+  const auto& R = discs.get<Radius>();
+  const double dt = dt_;
+  const int nthreads = omp_get_max_threads();
+  std::vector<std::vector<AcousticEvent>> local(static_cast<std::size_t>(nthreads));
+#pragma omp parallel if (static_cast <std::int64_t>(nb) > kParallelMin)
+  {
+    auto& ev = local[static_cast<std::size_t>(omp_get_thread_num())];
+#pragma omp for schedule(static)
+    for (std::int64_t bb = 0; bb < static_cast<std::int64_t>(nb); ++bb) {
+      const auto b = static_cast<std::size_t>(bb);
+      if (bonds.state[b] != BondState::Intact) continue;
+      const std::uint32_t ia = index_of_id_[bonds.id_a[b]], ib = index_of_id_[bonds.id_b[b]];
+      const double kn = bonds.normal_stiffness[b], ks = bonds.shear_stiffness[b];
+      const Vec2 d = x[ia] - x[ib];
+      const double r = d.norm();
+      const Vec2 nrm = d / r;
+      const Vec2 t = perp(nrm);
+      const double Rb = bonds.radius[b];
+      const double A = 2.0 * Rb, In = 2.0 / 3.0 * Rb * Rb * Rb;
+      const double fn = -kn * A * (r - bonds.rest_length[b]);            // on A along n; < 0 in tension
+      const double la = R[ia] + 0.5 * (r - R[ia] - R[ib]), lb = r - la;  // levers to the bond centre
+      const Vec2 vrel = v[ia] - v[ib] - (w[ia] * la + w[ib] * lb) * t;
+      double fs = bonds.shear_force[b] - ks * A * vrel.dot(t) * dt;
+      double mo = bonds.moment[b] - kn * In * (w[ia] - w[ib]) * dt;
+      const double sigma = -fn / A + std::abs(mo) * Rb / In;
+      const double tau = std::abs(fs) / A;
+      bonds.normal_force[b] = fn;
+      bonds.shear_force[b] = fs;
+      bonds.moment[b] = mo;
+      const bool tensile = sigma >= bonds.tensile_strength[b];
+      if (tensile || tau >= bonds.shear_strength[b]) {
+        const double energy = fn * fn / (2 * kn * A) + fs * fs / (2 * ks * A) + mo * mo / (2 * kn * In);
+        const Vec2 centre = x[ib] + nrm * lb;
+        ev.push_back(
+            {time_, centre, tensile ? FailureMode::Tensile : FailureMode::Shear, energy, static_cast<std::int64_t>(b)});
+        bonds.state[b] = tensile ? BondState::BrokenTension : BondState::BrokenShear;
+        bonds.force_on_a[b].setZero();
+        bonds.torque_on_a[b] = bonds.torque_on_b[b] = 0.0;
+        continue;
+      }
+      bonds.force_on_a[b] = fn * nrm + fs * t;
+      bonds.torque_on_a[b] = -la * fs + mo;
+      bonds.torque_on_b[b] = -lb * fs - mo;
+    }
+  }
+  const std::size_t before = events.size();
+  for (auto& l : local) events.insert(events.end(), l.begin(), l.end());
+  std::sort(events.begin() + static_cast<std::ptrdiff_t>(before), events.end(),
+            [](const AcousticEvent& a, const AcousticEvent& b) { return a.bond < b.bond; });
+
+  // Gather per disc (each disc writes only its own entries).
+  auto& F = discs.get<Force>();
+  auto& T = discs.get<Torque>();
+  auto& K = discs.get<StiffnessSum>();
+  auto& intact = discs.get<IntactBonds>();
+  auto& broken = discs.get<BrokenBonds>();
+  const auto& id = discs.get<ParticleId>();
+  const std::int64_t n = static_cast<std::int64_t>(discs.size());
+#pragma omp parallel for schedule(static) if (n > kParallelMin)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    Vec2 f = Vec2::Zero();
+    double tq = 0, ktr = 0, krot = 0;
+    std::int32_t ni = 0, nbk = 0;
+    for (std::uint32_t q = bond_offsets_[id[i]]; q < bond_offsets_[id[i] + 1]; ++q) {
+      const std::int64_t e = bond_entries_[q];
+      const std::size_t b = static_cast<std::size_t>(e >= 0 ? e : -e - 1);
+      const BondState s = bonds.state[b];
+      if (s == BondState::BrokenTension || s == BondState::BrokenShear) ++nbk;
+      if (s != BondState::Intact) continue;
+      ++ni;
+      const double kn = bonds.normal_stiffness[b], ks = bonds.shear_stiffness[b];
+      const double Rb = bonds.radius[b];
+      const double A = 2.0 * Rb, In = 2.0 / 3.0 * Rb * Rb * Rb;
+      if (e >= 0) {
+        f += bonds.force_on_a[b];
+        tq += bonds.torque_on_a[b];
+      } else {
+        f -= bonds.force_on_a[b];
+        tq += bonds.torque_on_b[b];
+      }
+      ktr += std::max(kn, ks) * A;
+      krot += kn * In + ks * A * R[i] * R[i];
+    }
+    F[i] += f;
+    T[i] += tq;
+    K[i] += Eigen::Vector2d(ktr, krot);
+    intact[i] = ni;
+    broken[i] = nbk;
+  }
+}
+
+template <class Law>
+void DemSolver::wall_forces(const Law& law) {
+  const std::size_t nw = walls.size();
+  if (nw == 0 && terrain.size() == 0) return;
+  const auto& x = discs.get<Position<2>>();
+  const auto& v = discs.get<Velocity<2>>();
+  const auto& w = discs.get<AngularVelocity>();
+  const auto& R = discs.get<Radius>();
+  const auto& m = discs.get<Mass>();
+  const auto& I = discs.get<Inertia>();
+  const auto& kin = discs.get<Kinematic>();
+  auto& F = discs.get<Force>();
+  auto& T = discs.get<Torque>();
+  auto& K = discs.get<StiffnessSum>();
+  auto& WC = discs.get<WallContacts>();
+  const double dt = dt_;
+  const double mu_r = contact.rolling_friction, eta_r = contact.rolling_damping;
+  const std::int64_t n = static_cast<std::int64_t>(discs.size());
+  // Bounding boxes of the walls grown by the largest radius: a cheap reject before the distance.
+  std::vector<Vec2> box_lo(nw), box_hi(nw);
+  for (std::size_t k = 0; k < nw; ++k) {
+    auto& wl = walls[k];
+    wl.force.setZero();
+    wl.stiffness = 0.0;
+    wl.contacts = 0;
+    box_lo[k] = wl.a.cwiseMin(wl.b) - Vec2::Constant(1.1 * rmax_);  // 10 %: radii grow while packing
+    box_hi[k] = wl.a.cwiseMax(wl.b) + Vec2::Constant(1.1 * rmax_);
+  }
+#pragma omp parallel if (n > kParallelMin)
+  {
+    std::vector<Vec2> wf(nw, Vec2::Zero());
+    std::vector<double> wk(nw, 0.0);
+    std::vector<int> wn(nw, 0);
+#pragma omp for schedule(static)
+    for (std::int64_t ii = 0; ii < n; ++ii) {
+      const auto i = static_cast<std::size_t>(ii);
+      if (kin[i]) continue;
+      const Vec2 xi = x[i];
+      const double Ri = R[i];
+      const WallContacts::type& old = WC[i];
+      const bool had = old(0, 0) >= 0.0;  // slots are filled from the first one
+      WallContacts::type now;
+      now.row(0).setConstant(-1.0);
+      now.row(1).setZero();
+      now.row(2).setZero();
+      int used = 0;
+      Vec2 f = Vec2::Zero();
+      double tq = 0, ktr = 0, krot = 0;
+      auto touch = [&](const WallSegment& s, std::size_t seg, std::size_t wall_index) {
+        const Vec2 p = closest_point_on_segment(s.a, s.b, xi);
+        const Vec2 d = xi - p;
+        const double r2 = d.squaredNorm();
+        if (r2 >= Ri * Ri || r2 == 0.0) return;
+        const double r = std::sqrt(r2);
+        const Vec2 nrm = d / r;
+        const Vec2 t = perp(nrm);
+        const ContactResponse c =
+            law.evaluate(Ri - r, m[i], Ri, 2.0 * Ri, damping_ratio_from_restitution(s.restitution));
+        const Vec2 vrel = v[i] - s.velocity - w[i] * Ri * t;
+        // A wall never pulls a disc: the dashpot cannot make the normal force tensile.
+        const double fn = std::max(c.fn_elastic - c.cn * vrel.dot(nrm), 0.0);
+        double fs = 0.0, mr = 0.0;
+        for (int q = 0; q < kWallSlots; ++q)
+          if (old(0, q) == static_cast<double>(seg)) {
+            fs = old(1, q);
+            mr = old(2, q);
+          }
+        fs -= c.kt * vrel.dot(t) * dt;
+        const double limit = s.friction * std::max(fn, 0.0);
+        if (std::abs(fs) > limit) fs = sgn(fs) * limit;
+        double md = 0.0, kr = 0.0;
+        if (mu_r > 0) {
+          kr = rolling_stiffness(mu_r, c.kn, Ri);
+          mr -= kr * w[i] * dt;
+          const double mmax = mu_r * Ri * std::max(fn, 0.0);
+          if (std::abs(mr) >= mmax)
+            mr = sgn(mr) * mmax;
+          else
+            md = -eta_r * 2.0 * std::sqrt((I[i] + m[i] * Ri * Ri) * kr) * w[i];
+        } else {
+          mr = 0.0;
+        }
+        const Vec2 fc = fn * nrm + fs * t;
+        f += fc;
+        tq += -Ri * fs + mr + md;
+        ktr += std::max(c.kn, c.kt);
+        krot += c.kt * Ri * Ri + kr;
+        if (wall_index < nw) {
+          wf[wall_index] -= fc;
+          wk[wall_index] += c.kn;
+          ++wn[wall_index];
+        }
+        if (used < kWallSlots) {
+          now(0, used) = static_cast<double>(seg);
+          now(1, used) = fs;
+          now(2, used) = mr;
+          ++used;
+        }
+      };
+      for (std::size_t k = 0; k < nw; ++k)
+        if (walls[k].active && (xi.array() >= box_lo[k].array()).all() && (xi.array() <= box_hi[k].array()).all())
+          touch(walls[k], k, k);
+      if (terrain.size() > 0) {
+        auto [b, e] = terrain.candidates(xi.x());
+        for (auto p = b; p != e; ++p) {
+          const WallSegment& s = terrain.segment(*p);
+          // A vertex shared by two segments of a polyline is one contact, not two: a segment
+          // whose closest point is its start skips it (the previous segment owns the vertex), and
+          // one whose closest point is its end keeps it only if the disc is past the start of the
+          // next segment too (convex vertex). Interior points of both (concave vertex) both count.
+          if (s.joined_prev || s.joined_next) {
+            const double u = segment_parameter(s.a, s.b, xi);
+            if (u <= 0.0 && s.joined_prev) continue;
+            if (u >= 1.0 && s.joined_next) {
+              const WallSegment& nx = terrain.segment(*p + 1);
+              if (segment_parameter(nx.a, nx.b, xi) > 0.0) continue;
+            }
+          }
+          touch(s, nw + *p, SIZE_MAX);
+        }
+      }
+      if (used == 0 && !had) continue;  // no wall contact before or now: nothing to write
+      WC[i] = now;
+      F[i] += f;
+      T[i] += tq;
+      K[i] += Eigen::Vector2d(ktr, krot);
+    }
+#pragma omp critical
+    for (std::size_t k = 0; k < nw; ++k) {
+      walls[k].force += wf[k];
+      walls[k].stiffness += wk[k];
+      walls[k].contacts += wn[k];
+    }
+  }
+}
+
+template <class Law>
+void DemSolver::compute_forces(const Law& law) {
+  pair_forces(law);
+  bond_forces();
+  wall_forces(law);
+}
+
+void DemSolver::update_time_step() {
+  const auto& m = discs.get<Mass>();
+  const auto& I = discs.get<Inertia>();
+  const auto& R = discs.get<Radius>();
+  const auto& K = discs.get<StiffnessSum>();
+  const std::int64_t n = static_cast<std::int64_t>(discs.size());
+  double inv2 = 0.0;  // max of k/m
+#pragma omp parallel for reduction(max : inv2) schedule(static) if (n > kParallelMin)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    const double kn0 = std::visit([&](const auto& l) { return l.reference_kn(R[i]); }, law);
+    const double kt0 = std::visit([&](const auto& l) { return l.reference_kt(R[i]); }, law);
+    const double ktr = std::max(K[i][0], std::max(kn0, kt0));
+    const double krot = std::max(K[i][1], kt0 * R[i] * R[i]);
+    inv2 = std::max(inv2, std::max(ktr / m[i], krot / I[i]));
+  }
+  dt_crit_ = inv2 > 0 ? 1.0 / std::sqrt(inv2) : 1.0;
+  if (settings.fixed_time_step > 0) {
+    dt_ = settings.fixed_time_step;
+  } else {
+    dt_ = settings.safety_factor * dt_crit_;
+  }
+}
+
+void DemSolver::check_state() const {
+  const auto& x = discs.get<Position<2>>();
+  const auto& v = discs.get<Velocity<2>>();
+  const auto& id = discs.get<ParticleId>();
+  const std::int64_t n = static_cast<std::int64_t>(discs.size());
+  const double vmax2 = settings.max_speed * settings.max_speed;
+  std::int64_t bad = -1;
+#pragma omp parallel for reduction(max : bad) schedule(static) if (n > kParallelMin)
+  for (std::int64_t i = 0; i < n; ++i)
+    if (!x[i].allFinite() || !v[i].allFinite() || v[i].squaredNorm() > vmax2) bad = std::max(bad, i);
+  if (bad >= 0) {
+    std::ostringstream s;
+    s << "disc id " << id[bad] << " at (" << x[bad].x() << ", " << x[bad].y() << ") m has velocity (" << v[bad].x()
+      << ", " << v[bad].y() << ") m/s at step " << steps_ << ", t = " << time_ << " s (limit " << settings.max_speed
+      << " m/s): the time step is too large for the stiffnesses, or walls overlap discs";
+    throw SimulationError(s.str());
+  }
+}
+
+void DemSolver::step() {
+  auto& x = discs.get<Position<2>>();
+  auto& v = discs.get<Velocity<2>>();
+  auto& th = discs.get<Rotation>();
+  auto& w = discs.get<AngularVelocity>();
+  const auto& F = discs.get<Force>();
+  const auto& T = discs.get<Torque>();
+  const auto& m = discs.get<Mass>();
+  const auto& I = discs.get<Inertia>();
+  const auto& kin = discs.get<Kinematic>();
+  const auto& xb = discs.get<PositionAtBuild>();
+  const double dt = dt_;
+  const std::int64_t n = static_cast<std::int64_t>(discs.size());
+  // 1. half kick + drift (and the largest displacement since the last list build)
+  double dmax2 = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : dmax2) if (n > kParallelMin)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    if (!kin[i]) {
+      v[i] += 0.5 * dt / m[i] * F[i];
+      w[i] += 0.5 * dt / I[i] * T[i];
+    }
+    x[i] += dt * v[i];
+    th[i] += dt * w[i];
+    dmax2 = std::max(dmax2, (x[i] - xb[i]).squaredNorm());
+  }
+  for (auto& wl : walls) {
+    wl.a += dt * wl.velocity;
+    wl.b += dt * wl.velocity;
+  }
+  time_ += dt;
+  ++steps_;
+  // 2. neighbours
+  if (4.0 * dmax2 >= skin_ * skin_) rebuild_neighbours();
+  // 3. forces, 4. second half kick, blow-up check and next time step (the law is resolved once here)
+  std::visit(
+      [&](const auto& l) {
+        compute_forces(l);
+        finish_step(l);
+      },
+      law);
+}
+
+template <class Law>
+void DemSolver::finish_step(const Law& law) {
+  // Gravity, Cundall's local damping, the second half kick, the blow-up check and the stiffness
+  // bound of the next time step, fused into one pass over the discs.
+  auto& F = discs.get<Force>();
+  auto& T = discs.get<Torque>();
+  auto& v = discs.get<Velocity<2>>();
+  auto& w = discs.get<AngularVelocity>();
+  const auto& x = discs.get<Position<2>>();
+  const auto& m = discs.get<Mass>();
+  const auto& I = discs.get<Inertia>();
+  const auto& R = discs.get<Radius>();
+  const auto& K = discs.get<StiffnessSum>();
+  const auto& kin = discs.get<Kinematic>();
+  const Vec2 g = settings.gravity;
+  const double alpha = settings.local_damping;
+  const double dt = dt_;
+  const double vmax2 = settings.max_speed * settings.max_speed;
+  const std::int64_t n = static_cast<std::int64_t>(discs.size());
+  double inv2 = 0.0;
+  std::int64_t bad = -1;
+#pragma omp parallel for schedule(static) reduction(max : inv2, bad) if (n > kParallelMin)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    if (!kin[i]) {
+      Vec2 f = F[i] + m[i] * g;
+      double tq = T[i];
+      if (alpha > 0) {
+        for (int d = 0; d < 2; ++d) f[d] -= alpha * std::abs(f[d]) * sgn(v[i][d]);
+        tq -= alpha * std::abs(tq) * sgn(w[i]);
+      }
+      F[i] = f;
+      T[i] = tq;
+      v[i] += 0.5 * dt / m[i] * f;
+      w[i] += 0.5 * dt / I[i] * tq;
+    }
+    if (!x[i].allFinite() || !v[i].allFinite() || v[i].squaredNorm() > vmax2) bad = std::max(bad, ii);
+    const double kn0 = law.reference_kn(R[i]), kt0 = law.reference_kt(R[i]);
+    const double ktr = std::max(K[i][0], std::max(kn0, kt0));
+    const double krot = std::max(K[i][1], kt0 * R[i] * R[i]);
+    inv2 = std::max(inv2, std::max(ktr / m[i], krot / I[i]));
+  }
+  // Servo walls: v = G (σ − σ_target) outward, G = α L / (Σk_n Δt).
+  for (auto& wl : walls) {
+    if (wl.control != WallControl::Servo || !wl.active) continue;
+    const double L = wl.loaded_length > 0 ? wl.loaded_length : wl.length();
+    const double sigma = wl.normal_stress(L);
+    const double k = std::max(wl.stiffness, 1e-300);
+    double speed = wl.servo_gain * L / (k * dt) * (sigma - wl.target_stress);
+    if (wl.contacts == 0) speed = -wl.max_speed;  // no contact: move in towards the sample
+    speed = std::clamp(speed, -wl.max_speed, wl.max_speed);
+    wl.velocity = -speed * wl.servo_normal;
+  }
+  if (bad >= 0) check_state();  // throws with the diagnosis
+  dt_crit_ = inv2 > 0 ? 1.0 / std::sqrt(inv2) : 1.0;
+  dt_ = settings.fixed_time_step > 0 ? settings.fixed_time_step : settings.safety_factor * dt_crit_;
+}
+
+void DemSolver::run_until(double t_end, std::int64_t max_steps) {
+  std::int64_t k = 0;
+  while (time_ < t_end && k < max_steps) {
+    step();
+    ++k;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Diagnostics
+
+double DemSolver::kinetic_energy() const {
+  const auto& v = discs.get<Velocity<2>>();
+  const auto& w = discs.get<AngularVelocity>();
+  const auto& m = discs.get<Mass>();
+  const auto& I = discs.get<Inertia>();
+  double e = 0;
+  for (std::size_t i = 0; i < discs.size(); ++i) e += 0.5 * m[i] * v[i].squaredNorm() + 0.5 * I[i] * w[i] * w[i];
+  return e;
+}
+
+double DemSolver::strain_energy() const {
+  double e = 0.0;
+  // Contacts: normal spring energy from the overlap (linear: ½k δ²; Hertz: 2/5 F δ), shear ½F_s²/k_s.
+  const auto& x = discs.get<Position<2>>();
+  const auto& R = discs.get<Radius>();
+  const auto& m = discs.get<Mass>();
+  const auto off = list_.offsets();
+  const auto nbr = list_.indices();
+  for (std::size_t i = 0; i < discs.size(); ++i) {
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+      const std::uint32_t j = nbr[k];
+      if (j < i) continue;
+      const double delta = R[i] + R[j] - (x[i] - x[j]).norm();
+      if (delta <= 0) continue;
+      const double reff = R[i] * R[j] / (R[i] + R[j]);
+      const double meff = m[i] * m[j] / (m[i] + m[j]);
+      std::visit(
+          [&](const auto& l) {
+            const ContactResponse c = l.evaluate(delta, meff, reff, R[i] + R[j], 0.0);
+            using L = std::decay_t<decltype(l)>;
+            if constexpr (std::is_same_v<L, LinearSpringCoulomb>)
+              e += 0.5 * c.fn_elastic * delta;
+            else
+              e += 0.4 * c.fn_elastic * delta;
+            const double fs = hist_.partner.size() > k && hist_.partner[k] >= 0 ? hist_.shear[k] : 0.0;
+            if (c.kt > 0) e += 0.5 * fs * fs / c.kt;
+          },
+          law);
+    }
+  }
+  for (std::size_t b = 0; b < bonds.size(); ++b) {
+    if (bonds.state[b] != BondState::Intact) continue;
+    const double kn = bonds.normal_stiffness[b], ks = bonds.shear_stiffness[b];
+    const double A = 2 * bonds.radius[b], In = 2.0 / 3.0 * std::pow(bonds.radius[b], 3);
+    e += bonds.normal_force[b] * bonds.normal_force[b] / (2 * kn * A) +
+         bonds.shear_force[b] * bonds.shear_force[b] / (2 * ks * A) + bonds.moment[b] * bonds.moment[b] / (2 * kn * In);
+  }
+  return e;
+}
+
+double DemSolver::potential_energy() const {
+  const auto& x = discs.get<Position<2>>();
+  const auto& m = discs.get<Mass>();
+  double e = 0;
+  for (std::size_t i = 0; i < discs.size(); ++i) e -= m[i] * settings.gravity.dot(x[i]);
+  return e;
+}
+
+Vec2 DemSolver::momentum() const {
+  const auto& v = discs.get<Velocity<2>>();
+  const auto& m = discs.get<Mass>();
+  Vec2 p = Vec2::Zero();
+  for (std::size_t i = 0; i < discs.size(); ++i) p += m[i] * v[i];
+  return p;
+}
+
+std::vector<std::pair<std::uint32_t, std::uint32_t>> DemSolver::contact_pairs() const {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+  const auto& x = discs.get<Position<2>>();
+  const auto& R = discs.get<Radius>();
+  const auto off = list_.offsets();
+  const auto nbr = list_.indices();
+  for (std::size_t i = 0; i < discs.size(); ++i)
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+      const std::uint32_t j = nbr[k];
+      if (j <= i) continue;
+      const double s = R[i] + R[j];
+      if ((x[i] - x[j]).squaredNorm() < s * s) out.emplace_back(static_cast<std::uint32_t>(i), j);
+    }
+  return out;
+}
+
+std::size_t DemSolver::contact_count() const {
+  return contact_pairs().size();
+}
+
+Vec2 DemSolver::kinematic_group_force(std::uint8_t group) const {
+  const auto& F = discs.get<Force>();
+  const auto& kin = discs.get<Kinematic>();
+  Vec2 s = Vec2::Zero();
+  for (std::size_t i = 0; i < discs.size(); ++i)
+    if (kin[i] == group) s += F[i];
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Terrain
+
+void TerrainSegments::add_polyline(const std::vector<Vec2>& pts, double friction, double restitution) {
+  for (std::size_t k = 0; k + 1 < pts.size(); ++k) {
+    WallSegment s;
+    s.a = pts[k];
+    s.b = pts[k + 1];
+    s.friction = friction;
+    s.restitution = restitution;
+    s.joined_prev = k > 0;
+    s.joined_next = k + 2 < pts.size();
+    segs_.push_back(s);
+  }
+}
+
+void TerrainSegments::build(double reach) {
+  start_.clear();
+  index_.clear();
+  if (segs_.empty()) return;
+  double lo = std::numeric_limits<double>::max(), hi = std::numeric_limits<double>::lowest();
+  for (const auto& s : segs_) {
+    lo = std::min({lo, s.a.x(), s.b.x()});
+    hi = std::max({hi, s.a.x(), s.b.x()});
+  }
+  lo -= reach;
+  hi += reach;
+  const std::size_t nb = std::clamp<std::size_t>(segs_.size(), 1, 1 << 16);
+  x0_ = lo;
+  dx_ = std::max((hi - lo) / static_cast<double>(nb), 1e-12);
+  std::vector<std::vector<std::uint32_t>> bins(nb);
+  for (std::size_t k = 0; k < segs_.size(); ++k) {
+    const double a = std::min(segs_[k].a.x(), segs_[k].b.x()) - reach;
+    const double b = std::max(segs_[k].a.x(), segs_[k].b.x()) + reach;
+    const auto c0 = static_cast<std::size_t>(std::clamp((a - x0_) / dx_, 0.0, static_cast<double>(nb - 1)));
+    const auto c1 = static_cast<std::size_t>(std::clamp((b - x0_) / dx_, 0.0, static_cast<double>(nb - 1)));
+    for (std::size_t c = c0; c <= c1; ++c) bins[c].push_back(static_cast<std::uint32_t>(k));
+  }
+  start_.assign(nb + 1, 0);
+  for (std::size_t c = 0; c < nb; ++c) {
+    start_[c + 1] = start_[c] + static_cast<std::uint32_t>(bins[c].size());
+    index_.insert(index_.end(), bins[c].begin(), bins[c].end());
+  }
+}
+
+std::pair<const std::uint32_t*, const std::uint32_t*> TerrainSegments::candidates(double x) const noexcept {
+  if (start_.empty()) return {nullptr, nullptr};
+  const double u = (x - x0_) / dx_;
+  if (!(u >= 0) || u >= static_cast<double>(start_.size() - 1)) return {nullptr, nullptr};
+  const auto c = static_cast<std::size_t>(u);
+  return {index_.data() + start_[c], index_.data() + start_[c + 1]};
+}
+
+double TerrainSegments::elevation(double x) const noexcept {
+  double z = std::numeric_limits<double>::quiet_NaN();
+  for (const auto& s : segs_) {
+    const double a = std::min(s.a.x(), s.b.x()), b = std::max(s.a.x(), s.b.x());
+    if (x < a || x > b || b == a) continue;
+    const double t = (x - s.a.x()) / (s.b.x() - s.a.x());
+    const double zz = s.a.y() + t * (s.b.y() - s.a.y());
+    if (!(zz <= z)) z = zz;
+  }
+  return z;
+}
+
+}  // namespace geohaz::dem
