@@ -120,7 +120,7 @@ RunSettings read_settings(ConfigReader& cfg) {
       cfg.get("output.series_interval", 1.0, Range::open_closed(0.0, 1e6), {"s", "time between rows of series.csv"});
   s.snapshot_interval =
       cfg.get("output.snapshot_interval", 30.0, Range::open_closed(0.0, 1e6), {"s", "time between particle snapshots"});
-  s.snapshots = cfg.get_bool("output.snapshots", true, {"", "write particles.h5 + .xmf"});
+  s.snapshots = cfg.get_bool("output.snapshots", true, {"", "write snapshots.h5 + .xmf"});
   s.pngs = cfg.get_bool("output.png", true, {"", "write the quick-look PNGs"});
   return s;
 }
@@ -399,7 +399,7 @@ int run(int argc, char** argv) {
   const fs::path out(common.out);
   make_output_dir(out);
   const std::string resolved = cfg.resolved();
-  write_text_file(out / "config.toml", resolved);
+  write_text_file(out / "config.resolved.toml", resolved);
   if (!common.quiet)
     std::cerr << kApp << ": " << rel.description << ": volume " << fmt(rel.volume_read, 12) << " m^3 read, "
               << fmt(seeded.volume_seeded, 12) << " m^3 seeded in " << seeded.particles
@@ -408,7 +408,7 @@ int run(int argc, char** argv) {
 
   std::unique_ptr<SnapshotWriter> snap;
   if (s.snapshots) {
-    snap = std::make_unique<SnapshotWriter>(out / "particles.h5", kApp, 2, resolved);
+    snap = std::make_unique<SnapshotWriter>(out / "snapshots.h5", kApp, 2, resolved);
     snap->set_attribute("crs_wkt", dsm.crs_wkt);
     snap->set_attribute("release_volume", rel.volume_read);
     snap->write(store, 0.0, 0);

@@ -80,8 +80,8 @@ TEST(DebrisRunoutApp, TinyValleyRunsAndBalancesVolume) {
                      " --d0 2.5 --h0 0.75 --duration 60 --out " + out.string() + " --quiet --threads 1");
   ASSERT_EQ(r.code, 0) << r.output;
   for (const char* f :
-       {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "arrival_time.tif", "particles.h5",
-        "particles.xmf", "series.csv", "summary.json", "config.toml", "deposit.png", "max_speed.png"})
+       {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "arrival_time.tif", "snapshots.h5",
+        "snapshots.xmf", "series.csv", "summary.json", "config.resolved.toml", "deposit.png", "max_speed.png"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
