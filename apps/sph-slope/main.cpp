@@ -1,0 +1,281 @@
+// sph-slope: SPH simulation of slope failure, large deformation and post-failure flow of
+// elasto-plastic soil under gravity and earthquake shaking (libs/sph, docs/sph.md).
+// This file turns the command line and the TOML config into a typed RunConfig, then runs.
+#include <cmath>
+#include <iostream>
+#include <numbers>
+
+#include "geohaz/core/app.hpp"
+#include "geohaz/core/config.hpp"
+#include "geohaz/core/errors.hpp"
+#include "geohaz/core/raster.hpp"
+#include "geohaz/sph/run.hpp"
+
+using namespace geohaz;
+using namespace geohaz::sph;
+
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+WallType wall(ConfigReader& r, const char* key, const char* def) {
+  const auto s =
+      r.get_choice(key, def, {"fixed", "roller", "none"},
+                   {"", "boundary condition of this wall: fixed (full fixity, no slip), roller (free slip), none"});
+  return s == "fixed" ? WallType::Fixed : (s == "roller" ? WallType::Roller : WallType::None);
+}
+
+/// Read every key into the typed config. In describe mode (`describe` true) every section is read
+/// so that --help-config lists them all.
+RunConfig read_config(ConfigReader& r, bool describe) {
+  RunConfig c;
+  c.config_source = r.source();
+  // [run]
+  c.dimension = static_cast<int>(r.get_int("run.dimension", 2, Range::closed(2, 3), {"1", "2 (plane strain) or 3"}));
+  const auto sc = r.get_choice("run.scenario", "slope", {"slope", "column", "biaxial", "section"},
+                               {"",
+                                "scenario type: parametric slope, granular column collapse, biaxial specimen, "
+                                "DSM cross-section"});
+  c.scenario = sc == "slope"     ? ScenarioType::Slope
+               : sc == "column"  ? ScenarioType::Column
+               : sc == "biaxial" ? ScenarioType::Biaxial
+                                 : ScenarioType::Section;
+  c.end_time = r.get("run.end_time", 1.0, Range::positive(), {"s", "simulated time of the main phase"});
+  c.output_interval = r.get("run.output_interval", 0.01, Range::positive(), {"s", "time-series interval"});
+  c.snapshot_interval = r.get("run.snapshot_interval", 0.1, Range::non_negative(),
+                              {"s", "HDF5 snapshot interval (0: first and last only)"});
+  c.velocity_png_times = r.get_array("run.velocity_png_times", {}, Range::non_negative(),
+                                     {"s", "times of quick-look PNGs of the speed field"});
+  c.rest_speed =
+      r.get("run.rest_speed", 0.005, Range::positive(), {"m/s", "max speed below which the mass is at rest"});
+  c.stop_at_rest =
+      r.get_bool("run.stop_at_rest", false,
+                 {"", "stop when max speed < rest_speed (after max(0.05 s, end_time/10) and any shaking)"});
+  const auto restart = r.get_string("run.restart", "",
+                                    {"",
+                                     "snapshot file (snapshots.h5) to restart from; "
+                                     "skips the geostatic phase"});
+  if (!restart.empty())
+    c.restart = std::filesystem::path(restart).is_absolute() ? std::filesystem::path(restart) : r.base_dir() / restart;
+
+  // [model]
+  const auto model = r.get_choice("model.constitutive", "drucker_prager",
+                                  {"drucker_prager", "von_mises", "linear_elastic", "newtonian_fluid"},
+                                  {"", "constitutive model of all soil materials"});
+  constitutive_model_from_name(model, c.model);
+  const auto fit = r.get_choice("model.dp_fit", "auto", {"auto", "plane_strain", "compression_3d"},
+                                {"",
+                                 "Drucker-Prager constants: auto = plane_strain in 2D (seed 002 eqs. 18-19), "
+                                 "compression_3d in 3D (seed 001 eq. 21)"});
+  const DruckerPragerFit dpfit =
+      fit == "plane_strain"     ? DruckerPragerFit::PlaneStrain
+      : fit == "compression_3d" ? DruckerPragerFit::Compression3D
+                                : (c.dimension == 2 ? DruckerPragerFit::PlaneStrain : DruckerPragerFit::Compression3D);
+  // [[material]]
+  auto mats = r.tables("material", {"", "soil materials, indexed from 0 in order (base layer first)"});
+  for (auto& m : mats) {
+    MaterialParams p;
+    c.material_names.push_back(m.get_string("name", "soil", {"", "label"}));
+    p.density = m.get("density", 1800.0, Range::positive(), {"kg/m^3", "density rho0"});
+    p.young = m.get("young", 1e6, Range::positive(), {"Pa", "Young's modulus E"});
+    p.poisson = m.get("poisson", 0.3, Range::closed_open(0.0, 0.5), {"1", "Poisson's ratio"});
+    p.cohesion = m.get("cohesion", 0.0, Range::non_negative(), {"Pa", "cohesion c (Drucker-Prager)"});
+    p.friction = kDeg * m.get("friction", 30.0, Range::closed_open(0.0, 90.0), {"deg", "friction angle phi"});
+    p.dilatancy =
+        kDeg * m.get("dilatancy", 0.0, Range::closed_open(0.0, 90.0), {"deg", "dilatancy angle psi (<= phi)"});
+    p.yield_stress = m.get("yield_stress", 1e5, Range::positive(), {"Pa", "uniaxial yield stress (von Mises)"});
+    p.viscosity = m.get("viscosity", 1e-3, Range::non_negative(), {"Pa s", "dynamic viscosity (Newtonian fluid)"});
+    p.fit = dpfit;
+    if (p.dilatancy > p.friction + 1e-12)
+      throw InputError("dilatancy must not exceed the friction angle", r.source(), "material.dilatancy",
+                       std::to_string(p.dilatancy / kDeg));
+    c.materials.push_back(p);
+  }
+
+  // [numerics]
+  auto& n = c.numerics;
+  n.spacing = r.get("numerics.spacing", 0.01, Range::positive(), {"m", "initial particle spacing dx"});
+  n.h_factor = r.get("numerics.h_factor", 1.2, Range::closed(1.0, 2.0), {"1", "smoothing length h = h_factor dx"});
+  n.kernel = r.get_choice("numerics.kernel", "cubic_spline", {"cubic_spline", "wendland_c2"}, {"", "SPH kernel"}) ==
+                     "cubic_spline"
+                 ? KernelChoice::CubicSpline
+                 : KernelChoice::WendlandC2;
+  n.gravity = r.get("numerics.gravity", 9.81, Range::non_negative(), {"m/s^2", "gravitational acceleration"});
+  n.cfl = r.get("numerics.cfl", 0.2, Range::open_closed(0.0, 1.0), {"1", "CFL number on (c_p + |v|max)"});
+  n.force_factor = r.get("numerics.force_factor", 0.25, Range::open_closed(0.0, 1.0), {"1", "dt <= f sqrt(h/|a|max)"});
+  n.dt_max = r.get("numerics.dt_max", 1e-3, Range::positive(), {"s", "largest time step"});
+  n.dt_min = r.get("numerics.dt_min", 1e-10, Range::positive(), {"s", "a smaller step stops the run (collapse)"});
+  n.viscosity_alpha =
+      r.get("numerics.viscosity_alpha", 0.1, Range::non_negative(), {"1", "Monaghan artificial viscosity alpha"});
+  n.viscosity_beta =
+      r.get("numerics.viscosity_beta", 0.0, Range::non_negative(), {"1", "Monaghan artificial viscosity beta"});
+  n.artificial_stress = r.get("numerics.artificial_stress", 0.3, Range::closed(0.0, 1.0),
+                              {"1", "Gray-Monaghan artificial stress epsilon (0: off)"});
+  n.artificial_stress_n = r.get("numerics.artificial_stress_n", 0.0, Range::non_negative(),
+                                {"1", "artificial-stress exponent n (0: W(0)/W(dx))"});
+  n.xsph =
+      r.get("numerics.xsph", 0.0, Range::closed(0.0, 1.0), {"1", "XSPH velocity-correction factor epsilon (seed 000)"});
+  n.damping = r.get("numerics.damping", 0.0, Range::closed_open(0.0, 1.0),
+                    {"1", "Cundall local damping zeta in the main phase (seed 002 uses 0.2 under shaking)"});
+  n.stress_free_fraction = r.get("numerics.stress_free_fraction", 0.0, Range::closed_open(0.0, 1.0),
+                                 {"1", "stress vanishes where the kernel-sum density < fraction rho0 (0: off)"});
+  n.reorder_every = static_cast<int>(r.get_int("numerics.reorder_every", 20, Range::closed(0, 1e6),
+                                               {"1", "steps between cell reorderings (0: never)"}));
+  n.wall_repulsion = r.get("numerics.wall_repulsion", 0.5, Range::closed(0.0, 1.0),
+                           {"1", "soil closer than this x dx to a wall particle is pushed back (0: off)"});
+  n.neighbour_skin = r.get("numerics.neighbour_skin", 0.0, Range::closed(0.0, 1.0),
+                           {"1", "Verlet skin in units of h (0: rebuild the neighbour list every step)"});
+
+  // [geostatic]
+  c.geostatic = r.get_bool("geostatic.enabled", true, {"", "apply gravity gradually before the main phase"});
+  c.geostatic_duration = r.get("geostatic.duration", 0.0, Range::non_negative(), {"s", "0: 20 H / c_p"});
+  c.geostatic_damping =
+      r.get("geostatic.damping", 0.7, Range::closed_open(0.0, 1.0), {"1", "Cundall zeta while loading"});
+  c.geostatic_elastic = r.get_bool("geostatic.elastic", true, {"", "linear-elastic soil while loading"});
+  c.rest_tolerance =
+      r.get("geostatic.rest_tolerance", 0.01, Range::positive(), {"1", "at rest: max|v| < tol sqrt(g H)"});
+
+  // [earthquake]
+  const auto eq = r.get_choice("earthquake.type", "none", {"none", "sine", "record"},
+                               {"", "earthquake acceleration applied to every particle (seed 002 eqs. 25-26)"});
+  {  // all keys are read whatever the type, so that --set earthquake.type=none works on any config
+    const double A =
+        r.get("earthquake.amplitude", 5.0, Range::non_negative(), {"m/s^2", "sine amplitude (500 gal = 5)"});
+    const double f = r.get("earthquake.frequency", 1.0, Range::positive(), {"Hz", "sine frequency"});
+    const double t0 = r.get("earthquake.start", 0.0, Range::non_negative(), {"s", "start time"});
+    const double d = r.get("earthquake.duration", 5.0, Range::positive(), {"s", "duration"});
+    const double ramp = r.get("earthquake.ramp", 0.5, Range::non_negative(), {"s", "linear ramp at both ends"});
+    if (eq == "sine") n.earthquake = EarthquakeLoading::sine(A, f, t0, d, ramp);
+  }
+  {
+    const auto file =
+        r.get_string("earthquake.file", "", {"", "CSV accelerogram: time (s), a_h (m/s^2), optional a_v (m/s^2)"});
+    if (eq == "record") {
+      if (file.empty())
+        throw InputError("earthquake.type = record needs earthquake.file", r.source(), "earthquake.file");
+      const auto p = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : r.base_dir() / file;
+      n.earthquake = EarthquakeLoading::read_csv(p);
+    }
+  }
+
+  // [output]
+  c.failed_threshold = r.get("output.failed_threshold", 0.01, Range::positive(),
+                             {"m", "displacement above which soil counts as failed (failed mass, slip surface)"});
+  c.bulking_factor =
+      r.get("output.bulking_factor", 1.0, Range::closed(1.0, 3.0), {"1", "volume factor for release.h5"});
+  c.write_release =
+      r.get_bool("output.release", true, {"", "section scenario: write release.h5 and release_thickness.tif"});
+
+  // Geometry of the chosen scenario.
+  const bool is3d = c.dimension == 3;
+  if (c.scenario == ScenarioType::Slope || describe) {
+    auto& g = c.slope;
+    g.height = r.get("slope.height", 0.25, Range::positive(), {"m", "slope height above the base"});
+    g.gradient = r.get("slope.gradient", 1.5, Range::non_negative(), {"1", "face gradient H:V (1.5 = 1.5H:1V)"});
+    g.crest_length = r.get("slope.crest_length", 0.3, Range::non_negative(), {"m", "flat crest behind the face"});
+    g.front_length = r.get("slope.front_length", 0.6, Range::non_negative(), {"m", "flat ground in front of the toe"});
+    g.base_thickness = r.get("slope.base_thickness", 0.05, Range::non_negative(), {"m", "soil base under everything"});
+    g.cut_depth =
+        r.get("slope.cut_depth", 0.0, Range::non_negative(), {"m", "upper cut: depth below the crest (0: none)"});
+    g.cut_gradient = r.get("slope.cut_gradient", 2.0, Range::positive(), {"1", "upper cut gradient H:V"});
+    c.layer_tops =
+        r.get_array("slope.layer_tops", {}, Range::non_negative(), {"m", "layer tops (elevations, ascending)"});
+    const auto lm = r.get_array("slope.layer_materials", {}, Range::closed(0, 1000),
+                                {"1", "material index per layer, bottom first (one more than layer_tops)"});
+    for (double v : lm) c.layer_materials.push_back(static_cast<int>(v));
+    c.piles.enabled = r.get_bool("piles.enabled", false, {"", "a row of rigid piles across the width (3D)"});
+    {  // read even when disabled, so that --set piles.enabled=false works on a config with piles
+      const auto pos = r.get_choice("piles.position", "middle", {"lower", "middle", "upper"},
+                                    {"", "row position on the face: lower 1/4, middle 1/2, upper 3/4 of the face"});
+      c.piles.position = pos == "lower" ? 0.25 : (pos == "middle" ? 0.5 : 0.75);
+      c.piles.diameter = r.get("piles.diameter", 0.02, Range::positive(), {"m", "pile diameter"});
+      c.piles.spacing = r.get("piles.spacing", 0.05, Range::positive(), {"m", "centre spacing across the width"});
+    }
+  }
+  if (c.scenario == ScenarioType::Column || describe) {
+    c.column_width = r.get("column.width", 0.1, Range::positive(), {"m", "column width L0 (against the left wall)"});
+    c.column_height =
+        r.get("column.height", 0.1, Range::positive(), {"m", "column height H0 (aspect ratio a = H0/L0)"});
+    c.floor_length = r.get("column.floor_length", 0.4, Range::positive(), {"m", "floor beyond the column"});
+  }
+  if (c.scenario == ScenarioType::Biaxial || describe) {
+    c.biaxial.width = r.get("biaxial.width", 0.05, Range::positive(), {"m", "specimen width"});
+    c.biaxial.height = r.get("biaxial.height", 0.1, Range::positive(), {"m", "specimen height"});
+    c.biaxial_strain_rate =
+        r.get("biaxial.strain_rate", 0.5, {}, {"1/s", "axial strain rate (> 0 compression, < 0 tension)"});
+    if (!describe && c.biaxial_strain_rate == 0.0)
+      throw InputError("must be non-zero", r.source(), "biaxial.strain_rate", "0");
+  }
+  if (is3d || describe) {
+    c.width = r.get("geometry.width", 0.1, Range::positive(), {"m", "3D width (axis y)"});
+    c.periodic_width =
+        r.get_bool("geometry.periodic", true, {"", "3D: periodic across the width (seed 001), else roller walls"});
+  }
+  const char* left_default = c.scenario == ScenarioType::Section ? "fixed" : "fixed";
+  const char* right_default = c.scenario == ScenarioType::Column ? "none" : "fixed";
+  c.left_wall = wall(r, "walls.left", left_default);
+  c.right_wall = wall(r, "walls.right", right_default);
+  c.bottom_wall = wall(r, "walls.bottom", "fixed");
+  if (c.scenario == ScenarioType::Section || describe) {
+    const auto dsm = r.get_string("section.dsm", "", {"", "DSM raster (GeoTIFF, projected CRS)"});
+    const auto poly = r.get_array("section.polyline", {}, {}, {"m", "x0, y0, x1, y1, ... in the DSM CRS"});
+    c.section.soil_thickness =
+        r.get("section.soil_thickness", 2.0, Range::positive(), {"m", "soil layer thickness below the surface"});
+    c.section.base_thickness =
+        r.get("section.base_thickness", 2.0, Range::positive(), {"m", "base below the lowest soil"});
+    c.section.soil_material = static_cast<int>(
+        r.get_int("section.soil_material", 1, Range::closed(0, 1000), {"1", "material index of the soil layer"}));
+    c.section.base_material = static_cast<int>(
+        r.get_int("section.base_material", 0, Range::closed(0, 1000), {"1", "material index of the base"}));
+    c.section.release_width = r.get("section.release_width", 10.0, Range::positive(),
+                                    {"m", "width W over which the plane-strain failed mass is spread for release.h5"});
+    if (!describe) {
+      if (dsm.empty()) throw InputError("the section scenario needs section.dsm", r.source(), "section.dsm");
+      if (poly.size() < 4 || poly.size() % 2)
+        throw InputError("needs an even number (>= 4) of coordinates x0, y0, x1, y1, ...", r.source(),
+                         "section.polyline");
+      const auto path = std::filesystem::path(dsm).is_absolute() ? std::filesystem::path(dsm) : r.base_dir() / dsm;
+      auto raster = std::make_shared<Raster>(read_raster(path));
+      std::vector<Vec2> line;
+      for (std::size_t k = 0; k < poly.size(); k += 2) line.emplace_back(poly[k], poly[k + 1]);
+      Terrain terrain(*raster);
+      c.section.profile = extract_profile(terrain, line, n.spacing);
+      c.section.crs_wkt = raster->crs_wkt;
+      c.section.dsm = raster;
+    }
+  }
+  return c;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return run_main("sph-slope", [&]() -> int {
+    CommonOptions opts;
+    boost::program_options::options_description desc(
+        "Options (all physical quantities in SI units: m, s, kg, Pa; angles in the config in degrees)");
+    add_common_options(desc, opts, "sph-slope-out");
+    if (!parse_command_line(
+            argc, argv, "sph-slope",
+            "SPH simulation of slope failure and post-failure flow of elasto-plastic soil "
+            "(2D plane strain / 3D) under gravity and earthquake shaking.\n"
+            "Usage: sph-slope --config slope.toml [--set key=value ...] [--out DIR] [--threads N] [--quiet]",
+            desc))
+      return kExitOk;
+    if (opts.help_config) {
+      auto r = ConfigReader::describe();
+      (void)read_config(r, true);
+      std::cout << ConfigReader::format_reference(r.reference());
+      return kExitOk;
+    }
+    if (opts.config.empty())
+      throw InputError("--config FILE is required (see sph-slope --help)", "command line", "--config");
+    setup_threads(opts.threads);
+    auto reader = load_config(opts);
+    RunConfig cfg = read_config(reader, false);
+    reader.finish();
+    cfg.resolved_config = reader.resolved();
+    validate(cfg);  // everything checked before the output directory is created
+    return run(cfg, opts.out, opts.quiet);
+  });
+}

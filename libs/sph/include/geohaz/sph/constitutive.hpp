@@ -1,0 +1,215 @@
+#pragma once
+/// \file constitutive.hpp
+/// Constitutive models of the SPH slope model (stress update per particle and step).
+///
+/// All models advance the Cauchy stress σ (3×3, tension positive) with the Jaumann rate
+/// (seed 001 eq. 22 / seed 002 eq. 21, Bui et al. 2008):
+///     dσ/dt = W σ − σ W + 2G ė + K tr(ε̇) I − (plastic correction)
+/// where ε̇ = ½(L + Lᵀ), W = ½(L − Lᵀ) (seed 001 eqs. 24–25), ė = ε̇ − ⅓ tr(ε̇) I,
+/// K = E / (3(1 − 2ν)), G = E / (2(1 + ν)). In 2D plane strain L is embedded in 3×3 with
+/// zero out-of-plane row/column, so σ_zz evolves with (K − 2G/3) tr(ε̇) (ε_zz = 0).
+///
+/// The plastic models use an elastic predictor followed by a return mapping (Bui et al. 2008,
+/// Int. J. Numer. Anal. Meth. Geomech. 32:1537–1570, §3):
+///   f = α_φ I1 + √J2 − k_c ,  g = α_ψ I1 + √J2 (non-associated when ψ ≠ φ),
+///   Δλ = f(σ_trial) / (9 α_φ α_ψ K + G),  σ = σ_trial − Δλ (3K α_ψ I + G s_trial/√J2_trial),
+/// i.e. the time-discrete form of the plastic term of seed 002 eqs. 21–22. Then Bui's two
+/// safeguards: tension cut-off (I1 > k_c/α_φ → hydrostatic shift to the apex) and scaling back
+/// (√J2 > k_c − α_φ I1 → s scaled by r = (k_c − α_φ I1)/√J2).
+/// The models are plain types with a static `update`; the solver picks one per run through a
+/// std::variant visited once per step, so the particle loop has no dispatch.
+
+#include <cmath>
+#include <string>
+#include <variant>
+
+#include "geohaz/core/vec.hpp"
+
+namespace geohaz::sph {
+
+/// Which Drucker–Prager fit to the Mohr–Coulomb parameters (c, φ).
+enum class DruckerPragerFit {
+  PlaneStrain,   ///< seed 002 eqs. 18–19: α = tanφ/√(9+12tan²φ), k = 3c/√(9+12tan²φ)
+  Compression3D  ///< seed 001 eq. 21: α = 2sinφ/(√3(3−sinφ)), k = 6c cosφ/(√3(3−sinφ)) (outer cone)
+};
+
+/// Drucker–Prager constants α_φ, k_c (Pa) and α_ψ.
+struct DruckerPragerConstants {
+  double alpha_phi = 0.0;
+  double kc = 0.0;
+  double alpha_psi = 0.0;
+};
+
+/// DP constants from cohesion c (Pa), friction φ and dilatancy ψ (radians) for the chosen fit.
+inline DruckerPragerConstants drucker_prager_constants(double c, double phi, double psi, DruckerPragerFit fit) {
+  DruckerPragerConstants k;
+  if (fit == DruckerPragerFit::PlaneStrain) {
+    const double tp = std::tan(phi), tq = std::tan(psi);
+    const double d = std::sqrt(9.0 + 12.0 * tp * tp);
+    k.alpha_phi = tp / d;
+    k.kc = 3.0 * c / d;
+    k.alpha_psi = tq / std::sqrt(9.0 + 12.0 * tq * tq);
+  } else {
+    const double sp = std::sin(phi), sq = std::sin(psi);
+    k.alpha_phi = 2.0 * sp / (std::sqrt(3.0) * (3.0 - sp));
+    k.kc = 6.0 * c * std::cos(phi) / (std::sqrt(3.0) * (3.0 - sp));
+    k.alpha_psi = 2.0 * sq / (std::sqrt(3.0) * (3.0 - sq));
+  }
+  return k;
+}
+
+/// Parameters of one material (SI units). Derived constants are filled by `finalise()`.
+struct MaterialParams {
+  double density = 1800.0;    ///< ρ0, kg/m³
+  double young = 1e6;         ///< E, Pa
+  double poisson = 0.3;       ///< ν, 1
+  double cohesion = 0.0;      ///< c, Pa (Drucker–Prager)
+  double friction = 0.5;      ///< φ, rad (Drucker–Prager)
+  double dilatancy = 0.0;     ///< ψ, rad (Drucker–Prager)
+  double yield_stress = 1e5;  ///< σ_y (uniaxial), Pa (von Mises: k = σ_y/√3)
+  double viscosity = 1e-3;    ///< μ, Pa·s (Newtonian fluid)
+  DruckerPragerFit fit = DruckerPragerFit::PlaneStrain;
+  // derived
+  double bulk = 0.0, shear = 0.0;  ///< K, G (Pa)
+  DruckerPragerConstants dp;
+  double p_wave_speed = 0.0;  ///< √((K + 4G/3)/ρ0), m/s
+
+  /// Compute K, G, the DP constants and the P-wave speed.
+  void finalise() {
+    bulk = young / (3.0 * (1.0 - 2.0 * poisson));
+    shear = young / (2.0 * (1.0 + poisson));
+    dp = drucker_prager_constants(cohesion, friction, dilatancy, fit);
+    p_wave_speed = std::sqrt((bulk + 4.0 * shear / 3.0) / density);
+  }
+};
+
+/// Embed a Dim×Dim velocity gradient into 3×3 (plane strain: zero out-of-plane row/column).
+template <int Dim>
+inline Mat3 embed3(const Mat<Dim>& L) noexcept {
+  if constexpr (Dim == 3) {
+    return L;
+  } else {
+    Mat3 m = Mat3::Zero();
+    m.template topLeftCorner<2, 2>() = L;
+    return m;
+  }
+}
+
+/// Elastic trial stress: σ + Δt (Wσ − σW + 2G ė + K tr(ε̇) I) (Jaumann rate, Hooke's law).
+inline Mat3 elastic_trial(const Mat3& sigma, const Mat3& L, double dt, double K, double G) noexcept {
+  const Mat3 D = 0.5 * (L + L.transpose());
+  const Mat3 W = 0.5 * (L - L.transpose());
+  const double trD = D.trace();
+  Mat3 dev = D;
+  dev.diagonal().array() -= trD / 3.0;
+  Mat3 rate = W * sigma - sigma * W + 2.0 * G * dev;
+  rate.diagonal().array() += K * trD;
+  return sigma + dt * rate;
+}
+
+/// Drucker–Prager return mapping with tension cut-off and scaling back (Bui et al. 2008).
+/// Modifies sigma in place and returns Δλ (≥ 0). α_φ = α_ψ = 0 gives von Mises with k_c = σ_y/√3.
+inline double drucker_prager_return(Mat3& sigma, double alpha_phi, double alpha_psi, double kc, double K,
+                                    double G) noexcept {
+  double I1 = sigma.trace();
+  Mat3 s = sigma;
+  s.diagonal().array() -= I1 / 3.0;
+  double sq = std::sqrt(0.5 * s.squaredNorm());
+  const double f = alpha_phi * I1 + sq - kc;
+  double dl = 0.0;
+  if (f > 0.0) {
+    dl = f / (9.0 * alpha_phi * alpha_psi * K + G);
+    if (sq > G * dl && sq > 0.0) {
+      // Radial return onto the cone (exact for the DP cone away from the apex).
+      s *= (sq - G * dl) / sq;
+      I1 -= 9.0 * K * alpha_psi * dl;
+      sq -= G * dl;
+    } else {
+      // The return passes the apex: the stress goes to the apex.
+      s.setZero();
+      sq = 0.0;
+      I1 = alpha_phi > 0.0 ? kc / alpha_phi : I1;
+    }
+  }
+  // Tension cut-off (Bui 2008 eq. 33): no hydrostatic tension beyond the apex.
+  if (alpha_phi > 0.0 && I1 > kc / alpha_phi) I1 = kc / alpha_phi;
+  // Scaling back (Bui 2008 eq. 34): put the deviator back on the surface if it is outside.
+  const double limit = kc - alpha_phi * I1;
+  if (sq > limit && sq > 0.0) {
+    s *= (limit > 0.0 ? limit : 0.0) / sq;
+  }
+  sigma = s;
+  sigma.diagonal().array() += I1 / 3.0;
+  return dl;
+}
+
+/// Yield function f = α_φ I1 + √J2 − k_c (Pa), for tests and diagnostics.
+inline double drucker_prager_yield(const Mat3& sigma, double alpha_phi, double kc) noexcept {
+  const double I1 = sigma.trace();
+  Mat3 s = sigma;
+  s.diagonal().array() -= I1 / 3.0;
+  return alpha_phi * I1 + std::sqrt(0.5 * s.squaredNorm()) - kc;
+}
+
+/// Linear elasticity with the Jaumann rate (Hooke's law, K and G from E and ν).
+struct LinearElastic {
+  static constexpr const char* name = "linear_elastic";
+  static double update(Mat3& sigma, const Mat3& L, double dt, double /*rho*/, const MaterialParams& p) noexcept {
+    sigma = elastic_trial(sigma, L, dt, p.bulk, p.shear);
+    return 0.0;
+  }
+};
+
+/// Elastic–perfectly plastic von Mises: f = √J2 − σ_y/√3, associated flow, radial return.
+struct VonMises {
+  static constexpr const char* name = "von_mises";
+  static double update(Mat3& sigma, const Mat3& L, double dt, double /*rho*/, const MaterialParams& p) noexcept {
+    sigma = elastic_trial(sigma, L, dt, p.bulk, p.shear);
+    return drucker_prager_return(sigma, 0.0, 0.0, p.yield_stress / std::sqrt(3.0), p.bulk, p.shear);
+  }
+};
+
+/// Elastic–perfectly plastic Drucker–Prager, non-associated (dilatancy ψ), Jaumann rate,
+/// seed 002 eqs. 17–22 / seed 001 eqs. 18–23, return mapping after Bui et al. (2008).
+struct DruckerPrager {
+  static constexpr const char* name = "drucker_prager";
+  static double update(Mat3& sigma, const Mat3& L, double dt, double /*rho*/, const MaterialParams& p) noexcept {
+    sigma = elastic_trial(sigma, L, dt, p.bulk, p.shear);
+    return drucker_prager_return(sigma, p.dp.alpha_phi, p.dp.alpha_psi, p.dp.kc, p.bulk, p.shear);
+  }
+};
+
+/// Weakly compressible Newtonian fluid: σ = −p I + 2μ ė, p = K (ρ/ρ0 − 1) (linear equation of
+/// state with bulk modulus K = E/(3(1−2ν))). Used for the viscous simple-shear check of seed 000.
+struct NewtonianFluid {
+  static constexpr const char* name = "newtonian_fluid";
+  static double update(Mat3& sigma, const Mat3& L, double /*dt*/, double rho, const MaterialParams& p) noexcept {
+    const Mat3 D = 0.5 * (L + L.transpose());
+    Mat3 dev = D;
+    dev.diagonal().array() -= D.trace() / 3.0;
+    sigma = 2.0 * p.viscosity * dev;
+    sigma.diagonal().array() -= p.bulk * (rho / p.density - 1.0);
+    return 0.0;
+  }
+};
+
+/// The run-time choice of model (one per run; all materials of a run share the model type).
+using ConstitutiveModel = std::variant<LinearElastic, VonMises, DruckerPrager, NewtonianFluid>;
+
+/// Model from its name ("linear_elastic", "von_mises", "drucker_prager", "newtonian_fluid");
+/// returns false for an unknown name.
+inline bool constitutive_model_from_name(const std::string& name, ConstitutiveModel& out) {
+  if (name == LinearElastic::name)
+    out = LinearElastic{};
+  else if (name == VonMises::name)
+    out = VonMises{};
+  else if (name == DruckerPrager::name)
+    out = DruckerPrager{};
+  else if (name == NewtonianFluid::name)
+    out = NewtonianFluid{};
+  else
+    return false;
+  return true;
+}
+
+}  // namespace geohaz::sph

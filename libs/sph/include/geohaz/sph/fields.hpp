@@ -1,0 +1,141 @@
+#pragma once
+/// \file fields.hpp
+/// Per-particle fields of the SPH slope model and the particle store that holds them all.
+///
+/// Every per-particle quantity (physical state and per-step scratch alike) is a field of the one
+/// store, so reordering by cell, restart and output can never forget one (STYLE.md §1).
+/// Stress is always a 3×3 tensor: in 2D plane strain the out-of-plane normal stress σ_zz is
+/// non-zero (ε_zz = 0) and is needed for the invariants I1 and J2 of the yield functions.
+/// Sign convention: tension positive (seed 002: σ' is negative in compression).
+
+#include <cstdint>
+
+#include "geohaz/core/particles.hpp"
+#include "geohaz/core/vec.hpp"
+
+namespace geohaz::sph {
+
+/// What a particle is. Soil particles carry the continuum; the others are boundary particles
+/// (Bui et al. 2008) whose velocity and stress are extrapolated from the soil each step.
+enum class Kind : std::uint8_t {
+  Soil = 0,
+  FixedWall = 1,   ///< full fixity (no slip): ghost velocity 2 v_wall − ⟨v⟩, stress ⟨σ⟩
+  RollerWall = 2,  ///< free roller (free slip): normal velocity mirrored, shear stress mirrored
+  Pile = 3         ///< rigid pile: treated as full fixity
+};
+
+/// Displacement since the start of the main phase (after geostatic loading), m.
+template <int Dim>
+struct Displacement {
+  using type = Vec<Dim>;
+  static constexpr const char* label = "displacement";
+  static constexpr const char* unit = "m";
+};
+/// Cauchy stress (3×3, tension positive), Pa.
+struct Stress {
+  using type = Mat3;
+  static constexpr const char* label = "stress";
+  static constexpr const char* unit = "Pa";
+};
+/// Velocity gradient L = ∂v/∂x (scratch, recomputed each step), 1/s.
+template <int Dim>
+struct VelocityGradient {
+  using type = Mat<Dim>;
+  static constexpr const char* label = "velocity_gradient";
+  static constexpr const char* unit = "1/s";
+};
+/// Density from the continuity equation, kg/m³.
+struct Density {
+  using type = double;
+  static constexpr const char* label = "density";
+  static constexpr const char* unit = "kg/m^3";
+};
+/// dρ/dt (scratch), kg/m³/s.
+struct DensityRate {
+  using type = double;
+  static constexpr const char* label = "density_rate";
+  static constexpr const char* unit = "kg/m^3/s";
+};
+/// Material index (soil: into the material table; boundary: the material it was built next to).
+struct MaterialId {
+  using type = std::int32_t;
+  static constexpr const char* label = "material_id";
+  static constexpr const char* unit = "1";
+};
+/// Kind (see enum Kind), stored as uint8.
+struct ParticleKind {
+  using type = std::uint8_t;
+  static constexpr const char* label = "kind";
+  static constexpr const char* unit = "1";
+};
+/// Outward unit normal of the wall a boundary particle belongs to (zero for soil and piles).
+template <int Dim>
+struct WallNormal {
+  using type = Vec<Dim>;
+  static constexpr const char* label = "wall_normal";
+  static constexpr const char* unit = "1";
+};
+/// Accumulated plastic multiplier Σ Δλ (equals the engineering plastic shear strain for the √J2 potential).
+struct PlasticStrain {
+  using type = double;
+  static constexpr const char* label = "plastic_strain";
+  static constexpr const char* unit = "1";
+};
+/// 1 when the particle is stress-free ("meeting and parting", seed 000), else 0.
+struct StressFree {
+  using type = std::uint8_t;
+  static constexpr const char* label = "stress_free";
+  static constexpr const char* unit = "1";
+};
+/// Kernel-summation density Σ_j m_j W_ij (incl. self), used for the stress-vanishing test, kg/m³.
+struct SummationDensity {
+  using type = double;
+  static constexpr const char* label = "summation_density";
+  static constexpr const char* unit = "kg/m^3";
+};
+/// Velocity seen by neighbours: soil = own velocity; boundary = extrapolated ghost velocity, m/s.
+template <int Dim>
+struct InteractionVelocity {
+  using type = Vec<Dim>;
+  static constexpr const char* label = "interaction_velocity";
+  static constexpr const char* unit = "m/s";
+};
+/// XSPH velocity correction Σ (m_j/ρ_j)(v_j − v_i) W_ij (scratch), m/s.
+template <int Dim>
+struct XsphCorrection {
+  using type = Vec<Dim>;
+  static constexpr const char* label = "xsph_correction";
+  static constexpr const char* unit = "m/s";
+};
+/// Gray–Monaghan artificial stress R_i/ρ_i² in the simulation plane (scratch), m²/s².
+template <int Dim>
+struct ArtificialStress {
+  using type = Mat<Dim>;
+  static constexpr const char* label = "artificial_stress";
+  static constexpr const char* unit = "m^2/s^2";
+};
+
+/// In-plane stress divided by ρ² (scratch for the momentum sum), m²/s².
+template <int Dim>
+struct StressOverDensitySquared {
+  using type = Mat<Dim>;
+  static constexpr const char* label = "stress_over_density_squared";
+  static constexpr const char* unit = "m^2/s^2";
+};
+/// Position when the neighbour list was last built (Verlet skin bookkeeping), m.
+template <int Dim>
+struct PositionAtBuild {
+  using type = Vec<Dim>;
+  static constexpr const char* label = "position_at_build";
+  static constexpr const char* unit = "m";
+};
+
+/// The store of the SPH model.
+template <int Dim>
+using SphStore =
+    ParticleStore<Position<Dim>, Velocity<Dim>, Acceleration<Dim>, Displacement<Dim>, Stress, VelocityGradient<Dim>,
+                  Density, DensityRate, Mass, MaterialId, ParticleKind, WallNormal<Dim>, PlasticStrain, StressFree,
+                  SummationDensity, InteractionVelocity<Dim>, XsphCorrection<Dim>, ArtificialStress<Dim>,
+                  StressOverDensitySquared<Dim>, PositionAtBuild<Dim>, ParticleId>;
+
+}  // namespace geohaz::sph

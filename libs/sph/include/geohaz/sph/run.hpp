@@ -1,0 +1,98 @@
+#pragma once
+/// \file run.hpp
+/// A complete sph-slope run from a typed configuration: build the scenario, apply gravity
+/// gradually (geostatic phase), run the main phase with optional earthquake loading, and write the
+/// outputs (snapshots, time series, free surface, slip surface, summary, quick-look PNGs, failed-mass
+/// release file for debris-runout per docs/handoff-spec). The app fills RunConfig from TOML; this
+/// library never sees the config reader.
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "geohaz/core/raster.hpp"
+#include "geohaz/sph/constitutive.hpp"
+#include "geohaz/sph/loading.hpp"
+#include "geohaz/sph/scenario.hpp"
+#include "geohaz/sph/solver.hpp"
+
+namespace geohaz::sph {
+
+/// Where the particles come from.
+enum class ScenarioType { Slope, Column, Biaxial, Section };
+
+/// Pile rows of seed 001 Fig. 17 (3D): one row across the width at a position along the face.
+struct PileRows {
+  bool enabled = false;
+  double position =
+      0.5;  ///< fraction along the face from the toe (0) to the crest edge (1): lower 0.25, middle 0.5, upper 0.75
+  double diameter = 0.02;  ///< m
+  double spacing = 0.05;   ///< centre spacing across the width (m)
+};
+
+/// A DSM cross-section (2D) prepared by the app: the profile and its map geometry.
+struct SectionInput {
+  std::vector<ProfilePoint> profile;  ///< s (m along the polyline), x, y (map), z (m)
+  std::string crs_wkt;
+  std::shared_ptr<const Raster> dsm;  ///< for release_thickness.tif (may be null)
+  double soil_thickness = 2.0;        ///< m: soil layer (material `soil_material`) below the surface
+  double base_thickness = 2.0;        ///< m: base material below the lowest point of the soil layer
+  int soil_material = 1, base_material = 0;
+  double release_width = 10.0;  ///< W (m): plane-strain particles are spread over this width
+};
+
+/// Everything a run needs (SI units; angles already in radians).
+struct RunConfig {
+  int dimension = 2;
+  ScenarioType scenario = ScenarioType::Slope;
+  ConstitutiveModel model = DruckerPrager{};
+  std::vector<MaterialParams> materials;
+  std::vector<std::string> material_names;
+
+  // Geometry.
+  SlopeGeometry slope;
+  WallType left_wall = WallType::Fixed, right_wall = WallType::Fixed, bottom_wall = WallType::Fixed;
+  double width = 0.1;  ///< 3D width (m)
+  bool periodic_width = true;
+  std::vector<double> layer_tops;  ///< m (elevations), slope scenario
+  std::vector<int> layer_materials;
+  PileRows piles;
+  double column_width = 0.1, column_height = 0.1, floor_length = 0.4;  ///< m
+  BiaxialGeometry biaxial;
+  double biaxial_strain_rate = 0.5;  ///< 1/s, > 0 compression, < 0 tension
+  SectionInput section;
+
+  // Numerics (copied into SolverSettings).
+  SolverSettings<3> numerics;  ///< Dim-independent scalars only are used
+  // Geostatic phase.
+  bool geostatic = true;
+  double geostatic_duration = 0.0;  ///< s; 0 → 20 H / c_p
+  double geostatic_damping = 0.7;
+  bool geostatic_elastic = true;
+  double rest_tolerance = 0.01;  ///< at rest: max |v| < tol·√(g H)
+  // Main phase.
+  double end_time = 1.0;                   ///< s
+  double output_interval = 0.01;           ///< s (time series)
+  double snapshot_interval = 0.1;          ///< s (0: first and last only)
+  std::vector<double> velocity_png_times;  ///< s
+  double rest_speed = 0.005;               ///< m/s; "at rest" for time-to-rest
+  bool stop_at_rest = false;
+  double failed_threshold = 0.01;  ///< m: displacement above which soil counts as failed
+  double bulking_factor = 1.0;
+  bool write_release = true;      ///< section scenario: release.h5 (+ release_thickness.tif)
+  std::filesystem::path restart;  ///< snapshot file to restart from ("" none)
+
+  std::string resolved_config;  ///< TOML text of the resolved config (written and stored in HDF5)
+  std::string config_source;    ///< config file name
+};
+
+/// Check the cross-field consistency of a config that the per-key ranges cannot express and build
+/// the particles (dry run). Throws InputError naming the key. Called before any output is created.
+void validate(const RunConfig& cfg);
+
+/// Run and write everything into `out` (created). Returns the process exit code (0).
+/// SimulationError propagates after the time series so far has been written.
+int run(const RunConfig& cfg, const std::filesystem::path& out, bool quiet);
+
+}  // namespace geohaz::sph

@@ -1,0 +1,159 @@
+#pragma once
+/// \file solver.hpp
+/// The SPH solver for elasto-plastic soil (2D plane strain and 3D), after Bui et al. (2008) and
+/// seeds 000–002. One step, in the order a reader follows in solver.cpp:
+///   0. neighbour list (rebuilt every step, or with a Verlet skin only when a particle has moved more
+///      than half the skin; store reordered by cell every `reorder_every` steps at a rebuild);
+///   1. boundary particles get ghost velocity and stress from the soil around them (Shepard
+///      interpolation; full fixity: v_B = 2v_wall − ⟨v⟩, σ_B = ⟨σ − ρ(ḡ·x_Bj) I⟩; roller: normal
+///      velocity and shear stress mirrored about the wall);
+///   2. velocity gradient L_i = Σ_j (m_j/ρ_j)(v_j − v_i) ⊗ ∇_i W_ij (seed 001 eqs. 24–25), continuity
+///      dρ_i/dt = Σ_j m_j (v_i − v_j)·∇_i W_ij (seed 001 eq. 11), kernel-summation density and the
+///      XSPH term Σ_j (m_j/ρ_j)(v_j − v_i) W_ij (seed 000);
+///   3. density and stress update (constitutive model chosen once per step), stress vanishing
+///      below a summation-density threshold (seed 000 "meeting and parting"), artificial stress
+///      R = −ε_as σ_a/ρ² on tensile principal stresses (Gray & Monaghan 2001);
+///   4. momentum (seed 002 eq. 12): a_i = Σ_j m_j (σ_i/ρ_i² + σ_j/ρ_j² − Π_ij I + f_ij^n (R_i + R_j)) ∇_i W_ij + ḡ
+///      with Monaghan's viscosity Π_ij (sound speed = P-wave speed √((K+4G/3)/ρ0)), f_ij = W(r)/W(Δx),
+///      ḡ = g + a_earthquake (seed 002 eqs. 25–26), Cundall local damping −ζ|a_α| sign(v_α) (seed 002 eq. 14);
+///   5. leap-frog (kick–drift: v^{n+½} = v^{n−½} + Δt a^n, x^{n+1} = x^n + Δt (v^{n+½} + ε ΔvXSPH));
+///   6. Δt = min(C_cfl h/(c_p + |v|max), C_f √(h/|a|max), 0.125 ρ h²/μ (fluid), Δt_max).
+/// Units: SI throughout (m, s, kg, Pa).
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "geohaz/core/neighbours.hpp"
+#include "geohaz/sph/constitutive.hpp"
+#include "geohaz/sph/fields.hpp"
+#include "geohaz/sph/loading.hpp"
+
+namespace geohaz::sph {
+
+/// Smoothing kernel choice (resolved once per step to a template parameter).
+enum class KernelChoice { CubicSpline, WendlandC2 };
+
+/// Numerical settings of a run (all SI).
+template <int Dim>
+struct SolverSettings {
+  double spacing = 0.01;  ///< initial particle spacing Δx (m)
+  double h_factor = 1.2;  ///< h = h_factor·Δx (1.2–1.5)
+  KernelChoice kernel = KernelChoice::CubicSpline;
+  double gravity = 9.81;              ///< |g| (m/s²), acting along −axis Dim−1
+  double cfl = 0.2;                   ///< C_cfl
+  double force_factor = 0.25;         ///< C_f
+  double dt_max = 1e-3;               ///< s
+  double dt_min = 1e-10;              ///< s; smaller → SimulationError (Δt collapse)
+  double viscosity_alpha = 0.1;       ///< Monaghan α_Π
+  double viscosity_beta = 0.0;        ///< Monaghan β_Π
+  double artificial_stress = 0.3;     ///< ε_as (0 switches it off)
+  double artificial_stress_n = 0.0;   ///< exponent n; 0 → W(0)/W(Δx)
+  double xsph = 0.0;                  ///< ε of the XSPH correction (seed 000), 0 = off
+  double damping = 0.0;               ///< Cundall ζ in the main phase
+  double stress_free_fraction = 0.0;  ///< stress vanishes where Σ m W < fraction·ρ0 (0 = off)
+  int reorder_every = 20;             ///< steps between cell reorderings of the store
+  /// Verlet skin in units of h: the list is built with cutoff 2h + skin·h and rebuilt when a particle
+  /// has moved more than skin·h/2 (or at a reordering). 0 rebuilds the list every step.
+  double neighbour_skin = 0.0;
+  /// Soil particles closer than this many Δx to a boundary particle are pushed back with
+  /// a = c_p² ((r0/r)⁴ − (r0/r)²) x/r² (Monaghan 1994 form); 0 switches it off.
+  double wall_repulsion = 0.5;
+  Periodicity<Dim> periodic;                       ///< periodic axes (3D: the width axis 1)
+  Vec<Dim> domain_lo = Vec<Dim>::Constant(-1e30);  ///< a particle leaving this box → SimulationError
+  Vec<Dim> domain_hi = Vec<Dim>::Constant(1e30);
+  EarthquakeLoading earthquake;  ///< applied in the main phase (time from 0 after the geostatic phase)
+};
+
+/// Outcome of the gravity-loading (geostatic) phase.
+struct GeostaticReport {
+  double duration = 0.0;  ///< s
+  std::int64_t steps = 0;
+  double max_speed = 0.0;         ///< max |v| at the end (m/s)
+  double max_stress_error = 0.0;  ///< unused by the solver (filled by callers that know σ_v)
+};
+
+/// Per-step statistics (cheap, gathered in the integration loop).
+struct StepStats {
+  double max_speed = 0.0;          ///< m/s (soil)
+  double max_acceleration = 0.0;   ///< m/s² (soil)
+  double plastic_increment = 0.0;  ///< Σ Δλ of the step over soil particles
+};
+
+template <int Dim>
+class SphSolver {
+ public:
+  /// Take ownership of the particles. Materials are indexed by MaterialId; they are finalised here.
+  /// Throws InputError when a soil particle names a missing material or settings are inconsistent.
+  SphSolver(SphStore<Dim> store, std::vector<MaterialParams> materials, ConstitutiveModel model,
+            SolverSettings<Dim> settings);
+
+  SphStore<Dim>& store() noexcept { return store_; }
+  const SphStore<Dim>& store() const noexcept { return store_; }
+  const std::vector<MaterialParams>& materials() const noexcept { return materials_; }
+  const SolverSettings<Dim>& settings() const noexcept { return settings_; }
+  double smoothing_length() const noexcept { return h_; }
+  double time() const noexcept { return time_; }
+  std::int64_t step_count() const noexcept { return step_; }
+  double dt() const noexcept { return dt_; }
+  const StepStats& last_stats() const noexcept { return stats_; }
+  /// Name of the constitutive model in use.
+  std::string model_name() const;
+
+  /// Set the simulated time (restart).
+  void set_time(double t) noexcept { time_ = t; }
+  /// Scale of gravity (0..1) used by the next steps.
+  void set_gravity_factor(double f) noexcept { gravity_factor_ = f; }
+  /// Whether earthquake loading is applied (main phase only).
+  void set_earthquake_enabled(bool on) noexcept { earthquake_on_ = on; }
+  /// Cundall damping ζ used by the next steps.
+  void set_damping(double zeta) noexcept { damping_ = zeta; }
+
+  /// Advance one step.
+  void step();
+
+  /// Gravity loading: ramp gravity linearly from 0 to g over the first half of `duration`, hold
+  /// it for the second half, with local damping ζ = `damping` and, when `elastic` is true, the
+  /// linear-elastic model (the soil's own model is restored afterwards). Then velocities,
+  /// displacements and plastic strain are reset and time is set to 0. `on_step` (optional) is
+  /// called after every step.
+  GeostaticReport apply_gravity_gradually(double duration, double damping, bool elastic,
+                                          const std::function<void()>& on_step = {});
+
+  /// Number of neighbour-list builds so far.
+  std::int64_t neighbour_builds() const noexcept { return builds_; }
+  /// Memory actually held per particle (store + neighbour list), bytes.
+  double bytes_per_particle() const;
+
+ private:
+  template <class Kernel, class Model>
+  void step_impl(const Model& model);
+  void check_state() const;
+  void update_dt();
+
+  SphStore<Dim> store_;
+  std::vector<MaterialParams> materials_;
+  ConstitutiveModel model_;
+  SolverSettings<Dim> settings_;
+  NeighbourList<Dim> list_;
+  double h_ = 0.0;
+  double time_ = 0.0;
+  double dt_ = 0.0;
+  std::int64_t step_ = 0;
+  double gravity_factor_ = 1.0;
+  bool earthquake_on_ = true;
+  double damping_ = 0.0;
+  double max_wave_speed_ = 0.0;
+  double max_kinematic_viscosity_ = 0.0;
+  double max_drift_ = 0.0;  // largest displacement since the last neighbour build (m)
+  std::int64_t last_reorder_ = -1000000;
+  std::int64_t builds_ = 0;
+  bool fluid_ = false;
+  StepStats stats_;
+};
+
+extern template class SphSolver<2>;
+extern template class SphSolver<3>;
+
+}  // namespace geohaz::sph

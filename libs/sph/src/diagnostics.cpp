@@ -1,0 +1,123 @@
+#include "geohaz/sph/diagnostics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace geohaz::sph {
+
+namespace {
+constexpr std::uint8_t kSoil = static_cast<std::uint8_t>(Kind::Soil);
+}
+
+template <int Dim>
+SeriesRow series_row(const SphStore<Dim>& s, const DiagnosticFrame& f) {
+  const auto& x = s.template get<Position<Dim>>();
+  const auto& v = s.template get<Velocity<Dim>>();
+  const auto& u = s.template get<Displacement<Dim>>();
+  const auto& m = s.template get<Mass>();
+  const auto& kind = s.template get<ParticleKind>();
+  const auto& ep = s.template get<PlasticStrain>();
+  const auto& sf = s.template get<StressFree>();
+  SeriesRow r;
+  r.front = f.toe_x;
+  r.tip = f.toe_x;
+  std::map<long, double> top;  // bin → highest particle top above base_top
+  std::size_t count = 0, plastic = 0;
+  double sum_speed = 0.0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (kind[i] != kSoil) continue;
+    ++count;
+    const double sp = v[i].norm();
+    r.max_speed = std::max(r.max_speed, sp);
+    sum_speed += sp;
+    r.kinetic_energy += 0.5 * m[i] * sp * sp;
+    r.max_displacement = std::max(r.max_displacement, u[i].norm());
+    if (ep[i] > f.plastic_threshold) ++plastic;
+    const double z0 = x[i][Dim - 1] - u[i][Dim - 1];
+    if (!sf[i] && z0 > f.base_top) {
+      r.tip = std::max(r.tip, x[i][0] + 0.5 * f.spacing);
+      const long b = static_cast<long>(std::floor(x[i][0] / f.spacing));
+      const double t = x[i][Dim - 1] + 0.5 * f.spacing - f.base_top;
+      auto [it, inserted] = top.emplace(b, t);
+      if (!inserted) it->second = std::max(it->second, t);
+    }
+  }
+  for (const auto& [b, t] : top)
+    if (t >= f.front_min_layers * f.spacing * (1.0 - 1e-9))
+      r.front = std::max(r.front, (static_cast<double>(b) + 1.0) * f.spacing);
+  // The front is measured at the particle's outer edge; the initial toe particle sits Δx/2 inside.
+  r.front = std::max(r.front, f.toe_x);
+  r.tip = std::max(r.tip, r.front);
+  r.runout = r.front - f.toe_x;
+  r.normalised_runout = r.runout / f.base_length;
+  if (count) {
+    r.mean_speed = sum_speed / static_cast<double>(count);
+    r.plastic_fraction = static_cast<double>(plastic) / static_cast<double>(count);
+  }
+  return r;
+}
+
+template <int Dim>
+std::vector<std::array<double, 2>> free_surface(const SphStore<Dim>& s, double dx) {
+  const auto& x = s.template get<Position<Dim>>();
+  const auto& kind = s.template get<ParticleKind>();
+  const auto& sf = s.template get<StressFree>();
+  std::map<long, double> top;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (kind[i] != kSoil || sf[i]) continue;
+    const long b = static_cast<long>(std::floor(x[i][0] / dx));
+    const double z = x[i][Dim - 1] + 0.5 * dx;
+    auto [it, inserted] = top.emplace(b, z);
+    if (!inserted) it->second = std::max(it->second, z);
+  }
+  std::vector<std::array<double, 2>> out;
+  out.reserve(top.size());
+  for (auto& [b, z] : top) out.push_back({(static_cast<double>(b) + 0.5) * dx, z});
+  return out;
+}
+
+template <int Dim>
+std::vector<std::array<double, 2>> slip_surface(const SphStore<Dim>& s, double dx, double threshold) {
+  const auto& x = s.template get<Position<Dim>>();
+  const auto& u = s.template get<Displacement<Dim>>();
+  const auto& kind = s.template get<ParticleKind>();
+  std::map<long, double> low;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (kind[i] != kSoil || u[i].norm() <= threshold) continue;
+    const Vec<Dim> x0 = x[i] - u[i];
+    const long b = static_cast<long>(std::floor(x0[0] / dx));
+    const double z = x0[Dim - 1] - 0.5 * dx;
+    auto [it, inserted] = low.emplace(b, z);
+    if (!inserted) it->second = std::min(it->second, z);
+  }
+  std::vector<std::array<double, 2>> out;
+  for (auto& [b, z] : low) out.push_back({(static_cast<double>(b) + 0.5) * dx, z});
+  return out;
+}
+
+template <int Dim>
+FailedMass failed_mass(const SphStore<Dim>& s, const std::vector<double>& rho0, double threshold) {
+  const auto& u = s.template get<Displacement<Dim>>();
+  const auto& m = s.template get<Mass>();
+  const auto& kind = s.template get<ParticleKind>();
+  const auto& mat = s.template get<MaterialId>();
+  FailedMass f;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (kind[i] != kSoil || u[i].norm() <= threshold) continue;
+    ++f.count;
+    f.volume += m[i] / rho0[static_cast<std::size_t>(mat[i])];
+  }
+  return f;
+}
+
+template SeriesRow series_row<2>(const SphStore<2>&, const DiagnosticFrame&);
+template SeriesRow series_row<3>(const SphStore<3>&, const DiagnosticFrame&);
+template std::vector<std::array<double, 2>> free_surface<2>(const SphStore<2>&, double);
+template std::vector<std::array<double, 2>> free_surface<3>(const SphStore<3>&, double);
+template std::vector<std::array<double, 2>> slip_surface<2>(const SphStore<2>&, double, double);
+template std::vector<std::array<double, 2>> slip_surface<3>(const SphStore<3>&, double, double);
+template FailedMass failed_mass<2>(const SphStore<2>&, const std::vector<double>&, double);
+template FailedMass failed_mass<3>(const SphStore<3>&, const std::vector<double>&, double);
+
+}  // namespace geohaz::sph

@@ -1,0 +1,603 @@
+#include "geohaz/sph/run.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iomanip>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "geohaz/core/errors.hpp"
+#include "geohaz/core/output.hpp"
+#include "geohaz/core/progress.hpp"
+#include "geohaz/core/snapshot.hpp"
+#include "geohaz/sph/diagnostics.hpp"
+
+namespace geohaz::sph {
+
+namespace {
+
+constexpr std::uint8_t kSoil = static_cast<std::uint8_t>(Kind::Soil);
+
+const char* scenario_name(ScenarioType t) {
+  switch (t) {
+    case ScenarioType::Slope:
+      return "slope";
+    case ScenarioType::Column:
+      return "column";
+    case ScenarioType::Biaxial:
+      return "biaxial";
+    case ScenarioType::Section:
+      return "section";
+  }
+  return "?";
+}
+
+template <int Dim>
+struct Built {
+  Scenario<Dim> sc;
+  DiagnosticFrame frame;
+};
+
+/// The particles of the configured scenario.
+template <int Dim>
+Built<Dim> build(const RunConfig& c) {
+  std::vector<double> rho;
+  for (const auto& m : c.materials) rho.push_back(m.density);
+  const double dx = c.numerics.spacing, hf = c.numerics.h_factor;
+  Built<Dim> b;
+  switch (c.scenario) {
+    case ScenarioType::Slope: {
+      ProfileDomain d = c.slope.profile();
+      d.left = c.left_wall;
+      d.right = c.right_wall;
+      d.bottom = c.bottom_wall;
+      d.width = c.width;
+      d.periodic_width = c.periodic_width;
+      if (!c.layer_materials.empty()) {
+        d.layer_tops = c.layer_tops;
+        d.layer_materials = c.layer_materials;
+      } else {
+        d.layer_tops.clear();
+        d.layer_materials.clear();
+      }
+      if (c.piles.enabled) {
+        if (Dim != 3)
+          throw InputError("pile rows need dimension = 3 (a pile row in plane strain is a wall)", c.config_source,
+                           "piles.enabled", "true");
+        const double xp = c.slope.toe_x() - c.piles.position * c.slope.gradient * c.slope.height;
+        for (double y = 0.5 * c.piles.spacing; y < c.width; y += c.piles.spacing)
+          d.piles.push_back({xp, y, c.piles.diameter});
+        d.pile_top_margin = 2.0 * dx;
+      }
+      b.sc = build_profile<Dim>(d, dx, rho, hf);
+      b.frame.toe_x = c.slope.toe_x();
+      b.frame.base_length = c.slope.base_length();
+      b.frame.base_top = c.slope.base_thickness;
+      break;
+    }
+    case ScenarioType::Column: {
+      ProfileDomain d;
+      const double a = c.column_width, H = c.column_height;
+      d.surface = {{0.0, H}, {a, H}, {a, 0.0}, {a + c.floor_length, 0.0}};
+      d.x_left = 0.0;
+      d.x_right = a + c.floor_length;
+      d.left = c.left_wall;
+      d.right = c.right_wall;
+      d.bottom = c.bottom_wall;
+      d.width = c.width;
+      d.periodic_width = c.periodic_width;
+      b.sc = build_profile<Dim>(d, dx, rho, hf);
+      b.frame.toe_x = a;
+      b.frame.base_length = a;
+      b.frame.base_top = 0.0;
+      break;
+    }
+    case ScenarioType::Biaxial: {
+      b.sc = build_biaxial<Dim>(c.biaxial, dx, rho.front(), hf);
+      b.frame.toe_x = c.biaxial.width;
+      b.frame.base_length = c.biaxial.width;
+      b.frame.base_top = -1e300;
+      break;
+    }
+    case ScenarioType::Section: {
+      if (Dim != 2)
+        throw InputError("the DSM cross-section scenario is 2D (plane strain)", c.config_source, "run.dimension", "3");
+      const auto& P = c.section.profile;
+      if (P.size() < 2)
+        throw InputError("the cross-section profile has fewer than 2 points", c.config_source, "section.polyline");
+      ProfileDomain d;
+      double zmin = 1e300;
+      for (const auto& p : P) {
+        d.surface.push_back({p.s, p.z});
+        zmin = std::min(zmin, p.z);
+      }
+      d.x_left = P.front().s;
+      d.x_right = P.back().s;
+      d.z_bottom = zmin - c.section.soil_thickness - c.section.base_thickness;
+      d.left = c.left_wall;
+      d.right = c.right_wall;
+      d.bottom = c.bottom_wall;
+      d.layer_tops.clear();
+      d.layer_materials = {c.section.base_material};
+      d.surface_layer_depth = c.section.soil_thickness;
+      d.surface_material = c.section.soil_material;
+      b.sc = build_profile<Dim>(d, dx, rho, hf);
+      b.frame.toe_x = d.x_left;  // run-out on a section: reported as the largest horizontal displacement
+      b.frame.base_length = d.x_right - d.x_left;
+      b.frame.base_top = 1e300;  // no particle counts for the front
+      break;
+    }
+  }
+  b.frame.spacing = dx;
+  return b;
+}
+
+template <int Dim>
+SolverSettings<Dim> settings_for(const RunConfig& c, const Scenario<Dim>& sc) {
+  const auto& n = c.numerics;
+  SolverSettings<Dim> s;
+  s.spacing = n.spacing;
+  s.h_factor = n.h_factor;
+  s.kernel = n.kernel;
+  s.gravity = c.scenario == ScenarioType::Biaxial ? 0.0 : n.gravity;
+  s.cfl = n.cfl;
+  s.force_factor = n.force_factor;
+  s.dt_max = n.dt_max;
+  s.dt_min = n.dt_min;
+  s.viscosity_alpha = n.viscosity_alpha;
+  s.viscosity_beta = n.viscosity_beta;
+  s.artificial_stress = n.artificial_stress;
+  s.artificial_stress_n = n.artificial_stress_n;
+  s.xsph = n.xsph;
+  s.damping = n.damping;
+  s.stress_free_fraction = n.stress_free_fraction;
+  s.reorder_every = n.reorder_every;
+  s.neighbour_skin = n.neighbour_skin;
+  s.wall_repulsion = n.wall_repulsion;
+  s.periodic = sc.periodic;
+  s.domain_lo = sc.domain_lo;
+  s.domain_hi = sc.domain_hi;
+  s.earthquake = n.earthquake;
+  return s;
+}
+
+template <class Tag, class Store>
+void add_view(std::vector<FieldView>& v, const Store& s) {
+  using Tr = FieldTraits<typename Tag::type>;
+  const auto& a = s.template get<Tag>();
+  v.push_back({Tag::label, Tag::unit, scalar_type_of<typename Tr::scalar>(), a.data(), a.size(), Tr::rows, Tr::cols});
+}
+
+/// The fields written to snapshots: the state a restart needs plus what the issue asks to see.
+template <int Dim>
+void write_snapshot(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int64_t step) {
+  std::vector<FieldView> v;
+  add_view<Position<Dim>>(v, s);
+  add_view<Velocity<Dim>>(v, s);
+  add_view<Displacement<Dim>>(v, s);
+  add_view<Stress>(v, s);
+  add_view<PlasticStrain>(v, s);
+  add_view<Density>(v, s);
+  add_view<MaterialId>(v, s);
+  add_view<StressFree>(v, s);
+  add_view<ParticleKind>(v, s);
+  add_view<Mass>(v, s);
+  add_view<WallNormal<Dim>>(v, s);
+  add_view<ParticleId>(v, s);
+  w.write(t, step, v);
+}
+
+/// Replace the store by the last snapshot of a file written by sph-slope.
+template <int Dim>
+double load_restart(const std::filesystem::path& path, SphStore<Dim>& s, std::int64_t& step) {
+  SnapshotReader r(path);
+  if (r.model() != "sph-slope")
+    throw InputError("not an sph-slope snapshot file (model '" + r.model() + "')", path.string());
+  if (r.dimension() != Dim)
+    throw InputError(
+        "snapshot dimension " + std::to_string(r.dimension()) + " differs from run.dimension " + std::to_string(Dim),
+        path.string());
+  if (r.snapshot_count() == 0) throw InputError("the snapshot file holds no snapshot", path.string());
+  const std::size_t k = r.snapshot_count() - 1;
+  for (const char* need : {"position", "velocity", "stress", "density", "mass", "material_id", "kind"})
+    if (!r.has_field(k, need))
+      throw InputError(std::string("restart snapshot lacks field '") + need + "'", path.string());
+  const auto pos = r.read(k, "position");
+  s.resize(pos.count);
+  try {
+    s.for_each_field([&](auto tag, auto&) {
+      using Tag = decltype(tag);
+      if (r.has_field(k, Tag::label)) load_field<Tag>(r.read(k, Tag::label), s);
+    });
+  } catch (const std::invalid_argument& e) {
+    throw InputError(e.what(), path.string());
+  }
+  step = r.step(k);
+  return r.time(k);
+}
+
+/// Quick-look picture: particles in the x–z plane coloured by `value` (soil) on a ramp, boundary grey.
+template <int Dim>
+void draw_particles(const std::filesystem::path& path, const SphStore<Dim>& s, const std::vector<double>& value,
+                    double vmax, double dx) {
+  const auto& x = s.template get<Position<Dim>>();
+  const auto& kind = s.template get<ParticleKind>();
+  double x0 = 1e300, x1 = -1e300, z0 = 1e300, z1 = -1e300;
+  for (const auto& p : x) {
+    x0 = std::min(x0, p[0]);
+    x1 = std::max(x1, p[0]);
+    z0 = std::min(z0, p[Dim - 1]);
+    z1 = std::max(z1, p[Dim - 1]);
+  }
+  const int W = 1200, margin = 20;
+  // Fit the x–z extent into at most 1200 × 1200 pixels of drawing area.
+  const double scale =
+      std::min((W - 2 * margin) / std::max(x1 - x0 + dx, 1e-12), (1200.0 - 2 * margin) / std::max(z1 - z0 + dx, 1e-12));
+  const int H = std::max(static_cast<int>((z1 - z0 + dx) * scale) + 2 * margin + 30, 60);
+  Image img(W, H);
+  const double r = std::max(1.0, 0.5 * dx * scale);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const double px = margin + (x[i][0] - x0) * scale + 0.5 * (W - 2 * margin - (x1 - x0) * scale);
+    const double pz = H - 30 - margin - (x[i][Dim - 1] - z0) * scale;
+    std::array<std::uint8_t, 3> col{160, 160, 160};
+    if (kind[i] == kSoil)
+      col = ramp_colour(ColourRamp::Viridis, vmax > 0 ? std::clamp(value[i] / vmax, 0.0, 1.0) : 0.0);
+    img.fill_circle(px, pz, r, col);
+  }
+  // Colour bar along the bottom (0 … vmax).
+  for (int px = margin; px < W - margin; ++px) {
+    const auto col = ramp_colour(ColourRamp::Viridis, static_cast<double>(px - margin) / (W - 2 * margin));
+    for (int py = H - 22; py < H - 8; ++py) img.set(px, py, col);
+  }
+  write_png(path, img);
+}
+
+std::string csv_number(double v) {
+  std::ostringstream os;
+  os << std::setprecision(9) << v;
+  return os.str();
+}
+
+template <int Dim>
+int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
+  auto wall0 = std::chrono::steady_clock::now();
+  Built<Dim> b = build<Dim>(c);
+  const auto settings = settings_for<Dim>(c, b.sc);
+  const std::size_t soil_count = b.sc.soil_count, boundary_count = b.sc.boundary_count;
+  const double href = b.sc.reference_height;
+  SphSolver<Dim> solver(std::move(b.sc.store), c.materials, c.model, settings);
+  const auto& mats = solver.materials();
+  std::vector<double> rho0;
+  double cmax = 0.0;
+  for (const auto& m : mats) {
+    rho0.push_back(m.density);
+    cmax = std::max(cmax, m.p_wave_speed);
+  }
+  if (!quiet) {
+    std::fprintf(stderr, "sph-slope: %dD %s, %zu soil + %zu boundary particles, h = %.4g m, model %s\n", Dim,
+                 scenario_name(c.scenario), soil_count, boundary_count, solver.smoothing_length(),
+                 solver.model_name().c_str());
+    for (std::size_t k = 0; k < mats.size(); ++k)
+      std::fprintf(stderr,
+                   "  material %zu (%s): K = %.4g Pa, G = %.4g Pa, c_p = %.4g m/s, DP fit %s: alpha_phi = %.6g, "
+                   "k_c = %.6g Pa, alpha_psi = %.6g\n",
+                   k, k < c.material_names.size() ? c.material_names[k].c_str() : "", mats[k].bulk, mats[k].shear,
+                   mats[k].p_wave_speed,
+                   mats[k].fit == DruckerPragerFit::PlaneStrain ? "plane_strain" : "compression_3d",
+                   mats[k].dp.alpha_phi, mats[k].dp.kc, mats[k].dp.alpha_psi);
+  }
+
+  make_output_dir(out);
+  write_text_file(out / "resolved_config.toml", c.resolved_config);
+  SnapshotWriter snaps(out / "snapshots.h5", "sph-slope", Dim, c.resolved_config);
+  snaps.set_attribute("scenario", scenario_name(c.scenario));
+  snaps.set_attribute("units", "SI: m, s, kg, Pa");
+  if (c.scenario == ScenarioType::Section && !c.section.crs_wkt.empty())
+    snaps.set_attribute("crs_wkt", c.section.crs_wkt);
+
+  nlohmann::json summary;
+  summary["scenario"] = scenario_name(c.scenario);
+  summary["dimension"] = Dim;
+  summary["model"] = solver.model_name();
+  summary["config"] = c.config_source;
+  summary["soil_particles"] = soil_count;
+  summary["boundary_particles"] = boundary_count;
+  summary["spacing_m"] = c.numerics.spacing;
+  summary["smoothing_length_m"] = solver.smoothing_length();
+  for (std::size_t k = 0; k < mats.size(); ++k)
+    summary["materials"].push_back(
+        {{"name", k < c.material_names.size() ? c.material_names[k] : ""},
+         {"p_wave_speed_m_per_s", mats[k].p_wave_speed},
+         {"dp_fit", mats[k].fit == DruckerPragerFit::PlaneStrain ? "plane_strain" : "compression_3d"},
+         {"alpha_phi", mats[k].dp.alpha_phi},
+         {"k_c_Pa", mats[k].dp.kc},
+         {"alpha_psi", mats[k].dp.alpha_psi}});
+
+  // Geostatic phase or restart.
+  std::int64_t step_offset = 0;
+  if (!c.restart.empty()) {
+    std::int64_t st = 0;
+    const double t = load_restart<Dim>(c.restart, solver.store(), st);
+    solver.set_time(t);
+    summary["restart"] = {{"file", c.restart.string()}, {"time_s", t}, {"step", st}};
+    step_offset = st;
+  } else if (c.geostatic && c.scenario != ScenarioType::Biaxial) {
+    const double dur = c.geostatic_duration > 0.0 ? c.geostatic_duration : 20.0 * href / cmax;
+    ProgressReporter prog("sph-slope geostatic", dur, quiet);
+    std::int64_t k = 0;
+    const auto rep = solver.apply_gravity_gradually(dur, c.geostatic_damping, c.geostatic_elastic, [&] {
+      if (++k % 50 == 0) prog.update(solver.time(), k, solver.store().size());
+    });
+    prog.finish(dur, rep.steps, solver.store().size());
+    const double tol = c.rest_tolerance * std::sqrt(c.numerics.gravity * href);
+    const bool at_rest = rep.max_speed < tol;
+    summary["geostatic"] = {{"duration_s", dur},
+                            {"steps", rep.steps},
+                            {"max_speed_m_per_s", rep.max_speed},
+                            {"rest_tolerance_m_per_s", tol},
+                            {"at_rest", at_rest}};
+    if (!quiet)
+      std::fprintf(stderr, "sph-slope: geostatic phase %.4g s (%lld steps): max speed %.3g m/s -> %s\n", dur,
+                   static_cast<long long>(rep.steps), rep.max_speed,
+                   at_rest ? "at rest" : "NOT at rest (see summary.json)");
+  }
+  if (c.scenario == ScenarioType::Biaxial) {
+    // Platens move towards each other (compression) or apart (tension) at ε̇ H / 2 each.
+    auto& S = solver.store();
+    const double vp = 0.5 * c.biaxial_strain_rate * c.biaxial.height;
+    for (std::size_t i = 0; i < S.size(); ++i) {
+      if (S.template get<ParticleKind>()[i] == kSoil) continue;
+      const bool top = S.template get<Position<Dim>>()[i][Dim - 1] > 0.5 * c.biaxial.height;
+      S.template get<Velocity<Dim>>()[i].setZero();
+      S.template get<Velocity<Dim>>()[i][Dim - 1] = top ? -vp : vp;
+    }
+  }
+
+  // Main phase.
+  write_snapshot<Dim>(snaps, solver.store(), solver.time(), step_offset);
+  std::ostringstream series;
+  series << "time_s,front_m,tip_m,runout_m,normalised_runout,max_speed_m_per_s,mean_speed_m_per_s,kinetic_energy_J,"
+            "plastic_fraction,max_displacement_m,earthquake_acceleration_m_per_s2\n";
+  std::ostringstream biax;
+  biax << "time_s,axial_strain,sigma_axial_Pa,sigma_lateral_Pa,deviator_Pa\n";
+  auto png_times = c.velocity_png_times;
+  std::sort(png_times.begin(), png_times.end());
+  std::size_t next_png = 0;
+  double next_out = solver.time(), next_snap = solver.time() + c.snapshot_interval;
+  double max_speed_run = 0.0, max_runout = 0.0, last_moving = solver.time();
+  const double t_start = solver.time();
+  ProgressReporter prog("sph-slope", c.end_time, quiet);
+  auto record = [&] {
+    const auto r = series_row(solver.store(), b.frame);
+    double runout = r.runout, nrun = r.normalised_runout;
+    if (c.scenario == ScenarioType::Section) {
+      runout = 0.0;
+      for (const auto& u : solver.store().template get<Displacement<Dim>>()) runout = std::max(runout, std::abs(u[0]));
+      nrun = runout / b.frame.base_length;
+    }
+    max_runout = std::max(max_runout, runout);
+    series << csv_number(solver.time()) << ',' << csv_number(r.front) << ',' << csv_number(r.tip) << ','
+           << csv_number(runout) << ',' << csv_number(nrun) << ',' << csv_number(r.max_speed) << ','
+           << csv_number(r.mean_speed) << ',' << csv_number(r.kinetic_energy) << ',' << csv_number(r.plastic_fraction)
+           << ',' << csv_number(r.max_displacement) << ',' << csv_number(settings.earthquake.horizontal(solver.time()))
+           << '\n';
+    if (c.scenario == ScenarioType::Biaxial) {
+      const auto& S = solver.store();
+      double sa = 0, sl = 0;
+      int n = 0;
+      for (std::size_t i = 0; i < S.size(); ++i)
+        if (S.template get<ParticleKind>()[i] == kSoil) {
+          sa += S.template get<Stress>()[i](Dim - 1, Dim - 1);
+          sl += S.template get<Stress>()[i](0, 0);
+          ++n;
+        }
+      sa /= std::max(n, 1);
+      sl /= std::max(n, 1);
+      biax << csv_number(solver.time()) << ',' << csv_number(c.biaxial_strain_rate * solver.time()) << ','
+           << csv_number(sa) << ',' << csv_number(sl) << ',' << csv_number(sa - sl) << '\n';
+    }
+    return r;
+  };
+  auto speed_field = [&] {
+    std::vector<double> v(solver.store().size());
+    for (std::size_t i = 0; i < v.size(); ++i) v[i] = solver.store().template get<Velocity<Dim>>()[i].norm();
+    return v;
+  };
+  bool stopped_at_rest = false;
+  try {
+    while (solver.time() < c.end_time - 1e-12) {
+      if (solver.time() >= next_out - 1e-12) {
+        record();
+        next_out += c.output_interval;
+      }
+      while (next_png < png_times.size() && solver.time() >= png_times[next_png] - 1e-12) {
+        auto v = speed_field();
+        const double vm = *std::max_element(v.begin(), v.end());
+        std::ostringstream name;
+        name << "velocity_t" << std::fixed << std::setprecision(3) << png_times[next_png] << ".png";
+        draw_particles<Dim>(out / name.str(), solver.store(), v, vm, c.numerics.spacing);
+        ++next_png;
+      }
+      solver.step();
+      const double vmax = solver.last_stats().max_speed;
+      max_speed_run = std::max(max_speed_run, vmax);
+      if (vmax > c.rest_speed) last_moving = solver.time();
+      prog.update(solver.time(), solver.step_count(), solver.store().size());
+      if (c.snapshot_interval > 0.0 && solver.time() >= next_snap - 1e-12) {
+        write_snapshot<Dim>(snaps, solver.store(), solver.time(), step_offset + solver.step_count());
+        next_snap += c.snapshot_interval;
+      }
+      if (c.stop_at_rest && solver.time() - t_start > std::max(0.05, 0.1 * c.end_time) && vmax < c.rest_speed &&
+          solver.time() > settings.earthquake.end_time()) {
+        stopped_at_rest = true;
+        break;
+      }
+    }
+  } catch (const SimulationError&) {
+    write_text_file(out / "series.csv", series.str());
+    throw;
+  }
+  prog.finish(solver.time(), solver.step_count(), solver.store().size());
+  const auto last = record();
+  write_snapshot<Dim>(snaps, solver.store(), solver.time(), step_offset + solver.step_count());
+  write_text_file(out / "series.csv", series.str());
+  if (c.scenario == ScenarioType::Biaxial) write_text_file(out / "stress_strain.csv", biax.str());
+
+  // Free surface and slip surface.
+  {
+    std::ostringstream os;
+    os << "x_m,z_m\n";
+    for (const auto& p : free_surface(solver.store(), c.numerics.spacing))
+      os << csv_number(p[0]) << ',' << csv_number(p[1]) << '\n';
+    write_text_file(out / "surface_final.csv", os.str());
+    std::ostringstream ss;
+    ss << "x_m,z_m\n";
+    for (const auto& p : slip_surface(solver.store(), c.numerics.spacing, c.failed_threshold))
+      ss << csv_number(p[0]) << ',' << csv_number(p[1]) << '\n';
+    write_text_file(out / "slip_surface.csv", ss.str());
+  }
+  // Quick-look of the final state coloured by displacement.
+  double umax = 0.0;
+  {
+    std::vector<double> u(solver.store().size());
+    for (std::size_t i = 0; i < u.size(); ++i) {
+      u[i] = solver.store().template get<Displacement<Dim>>()[i].norm();
+      if (solver.store().template get<ParticleKind>()[i] == kSoil) umax = std::max(umax, u[i]);
+    }
+    draw_particles<Dim>(out / "final_displacement.png", solver.store(), u, umax, c.numerics.spacing);
+    const auto& ep = solver.store().template get<PlasticStrain>();
+    const double epmax = ep.empty() ? 0.0 : *std::max_element(ep.begin(), ep.end());
+    draw_particles<Dim>(out / "final_plastic_strain.png", solver.store(), ep, epmax, c.numerics.spacing);
+    summary["max_plastic_strain"] = epmax;
+  }
+  const auto fm = failed_mass(solver.store(), rho0, c.failed_threshold);
+  summary["end_time_s"] = solver.time();
+  summary["steps"] = solver.step_count();
+  summary["stopped_at_rest"] = stopped_at_rest;
+  summary["runout_m"] = c.scenario == ScenarioType::Section ? max_runout : last.runout;
+  summary["normalised_runout"] =
+      c.scenario == ScenarioType::Section ? max_runout / b.frame.base_length : last.normalised_runout;
+  summary["front_m"] = last.front;
+  summary["tip_m"] = last.tip;
+  summary["max_runout_m"] = max_runout;
+  summary["max_speed_m_per_s"] = max_speed_run;
+  summary["final_max_speed_m_per_s"] = last.max_speed;
+  summary["max_displacement_m"] = umax;
+  summary["failed_threshold_m"] = c.failed_threshold;
+  summary["failed_particles"] = fm.count;
+  if (Dim == 2)
+    summary["failed_area_m2_per_m"] = fm.volume;
+  else
+    summary["failed_volume_m3"] = fm.volume;
+  summary["time_to_rest_s"] =
+      last.max_speed < c.rest_speed ? nlohmann::json(last_moving - t_start) : nlohmann::json(nullptr);
+  summary["rest_speed_m_per_s"] = c.rest_speed;
+  summary["bytes_per_particle"] = solver.bytes_per_particle();
+
+  // Failed mass for debris-runout (handoff spec): only when the section is georeferenced.
+  if (c.scenario == ScenarioType::Section && c.write_release) {
+    if constexpr (Dim == 2) {
+      const auto& P = c.section.profile;
+      const auto& S = solver.store();
+      std::vector<Vec2> pts;
+      std::vector<double> vols;
+      double total = 0.0;
+      const double W = c.section.release_width;
+      const int k = std::max(1, static_cast<int>(std::lround(W / c.numerics.spacing)));
+      for (std::size_t i = 0; i < S.size(); ++i) {
+        if (S.template get<ParticleKind>()[i] != kSoil) continue;
+        if (S.template get<Displacement<2>>()[i].norm() <= c.failed_threshold) continue;
+        const double s = std::clamp(S.template get<Position<2>>()[i][0], P.front().s, P.back().s);
+        std::size_t seg = 1;
+        while (seg + 1 < P.size() && P[seg].s < s) ++seg;
+        const double ds = P[seg].s - P[seg - 1].s;
+        const double w = ds > 0 ? (s - P[seg - 1].s) / ds : 0.0;
+        const Vec2 a(P[seg - 1].x, P[seg - 1].y), bb(P[seg].x, P[seg].y);
+        const Vec2 p = a + w * (bb - a);
+        Vec2 t = bb - a;
+        t = t.norm() > 0 ? Vec2(t / t.norm()) : Vec2(1.0, 0.0);
+        const Vec2 nrm(-t.y(), t.x());
+        const double A = S.template get<Mass>()[i] / rho0[static_cast<std::size_t>(S.template get<MaterialId>()[i])];
+        const double vol = A * W / k * c.bulking_factor;
+        for (int q = 0; q < k; ++q) {
+          pts.push_back(p + (-0.5 * W + (q + 0.5) * W / k) * nrm);
+          vols.push_back(vol);
+          total += vol;
+        }
+      }
+      SnapshotWriter rel(out / "release.h5", "sph-slope-release", 2, c.resolved_config);
+      rel.set_attribute("crs_wkt", c.section.crs_wkt);
+      rel.set_attribute("total_volume", total);
+      std::ostringstream src;
+      src << c.config_source << "; displacement > " << c.failed_threshold << " m; width " << W << " m";
+      rel.set_attribute("source", src.str());
+      rel.set_attribute("bulking_factor", c.bulking_factor);
+      std::vector<FieldView> views{{"position", "m", ScalarType::Float64, pts.data(), pts.size(), 2, 1},
+                                   {"volume", "m^3", ScalarType::Float64, vols.data(), vols.size(), 1, 1}};
+      rel.write(solver.time(), solver.step_count(), views);
+      summary["release"] = {{"file", "release.h5"}, {"points", pts.size()}, {"total_volume_m3", total}, {"width_m", W}};
+      if (c.section.dsm) {
+        Raster th = c.section.dsm->like(0.0);
+        const double cell = th.cell_size_x() * th.cell_size_y();
+        double binned = 0.0;
+        for (std::size_t q = 0; q < pts.size(); ++q) {
+          const Vec2 px = th.to_pixel(pts[q]);
+          const int col = static_cast<int>(std::lround(px.x())), row = static_cast<int>(std::lround(px.y()));
+          if (col < 0 || row < 0 || col >= th.nx || row >= th.ny) continue;
+          th.at(col, row) += vols[q] / cell;
+          binned += vols[q];
+        }
+        write_geotiff(out / "release_thickness.tif", th);
+        summary["release"]["thickness_raster"] = "release_thickness.tif";
+        summary["release"]["volume_on_raster_m3"] = binned;
+      }
+    }
+  }
+  summary["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  write_text_file(out / "summary.json", summary.dump(2) + "\n");
+  if (!quiet)
+    std::fprintf(stderr, "sph-slope: t = %.4g s, run-out %.4g m (normalised %.4g), failed %s %.4g, outputs in %s\n",
+                 solver.time(), summary["runout_m"].get<double>(), summary["normalised_runout"].get<double>(),
+                 Dim == 2 ? "area (m^2/m)" : "volume (m^3)", fm.volume, out.string().c_str());
+  return 0;
+}
+
+}  // namespace
+
+void validate(const RunConfig& c) {
+  if (c.materials.empty()) throw InputError("at least one [[material]] is required", c.config_source, "material");
+  auto check_index = [&](int m, const char* key) {
+    if (m < 0 || static_cast<std::size_t>(m) >= c.materials.size())
+      throw InputError("material index out of range: allowed [0, " + std::to_string(c.materials.size() - 1) + "]",
+                       c.config_source, key, std::to_string(m));
+  };
+  for (int m : c.layer_materials) check_index(m, "slope.layer_materials");
+  if (!c.layer_materials.empty() && c.layer_materials.size() != c.layer_tops.size() + 1)
+    throw InputError("slope.layer_materials needs one entry more than slope.layer_tops (" +
+                         std::to_string(c.layer_tops.size() + 1) + ")",
+                     c.config_source, "slope.layer_materials");
+  for (std::size_t k = 1; k < c.layer_tops.size(); ++k)
+    if (!(c.layer_tops[k] > c.layer_tops[k - 1]))
+      throw InputError("slope.layer_tops must increase", c.config_source, "slope.layer_tops");
+  if (c.scenario == ScenarioType::Section) {
+    check_index(c.section.soil_material, "section.soil_material");
+    check_index(c.section.base_material, "section.base_material");
+  }
+  if (c.end_time <= 0.0) throw InputError("must be > 0", c.config_source, "run.end_time");
+  // Build once (dry run) so that geometry errors surface before any output exists.
+  if (c.dimension == 2)
+    (void)build<2>(c);
+  else
+    (void)build<3>(c);
+  if (!c.restart.empty() && !std::filesystem::exists(c.restart))
+    throw InputError("restart file does not exist", c.config_source, "run.restart", c.restart.string());
+}
+
+int run(const RunConfig& cfg, const std::filesystem::path& out, bool quiet) {
+  return cfg.dimension == 2 ? run_dim<2>(cfg, out, quiet) : run_dim<3>(cfg, out, quiet);
+}
+
+}  // namespace geohaz::sph

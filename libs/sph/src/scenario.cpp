@@ -1,0 +1,290 @@
+#include "geohaz/sph/scenario.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "geohaz/core/errors.hpp"
+
+namespace geohaz::sph {
+
+double surface_at(const std::vector<std::array<double, 2>>& s, double x) {
+  if (s.empty()) return -1e300;
+  if (x <= s.front()[0]) return s.front()[1];
+  for (std::size_t k = 1; k < s.size(); ++k) {
+    if (x <= s[k][0]) {
+      const double dx = s[k][0] - s[k - 1][0];
+      if (dx <= 0.0) return s[k - 1][1];
+      const double w = (x - s[k - 1][0]) / dx;
+      return (1.0 - w) * s[k - 1][1] + w * s[k][1];
+    }
+  }
+  return s.back()[1];
+}
+
+namespace {
+
+template <int Dim>
+struct Builder {
+  SphStore<Dim> store;
+  double dx;
+  std::int64_t next_id = 0;
+  void add(const Vec<Dim>& p, Kind kind, int material, double density, const Vec<Dim>& normal) {
+    const std::size_t i = store.append(1);
+    store.template get<Position<Dim>>()[i] = p;
+    store.template get<Density>()[i] = density;
+    store.template get<SummationDensity>()[i] = density;
+    store.template get<Mass>()[i] = density * std::pow(dx, Dim);
+    store.template get<MaterialId>()[i] = material;
+    store.template get<ParticleKind>()[i] = static_cast<std::uint8_t>(kind);
+    store.template get<WallNormal<Dim>>()[i] = normal;
+    store.template get<ParticleId>()[i] = next_id++;
+  }
+};
+
+Kind wall_kind(WallType t) {
+  return t == WallType::Roller ? Kind::RollerWall : Kind::FixedWall;
+}
+
+}  // namespace
+
+template <int Dim>
+Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vector<double>& densities,
+                            double h_factor) {
+  if (!(dx > 0.0)) throw InputError("particle spacing must be > 0", "", "spacing");
+  if (dom.surface.size() < 2) throw InputError("the soil surface needs at least two vertices");
+  for (std::size_t k = 1; k < dom.surface.size(); ++k)
+    if (dom.surface[k][0] < dom.surface[k - 1][0]) throw InputError("the soil surface must have non-decreasing x");
+  if (!(dom.x_right > dom.x_left)) throw InputError("the domain needs x_right > x_left");
+  const std::size_t nmat = densities.size();
+  auto check_mat = [&](int m) {
+    if (m < 0 || static_cast<std::size_t>(m) >= nmat)
+      throw InputError("material index " + std::to_string(m) + " is not defined (" + std::to_string(nmat) +
+                       " materials)");
+  };
+  if (!dom.layer_materials.empty() && dom.layer_materials.size() != dom.layer_tops.size() + 1)
+    throw InputError("layer_materials must have one entry more than layer_tops");
+  for (int m : dom.layer_materials) check_mat(m);
+  if (dom.surface_layer_depth > 0.0) check_mat(dom.surface_material);
+  if constexpr (Dim == 3) {
+    if (!(dom.width >= 4.0 * h_factor * dx + 1e-12 * dx))
+      throw InputError("the 3D width must be at least 4h = " + std::to_string(4.0 * h_factor * dx) +
+                           " m (periodic neighbour search)",
+                       "", "width", std::to_string(dom.width));
+  } else {
+    if (!dom.piles.empty())
+      throw InputError("piles need a 3D run: in 2D plane strain a pile row would be a continuous wall", "", "piles");
+  }
+  const int layers = static_cast<int>(std::ceil(2.0 * h_factor)) + 1;  // ≥ kernel support 2h
+  const double zmax_surface = [&] {
+    double z = -1e300;
+    for (auto& p : dom.surface) z = std::max(z, p[1]);
+    return z;
+  }();
+  const double wall_top =
+      dom.z_bottom + (dom.wall_height > 0.0 ? dom.wall_height : (zmax_surface - dom.z_bottom) + 3 * dx);
+  const int ny = Dim == 3 ? static_cast<int>(std::lround(dom.width / dx)) : 1;
+
+  Builder<Dim> B;
+  B.dx = dx;
+  auto material_at = [&](double x, double z) {
+    if (dom.surface_layer_depth > 0.0 && z > surface_at(dom.surface, x) - dom.surface_layer_depth)
+      return dom.surface_material;
+    if (dom.layer_materials.empty()) return 0;
+    std::size_t k = 0;
+    while (k < dom.layer_tops.size() && z >= dom.layer_tops[k]) ++k;
+    return dom.layer_materials[k];
+  };
+  auto in_pile = [&](double x, double y) {
+    for (const auto& p : dom.piles) {
+      const double ex = x - p.x, ey = Dim == 3 ? y - p.y : 0.0;
+      if (ex * ex + ey * ey <= 0.25 * p.diameter * p.diameter) return true;
+    }
+    return false;
+  };
+  auto make = [&](double x, double y, double z) {
+    Vec<Dim> p;
+    p[0] = x;
+    if constexpr (Dim == 3) p[1] = y;
+    p[Dim - 1] = z;
+    return p;
+  };
+  Vec<Dim> ez = Vec<Dim>::Zero();
+  ez[Dim - 1] = 1.0;
+  Vec<Dim> ex = Vec<Dim>::Zero();
+  ex[0] = 1.0;
+  const int material_floor = dom.layer_materials.empty() ? 0 : dom.layer_materials.front();
+
+  const int nx = static_cast<int>(std::lround((dom.x_right - dom.x_left) / dx));
+  const int nz = static_cast<int>(std::ceil((zmax_surface - dom.z_bottom) / dx)) + 1;
+  double soil_zmax = -1e300;
+  for (int j = 0; j < ny; ++j) {
+    const double y = (j + 0.5) * dx;
+    for (int i = 0; i < nx; ++i) {
+      const double x = dom.x_left + (i + 0.5) * dx;
+      const double zs = surface_at(dom.surface, x);
+      const bool pile_here = in_pile(x, y);
+      for (int k = 0; k < nz; ++k) {
+        const double z = dom.z_bottom + (k + 0.5) * dx;
+        if (pile_here) {
+          if (z < zs + dom.pile_top_margin)
+            B.add(make(x, y, z), Kind::Pile, material_floor, densities[material_floor], Vec<Dim>::Zero());
+          continue;
+        }
+        if (z >= zs) break;
+        const int m = material_at(x, z);
+        B.add(make(x, y, z), Kind::Soil, m, densities[static_cast<std::size_t>(m)], Vec<Dim>::Zero());
+        soil_zmax = std::max(soil_zmax, z);
+      }
+    }
+  }
+  Scenario<Dim> sc;
+  sc.soil_count = B.store.size();
+  if (sc.soil_count == 0) throw InputError("the scenario contains no soil particles (check the geometry)");
+  // Bottom wall, extended under the end walls and the optional floor extension.
+  const double wall_rho = densities[static_cast<std::size_t>(material_floor)];
+  const double xb0 = dom.x_left - (dom.left != WallType::None ? layers * dx : 0.0);
+  const double xb1 = dom.x_right + dom.floor_extension + (dom.right != WallType::None ? layers * dx : 0.0);
+  const int nbx = static_cast<int>(std::lround((xb1 - xb0) / dx));
+  for (int j = 0; j < ny; ++j) {
+    const double y = (j + 0.5) * dx;
+    if (dom.bottom != WallType::None)
+      for (int l = 0; l < layers; ++l)
+        for (int i = 0; i < nbx; ++i)
+          B.add(make(xb0 + (i + 0.5) * dx, y, dom.z_bottom - (l + 0.5) * dx), wall_kind(dom.bottom), material_floor,
+                wall_rho, ez);
+    const int nzw = static_cast<int>(std::lround((wall_top - dom.z_bottom) / dx));
+    for (int l = 0; l < layers; ++l)
+      for (int k = 0; k < nzw; ++k) {
+        const double z = dom.z_bottom + (k + 0.5) * dx;
+        if (dom.left != WallType::None)
+          B.add(make(dom.x_left - (l + 0.5) * dx, y, z), wall_kind(dom.left), material_floor, wall_rho, ex);
+        if (dom.right != WallType::None)
+          B.add(make(dom.x_right + (l + 0.5) * dx, y, z), wall_kind(dom.right), material_floor, wall_rho, ex);
+      }
+  }
+  if constexpr (Dim == 3) {
+    if (!dom.periodic_width) {
+      // Roller side walls across the width.
+      Vec<Dim> ey = Vec<Dim>::Zero();
+      ey[1] = 1.0;
+      const int nzw = static_cast<int>(std::lround((wall_top - dom.z_bottom) / dx));
+      for (int l = 0; l < layers; ++l)
+        for (int i = 0; i < nx; ++i)
+          for (int k = 0; k < nzw; ++k) {
+            const double x = dom.x_left + (i + 0.5) * dx, z = dom.z_bottom + (k + 0.5) * dx;
+            B.add(make(x, -(l + 0.5) * dx, z), Kind::RollerWall, material_floor, wall_rho, ey);
+            B.add(make(x, ny * dx + (l + 0.5) * dx, z), Kind::RollerWall, material_floor, wall_rho, ey);
+          }
+    }
+  }
+  sc.store = std::move(B.store);
+  sc.boundary_count = sc.store.size() - sc.soil_count;
+  sc.spacing = dx;
+  const double span = (xb1 - xb0) + (wall_top - dom.z_bottom);
+  sc.domain_lo = Vec<Dim>::Constant(-1e30);
+  sc.domain_hi = Vec<Dim>::Constant(1e30);
+  sc.domain_lo[0] = xb0 - 0.5 * span;
+  sc.domain_hi[0] = xb1 + 0.5 * span;
+  sc.domain_lo[Dim - 1] = dom.z_bottom - layers * dx - 0.5 * span;
+  sc.domain_hi[Dim - 1] = wall_top + span;
+  if constexpr (Dim == 3) {
+    if (dom.periodic_width) {
+      sc.periodic.axis = {false, true, false};
+      sc.periodic.lo = Vec<Dim>::Zero();
+      sc.periodic.hi = Vec<Dim>::Zero();
+      sc.periodic.lo[1] = 0.0;
+      sc.periodic.hi[1] = ny * dx;
+    }
+  }
+  sc.reference_height = soil_zmax + 0.5 * dx - dom.z_bottom;
+  sc.base_top = dom.z_bottom;
+  sc.toe_x = dom.x_right;
+  sc.base_length = dom.x_right - dom.x_left;
+  return sc;
+}
+
+ProfileDomain SlopeGeometry::profile() const {
+  if (!(height > 0.0) || !(gradient >= 0.0) || !(crest_length >= 0.0) || !(front_length >= 0.0) ||
+      !(base_thickness >= 0.0))
+    throw InputError("slope geometry: height > 0 and non-negative lengths, gradient and base thickness required");
+  ProfileDomain d;
+  const double zt = base_thickness + height, zb = base_thickness;
+  const double xt = crest_length + gradient * height;
+  d.x_left = 0.0;
+  d.x_right = xt + front_length;
+  d.z_bottom = 0.0;
+  if (cut_depth > 0.0) {
+    if (cut_depth >= height) throw InputError("the upper cut must be shallower than the slope", "", "cut_depth");
+    // The cut plane meets the face cut_depth below the crest and rises at 1/cut_gradient into the crest.
+    const double xf = crest_length + gradient * cut_depth;
+    const double xc = xf - cut_gradient * cut_depth;
+    if (xc < 0.0) throw InputError("the upper cut reaches beyond the crest length", "", "cut_gradient");
+    d.surface = {{0.0, zt}, {xc, zt}, {xf, zt - cut_depth}, {xt, zb}, {d.x_right, zb}};
+  } else {
+    d.surface = {{0.0, zt}, {crest_length, zt}, {xt, zb}, {d.x_right, zb}};
+  }
+  d.layer_tops = {base_thickness};
+  d.layer_materials = {0, 0};
+  return d;
+}
+
+template <int Dim>
+Scenario<Dim> build_biaxial(const BiaxialGeometry& g, double dx, double density, double h_factor) {
+  if (!(g.width >= 4 * dx && g.height >= 4 * dx))
+    throw InputError("the biaxial specimen must be at least 4 spacings wide and high");
+  const int layers = static_cast<int>(std::ceil(2.0 * h_factor)) + 1;
+  Builder<Dim> B;
+  B.dx = dx;
+  const int nx = static_cast<int>(std::lround(g.width / dx)), nz = static_cast<int>(std::lround(g.height / dx));
+  const int ny = Dim == 3 ? static_cast<int>(std::ceil(4.0 * h_factor)) + 1 : 1;
+  Vec<Dim> ez = Vec<Dim>::Zero();
+  ez[Dim - 1] = 1.0;
+  auto make = [&](double x, double y, double z) {
+    Vec<Dim> p;
+    p[0] = x;
+    if constexpr (Dim == 3) p[1] = y;
+    p[Dim - 1] = z;
+    return p;
+  };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i)
+      for (int k = 0; k < nz; ++k)
+        B.add(make((i + 0.5) * dx, (j + 0.5) * dx, (k + 0.5) * dx), Kind::Soil, 0, density, Vec<Dim>::Zero());
+  Scenario<Dim> sc;
+  sc.soil_count = B.store.size();
+  // Platens a few spacings wider than the specimen (rough: full fixity).
+  const int extra = layers;
+  for (int j = 0; j < ny; ++j)
+    for (int l = 0; l < layers; ++l)
+      for (int i = -extra; i < nx + extra; ++i) {
+        B.add(make((i + 0.5) * dx, (j + 0.5) * dx, -(l + 0.5) * dx), Kind::FixedWall, 0, density, ez);
+        B.add(make((i + 0.5) * dx, (j + 0.5) * dx, g.height + (l + 0.5) * dx), Kind::FixedWall, 0, density, ez);
+      }
+  sc.store = std::move(B.store);
+  sc.boundary_count = sc.store.size() - sc.soil_count;
+  sc.spacing = dx;
+  sc.domain_lo = Vec<Dim>::Constant(-1e30);
+  sc.domain_hi = Vec<Dim>::Constant(1e30);
+  sc.domain_lo[0] = -2.0 * g.width - g.height;
+  sc.domain_hi[0] = 3.0 * g.width + g.height;
+  sc.domain_lo[Dim - 1] = -g.height;
+  sc.domain_hi[Dim - 1] = 2.0 * g.height;
+  if constexpr (Dim == 3) {
+    sc.periodic.axis = {false, true, false};
+    sc.periodic.lo = Vec<Dim>::Zero();
+    sc.periodic.hi = Vec<Dim>::Zero();
+    sc.periodic.hi[1] = ny * dx;
+  }
+  sc.reference_height = g.height;
+  sc.base_length = g.width;
+  sc.toe_x = g.width;
+  sc.base_top = -1e300;
+  return sc;
+}
+
+template Scenario<2> build_profile<2>(const ProfileDomain&, double, const std::vector<double>&, double);
+template Scenario<3> build_profile<3>(const ProfileDomain&, double, const std::vector<double>&, double);
+template Scenario<2> build_biaxial<2>(const BiaxialGeometry&, double, double, double);
+template Scenario<3> build_biaxial<3>(const BiaxialGeometry&, double, double, double);
+
+}  // namespace geohaz::sph

@@ -1,0 +1,474 @@
+#include "geohaz/sph/solver.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "geohaz/core/errors.hpp"
+#include "geohaz/core/kernels.hpp"
+
+namespace geohaz::sph {
+
+namespace {
+
+/// Principal-frame artificial stress (Gray & Monaghan 2001): R = Q diag(r_a) Qᵀ,
+/// r_a = −ε σ_a/ρ² for σ_a > 0 (tension), 0 otherwise. σ is the in-plane block.
+template <int Dim>
+Mat<Dim> artificial_stress(const Mat<Dim>& s, double eps, double rho) {
+  const double inv = -eps / (rho * rho);
+  if constexpr (Dim == 2) {
+    const double a = s(0, 0), b = s(1, 1), c = 0.5 * (s(0, 1) + s(1, 0));
+    const double m = 0.5 * (a + b), d = std::sqrt(0.25 * (a - b) * (a - b) + c * c);
+    const double s1 = m + d, s2 = m - d;
+    if (s1 <= 0.0) return Mat<2>::Zero();
+    // Principal direction of s1.
+    double ex, ey;
+    if (d < 1e-300 * (std::abs(m) + 1.0)) {
+      ex = 1.0;
+      ey = 0.0;
+    } else {
+      const double theta = 0.5 * std::atan2(2.0 * c, a - b);
+      ex = std::cos(theta);
+      ey = std::sin(theta);
+    }
+    const double r1 = inv * s1, r2 = s2 > 0.0 ? inv * s2 : 0.0;
+    Mat<2> R;
+    R(0, 0) = r1 * ex * ex + r2 * ey * ey;
+    R(1, 1) = r1 * ey * ey + r2 * ex * ex;
+    R(0, 1) = R(1, 0) = (r1 - r2) * ex * ey;
+    return R;
+  } else {
+    Eigen::SelfAdjointEigenSolver<Mat3> es;
+    es.computeDirect(s);
+    const Vec3 ev = es.eigenvalues();
+    if (ev.maxCoeff() <= 0.0) return Mat3::Zero();
+    Vec3 r;
+    for (int k = 0; k < 3; ++k) r[k] = ev[k] > 0.0 ? inv * ev[k] : 0.0;
+    const Mat3& Q = es.eigenvectors();
+    return Q * r.asDiagonal() * Q.transpose();
+  }
+}
+
+}  // namespace
+
+template <int Dim>
+SphSolver<Dim>::SphSolver(SphStore<Dim> store, std::vector<MaterialParams> materials, ConstitutiveModel model,
+                          SolverSettings<Dim> settings)
+    : store_(std::move(store)), materials_(std::move(materials)), model_(model), settings_(std::move(settings)) {
+  if (materials_.empty()) throw InputError("the SPH model needs at least one material");
+  if (!(settings_.spacing > 0.0)) throw InputError("particle spacing must be > 0", "", "spacing");
+  if (!(settings_.h_factor >= 1.0 && settings_.h_factor <= 2.0))
+    throw InputError("h_factor must be in [1, 2]", "", "h_factor");
+  fluid_ = std::holds_alternative<NewtonianFluid>(model_);
+  for (auto& m : materials_) {
+    m.finalise();
+    const double c = fluid_ ? std::sqrt(m.bulk / m.density) : m.p_wave_speed;
+    max_wave_speed_ = std::max(max_wave_speed_, c);
+    if (fluid_) max_kinematic_viscosity_ = std::max(max_kinematic_viscosity_, m.viscosity / m.density);
+  }
+  const auto& mat = store_.template get<MaterialId>();
+  for (std::size_t i = 0; i < store_.size(); ++i)
+    if (mat[i] < 0 || static_cast<std::size_t>(mat[i]) >= materials_.size())
+      throw InputError("particle " + std::to_string(i) + " names material " + std::to_string(mat[i]) + " but only " +
+                       std::to_string(materials_.size()) + " are defined");
+  h_ = settings_.h_factor * settings_.spacing;
+  damping_ = settings_.damping;
+  dt_ = std::min(settings_.dt_max, settings_.cfl * h_ / max_wave_speed_);
+  if (fluid_ && max_kinematic_viscosity_ > 0.0) dt_ = std::min(dt_, 0.125 * h_ * h_ / max_kinematic_viscosity_);
+}
+
+template <int Dim>
+std::string SphSolver<Dim>::model_name() const {
+  return std::visit([](const auto& m) { return std::string(std::decay_t<decltype(m)>::name); }, model_);
+}
+
+template <int Dim>
+double SphSolver<Dim>::bytes_per_particle() const {
+  const double n = std::max<double>(1.0, static_cast<double>(store_.size()));
+  return static_cast<double>(SphStore<Dim>::bytes_per_particle()) + 4.0 * static_cast<double>(list_.pair_count()) / n +
+         4.0 + 3.0 * 4.0;  // CSR indices + offsets + cell data
+}
+
+template <int Dim>
+void SphSolver<Dim>::step() {
+  std::visit(
+      [&](const auto& model) {
+        if (settings_.kernel == KernelChoice::CubicSpline)
+          step_impl<CubicSpline<Dim>>(model);
+        else
+          step_impl<WendlandC2<Dim>>(model);
+      },
+      model_);
+}
+
+template <int Dim>
+template <class Kernel, class Model>
+void SphSolver<Dim>::step_impl(const Model& /*model*/) {
+  auto& S = store_;
+  const double h = h_;
+  const double cutoff = Kernel::support * h;
+  const auto& per = settings_.periodic;
+
+  // 0. Neighbours (cell reordering keeps neighbours close in memory; an optional Verlet skin lets
+  //    the list be reused while no particle has moved more than half the skin).
+  const double skin = settings_.neighbour_skin * h;
+  const bool rebuild = skin <= 0.0 || list_.size() != S.size() || max_drift_ > 0.5 * skin;
+  if (rebuild) {
+    if (settings_.reorder_every > 0 && step_ - last_reorder_ >= settings_.reorder_every) {
+      list_.build(S.template get<Position<Dim>>(), cutoff + skin, per);
+      S.reorder(list_.cell_order());
+      last_reorder_ = step_;
+    }
+    list_.build(S.template get<Position<Dim>>(), cutoff + skin, per);
+    ++builds_;
+    S.template get<PositionAtBuild<Dim>>() = S.template get<Position<Dim>>();
+    max_drift_ = 0.0;
+  }
+  const double cutoff2 = cutoff * cutoff;
+
+  const std::int64_t n = static_cast<std::int64_t>(S.size());
+  Vec<Dim>* x = S.template get<Position<Dim>>().data();
+  Vec<Dim>* v = S.template get<Velocity<Dim>>().data();
+  Vec<Dim>* acc = S.template get<Acceleration<Dim>>().data();
+  Vec<Dim>* disp = S.template get<Displacement<Dim>>().data();
+  Mat3* sig = S.template get<Stress>().data();
+  Mat<Dim>* L = S.template get<VelocityGradient<Dim>>().data();
+  double* rho = S.template get<Density>().data();
+  double* drho = S.template get<DensityRate>().data();
+  const double* m = S.template get<Mass>().data();
+  const std::int32_t* mat = S.template get<MaterialId>().data();
+  const std::uint8_t* kind = S.template get<ParticleKind>().data();
+  const Vec<Dim>* nrm = S.template get<WallNormal<Dim>>().data();
+  double* eps_p = S.template get<PlasticStrain>().data();
+  std::uint8_t* sfree = S.template get<StressFree>().data();
+  double* rsum = S.template get<SummationDensity>().data();
+  Vec<Dim>* vI = S.template get<InteractionVelocity<Dim>>().data();
+  Vec<Dim>* xs = S.template get<XsphCorrection<Dim>>().data();
+  Mat<Dim>* R = S.template get<ArtificialStress<Dim>>().data();
+  Mat<Dim>* sr2 = S.template get<StressOverDensitySquared<Dim>>().data();
+  const Vec<Dim>* xb = S.template get<PositionAtBuild<Dim>>().data();
+  const std::uint32_t* off = list_.offsets().data();
+  const std::uint32_t* idx = list_.indices().data();
+  const MaterialParams* mats = materials_.data();
+  const double dt = dt_;
+
+  // Effective body acceleration ḡ = g + a_eq (seed 002 eq. 26); gravity along −axis Dim−1.
+  Vec<Dim> gbar = Vec<Dim>::Zero();
+  gbar[Dim - 1] = -settings_.gravity * gravity_factor_;
+  if (earthquake_on_ && settings_.earthquake.active()) {
+    gbar[0] += settings_.earthquake.horizontal(time_);
+    gbar[Dim - 1] += settings_.earthquake.vertical(time_);
+  }
+  const bool periodic_any = per.any();
+  // Minimum image without std::round: positions are wrapped into the box after every move, so a
+  // difference along a periodic axis lies in (−L, L) and one conditional shift suffices.
+  Vec<Dim> period = Vec<Dim>::Zero();
+  for (int k = 0; k < Dim; ++k)
+    if (per.axis[k]) period[k] = per.hi[k] - per.lo[k];
+  auto displacement = [periodic_any, period](const Vec<Dim>& a, const Vec<Dim>& b) -> Vec<Dim> {
+    Vec<Dim> d = a - b;
+    if (periodic_any) {
+      for (int k = 0; k < Dim; ++k) {
+        const double L = period[k];
+        if (L > 0.0) d[k] -= d[k] > 0.5 * L ? L : (d[k] < -0.5 * L ? -L : 0.0);
+      }
+    }
+    return d;
+  };
+  constexpr std::uint8_t kSoil = static_cast<std::uint8_t>(Kind::Soil);
+  constexpr std::uint8_t kRoller = static_cast<std::uint8_t>(Kind::RollerWall);
+
+  // 1. Boundary particles: ghost velocity and stress from the soil neighbours (Bui et al. 2008).
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    if (kind[i] == kSoil) {
+      vI[i] = v[i];
+      continue;
+    }
+    double sw = 0.0;
+    Vec<Dim> sv = Vec<Dim>::Zero();
+    Mat3 ss = Mat3::Zero();
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+      const std::uint32_t j = idx[k];
+      if (kind[j] != kSoil) continue;
+      const Vec<Dim> xij = displacement(x[i], x[j]);
+      const double r2 = xij.squaredNorm();
+      if (r2 >= cutoff2) continue;
+      const double w = Kernel::value(std::sqrt(r2), h);
+      sw += w;
+      sv += w * v[j];
+      Mat3 sj = sig[j];
+      sj.diagonal().array() -= rho[j] * gbar.dot(xij);  // hydrostatic extrapolation (Adami et al. 2012)
+      ss += w * sj;
+    }
+    if (sw <= 0.0) {
+      vI[i] = v[i];
+      sig[i].setZero();
+      continue;
+    }
+    sv /= sw;
+    ss /= sw;
+    if (kind[i] == kRoller) {
+      // Free slip: mirror the normal component of the relative velocity and the shear stress.
+      const Vec<Dim>& nn = nrm[i];
+      vI[i] = sv - 2.0 * (sv - v[i]).dot(nn) * nn;
+      Mat3 M = Mat3::Identity();
+      M.template topLeftCorner<Dim, Dim>() -= 2.0 * nn * nn.transpose();
+      sig[i] = M * ss * M;
+    } else {
+      vI[i] = 2.0 * v[i] - sv;  // no slip
+      sig[i] = ss;
+    }
+    rsum[i] = rho[i];
+  }
+
+  // 2. Velocity gradient, continuity, summation density, XSPH (soil particles).
+  const double w_self = Kernel::value(0.0, h);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    if (kind[i] != kSoil) continue;
+    Mat<Dim> Li = Mat<Dim>::Zero();
+    Vec<Dim> xi_sum = Vec<Dim>::Zero();
+    double dr = 0.0, rs = m[i] * w_self;
+    const Vec<Dim> vi = v[i];
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+      const std::uint32_t j = idx[k];
+      const Vec<Dim> xij = displacement(x[i], x[j]);
+      const double r2 = xij.squaredNorm();
+      if (r2 >= cutoff2) continue;
+      const double r = std::sqrt(r2);
+      const Vec<Dim> gw = Kernel::gradient(xij, r, h);
+      const double Vj = m[j] / rho[j];
+      const Vec<Dim> dv = vI[j] - vi;
+      Li.noalias() += (Vj * dv) * gw.transpose();
+      dr -= m[j] * dv.dot(gw);
+      const double w = Kernel::value(r, h);
+      rs += m[j] * w;
+      xi_sum += (Vj * w) * dv;
+    }
+    L[i] = Li;
+    drho[i] = dr;
+    rsum[i] = rs;
+    xs[i] = xi_sum;
+  }
+
+  // 3. Density, stress (constitutive model), stress vanishing, artificial stress.
+  const double eps_as = settings_.artificial_stress;
+  const double sf_frac = settings_.stress_free_fraction;
+  double plastic_sum = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : plastic_sum)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    if (kind[i] != kSoil) {
+      R[i].setZero();
+      sr2[i] = sig[i].template topLeftCorner<Dim, Dim>() / (rho[i] * rho[i]);
+      continue;
+    }
+    const MaterialParams& p = mats[mat[i]];
+    rho[i] += dt * drho[i];
+    if (sf_frac > 0.0 && rsum[i] < sf_frac * p.density) {
+      sfree[i] = 1;
+      sig[i].setZero();
+      R[i].setZero();
+      sr2[i].setZero();
+      continue;
+    }
+    sfree[i] = 0;
+    const double dl = Model::update(sig[i], embed3<Dim>(L[i]), dt, rho[i], p);
+    eps_p[i] += dl;
+    plastic_sum += dl;
+    if (eps_as > 0.0) {
+      const Mat<Dim> s2 = sig[i].template topLeftCorner<Dim, Dim>();
+      R[i] = artificial_stress<Dim>(s2, eps_as, rho[i]);
+    }
+    sr2[i] = sig[i].template topLeftCorner<Dim, Dim>() / (rho[i] * rho[i]);
+  }
+  stats_.plastic_increment = plastic_sum;
+
+  // 4. Momentum (seed 002 eq. 12) with artificial viscosity and artificial stress.
+  const double w_dx = Kernel::value(settings_.spacing, h);
+  const double n_as = settings_.artificial_stress_n > 0.0 ? settings_.artificial_stress_n : w_self / w_dx;
+  const double alpha = settings_.viscosity_alpha, beta = settings_.viscosity_beta;
+  const double eta2 = 0.01 * h * h;
+  const double r_rep = settings_.wall_repulsion * settings_.spacing;
+  const bool fluid = fluid_;
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    if (kind[i] != kSoil) continue;
+    const Mat<Dim> si = sr2[i];
+    const Mat<Dim> Ri = R[i];
+    const bool has_Ri = Ri.squaredNorm() > 0.0;
+    const MaterialParams& pi = mats[mat[i]];
+    const double ci = fluid ? std::sqrt(pi.bulk / pi.density) : pi.p_wave_speed;
+    Vec<Dim> ai = Vec<Dim>::Zero();
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+      const std::uint32_t j = idx[k];
+      const Vec<Dim> xij = displacement(x[i], x[j]);
+      const double r2 = xij.squaredNorm();
+      if (r2 >= cutoff2) continue;
+      const double r = std::sqrt(r2);
+      const Vec<Dim> gw = Kernel::gradient(xij, r, h);
+      Mat<Dim> T = si + sr2[j];
+      const Vec<Dim> vij = v[i] - vI[j];
+      const double vr = vij.dot(xij);
+      if (vr < 0.0 && alpha + beta > 0.0) {
+        const MaterialParams& pj = mats[mat[j]];
+        const double cj = fluid ? std::sqrt(pj.bulk / pj.density) : pj.p_wave_speed;
+        const double mu = h * vr / (r * r + eta2);
+        const double Pi = (-alpha * 0.5 * (ci + cj) * mu + beta * mu * mu) / (0.5 * (rho[i] + rho[j]));
+        T.diagonal().array() -= Pi;
+      }
+      if (has_Ri || R[j].squaredNorm() > 0.0) {
+        const double f = Kernel::value(r, h) / w_dx;
+        T += std::pow(f, n_as) * (Ri + R[j]);
+      }
+      ai.noalias() += m[j] * (T * gw);
+      // Last-resort wall repulsion (Monaghan 1994 form, exponents 4 and 2): only a soil particle
+      // closer than r0 = wall_repulsion·Δx to a boundary particle feels it — nothing in a normal
+      // configuration (spacing ≈ Δx) — and it stops particles from being squeezed through walls.
+      if (kind[j] != kSoil && r < r_rep) {
+        const double q2 = (r_rep * r_rep) / r2;
+        ai.noalias() += (ci * ci * (q2 * q2 - q2) / r2) * xij;
+      }
+    }
+    acc[i] = ai;
+  }
+
+  // 5. Body force, local damping, leap-frog update.
+  const double zeta = damping_;
+  const double eps_x = settings_.xsph;
+  double vmax = 0.0, amax = 0.0, drift = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : vmax, amax, drift)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    if (kind[i] != kSoil) {
+      const Vec<Dim> dx = dt * v[i];
+      x[i] += dx;
+      disp[i] += dx;
+      if (periodic_any) x[i] = per.wrap(x[i]);
+      drift = std::max(drift, displacement(x[i], xb[i]).squaredNorm());
+      continue;
+    }
+    Vec<Dim> a = acc[i] + gbar;
+    if (zeta > 0.0) {
+      for (int d = 0; d < Dim; ++d) {
+        const double sgn = v[i][d] > 0.0 ? 1.0 : (v[i][d] < 0.0 ? -1.0 : 0.0);
+        a[d] -= zeta * std::abs(a[d]) * sgn;
+      }
+    }
+    acc[i] = a;
+    v[i] += dt * a;
+    const Vec<Dim> dx = dt * (v[i] + eps_x * xs[i]);
+    x[i] += dx;
+    disp[i] += dx;
+    if (periodic_any) x[i] = per.wrap(x[i]);
+    vmax = std::max(vmax, v[i].norm());
+    amax = std::max(amax, a.norm());
+    drift = std::max(drift, displacement(x[i], xb[i]).squaredNorm());
+  }
+  max_drift_ = std::sqrt(drift);
+  stats_.max_speed = vmax;
+  stats_.max_acceleration = amax;
+  time_ += dt;
+  ++step_;
+  check_state();
+  update_dt();
+}
+
+template <int Dim>
+void SphSolver<Dim>::check_state() const {
+  const auto& x = store_.template get<Position<Dim>>();
+  const auto& v = store_.template get<Velocity<Dim>>();
+  const auto& sig = store_.template get<Stress>();
+  const auto& id = store_.template get<ParticleId>();
+  const std::size_t n = store_.size();
+  const bool ok_stats = std::isfinite(stats_.max_speed) && std::isfinite(stats_.max_acceleration);
+  std::size_t bad = n;
+  std::string what;
+  // Cheap global test first; locate the culprit only when something is wrong.
+  bool box_ok = true;
+  for (std::size_t i = 0; i < n && box_ok; ++i)
+    for (int d = 0; d < Dim; ++d)
+      if (!(x[i][d] >= settings_.domain_lo[d] && x[i][d] <= settings_.domain_hi[d])) {
+        box_ok = false;
+        bad = i;
+        what = std::isfinite(x[i][d]) ? "left the domain" : "has a non-finite position";
+      }
+  if (ok_stats && box_ok) return;
+  if (bad == n) {
+    for (std::size_t i = 0; i < n; ++i)
+      if (!v[i].allFinite() || !sig[i].allFinite()) {
+        bad = i;
+        what = "has a non-finite velocity or stress";
+        break;
+      }
+  }
+  std::ostringstream os;
+  if (bad < n) {
+    os << "particle id " << id[bad] << " " << what << " at position (";
+    for (int d = 0; d < Dim; ++d) os << (d ? ", " : "") << x[bad][d];
+    os << ") m";
+  } else {
+    os << "non-finite speed or acceleration";
+  }
+  os << " at step " << step_ << ", t = " << time_ << " s (dt = " << dt_ << " s)";
+  throw SimulationError(os.str());
+}
+
+template <int Dim>
+void SphSolver<Dim>::update_dt() {
+  double dt = settings_.cfl * h_ / (max_wave_speed_ + stats_.max_speed);
+  if (stats_.max_acceleration > 0.0)
+    dt = std::min(dt, settings_.force_factor * std::sqrt(h_ / stats_.max_acceleration));
+  if (fluid_ && max_kinematic_viscosity_ > 0.0) dt = std::min(dt, 0.125 * h_ * h_ / max_kinematic_viscosity_);
+  dt = std::min(dt, settings_.dt_max);
+  if (!(dt >= settings_.dt_min)) {
+    std::ostringstream os;
+    os << "time step collapsed to " << dt << " s (< dt_min " << settings_.dt_min << " s) at step " << step_
+       << ", t = " << time_ << " s: max speed " << stats_.max_speed << " m/s, max acceleration "
+       << stats_.max_acceleration << " m/s^2";
+    throw SimulationError(os.str());
+  }
+  dt_ = dt;
+}
+
+template <int Dim>
+GeostaticReport SphSolver<Dim>::apply_gravity_gradually(double duration, double damping, bool elastic,
+                                                        const std::function<void()>& on_step) {
+  GeostaticReport rep;
+  rep.duration = duration;
+  const ConstitutiveModel saved = model_;
+  const double saved_damping = damping_;
+  if (elastic && !fluid_) model_ = LinearElastic{};
+  damping_ = damping;
+  earthquake_on_ = false;
+  const double t0 = time_;
+  const std::int64_t s0 = step_;
+  while (time_ - t0 < duration) {
+    const double s = (time_ - t0) / (0.5 * duration);
+    gravity_factor_ = std::min(1.0, s);
+    step();
+    if (on_step) on_step();
+  }
+  model_ = saved;
+  damping_ = saved_damping;
+  gravity_factor_ = 1.0;
+  earthquake_on_ = true;
+  rep.steps = step_ - s0;
+  rep.max_speed = stats_.max_speed;
+  for (auto& v : store_.template get<Velocity<Dim>>()) v.setZero();
+  // Boundary particles keep their prescribed wall velocity only in the main phase: none here.
+  for (auto& d : store_.template get<Displacement<Dim>>()) d.setZero();
+  for (auto& e : store_.template get<PlasticStrain>()) e = 0.0;
+  time_ = 0.0;
+  return rep;
+}
+
+template class SphSolver<2>;
+template class SphSolver<3>;
+
+}  // namespace geohaz::sph

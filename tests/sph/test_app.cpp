@@ -1,0 +1,240 @@
+// Regression tests of the sph-slope app (label: regression): shrunken twins of the data/sph
+// examples run end to end, the outputs exist and agree with each other, bad input exits with 2
+// naming the key, value and range and writes nothing, restart continues from a snapshot, and the
+// release file for debris-runout conserves the failed volume (handoff spec).
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "geohaz/core/snapshot.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kApp = fs::path(GEOHAZ_BINARY_DIR) / "apps/sph-slope/sph-slope";
+const fs::path kData = fs::path(GEOHAZ_SOURCE_DIR) / "data/sph";
+const fs::path kWork = fs::path(GEOHAZ_BINARY_DIR) / "tests/sph/app_runs";
+
+struct Result {
+  int code;
+  std::string err;
+};
+
+Result run(const std::string& args, const std::string& name) {
+  fs::create_directories(kWork);
+  const fs::path log = kWork / (name + ".log");
+  const std::string cmd = kApp.string() + " " + args + " --threads 1 > " + log.string() + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  std::ifstream in(log);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
+}
+
+nlohmann::json summary(const fs::path& dir) {
+  std::ifstream in(dir / "summary.json");
+  return nlohmann::json::parse(in);
+}
+
+std::size_t csv_rows(const fs::path& p) {
+  std::ifstream in(p);
+  std::string line;
+  std::size_t n = 0;
+  while (std::getline(in, line)) ++n;
+  return n > 0 ? n - 1 : 0;
+}
+
+TEST(SphSlopeApp, TinySlopeWritesAllOutputs) {
+  const fs::path out = kWork / "tiny_slope";
+  fs::remove_all(out);
+  const auto r = run("--config " + (kData / "slope_2d_granular.toml").string() + " --out " + out.string() +
+                         " --set numerics.spacing=0.025 --set run.end_time=0.1 --set run.snapshot_interval=0.05"
+                         " --set run.velocity_png_times=[0.05] --quiet",
+                     "tiny_slope");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* f : {"summary.json", "series.csv", "surface_final.csv", "slip_surface.csv", "snapshots.h5",
+                        "snapshots.xmf", "final_displacement.png", "velocity_t0.050.png", "resolved_config.toml"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  const auto s = summary(out);
+  EXPECT_EQ(s["dimension"], 2);
+  EXPECT_EQ(s["model"], "drucker_prager");
+  EXPECT_TRUE(s["geostatic"]["at_rest"].get<bool>());
+  EXPECT_GT(s["soil_particles"].get<int>(), 100);
+  // Time series every 0.01 s over 0.1 s: 10 rows plus the final one.
+  EXPECT_NEAR(static_cast<double>(csv_rows(out / "series.csv")), 11.0, 1.0);
+  // Snapshots: initial, 0.05, 0.1 (+ final).
+  geohaz::SnapshotReader snap(out / "snapshots.h5");
+  EXPECT_GE(snap.snapshot_count(), 3u);
+  for (const char* f :
+       {"position", "velocity", "displacement", "stress", "plastic_strain", "density", "material_id", "stress_free"})
+    EXPECT_TRUE(snap.has_field(snap.snapshot_count() - 1, f)) << f;
+  // The granular slope (phi = 17.5 deg on a 1.5:1 face, i.e. steeper than phi) starts to fail.
+  EXPECT_GT(s["max_speed_m_per_s"].get<double>(), 0.01);
+  EXPECT_GT(s["failed_particles"].get<int>(), 0);
+}
+
+TEST(SphSlopeApp, BadValueExitsTwoNamingKeyAndWritesNothing) {
+  const fs::path out = kWork / "bad_value";
+  fs::remove_all(out);
+  const auto r = run("--config " + (kData / "slope_2d_granular.toml").string() + " --out " + out.string() +
+                         " --set material[0].friction=95",
+                     "bad_value");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("friction"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("95"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("[0, 90)"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(SphSlopeApp, UnknownKeyAndBadGeometryExitTwo) {
+  const fs::path out = kWork / "bad_key";
+  fs::remove_all(out);
+  auto r = run(
+      "--config " + (kData / "slope_2d_granular.toml").string() + " --out " + out.string() + " --set slope.heigth=0.3",
+      "bad_key");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("heigth"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  r = run(
+      "--config " + (kData / "slope_upper_cut.toml").string() + " --out " + out.string() + " --set slope.cut_depth=0.4",
+      "bad_geometry");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("cut_depth"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  r = run("--config " + (kData / "slope_piles_3d.toml").string() + " --out " + out.string() + " --set run.dimension=2",
+          "bad_piles");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(SphSlopeApp, HelpVersionAndHelpConfig) {
+  auto r = run("--help", "help");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.err.find("--config"), std::string::npos);
+  r = run("--version", "version");
+  EXPECT_EQ(r.code, 0);
+  r = run("--help-config", "help_config");
+  EXPECT_EQ(r.code, 0);
+  for (const char* key : {"material[].friction", "slope.gradient", "earthquake.amplitude", "section.polyline",
+                          "numerics.xsph", "piles.position", "biaxial.strain_rate"})
+    EXPECT_NE(r.err.find(key), std::string::npos) << key;
+}
+
+TEST(SphSlopeApp, RestartContinuesFromLastSnapshot) {
+  const fs::path a = kWork / "restart_a", b = kWork / "restart_b";
+  fs::remove_all(a);
+  fs::remove_all(b);
+  const std::string base = "--config " + (kData / "column_collapse.toml").string() +
+                           " --set numerics.spacing=0.01 --set run.stop_at_rest=false --quiet";
+  auto r = run(base + " --out " + a.string() + " --set run.end_time=0.05", "restart_a");
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run(base + " --out " + b.string() + " --set run.end_time=0.08 --set run.restart=" + (a / "snapshots.h5").string(),
+          "restart_b");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto s = summary(b);
+  EXPECT_NEAR(s["restart"]["time_s"].get<double>(), 0.05, 2e-3);
+  EXPECT_NEAR(s["end_time_s"].get<double>(), 0.08, 2e-3);
+  geohaz::SnapshotReader snap(b / "snapshots.h5");
+  EXPECT_NEAR(snap.time(0), s["restart"]["time_s"].get<double>(), 1e-12);
+}
+
+TEST(SphSlopeApp, SectionReleaseConservesFailedVolume) {
+  const fs::path out = kWork / "section";
+  fs::remove_all(out);
+  const auto r = run("--config " + (kData / "section_dsm.toml").string() + " --out " + out.string() +
+                         " --set numerics.spacing=1.0 --set run.end_time=1.0 --set geostatic.duration=1.5 --quiet",
+                     "section");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto s = summary(out);
+  ASSERT_TRUE(s.contains("release")) << s.dump();
+  geohaz::SnapshotReader rel(out / "release.h5");
+  EXPECT_EQ(rel.model(), "sph-slope-release");
+  EXPECT_EQ(rel.dimension(), 2);
+  EXPECT_NE(rel.attribute("crs_wkt").find("UTM zone 54N"), std::string::npos);
+  const auto vol = rel.read(0, "volume");
+  double sum = 0.0;
+  for (double v : vol.values) sum += v;
+  const double total = std::stod(rel.attribute("total_volume"));
+  EXPECT_NEAR(sum, total, 1e-9 * std::max(1.0, total));
+  // Plane-strain area × width W (handoff spec), bulking factor 1.
+  const double area = s["failed_area_m2_per_m"].get<double>();
+  EXPECT_NEAR(total, area * 20.0, 1e-9 * std::max(1.0, total));
+  if (area > 0.0) {
+    EXPECT_TRUE(fs::exists(out / "release_thickness.tif"));
+    EXPECT_NEAR(s["release"]["volume_on_raster_m3"].get<double>(), total, 1e-6 * total);
+  }
+}
+
+TEST(SphSlopeApp, AccelerogramDrivesTheSeries) {
+  const fs::path out = kWork / "accelerogram";
+  fs::remove_all(out);
+  fs::create_directories(kWork);
+  const fs::path rec = kWork / "record.csv";
+  {
+    std::ofstream f(rec);
+    f << "time_s,a_h_m_per_s2\n0,0\n0.05,2.0\n0.1,-2.0\n";
+  }
+  const auto r = run("--config " + (kData / "slope_2d_granular.toml").string() + " --out " + out.string() +
+                         " --set numerics.spacing=0.025 --set run.end_time=0.1 --set run.output_interval=0.025"
+                         " --set earthquake.type=record --set earthquake.file=" +
+                         rec.string() + " --quiet",
+                     "accelerogram");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(out / "series.csv");
+  std::string line;
+  std::getline(in, line);
+  int checked = 0;
+  while (std::getline(in, line)) {
+    std::vector<double> v;
+    std::stringstream ss(line);
+    std::string tok;
+    while (std::getline(ss, tok, ',')) v.push_back(std::stod(tok));
+    ASSERT_EQ(v.size(), 11u);
+    const double t = v[0];
+    const double expect = t <= 0.05 ? 40.0 * t : (t <= 0.1 ? 2.0 - 80.0 * (t - 0.05) : 0.0);
+    EXPECT_NEAR(v[10], expect, 1e-6) << "t = " << t;
+    ++checked;
+  }
+  EXPECT_GE(checked, 4);
+}
+
+TEST(SphSlopeApp, Tiny3DPeriodicSlopeWithPiles) {
+  const fs::path out = kWork / "tiny_3d";
+  fs::remove_all(out);
+  const auto r = run("--config " + (kData / "slope_piles_3d.toml").string() + " --out " + out.string() +
+                         " --set numerics.spacing=0.04 --set geometry.width=0.24 --set piles.spacing=0.12"
+                         " --set piles.diameter=0.08 --set run.end_time=0.02 --set geostatic.duration=0.1 --quiet",
+                     "tiny_3d");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto s = summary(out);
+  EXPECT_EQ(s["dimension"], 3);
+  EXPECT_EQ(s["materials"][0]["dp_fit"], "compression_3d");
+  EXPECT_TRUE(s.contains("failed_volume_m3"));
+  EXPECT_LT(s["bytes_per_particle"].get<double>(), 2048.0);
+}
+
+TEST(SphSlopeApp, BlowUpStopsWithDiagnosisAndKeepsSnapshots) {
+  const fs::path out = kWork / "blowup";
+  fs::remove_all(out);
+  // dt_min above the stable step: the first main-phase step reports a time-step collapse.
+  const auto r = run("--config " + (kData / "column_collapse.toml").string() + " --out " + out.string() +
+                         " --set numerics.spacing=0.01 --set numerics.dt_min=0.01 --quiet",
+                     "blowup");
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("simulation stopped"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("time step collapsed"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("at step"), std::string::npos) << r.err;
+  ASSERT_TRUE(fs::exists(out / "snapshots.h5"));
+  geohaz::SnapshotReader snap(out / "snapshots.h5");
+  EXPECT_EQ(snap.snapshot_count(), 1u);  // the initial state, kept
+  EXPECT_TRUE(fs::exists(out / "series.csv"));
+  EXPECT_FALSE(fs::exists(out / "summary.json"));
+}
+
+}  // namespace

@@ -1,0 +1,180 @@
+// Unit tests of the constitutive models (constitutive.hpp): Drucker–Prager constants against hand
+// values, return mapping onto the yield surface, tension cut-off, Jaumann objectivity, Hooke's law.
+#include <gtest/gtest.h>
+
+#include <Eigen/LU>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "geohaz/sph/constitutive.hpp"
+
+namespace geohaz::sph {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+double J2(const Mat3& s) {
+  Mat3 d = s;
+  d.diagonal().array() -= s.trace() / 3.0;
+  return 0.5 * d.squaredNorm();
+}
+
+TEST(DruckerPragerConstants, PlaneStrainHandValues) {
+  // φ = 30°, c = 10 kPa: tanφ = 1/√3, √(9 + 12 tan²φ) = √13 (seed 002 eqs. 18–19).
+  const auto k = drucker_prager_constants(10e3, 30 * kDeg, 0.0, DruckerPragerFit::PlaneStrain);
+  EXPECT_NEAR(k.alpha_phi, (1.0 / std::sqrt(3.0)) / std::sqrt(13.0), 1e-12);
+  EXPECT_NEAR(k.alpha_phi, 0.160128, 1e-6);
+  EXPECT_NEAR(k.kc, 30e3 / std::sqrt(13.0), 1e-9);
+  EXPECT_NEAR(k.kc, 8320.50, 1e-2);
+  EXPECT_DOUBLE_EQ(k.alpha_psi, 0.0);
+}
+
+TEST(DruckerPragerConstants, ThreeDHandValues) {
+  // φ = 30°, c = 10 kPa: sinφ = 1/2 → α = 1/(√3·2.5), k = 6c cos30°/(√3·2.5) = 12 kPa (seed 001 eq. 21).
+  const auto k = drucker_prager_constants(10e3, 30 * kDeg, 30 * kDeg, DruckerPragerFit::Compression3D);
+  EXPECT_NEAR(k.alpha_phi, 0.2309401, 1e-7);
+  EXPECT_NEAR(k.kc, 12000.0, 1e-6);
+  EXPECT_NEAR(k.alpha_psi, k.alpha_phi, 1e-15);
+}
+
+TEST(DruckerPragerConstants, SeedMasaSoil) {
+  // seed 002 Table 1: c = 0.78 kPa, φ = 22.56°: tanφ = 0.41544, √(9+12·0.172591) = 3.327325.
+  const auto k = drucker_prager_constants(780.0, 22.56 * kDeg, 0.0, DruckerPragerFit::PlaneStrain);
+  EXPECT_NEAR(k.alpha_phi, 0.124857, 1e-6);
+  EXPECT_NEAR(k.kc, 703.27, 0.01);
+}
+
+TEST(DruckerPragerReturn, LandsOnYieldSurface) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-200e3, 50e3);
+  const double K = 5e6, G = 3e6;
+  for (double psi : {0.0, 10.0, 30.0}) {
+    const auto k = drucker_prager_constants(5e3, 30 * kDeg, psi * kDeg, DruckerPragerFit::PlaneStrain);
+    int plastic = 0;
+    for (int t = 0; t < 2000; ++t) {
+      Mat3 s;
+      for (int a = 0; a < 3; ++a)
+        for (int b = a; b < 3; ++b) s(a, b) = s(b, a) = u(rng);
+      const double f0 = drucker_prager_yield(s, k.alpha_phi, k.kc);
+      const double I1_0 = s.trace();
+      Mat3 r = s;
+      const double dl = drucker_prager_return(r, k.alpha_phi, k.alpha_psi, k.kc, K, G);
+      const double f = drucker_prager_yield(r, k.alpha_phi, k.kc);
+      EXPECT_LE(f, 1e-9 * k.kc) << "outside the surface after return";
+      EXPECT_LE(r.trace(), k.kc / k.alpha_phi * (1 + 1e-12)) << "tension cut-off violated";
+      if (f0 <= 0.0) {
+        EXPECT_EQ(dl, 0.0);
+        EXPECT_TRUE(r.isApprox(s)) << "elastic state changed";
+      } else {
+        ++plastic;
+        EXPECT_GT(dl, 0.0);
+        EXPECT_NEAR(f, 0.0, 1e-8 * std::max(k.kc, 1.0)) << "plastic state not on the surface";
+        // Non-dilatant flow (ψ = 0) keeps I1 unless the apex is reached.
+        if (psi == 0.0 && J2(r) > 1e-6) {
+          EXPECT_NEAR(r.trace(), I1_0, 1e-6 * std::abs(I1_0) + 1e-6);
+        }
+        // Symmetric stress stays symmetric.
+        EXPECT_NEAR((r - r.transpose()).norm(), 0.0, 1e-9);
+      }
+    }
+    EXPECT_GT(plastic, 100);  // the test exercised the plastic branch
+  }
+}
+
+TEST(DruckerPragerReturn, TensionCutOffGoesToApex) {
+  const auto k = drucker_prager_constants(5e3, 30 * kDeg, 0.0, DruckerPragerFit::PlaneStrain);
+  Mat3 s = Mat3::Identity() * 1e5;  // large hydrostatic tension
+  s(0, 1) = s(1, 0) = 1e3;
+  drucker_prager_return(s, k.alpha_phi, k.alpha_psi, k.kc, 5e6, 3e6);
+  EXPECT_NEAR(s.trace(), k.kc / k.alpha_phi, 1e-9 * k.kc / k.alpha_phi);
+  EXPECT_NEAR(J2(s), 0.0, 1e-12);
+  // Cohesionless: no tension at all.
+  const auto k0 = drucker_prager_constants(0.0, 30 * kDeg, 0.0, DruckerPragerFit::PlaneStrain);
+  Mat3 t = Mat3::Identity() * 1e4;
+  drucker_prager_return(t, k0.alpha_phi, k0.alpha_psi, k0.kc, 5e6, 3e6);
+  EXPECT_NEAR(t.norm(), 0.0, 1e-9);
+}
+
+TEST(VonMises, RadialReturn) {
+  MaterialParams p;
+  p.young = 10e6;
+  p.poisson = 0.3;
+  p.yield_stress = 30e3;
+  p.finalise();
+  Mat3 s = Mat3::Zero();
+  Mat3 L = Mat3::Zero();
+  L(0, 1) = 1.0;  // simple shear rate 1/s
+  for (int i = 0; i < 2000; ++i) VonMises::update(s, L, 1e-5, p.density, p);
+  EXPECT_NEAR(std::sqrt(J2(s)), 30e3 / std::sqrt(3.0), 1e-6 * 30e3);
+}
+
+TEST(Jaumann, RigidRotationKeepsInvariants) {
+  MaterialParams p;
+  p.young = 10e6;
+  p.poisson = 0.25;
+  p.finalise();
+  Mat3 s0;
+  s0 << -50e3, 10e3, 0, 10e3, -20e3, 0, 0, 0, -30e3;
+  Mat3 s = s0;
+  const double omega = 2.0;  // rad/s
+  Mat3 L = Mat3::Zero();
+  L(0, 1) = -omega;
+  L(1, 0) = omega;  // rigid rotation about z: v = ω × x
+  const double dt = 1e-4, T = std::numbers::pi / 4.0 / omega;
+  const int n = static_cast<int>(std::round(T / dt));
+  for (int i = 0; i < n; ++i) LinearElastic::update(s, L, dt, p.density, p);
+  EXPECT_NEAR(s.trace(), s0.trace(), 1e-9 * std::abs(s0.trace()));
+  EXPECT_NEAR(J2(s), J2(s0), 1e-3 * J2(s0));
+  EXPECT_NEAR(s.determinant(), s0.determinant(), 2e-3 * std::abs(s0.determinant()));
+  // And the stress is the rotated one: σ = Q σ0 Qᵀ with Q a rotation by ωT = π/4.
+  const double c = std::cos(omega * n * dt), sn = std::sin(omega * n * dt);
+  Mat3 Q;
+  Q << c, -sn, 0, sn, c, 0, 0, 0, 1;
+  EXPECT_LT((s - Q * s0 * Q.transpose()).norm(), 2e-3 * s0.norm());
+}
+
+TEST(LinearElastic, UniaxialStrainAndPlaneStrainSigmaZZ) {
+  MaterialParams p;
+  p.young = 10e6;
+  p.poisson = 0.3;
+  p.finalise();
+  Mat3 s = Mat3::Zero();
+  Mat<2> L2 = Mat<2>::Zero();
+  L2(1, 1) = -1.0;  // plane-strain compression rate along y
+  const double dt = 1e-5;
+  for (int i = 0; i < 100; ++i) LinearElastic::update(s, embed3<2>(L2), dt, p.density, p);
+  const double eps = -1e-3;
+  const double lambda = p.bulk - 2.0 * p.shear / 3.0;
+  EXPECT_NEAR(s(1, 1), (p.bulk + 4.0 * p.shear / 3.0) * eps, 1e-9 * p.young);
+  EXPECT_NEAR(s(0, 0), lambda * eps, 1e-9 * p.young);
+  EXPECT_NEAR(s(2, 2), lambda * eps, 1e-9 * p.young) << "plane strain must carry sigma_zz";
+}
+
+TEST(NewtonianFluid, StressFromRate) {
+  MaterialParams p;
+  p.density = 1000;
+  p.young = 3e6;
+  p.poisson = 0.0;
+  p.viscosity = 2.0;
+  p.finalise();
+  Mat3 s = Mat3::Zero();
+  Mat3 L = Mat3::Zero();
+  L(0, 1) = 3.0;
+  NewtonianFluid::update(s, L, 1e-3, 1000.0, p);
+  EXPECT_NEAR(s(0, 1), 2.0 * 3.0, 1e-12);  // μ du/dy
+  NewtonianFluid::update(s, Mat3::Zero(), 1e-3, 1010.0, p);
+  EXPECT_NEAR(s.trace() / 3.0, -p.bulk * 0.01, 1e-9);
+}
+
+TEST(ConstitutiveModel, NamesRoundTrip) {
+  ConstitutiveModel m;
+  for (const char* n : {"linear_elastic", "von_mises", "drucker_prager", "newtonian_fluid"}) {
+    ASSERT_TRUE(constitutive_model_from_name(n, m));
+    EXPECT_EQ(std::visit([](auto& x) { return std::string(std::decay_t<decltype(x)>::name); }, m), n);
+  }
+  EXPECT_FALSE(constitutive_model_from_name("mohr", m));
+}
+
+}  // namespace
+}  // namespace geohaz::sph

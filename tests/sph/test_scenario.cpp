@@ -1,0 +1,122 @@
+// Unit tests of the scenario builders (scenario.hpp) and diagnostics (diagnostics.hpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "geohaz/core/errors.hpp"
+#include "geohaz/sph/diagnostics.hpp"
+#include "geohaz/sph/scenario.hpp"
+
+namespace geohaz::sph {
+namespace {
+
+TEST(Scenario, SlopeParticleCountAndMass) {
+  SlopeGeometry g;
+  g.height = 0.2;
+  g.gradient = 1.0;
+  g.crest_length = 0.2;
+  g.front_length = 0.2;
+  g.base_thickness = 0.04;
+  const double dx = 0.01;
+  auto sc = build_profile<2>(g.profile(), dx, {2000.0}, 1.2);
+  // Area: base 0.6·0.04 + crest 0.2·0.2 + face ½·0.2·0.2 = 0.084 m² → 840 particles (staircase face
+  // makes the count exact only to within the face's row count, 20).
+  EXPECT_NEAR(static_cast<double>(sc.soil_count), 840.0, 20.0);
+  double mass = 0.0;
+  const auto& k = sc.store.get<ParticleKind>();
+  for (std::size_t i = 0; i < sc.store.size(); ++i)
+    if (k[i] == 0) mass += sc.store.get<Mass>()[i];
+  EXPECT_NEAR(mass, 2000.0 * dx * dx * static_cast<double>(sc.soil_count), 1e-9);
+  EXPECT_GT(sc.boundary_count, 0u);
+  EXPECT_DOUBLE_EQ(g.toe_x(), 0.4);
+}
+
+TEST(Scenario, LayersByElevation) {
+  ProfileDomain d;
+  d.surface = {{0.0, 0.3}, {0.2, 0.3}};
+  d.x_right = 0.2;
+  d.layer_tops = {0.1, 0.2};
+  d.layer_materials = {0, 2, 1};
+  auto sc = build_profile<2>(d, 0.01, {1000.0, 1500.0, 2000.0}, 1.2);
+  const auto& x = sc.store.get<Position<2>>();
+  const auto& m = sc.store.get<MaterialId>();
+  const auto& k = sc.store.get<ParticleKind>();
+  for (std::size_t i = 0; i < sc.store.size(); ++i) {
+    if (k[i] != 0) continue;
+    const int expect = x[i][1] < 0.1 ? 0 : (x[i][1] < 0.2 ? 2 : 1);
+    EXPECT_EQ(m[i], expect);
+    EXPECT_DOUBLE_EQ(sc.store.get<Density>()[i], expect == 0 ? 1000.0 : (expect == 2 ? 2000.0 : 1500.0));
+  }
+  d.layer_materials = {0, 5, 1};
+  EXPECT_THROW(build_profile<2>(d, 0.01, {1000.0, 1500.0, 2000.0}, 1.2), InputError);
+}
+
+TEST(Scenario, UpperCutRemovesSoil) {
+  SlopeGeometry g;
+  const auto full = build_profile<2>(g.profile(), 0.01, {1800.0}, 1.2);
+  g.cut_depth = 0.05;
+  g.cut_gradient = 2.0;
+  const auto cut = build_profile<2>(g.profile(), 0.01, {1800.0}, 1.2);
+  // Removed wedge: between the 1.5:1 face and the 2:1 cut over 0.05 m depth: ½·0.05·(2 − 1.5)·0.05 m².
+  const double removed = 0.5 * 0.05 * 0.05 * 0.5;
+  EXPECT_NEAR(static_cast<double>(full.soil_count - cut.soil_count), removed / 1e-4, 4.0);
+  g.cut_depth = 0.3;
+  EXPECT_THROW(g.profile(), InputError);
+}
+
+TEST(Scenario, PilesIn3DAndRejectedIn2D) {
+  SlopeGeometry g;
+  auto d = g.profile();
+  d.width = 0.1;
+  d.piles = {{0.5, 0.05, 0.04}};
+  auto sc = build_profile<3>(d, 0.01, {1800.0}, 1.2);
+  std::size_t piles = 0;
+  for (auto k : sc.store.get<ParticleKind>()) piles += k == static_cast<std::uint8_t>(Kind::Pile);
+  EXPECT_GT(piles, 10u);
+  EXPECT_TRUE(sc.periodic.axis[1]);
+  EXPECT_NEAR(sc.periodic.hi[1] - sc.periodic.lo[1], 0.1, 1e-12);
+  EXPECT_THROW(build_profile<2>(d, 0.01, {1800.0}, 1.2), InputError);
+  d.piles.clear();
+  d.width = 0.03;  // narrower than 4h
+  EXPECT_THROW(build_profile<3>(d, 0.01, {1800.0}, 1.2), InputError);
+}
+
+TEST(Diagnostics, FrontSurfaceSlipAndFailedMass) {
+  ProfileDomain d;
+  d.surface = {{0.0, 0.1}, {0.1, 0.1}, {0.1, 0.0}, {0.5, 0.0}};
+  d.x_right = 0.5;
+  d.right = WallType::None;
+  auto sc = build_profile<2>(d, 0.01, {2000.0}, 1.2);
+  auto& S = sc.store;
+  DiagnosticFrame f;
+  f.toe_x = 0.1;
+  f.base_length = 0.1;
+  f.base_top = 0.0;
+  f.spacing = 0.01;
+  auto r = series_row(S, f);
+  EXPECT_NEAR(r.front, 0.1, 1e-12);
+  EXPECT_NEAR(r.runout, 0.0, 1e-12);
+  // Move the top-right 3×3 block of particles 0.05 m to the right and 0.07 m down (still ≥ 2 layers).
+  auto& x = S.get<Position<2>>();
+  auto& u = S.get<Displacement<2>>();
+  for (std::size_t i = 0; i < S.size(); ++i)
+    if (S.get<ParticleKind>()[i] == 0 && x[i][0] > 0.07 && x[i][1] > 0.07) {
+      const Vec2 du(0.05, -0.07);
+      x[i] += du;
+      u[i] = du;
+    }
+  r = series_row(S, f);
+  EXPECT_NEAR(r.front, 0.15, 1e-9);
+  EXPECT_NEAR(r.normalised_runout, 0.5, 1e-9);
+  const auto fm = failed_mass(S, {2000.0}, 0.01);
+  EXPECT_EQ(fm.count, 9u);
+  EXPECT_NEAR(fm.volume, 9e-4, 1e-12);
+  const auto slip = slip_surface(S, 0.01, 0.01);
+  ASSERT_EQ(slip.size(), 3u);
+  for (const auto& p : slip) EXPECT_NEAR(p[1], 0.07, 1e-9);
+  const auto surf = free_surface(S, 0.01);
+  EXPECT_NEAR(surf.front()[1], 0.1, 1e-9);
+}
+
+}  // namespace
+}  // namespace geohaz::sph

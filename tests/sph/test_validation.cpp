@@ -1,0 +1,373 @@
+// Validation runs of the SPH slope model (label: validation, not run in CI; minutes each).
+// Each test runs the sph-slope app on a data/sph example (with overrides), checks the physics
+// against the experiment / seed number with a stated tolerance, appends its numbers to
+// <build>/validation/sph/results.jsonl and copies its quick-look pictures to docs/figures/sph/.
+// docs/validation/sph.md quotes these numbers.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "geohaz/core/raster.hpp"
+#include "geohaz/core/snapshot.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kApp = fs::path(GEOHAZ_BINARY_DIR) / "apps/sph-slope/sph-slope";
+const fs::path kData = fs::path(GEOHAZ_SOURCE_DIR) / "data/sph";
+const fs::path kFigures = fs::path(GEOHAZ_SOURCE_DIR) / "docs/figures/sph";
+const fs::path kWork = fs::path(GEOHAZ_BINARY_DIR) / "validation/sph";
+
+nlohmann::json run_case(const std::string& name, const std::string& config, const std::string& sets) {
+  fs::create_directories(kWork);
+  const fs::path out = kWork / name;
+  fs::remove_all(out);
+  const char* threads = std::getenv("SPH_VALIDATION_THREADS");
+  const std::string cmd = kApp.string() + " --config " + (kData / config).string() + " --out " + out.string() + " " +
+                          sets + " --threads " + (threads ? threads : "1") + " --quiet > " +
+                          (kWork / (name + ".log")).string() + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  EXPECT_EQ(status, 0) << cmd;
+  std::ifstream in(out / "summary.json");
+  if (!in) return nlohmann::json::object();
+  auto s = nlohmann::json::parse(in);
+  s["case"] = name;
+  std::ofstream log(kWork / "results.jsonl", std::ios::app);
+  log << s.dump() << "\n";
+  return s;
+}
+
+/// Normalised run-out at time t from series.csv (linear interpolation; last value after the end).
+double runout_at(const std::string& name, double t) {
+  std::ifstream in(kWork / name / "series.csv");
+  std::string line;
+  std::getline(in, line);
+  double tp = 0, vp = 0;
+  bool first = true;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::vector<double> v;
+    std::string tok;
+    while (std::getline(ss, tok, ',')) v.push_back(std::stod(tok));
+    if (v.size() < 5) continue;
+    if (!first && v[0] >= t) return vp + (v[4] - vp) * (t - tp) / std::max(v[0] - tp, 1e-12);
+    tp = v[0];
+    vp = v[4];
+    first = false;
+  }
+  return vp;
+}
+
+void copy_figure(const std::string& name, const std::string& file, const std::string& as) {
+  fs::create_directories(kFigures);
+  const fs::path src = kWork / name / file;
+  if (fs::exists(src)) fs::copy_file(src, kFigures / as, fs::copy_options::overwrite_existing);
+}
+
+/// A bare line plot (no text: axes ranges are given in docs/validation/sph.md): frame, grid lines
+/// at every `xtick` / `ytick`, curves as lines, measurements as dots.
+struct Curve {
+  std::vector<double> x, y;
+  std::array<std::uint8_t, 3> colour;
+  bool dots = false;
+};
+void plot(const fs::path& path, const std::vector<Curve>& curves, double x0, double x1, double y0, double y1,
+          double xtick, double ytick) {
+  const int W = 640, H = 420, m = 40;
+  geohaz::Image img(W, H);
+  auto px = [&](double x) { return m + (x - x0) / (x1 - x0) * (W - 2 * m); };
+  auto py = [&](double y) { return H - m - (y - y0) / (y1 - y0) * (H - 2 * m); };
+  const std::array<std::uint8_t, 3> grid{220, 220, 220}, black{0, 0, 0};
+  for (double x = x0; x <= x1 + 1e-9; x += xtick) img.line(px(x), py(y0), px(x), py(y1), grid);
+  for (double y = y0; y <= y1 + 1e-9; y += ytick) img.line(px(x0), py(y), px(x1), py(y), grid);
+  img.line(px(x0), py(y0), px(x1), py(y0), black);
+  img.line(px(x0), py(y0), px(x0), py(y1), black);
+  img.line(px(x1), py(y0), px(x1), py(y1), black);
+  img.line(px(x0), py(y1), px(x1), py(y1), black);
+  for (const auto& c : curves)
+    for (std::size_t i = 0; i < c.x.size(); ++i) {
+      if (c.dots)
+        img.fill_circle(px(c.x[i]), py(c.y[i]), 5, c.colour);
+      else if (i)
+        img.line(px(c.x[i - 1]), py(c.y[i - 1]), px(c.x[i]), py(c.y[i]), c.colour);
+    }
+  fs::create_directories(path.parent_path());
+  geohaz::write_png(path, img);
+}
+
+/// Column `col` of a CSV with a header line.
+std::vector<double> csv_column(const fs::path& p, int col) {
+  std::ifstream in(p);
+  std::string line;
+  std::getline(in, line);
+  std::vector<double> out;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::string tok;
+    for (int k = 0; std::getline(ss, tok, ','); ++k)
+      if (k == col) out.push_back(std::stod(tok));
+  }
+  return out;
+}
+
+// Granular column collapse vs quasi-2D experiments (Lube et al. 2005; Lajeunesse et al. 2005):
+// (L∞ − L0)/L0 ≈ 1.2 a for small a and ≈ 1.9 a^{2/3} for large a (transition a ≈ 1.8–2.8 in
+// Lube et al. 2005; the linear law is used up to a = 2.8 here). Tolerance ±30 % (experimental scatter
+// of the two data sets plus the resolution Δx = L0/20).
+TEST(Validation, ColumnCollapseRunoutScaling) {
+  for (double a : {0.5, 1.0, 2.0, 3.0}) {
+    const std::string name = "column_a" + std::to_string(static_cast<int>(a * 10));
+    std::ostringstream sets;
+    sets << "--set column.height=" << 0.1 * a << " --set column.floor_length=" << 0.1 * (2.0 + 2.5 * a)
+         << " --set numerics.spacing=0.005 --set material[0].young=3e5 --set run.end_time=1.5"
+         << " --set run.snapshot_interval=0";
+    const auto s = run_case(name, "column_collapse.toml", sets.str());
+    ASSERT_TRUE(s.contains("normalised_runout"));
+    const double law = a <= 2.8 ? 1.2 * a : 1.9 * std::pow(a, 2.0 / 3.0);
+    const double got = s["normalised_runout"].get<double>();
+    std::printf("column a = %.1f: (L-L0)/L0 = %.3f, law %.3f, error %+.1f %%, tip %.3f\n", a, got, law,
+                100 * (got - law) / law, (s["tip_m"].get<double>() - 0.1) / 0.1);
+    EXPECT_NEAR(got, law, 0.3 * law) << "a = " << a;
+    copy_figure(name, "final_displacement.png", name + "_final.png");
+  }
+}
+
+// Seed 001 Table 1 (2D section of the 3D model): granular vs cohesive slope, normalised run-out at
+// 1 s (seed: ~0.4 vs ~0.13). We require the cohesive slope to run out much less (< half) — the
+// seed's absolute values come from a 3D model whose run-out definition is only described in words.
+TEST(Validation, Seed001GranularVsCohesive) {
+  run_case("seed001_granular", "slope_2d_granular.toml", "--set run.end_time=3 --set run.stop_at_rest=false");
+  run_case("seed001_cohesive", "slope_2d_granular.toml",
+           "--set run.end_time=3 --set run.stop_at_rest=false --set material[0].cohesion=10e3");
+  const double g1 = runout_at("seed001_granular", 1.0), c1 = runout_at("seed001_cohesive", 1.0);
+  std::printf("seed 001 Table 1 at 1 s: granular %.3f (seed ~0.4), cohesive %.3f (seed ~0.13)\n", g1, c1);
+  EXPECT_GT(g1, 0.05);
+  EXPECT_LT(c1, 0.5 * g1);
+  copy_figure("seed001_granular", "final_displacement.png", "seed001_granular_final.png");
+  copy_figure("seed001_granular", "velocity_t0.200.png", "seed001_granular_velocity_0.2s.png");
+  copy_figure("seed001_cohesive", "final_displacement.png", "seed001_cohesive_final.png");
+}
+
+// Seed 001 Table 2: the five layered slopes run (finite run-out, no blow-up); slope-2 (loose
+// middle layer) runs out further than slope-3 (seed: ~50 % less with the dense layer at the toe).
+TEST(Validation, Seed001LayeredSlopes) {
+  struct Layers {
+    double c3, p3, c2, p2;
+  };
+  const Layers t2[5] = {
+      {8.5e3, 14, 0, 15}, {0, 20, 0, 14}, {0, 14, 0, 20}, {8.5e3, 14, 18e3, 18}, {18e3, 18, 8.5e3, 14}};
+  std::vector<double> r(5);
+  for (int k = 0; k < 5; ++k) {
+    std::ostringstream sets;
+    sets << "--set run.end_time=3 --set run.stop_at_rest=false --set material[2].cohesion=" << t2[k].c3
+         << " --set material[2].friction=" << t2[k].p3 << " --set material[1].cohesion=" << t2[k].c2
+         << " --set material[1].friction=" << t2[k].p2;
+    const std::string name = "seed001_layered_" + std::to_string(k + 1);
+    auto s = run_case(name, "slope_layered.toml", sets.str());
+    r[k] = s.value("normalised_runout", -1.0);
+    std::printf("seed 001 Table 2 slope-%d: normalised run-out %.3f at 3 s\n", k + 1, r[k]);
+    copy_figure(name, "final_displacement.png", name + "_final.png");
+  }
+  for (double v : r) EXPECT_GE(v, 0.0);
+  EXPECT_GT(r[1], r[2]);
+}
+
+// Seed 001 upper cut (50 mm at 2H:1V): run-out reduced (seed: 6–8 %).
+TEST(Validation, Seed001UpperCut) {
+  auto base = run_case("seed001_nocut", "slope_2d_granular.toml", "--set run.end_time=3 --set run.stop_at_rest=false");
+  auto cut = run_case("seed001_cut", "slope_upper_cut.toml", "--set run.end_time=3 --set run.stop_at_rest=false");
+  const double b = base.value("normalised_runout", 0.0), c = cut.value("normalised_runout", 0.0);
+  std::printf("seed 001 upper cut: run-out %.3f -> %.3f (%.1f %% reduction; seed 6-8 %%)\n", b, c, 100 * (b - c) / b);
+  EXPECT_LT(c, b);
+  copy_figure("seed001_cut", "final_displacement.png", "seed001_upper_cut_final.png");
+}
+
+// Seed 001 piles (3D, coarse): a row at mid-slope reduces run-out more than a row at the top.
+TEST(Validation, Seed001Piles) {
+  auto none = run_case("seed001_piles_none", "slope_piles_3d.toml", "--set piles.enabled=false");
+  auto mid = run_case("seed001_piles_middle", "slope_piles_3d.toml", "--set piles.position=middle");
+  auto top = run_case("seed001_piles_upper", "slope_piles_3d.toml", "--set piles.position=upper");
+  const double n = none.value("normalised_runout", 0.0), m = mid.value("normalised_runout", 0.0),
+               u = top.value("normalised_runout", 0.0);
+  std::printf("seed 001 piles (3D): none %.3f, middle %.3f, upper %.3f\n", n, m, u);
+  EXPECT_LT(m, u);
+  EXPECT_LE(m, n);
+  copy_figure("seed001_piles_middle", "final_displacement.png", "seed001_piles_middle_final.png");
+}
+
+// Seed 002 Masa-soil shaking-table slope: the slope fails under shaking (displacements grow while
+// shaking, a slip surface reaching down into the slope). Displacements over time go to the docs.
+TEST(Validation, Seed002MasaShakingTable) {
+  auto s = run_case("seed002_masa", "masa_shaking_table.toml", "");
+  std::printf("seed 002 Masa: max displacement %.3f m, failed area %.4f m2/m, run-out %.3f m\n",
+              s.value("max_displacement_m", 0.0), s.value("failed_area_m2_per_m", 0.0), s.value("runout_m", 0.0));
+  EXPECT_GT(s.value("max_displacement_m", 0.0), 0.02);
+  copy_figure("seed002_masa", "final_displacement.png", "seed002_masa_final.png");
+  copy_figure("seed002_masa", "final_plastic_strain.png", "seed002_masa_plastic_strain.png");
+  copy_figure("seed002_masa", "velocity_t4.000.png", "seed002_masa_velocity_4s.png");
+}
+
+// Biaxial compression (seed 000): shear band inclination between Roscoe (45° + ψ/2) and Coulomb
+// (45° + φ/2) angles; the band is located from the plastic strain in the final snapshot (docs).
+TEST(Validation, BiaxialCompression) {
+  const double phi = 25.0, psi = 0.0;
+  auto s = run_case("biaxial", "biaxial.toml", "--set numerics.spacing=0.002 --set run.end_time=0.06");
+  ASSERT_TRUE(fs::exists(kWork / "biaxial" / "stress_strain.csv"));
+  // Band: soil particles in the top 15 % of accumulated plastic strain in the final snapshot. Its
+  // inclination to the horizontal: the direction θ (and its mirror) along which the band's
+  // particles pile up most in a histogram of their distance to lines of that direction (bins 2Δx).
+  geohaz::SnapshotReader snap(kWork / "biaxial" / "snapshots.h5");
+  const std::size_t k = snap.snapshot_count() - 1;
+  const auto pos = snap.read(k, "position"), ep = snap.read(k, "plastic_strain"), kind = snap.read(k, "kind");
+  std::vector<double> vals;
+  for (std::size_t i = 0; i < ep.count; ++i)
+    if (kind.values[i] == 0) vals.push_back(ep.values[i]);
+  ASSERT_FALSE(vals.empty());
+  std::vector<double> sorted = vals;
+  std::sort(sorted.begin(), sorted.end());
+  const double thr = sorted[static_cast<std::size_t>(0.85 * static_cast<double>(sorted.size()))];
+  std::vector<std::array<double, 2>> band;
+  for (std::size_t i = 0; i < ep.count; ++i)
+    if (kind.values[i] == 0 && ep.values[i] >= thr && thr > 0)
+      band.push_back({pos.values[2 * i], pos.values[2 * i + 1]});
+  double best_theta = 0.0;
+  std::size_t best = 0;
+  for (int deg10 = 200; deg10 <= 890; deg10 += 5) {
+    const double th = deg10 / 10.0 * std::numbers::pi / 180.0;
+    for (double sgn : {1.0, -1.0}) {
+      const double nx = -std::sin(th) * sgn, nz = std::cos(th);
+      std::map<long, std::size_t> hist;
+      for (const auto& p : band) ++hist[static_cast<long>(std::floor((p[0] * nx + p[1] * nz) / 0.004))];
+      for (const auto& [b, c] : hist)
+        if (c > best) {
+          best = c;
+          best_theta = deg10 / 10.0;
+        }
+    }
+  }
+  const double roscoe = 45.0 + psi / 2.0, coulomb = 45.0 + phi / 2.0;
+  std::printf(
+      "biaxial: peak deviator from stress_strain.csv; shear band %.1f deg (Roscoe %.1f, Coulomb %.1f), "
+      "%zu band particles\n",
+      best_theta, roscoe, coulomb, band.size());
+  std::ofstream(kWork / "biaxial_band.txt") << best_theta << "\n";
+  // ±3° for the angular resolution of the band (its thickness is a few Δx over a 0.1 m specimen).
+  EXPECT_GE(best_theta, roscoe - 3.0);
+  EXPECT_LE(best_theta, coulomb + 3.0);
+  copy_figure("biaxial", "final_plastic_strain.png", "biaxial_plastic_strain.png");
+}
+
+// Figures of docs/validation/sph.md from the runs above (run this test last).
+TEST(Validation, Figures) {
+  // Column collapse: (L∞ − L0)/L0 vs a, model dots (blue) and the experimental laws (black).
+  {
+    Curve law{{}, {}, {0, 0, 0}, false}, law2{{}, {}, {130, 130, 130}, false}, model{{}, {}, {30, 90, 200}, true};
+    for (double a = 0.0; a <= 2.8 + 1e-9; a += 0.05) {
+      law.x.push_back(a);
+      law.y.push_back(1.2 * a);
+    }
+    for (double a = 1.8; a <= 3.5 + 1e-9; a += 0.05) {
+      law2.x.push_back(a);
+      law2.y.push_back(1.9 * std::pow(a, 2.0 / 3.0));
+    }
+    for (double a : {0.5, 1.0, 2.0, 3.0}) {
+      std::ifstream in(kWork / ("column_a" + std::to_string(static_cast<int>(a * 10))) / "summary.json");
+      if (!in) continue;
+      const auto s = nlohmann::json::parse(in);
+      model.x.push_back(a);
+      model.y.push_back(s["normalised_runout"].get<double>());
+    }
+    plot(kFigures / "column_runout_vs_aspect_ratio.png", {law, law2, model}, 0.0, 3.5, 0.0, 7.0, 0.5, 1.0);
+  }
+  // Seed 001: normalised run-out vs time, granular (blue), cohesive (red), upper cut (green).
+  {
+    std::vector<Curve> cs;
+    const std::pair<const char*, std::array<std::uint8_t, 3>> runs[] = {
+        {"seed001_granular", {30, 90, 200}}, {"seed001_cohesive", {200, 40, 40}}, {"seed001_cut", {40, 160, 60}}};
+    for (const auto& [name, col] : runs) {
+      const auto f = kWork / name / "series.csv";
+      if (!fs::exists(f)) continue;
+      cs.push_back({csv_column(f, 0), csv_column(f, 4), col, false});
+    }
+    plot(kFigures / "seed001_runout_vs_time.png", cs, 0.0, 3.0, 0.0, 0.8, 0.5, 0.1);
+  }
+  // Seed 002 Masa: max displacement (blue) and run-out (green) vs time, input acceleration/10 (grey).
+  {
+    const auto f = kWork / "seed002_masa" / "series.csv";
+    if (fs::exists(f)) {
+      auto t = csv_column(f, 0), umax = csv_column(f, 9), run = csv_column(f, 3), acc = csv_column(f, 10);
+      for (auto& a : acc) a = 0.25 + a / 40.0;
+      plot(kFigures / "seed002_masa_displacement_vs_time.png",
+           {{t, acc, {170, 170, 170}, false}, {t, umax, {30, 90, 200}, false}, {t, run, {40, 160, 60}, false}}, 0.0,
+           8.0, 0.0, 0.5, 1.0, 0.05);
+    }
+  }
+  // Biaxial: deviator (kPa) vs axial strain (%).
+  {
+    const auto f = kWork / "biaxial" / "stress_strain.csv";
+    if (fs::exists(f)) {
+      auto e = csv_column(f, 1), q = csv_column(f, 4);
+      for (auto& v : e) v *= 100.0;
+      for (auto& v : q) v = -v / 1e3;
+      plot(kFigures / "biaxial_stress_strain.png", {{e, q, {30, 90, 200}, false}}, 0.0, 6.0, 0.0, 80.0, 1.0, 10.0);
+    }
+  }
+
+  // Seed 002 Masa: displacement history of marker particles (face centre, crest edge, crest 0.2 m
+  // behind the edge) from the 1 s snapshots, like the seed's sensors SH/SV along the slope centre.
+  {
+    const auto f = kWork / "seed002_masa" / "snapshots.h5";
+    if (fs::exists(f)) {
+      geohaz::SnapshotReader r(f);
+      const auto pos0 = r.read(0, "position"), id0 = r.read(0, "id");
+      const std::array<std::array<double, 2>, 3> targets{{{0.65, 0.25}, {0.405, 0.495}, {0.205, 0.495}}};
+      std::array<double, 3> ids{};
+      for (int m = 0; m < 3; ++m) {
+        double best = 1e300;
+        for (std::size_t i = 0; i < pos0.count; ++i) {
+          const double dx = pos0.values[2 * i] - targets[m][0], dz = pos0.values[2 * i + 1] - targets[m][1];
+          if (dx * dx + dz * dz < best) {
+            best = dx * dx + dz * dz;
+            ids[m] = id0.values[i];
+          }
+        }
+      }
+      std::ofstream tab(kWork / "masa_markers.csv");
+      tab << "time_s,face_ux,face_uz,crest_edge_ux,crest_edge_uz,crest_ux,crest_uz\n";
+      std::vector<Curve> cs(6);
+      const std::array<std::array<std::uint8_t, 3>, 3> cols{{{30, 90, 200}, {200, 40, 40}, {40, 160, 60}}};
+      for (std::size_t k = 0; k < r.snapshot_count(); ++k) {
+        const auto id = r.read(k, "id"), u = r.read(k, "displacement");
+        tab << r.time(k);
+        for (int m = 0; m < 3; ++m) {
+          for (std::size_t i = 0; i < id.count; ++i)
+            if (id.values[i] == ids[m]) {
+              tab << ',' << u.values[2 * i] << ',' << u.values[2 * i + 1];
+              cs[2 * m].x.push_back(r.time(k));
+              cs[2 * m].y.push_back(u.values[2 * i]);
+              cs[2 * m + 1].x.push_back(r.time(k));
+              cs[2 * m + 1].y.push_back(u.values[2 * i + 1]);
+              cs[2 * m].colour = cols[m];
+              cs[2 * m + 1].colour = cols[m];
+              cs[2 * m + 1].dots = true;
+            }
+        }
+        tab << '\n';
+      }
+      plot(kFigures / "seed002_masa_marker_displacements.png", cs, 0.0, 8.0, -0.15, 0.15, 1.0, 0.05);
+    }
+  }
+}
+
+}  // namespace
