@@ -221,8 +221,12 @@ RunConfig read_config(ConfigReader& r, bool describe) {
     const auto poly = r.get_array("section.polyline", {}, {}, {"m", "x0, y0, x1, y1, ... in the DSM CRS"});
     c.section.soil_thickness =
         r.get("section.soil_thickness", 2.0, Range::positive(), {"m", "soil layer thickness below the surface"});
-    c.section.base_thickness =
-        r.get("section.base_thickness", 2.0, Range::positive(), {"m", "base below the lowest soil"});
+    c.section.bedrock = r.get_choice("section.base", "bedrock", {"bedrock", "fill"},
+                                     {"", "bedrock: soil and base layers follow the surface on fixed bedrock "
+                                          "particles; fill: the base fills down to a flat bottom"}) == "bedrock";
+    c.section.base_thickness = r.get("section.base_thickness", 2.0, Range::positive(),
+                                     {"m", "base layer under the soil (bedrock: parallel to the surface; fill: "
+                                           "below the lowest soil)"});
     c.section.soil_material = static_cast<int>(
         r.get_int("section.soil_material", 1, Range::closed(0, 1000), {"1", "material index of the soil layer"}));
     c.section.base_material = static_cast<int>(

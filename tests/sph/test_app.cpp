@@ -59,7 +59,7 @@ TEST(SphSlopeApp, TinySlopeWritesAllOutputs) {
                      "tiny_slope");
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* f : {"summary.json", "series.csv", "surface_final.csv", "slip_surface.csv", "snapshots.h5",
-                        "snapshots.xmf", "final_displacement.png", "velocity_t0.050.png", "resolved_config.toml"})
+                        "snapshots.xmf", "final_displacement.png", "velocity_t0.050.png", "config.resolved.toml"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   const auto s = summary(out);
   EXPECT_EQ(s["dimension"], 2);

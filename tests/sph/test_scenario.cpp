@@ -51,6 +51,43 @@ TEST(Scenario, LayersByElevation) {
   EXPECT_THROW(build_profile<2>(d, 0.01, {1000.0, 1500.0, 2000.0}, 1.2), InputError);
 }
 
+// DSM sections on a mountainside: with bedrock_depth the soil is a cover of that depth resting on
+// boundary particles that follow the surface, so the particle count scales with length × depth,
+// not with the relief, and the geostatic loading height is the cover depth.
+TEST(Scenario, BedrockCoverFollowsTheSurface) {
+  ProfileDomain d;
+  d.surface = {{0.0, 60.0}, {100.0, 0.0}};  // a 31° slope, 60 m of relief
+  d.x_left = 0.0;
+  d.x_right = 100.0;
+  d.z_bottom = -10.0;
+  d.layer_materials = {0};
+  d.surface_layer_depth = 2.0;
+  d.surface_material = 1;
+  d.bedrock_depth = 4.0;
+  const double dx = 0.5;
+  auto sc = build_profile<2>(d, dx, {2200.0, 1800.0}, 1.2);
+  const auto& x = sc.store.get<Position<2>>();
+  const auto& m = sc.store.get<MaterialId>();
+  const auto& k = sc.store.get<ParticleKind>();
+  std::size_t soil = 0;
+  for (std::size_t i = 0; i < sc.store.size(); ++i) {
+    const double zs = 60.0 - 0.6 * x[i][0];
+    if (k[i] != 0) {
+      if (x[i][0] > 0.0 && x[i][0] < 100.0) {
+        EXPECT_LT(x[i][1], zs - 4.0 + 1e-9);  // bedrock below the cover
+      }
+      continue;
+    }
+    ++soil;
+    EXPECT_GT(x[i][1], zs - 4.0 - 1e-9);
+    EXPECT_LT(x[i][1], zs);
+    EXPECT_EQ(m[i], x[i][1] > zs - 2.0 ? 1 : 0);  // 2 m soil over 2 m base
+  }
+  EXPECT_EQ(soil, sc.soil_count);
+  EXPECT_NEAR(static_cast<double>(soil), 100.0 * 4.0 / (dx * dx), 0.02 * 100.0 * 4.0 / (dx * dx));
+  EXPECT_DOUBLE_EQ(sc.reference_height, 4.0);
+}
+
 TEST(Scenario, UpperCutRemovesSoil) {
   SlopeGeometry g;
   const auto full = build_profile<2>(g.profile(), 0.01, {1800.0}, 1.2);

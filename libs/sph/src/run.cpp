@@ -124,6 +124,7 @@ Built<Dim> build(const RunConfig& c) {
       d.layer_materials = {c.section.base_material};
       d.surface_layer_depth = c.section.soil_thickness;
       d.surface_material = c.section.soil_material;
+      if (c.section.bedrock) d.bedrock_depth = c.section.soil_thickness + c.section.base_thickness;
       b.sc = build_profile<Dim>(d, dx, rho, hf);
       b.frame.toe_x = d.x_left;  // run-out on a section: reported as the largest horizontal displacement
       b.frame.base_length = d.x_right - d.x_left;
@@ -291,7 +292,7 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
   }
 
   make_output_dir(out);
-  write_text_file(out / "resolved_config.toml", c.resolved_config);
+  write_text_file(out / "config.resolved.toml", c.resolved_config);
   SnapshotWriter snaps(out / "snapshots.h5", "sph-slope", Dim, c.resolved_config);
   snaps.set_attribute("scenario", scenario_name(c.scenario));
   snaps.set_attribute("units", "SI: m, s, kg, Pa");

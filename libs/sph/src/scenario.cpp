@@ -115,7 +115,9 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
   const int material_floor = dom.layer_materials.empty() ? 0 : dom.layer_materials.front();
 
   const int nx = static_cast<int>(std::lround((dom.x_right - dom.x_left) / dx));
-  const int nz = static_cast<int>(std::ceil((zmax_surface - dom.z_bottom) / dx)) + 1;
+  const bool bedrock = dom.bedrock_depth > 0.0;
+  const int nz = bedrock ? static_cast<int>(std::ceil(dom.bedrock_depth / dx)) + 1
+                         : static_cast<int>(std::ceil((zmax_surface - dom.z_bottom) / dx)) + 1;
   double soil_zmax = -1e300;
   for (int j = 0; j < ny; ++j) {
     const double y = (j + 0.5) * dx;
@@ -123,8 +125,9 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
       const double x = dom.x_left + (i + 0.5) * dx;
       const double zs = surface_at(dom.surface, x);
       const bool pile_here = in_pile(x, y);
+      const double z0 = bedrock ? zs - dom.bedrock_depth : dom.z_bottom;
       for (int k = 0; k < nz; ++k) {
-        const double z = dom.z_bottom + (k + 0.5) * dx;
+        const double z = z0 + (k + 0.5) * dx;
         if (pile_here) {
           if (z < zs + dom.pile_top_margin)
             B.add(make(x, y, z), Kind::Pile, material_floor, densities[material_floor], Vec<Dim>::Zero());
@@ -147,6 +150,28 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
   const int nbx = static_cast<int>(std::lround((xb1 - xb0) / dx));
   for (int j = 0; j < ny; ++j) {
     const double y = (j + 0.5) * dx;
+    if (bedrock) {
+      // Bedrock: `layers` rows of boundary particles under the soil cover, following the surface
+      // (beyond the ends at the end elevations); end walls rise from it to 3Δx above the surface.
+      for (int l = 0; l < layers; ++l)
+        for (int i = 0; i < nbx; ++i) {
+          const double x = xb0 + (i + 0.5) * dx;
+          const double zr = surface_at(dom.surface, std::clamp(x, dom.x_left, dom.x_right)) - dom.bedrock_depth;
+          B.add(make(x, y, zr - (l + 0.5) * dx), wall_kind(dom.bottom), material_floor, wall_rho, ez);
+        }
+      for (int side = 0; side < 2; ++side) {
+        const WallType w = side == 0 ? dom.left : dom.right;
+        if (w == WallType::None) continue;
+        const double xe = side == 0 ? dom.x_left : dom.x_right;
+        const double ze = surface_at(dom.surface, xe);
+        const int nzw = static_cast<int>(std::lround((dom.bedrock_depth + 3 * dx) / dx));
+        for (int l = 0; l < layers; ++l)
+          for (int k = 0; k < nzw; ++k)
+            B.add(make(side == 0 ? xe - (l + 0.5) * dx : xe + (l + 0.5) * dx, y, ze - dom.bedrock_depth + (k + 0.5) * dx),
+                  wall_kind(w), material_floor, wall_rho, ex);
+      }
+      continue;
+    }
     if (dom.bottom != WallType::None)
       for (int l = 0; l < layers; ++l)
         for (int i = 0; i < nbx; ++i)
@@ -196,7 +221,8 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
       sc.periodic.hi[1] = ny * dx;
     }
   }
-  sc.reference_height = soil_zmax + 0.5 * dx - dom.z_bottom;
+  // Height that sets the geostatic loading time (20 H / c_p): the soil column, not the relief.
+  sc.reference_height = bedrock ? dom.bedrock_depth : soil_zmax + 0.5 * dx - dom.z_bottom;
   sc.base_top = dom.z_bottom;
   sc.toe_x = dom.x_right;
   sc.base_length = dom.x_right - dom.x_left;

@@ -37,6 +37,9 @@ struct SectionInput {
   std::string crs_wkt;
   std::shared_ptr<const Raster> dsm;  ///< for release_thickness.tif (may be null)
   double soil_thickness = 2.0;        ///< m: soil layer (material `soil_material`) below the surface
+  /// true: soil + base layers rest on fixed bedrock following the surface; false: the base fills
+  /// down to a flat bottom base_thickness below the lowest point of the soil.
+  bool bedrock = true;
   double base_thickness = 2.0;        ///< m: base material below the lowest point of the soil layer
   int soil_material = 1, base_material = 0;
   double release_width = 10.0;  ///< W (m): plane-strain particles are spread over this width

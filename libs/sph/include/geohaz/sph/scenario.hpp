@@ -45,6 +45,10 @@ struct ProfileDomain {
   /// `surface_material`, else by elevation.
   double surface_layer_depth = 0.0;
   int surface_material = 0;
+  /// Optional (DSM sections): > 0 fills soil only down to this depth below the surface, resting on
+  /// fixed boundary particles that follow the surface ("bedrock"), instead of filling down to a flat
+  /// z_bottom. A 500 m section through a mountainside then costs its soil cover, not its relief.
+  double bedrock_depth = 0.0;
   std::vector<Pile> piles;
   double pile_top_margin = 0.0;  ///< piles stick out of the surface by this (m)
 };
