@@ -87,7 +87,14 @@ void flatten(const json& j, const std::string& prefix, std::vector<std::pair<std
     if (it->is_object()) {
       flatten(*it, key, out);
     } else if (it->is_array()) {
-      if (it->size() <= 8) out.emplace_back(key, it->dump());
+      // Short arrays of tables (e.g. one entry per confining stress) are flattened with their
+      // index; short arrays of numbers are shown inline; long arrays are left to the files.
+      if (it->size() > 8) continue;
+      if (!it->empty() && it->front().is_object()) {
+        for (std::size_t k = 0; k < it->size(); ++k) flatten((*it)[k], key + "[" + std::to_string(k) + "]", out);
+      } else {
+        out.emplace_back(key, it->dump());
+      }
     } else {
       out.emplace_back(key, format_value(*it));
     }
@@ -96,8 +103,8 @@ void flatten(const json& j, const std::string& prefix, std::vector<std::pair<std
 
 // Keys worth lifting into the table of key numbers.
 bool is_key_number(const std::string& k) {
-  static const char* words[] = {"runout", "run_out", "volume", "max_speed", "peak", "h_over_l", "fahrb",
-                                "strength", "deposit", "area", "young", "friction_angle", "cohesion"};
+  static const char* words[] = {"runout", "run_out", "volume", "max_speed", "peak_stress", "h_over_l",
+                                "strength", "deposited", "area_affected", "youngs", "friction_angle", "cohesion"};
   std::string lower = k;
   std::transform(lower.begin(), lower.end(), lower.begin(), ::tolower);
   if (lower.find("error") != std::string::npos) return lower.find("mass_balance") != std::string::npos;
