@@ -123,7 +123,7 @@ RunConfig read_config(ConfigReader& r, bool describe) {
                                                {"1", "steps between cell reorderings (0: never)"}));
   n.wall_repulsion = r.get("numerics.wall_repulsion", 0.5, Range::closed(0.0, 1.0),
                            {"1", "soil closer than this x dx to a wall particle is pushed back (0: off)"});
-  n.neighbour_skin = r.get("numerics.neighbour_skin", 0.0, Range::closed(0.0, 1.0),
+  n.neighbour_skin = r.get("numerics.neighbour_skin", 0.3, Range::closed(0.0, 1.0),
                            {"1", "Verlet skin in units of h (0: rebuild the neighbour list every step)"});
 
   // [geostatic]
