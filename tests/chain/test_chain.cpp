@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "geohaz/core/snapshot.hpp"
+#include "run_command.hpp"
 
 namespace fs = std::filesystem;
 
@@ -23,8 +24,9 @@ nlohmann::json read_json(const fs::path& p) {
 }
 
 int run(const std::string& cmd) {
-  const int rc = std::system(cmd.c_str());
-  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+  const auto r = geohaz::testing::run_command(cmd);
+  if (r.code != 0) std::fputs(r.output.c_str(), stderr);
+  return r.code;
 }
 
 TEST(Chain, SectionFailureRunsOutWithTheSameVolume) {

@@ -14,6 +14,8 @@
 
 #include "geohaz/core/raster.hpp"
 #include "geohaz/core/snapshot.hpp"
+#include "bonded_lab_spec.hpp"
+#include "run_command.hpp"
 #include "geohaz/dem/experiments.hpp"
 
 using namespace geohaz;
@@ -23,28 +25,7 @@ namespace fs = std::filesystem;
 namespace {
 
 LabTestSpec small_lab(double rmin = 1.2e-3) {
-  LabTestSpec s;
-  s.packing.width = 0.03;
-  s.packing.height = 0.06;
-  s.packing.r_min = rmin;
-  s.packing.r_max = 1.66 * rmin;
-  s.packing.porosity = 0.18;
-  s.packing.locked_in_stress = 1e6;
-  s.packing.seed = 1;
-  s.packing.expansion_steps = 1500;
-  s.packing.max_relax_steps = 5000;
-  const double Ec = 20e9;
-  s.material.law = LinearSpringCoulomb{2 * Ec, 2 * Ec / 2.5};
-  s.material.contact.friction = 0.5;
-  s.material.bond.modulus = Ec;
-  s.material.bond.stiffness_ratio = 2.5;
-  s.material.bond.tensile_strength = 50e6;
-  s.material.bond.tensile_strength_std = 10e6;
-  s.material.bond.shear_strength = 50e6;
-  s.material.bond.shear_strength_std = 10e6;
-  s.loading_velocity = 0.25;
-  s.max_axial_strain = 0.01;
-  return s;
+  return geohaz::dem::testing::bonded_lab({0.03, 0.06, rmin, 1, 1500, 5000, 0.25});
 }
 
 /// Elastic modulus only: strong bonds, stop at a small strain.
@@ -226,11 +207,7 @@ namespace {
 const fs::path kApp = fs::path(GEOHAZ_BINARY_DIR) / "apps" / "dem-avalanche" / "dem-avalanche";
 const fs::path kData = fs::path(GEOHAZ_SOURCE_DIR) / "data" / "dem";
 
-int run_app(const std::string& args) {
-  const std::string cmd = kApp.string() + " " + args + " > /dev/null 2>&1";
-  const int rc = std::system(cmd.c_str());
-  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
+int run_app(const std::string& args) { return geohaz::testing::run_command(kApp.string() + " " + args).code; }
 
 fs::path fresh_dir(const std::string& name) {
   const fs::path d = fs::path(GEOHAZ_BINARY_DIR) / "tests" / "dem" / name;
@@ -380,13 +357,8 @@ TEST(DemApp, BlowUpStopsWithExitCode1AndKeepsSnapshots) {
   const std::string cmd = kApp.string() + " --config " + (kData / "avalanche.toml").string() +
                           " --set sample.r_min=1.2 --set sample.r_max=2.0 --set avalanche.settle_time=0.2"
                           " --set numerics.max_speed=5 --threads 1 --quiet --out " +
-                          out.string() + " 2>&1";
-  std::string msg;
-  if (FILE* p = popen(cmd.c_str(), "r")) {
-    char buf[512];
-    while (fgets(buf, sizeof buf, p)) msg += buf;
-    pclose(p);
-  }
+                          out.string();
+  const std::string msg = geohaz::testing::run_command(cmd).output;
   // The diagnosis names the disc, its position and the step.
   EXPECT_NE(msg.find("disc id"), std::string::npos) << msg;
   EXPECT_NE(msg.find("at step"), std::string::npos) << msg;

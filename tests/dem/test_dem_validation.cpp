@@ -11,6 +11,7 @@
 
 #include "geohaz/dem/experiments.hpp"
 #include "geohaz/dem/output.hpp"
+#include "bonded_lab_spec.hpp"
 
 using namespace geohaz;
 using namespace geohaz::dem;
@@ -24,30 +25,7 @@ fs::path out_dir() {
   return d;
 }
 
-LabTestSpec lab(double rmin) {
-  LabTestSpec s;
-  s.packing.width = 0.05;
-  s.packing.height = 0.1;
-  s.packing.r_min = rmin;
-  s.packing.r_max = 1.66 * rmin;
-  s.packing.porosity = 0.18;
-  s.packing.locked_in_stress = 1e6;
-  s.packing.seed = 11;
-  s.packing.expansion_steps = 3000;
-  s.packing.max_relax_steps = 10000;
-  const double Ec = 20e9;
-  s.material.law = LinearSpringCoulomb{2 * Ec, 2 * Ec / 2.5};
-  s.material.contact.friction = 0.5;
-  s.material.bond.modulus = Ec;
-  s.material.bond.stiffness_ratio = 2.5;
-  s.material.bond.tensile_strength = 50e6;
-  s.material.bond.tensile_strength_std = 10e6;
-  s.material.bond.shear_strength = 50e6;
-  s.material.bond.shear_strength_std = 10e6;
-  s.loading_velocity = 0.1;
-  s.max_axial_strain = 0.01;
-  return s;
-}
+LabTestSpec lab(double rmin) { return geohaz::dem::testing::bonded_lab({0.05, 0.1, rmin, 11, 3000, 10000, 0.1}); }
 
 }  // namespace
 

@@ -15,26 +15,16 @@
 #include "geohaz/core/raster.hpp"
 #include "geohaz/core/snapshot.hpp"
 #include "geohaz/runout/synthetic_terrain.hpp"
+#include "run_command.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int code;
-  std::string output;
-};
+using Result = geohaz::testing::CommandResult;
 
 // Run the app through the shell, capturing stdout+stderr.
-Result run(const std::string& args) {
-  const std::string cmd = std::string(DEBRIS_RUNOUT_EXE) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
-  const int status = pclose(p);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+Result run(const std::string& args) { return geohaz::testing::run_command(std::string(DEBRIS_RUNOUT_EXE) + " " + args); }
 
 fs::path work_dir() {
   const fs::path d = fs::path(GEOHAZ_BINARY_DIR) / "tests" / "runout" / "app_work";

@@ -19,6 +19,7 @@
 
 #include "geohaz/core/raster.hpp"
 #include "geohaz/runout/solver.hpp"
+#include "run_command.hpp"
 
 namespace fs = std::filesystem;
 using namespace geohaz;
@@ -27,15 +28,10 @@ using namespace geohaz::runout;
 namespace {
 
 int run(const std::string& args, std::string* output = nullptr) {
-  const std::string cmd = std::string(DEBRIS_RUNOUT_EXE) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
-  const int status = pclose(p);
-  std::fputs(out.c_str(), stdout);
-  if (output) *output = out;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  const auto r = geohaz::testing::run_command(std::string(DEBRIS_RUNOUT_EXE) + " " + args);
+  std::fputs(r.output.c_str(), stdout);
+  if (output) *output = r.output;
+  return r.code;
 }
 
 fs::path work_dir() {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "run_command.hpp"
 #include "geohaz/core/snapshot.hpp"
 
 namespace {
@@ -29,12 +30,9 @@ struct Result {
 Result run(const std::string& args, const std::string& name) {
   fs::create_directories(kWork);
   const fs::path log = kWork / (name + ".log");
-  const std::string cmd = kApp.string() + " " + args + " --threads 1 > " + log.string() + " 2>&1";
-  const int status = std::system(cmd.c_str());
-  std::ifstream in(log);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
+  const auto r = geohaz::testing::run_command(kApp.string() + " " + args + " --threads 1");
+  std::ofstream(log) << r.output;  // kept for inspection after a failure
+  return {r.code, r.output};
 }
 
 nlohmann::json summary(const fs::path& dir) {
