@@ -207,9 +207,10 @@ RunConfig read_config(ConfigReader& r, bool describe) {
       throw InputError("must be non-zero", r.source(), "biaxial.strain_rate", "0");
   }
   if (is3d || describe) {
-    c.width = r.get("geometry.width", 0.1, Range::positive(), {"m", "3D width (axis y)"});
+    c.width = r.get("geometry.width", 0.1, Range::positive(), {"m", "3D width (axis y); a 3D DSM section: the strip width, centred on the polyline"});
     c.periodic_width =
-        r.get_bool("geometry.periodic", true, {"", "3D: periodic across the width (seed 001), else roller walls"});
+        r.get_bool("geometry.periodic", c.scenario != ScenarioType::Section,
+                   {"", "3D: periodic across the width (seed 001), else roller walls (default for a DSM section)"});
   }
   const char* left_default = c.scenario == ScenarioType::Section ? "fixed" : "fixed";
   const char* right_default = c.scenario == ScenarioType::Column ? "none" : "fixed";
@@ -246,6 +247,7 @@ RunConfig read_config(ConfigReader& r, bool describe) {
       c.section.profile = extract_profile(terrain, line, n.spacing);
       c.section.crs_wkt = raster->crs_wkt;
       c.section.dsm = raster;
+      c.section.terrain = std::make_shared<const Terrain>(*raster);
     }
   }
   return c;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -64,6 +65,51 @@ TEST(Chain, SectionFailureRunsOutWithTheSameVolume) {
               1e-9 * handed);
   for (const char* map : {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "arrival_time.tif"})
     EXPECT_TRUE(fs::exists(out / "runout" / map)) << map;
+  fs::remove_all(out);
+}
+
+
+// The 3D variant: a 6 m wide strip of the same hillside centred on a 50 m polyline, with roller
+// side walls following the terrain; each failed particle is handed over at its own map position
+// with its own volume Δx³. The soil is weakened (φ = 20°, c = 1 kPa) because the 3D
+// Drucker–Prager fit (compression cone) is stronger than the plane-strain one.
+TEST(Chain, ThreeDStripOnTheDsmHandsOverItsParticles) {
+  const fs::path src = GEOHAZ_SOURCE_DIR;
+  const fs::path out = fs::temp_directory_path() / ("geohaz_chain3d_" + std::to_string(getpid()));
+  fs::remove_all(out);
+  const double y_axis = 4000040.0, width = 6.0;
+  const std::string sph = std::string(SPH_SLOPE_EXE) + " --config " + (src / "data/sph/section_dsm.toml").string() +
+                          " --set run.dimension=3 --set geometry.width=6 --set numerics.spacing=1.0" +
+                          " --set section.polyline=[500030.0,4000040.0,500080.0,4000040.0]" +
+                          " --set material[1].friction=20 --set material[1].cohesion=1e3" +
+                          " --set run.end_time=1.0 --set run.stop_at_rest=false --set run.snapshot_interval=0" +
+                          " --threads 2 --quiet --out " + (out / "slope").string();
+  ASSERT_EQ(run(sph), 0) << sph;
+  const auto slope = read_json(out / "slope" / "summary.json");
+  ASSERT_TRUE(slope.contains("release")) << slope.dump(2);
+  const double handed = slope["release"]["total_volume_m3"].get<double>();
+  ASSERT_GT(handed, 0.0) << "no failed mass: the chain test would be vacuous";
+  // One point per failed particle of volume Δx³ = 1 m³, all on the strip.
+  EXPECT_NEAR(handed, slope["failed_volume_m3"].get<double>(), 1e-9 * handed);
+  geohaz::SnapshotReader rel(out / "slope" / "release.h5");
+  const auto pos = rel.read(0, "position");
+  const auto vol = rel.read(0, "volume");
+  ASSERT_EQ(pos.count, vol.count);
+  double sum = 0.0;
+  for (std::size_t q = 0; q < vol.count; ++q) {
+    sum += vol.values[q];
+    EXPECT_NEAR(vol.values[q], 1.0, 1e-12);
+    EXPECT_LE(std::abs(pos.values[2 * q + 1] - y_axis), 0.5 * width + 0.5) << "point " << q << " off the strip";
+  }
+  EXPECT_NEAR(sum, handed, 1e-9 * handed);
+
+  const std::string runout = std::string(DEBRIS_RUNOUT_EXE) + " " + (src / "data/sph/hillside_dsm.asc").string() +
+                             " --release-from " + (out / "slope" / "release.h5").string() +
+                             " --duration 30 --threads 2 --quiet --out " + (out / "runout").string();
+  ASSERT_EQ(run(runout), 0) << runout;
+  const auto flow = read_json(out / "runout" / "summary.json");
+  EXPECT_NEAR(flow["volumes_m3"]["release_read"].get<double>(), handed, 1e-9 * handed);
+  EXPECT_NEAR(flow["volumes_m3"]["seeded"].get<double>(), handed, 1e-9 * handed);
   fs::remove_all(out);
 }
 

@@ -309,5 +309,55 @@ TEST(Geostatic, ElasticColumnAtRest) {
   EXPECT_GT(min_soil_distance(S), 0.7 * dx) << "tensile-instability clumping";
 }
 
+
+// A cover on inclined bedrock (the DSM-section layout of the demo): 3 m of Drucker–Prager soil,
+// three particles deep, on a 50° slope; infinite-slope factor of safety ≈ 1.5. After the geostatic phase it must stay where it is. The
+// boundary particles carry the stress extrapolated along the layering normal (solver step 1); with
+// the extrapolation along the vertical instead — the flat-ground (Adami) form, which drops the
+// shear-stress gradient ρ g sin θ at the wall — the same cover creeps down the bedrock, the defect
+// that made the real-terrain section of the demo move without shaking.
+double cover_creep(bool vertical_layering) {
+  const double dx = 1.0, depth = 3.0, L = 30.0, slope = std::tan(50.0 * kDeg), rho = 1900.0;
+  ProfileDomain d;
+  d.surface = {{0.0, L * slope}, {L, 0.0}};
+  d.x_left = 0.0;
+  d.x_right = L;
+  d.z_bottom = -depth;
+  d.bedrock_depth = depth;
+  auto sc = build_profile<2>(d, dx, {rho}, 1.2);
+  if (vertical_layering)
+    for (auto& nu : sc.store.get<LayerNormal<2>>())
+      if (nu.squaredNorm() > 0.0) nu = Vec2(0.0, 1.0);
+  MaterialParams m;
+  m.density = rho;
+  m.young = 20e6;
+  m.poisson = 0.3;
+  m.friction = 35.0 * kDeg;
+  m.cohesion = 25e3;  // at 3 m: τ = ρ g z sinθ cosθ ≈ 27.5 kPa, strength c + ρ g z cos²θ tanφ ≈ 41 kPa
+  auto s = settings_for(sc);
+  SphSolver<2> solver(std::move(sc.store), {m}, DruckerPrager{}, s);
+  solver.apply_gravity_gradually(20.0 * depth / 120.0, 0.7, true);
+  while (solver.time() < 2.0) solver.step();
+  // Largest displacement of the soil away from the end walls (which hold the slope's ends).
+  const auto& S = solver.store();
+  double umax = 0.0;
+  for (std::size_t i = 0; i < S.size(); ++i) {
+    if (S.get<ParticleKind>()[i] != 0) continue;
+    const double x = S.get<Position<2>>()[i][0];
+    if (x < 5.0 || x > L - 5.0) continue;
+    umax = std::max(umax, S.get<Displacement<2>>()[i].norm());
+  }
+  return umax;
+}
+
+TEST(Geostatic, CoverOnInclinedBedrockStaysPut) {
+  const double u_layered = cover_creep(false), u_vertical = cover_creep(true);
+  std::printf("cover on 50 deg bedrock, 2 s after the geostatic phase: max displacement %.2e m (layer-normal "
+              "extrapolation), %.2e m (vertical extrapolation)\n",
+              u_layered, u_vertical);
+  EXPECT_LT(u_layered, 0.01);  // 1 cm: elastic adjustment only
+  EXPECT_GT(u_vertical, 10.0 * u_layered) << "the test no longer distinguishes the two extrapolations";
+}
+
 }  // namespace
 }  // namespace geohaz::sph

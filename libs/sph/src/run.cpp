@@ -103,8 +103,6 @@ Built<Dim> build(const RunConfig& c) {
       break;
     }
     case ScenarioType::Section: {
-      if (Dim != 2)
-        throw InputError("the DSM cross-section scenario is 2D (plane strain)", c.config_source, "run.dimension", "3");
       const auto& P = c.section.profile;
       if (P.size() < 2)
         throw InputError("the cross-section profile has fewer than 2 points", c.config_source, "section.polyline");
@@ -125,6 +123,28 @@ Built<Dim> build(const RunConfig& c) {
       d.surface_layer_depth = c.section.soil_thickness;
       d.surface_material = c.section.soil_material;
       if (c.section.bedrock) d.bedrock_depth = c.section.soil_thickness + c.section.base_thickness;
+      if constexpr (Dim == 3) {
+        if (!c.section.bedrock)
+          throw InputError("a 3D DSM section needs section.base = \"bedrock\"", c.config_source, "section.base",
+                           "fill");
+        if (c.periodic_width)
+          throw InputError("a 3D DSM section cannot be periodic across: the terrain differs on both sides",
+                           c.config_source, "geometry.periodic", "true");
+        if (!c.section.terrain) throw InputError("the 3D section has no terrain", c.config_source, "section.dsm");
+        d.width = c.width;
+        d.periodic_width = false;
+        const Terrain* terrain = c.section.terrain.get();
+        const double half = 0.5 * std::lround(c.width / dx) * dx;
+        d.surface_xy = [terrain, &P, half, &c](double s, double y) {
+          const Vec2 q = section_map_point(P, s, y - half);
+          const double z = terrain->elevation(q.x(), q.y());
+          if (!std::isfinite(z))
+            throw InputError("the 3D section strip leaves the DSM's data at (" + std::to_string(q.x()) + ", " +
+                                 std::to_string(q.y()) + "): narrow geometry.width or move the polyline",
+                             c.config_source, "geometry.width", std::to_string(c.width));
+          return z;
+        };
+      }
       b.sc = build_profile<Dim>(d, dx, rho, hf);
       b.frame.toe_x = d.x_left;  // run-out on a section: reported as the largest horizontal displacement
       b.frame.base_length = d.x_right - d.x_left;
@@ -187,6 +207,7 @@ void write_snapshot(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::in
   add_view<ParticleKind>(v, s);
   add_view<Mass>(v, s);
   add_view<WallNormal<Dim>>(v, s);
+  add_view<LayerNormal<Dim>>(v, s);
   add_view<ParticleId>(v, s);
   w.write(t, step, v);
 }
@@ -499,62 +520,56 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
   summary["bytes_per_particle"] = solver.bytes_per_particle();
 
   // Failed mass for debris-runout (handoff spec): only when the section is georeferenced.
+  // 2D: each plane-strain particle of area A becomes k = W/Δx map points spread across the width W,
+  // each of volume A·W/k. 3D: each particle is one map point (its position on the strip) carrying
+  // its own volume m/ρ0.
   if (c.scenario == ScenarioType::Section && c.write_release) {
-    if constexpr (Dim == 2) {
-      const auto& P = c.section.profile;
-      const auto& S = solver.store();
-      std::vector<Vec2> pts;
-      std::vector<double> vols;
-      double total = 0.0;
-      const double W = c.section.release_width;
-      const int k = std::max(1, static_cast<int>(std::lround(W / c.numerics.spacing)));
-      for (std::size_t i = 0; i < S.size(); ++i) {
-        if (S.template get<ParticleKind>()[i] != kSoil) continue;
-        if (S.template get<Displacement<2>>()[i].norm() <= c.failed_threshold) continue;
-        const double s = std::clamp(S.template get<Position<2>>()[i][0], P.front().s, P.back().s);
-        std::size_t seg = 1;
-        while (seg + 1 < P.size() && P[seg].s < s) ++seg;
-        const double ds = P[seg].s - P[seg - 1].s;
-        const double w = ds > 0 ? (s - P[seg - 1].s) / ds : 0.0;
-        const Vec2 a(P[seg - 1].x, P[seg - 1].y), bb(P[seg].x, P[seg].y);
-        const Vec2 p = a + w * (bb - a);
-        Vec2 t = bb - a;
-        t = t.norm() > 0 ? Vec2(t / t.norm()) : Vec2(1.0, 0.0);
-        const Vec2 nrm(-t.y(), t.x());
-        const double A = S.template get<Mass>()[i] / rho0[static_cast<std::size_t>(S.template get<MaterialId>()[i])];
-        const double vol = A * W / k * c.bulking_factor;
-        for (int q = 0; q < k; ++q) {
-          pts.push_back(p + (-0.5 * W + (q + 0.5) * W / k) * nrm);
-          vols.push_back(vol);
-          total += vol;
-        }
+    const auto& P = c.section.profile;
+    const auto& S = solver.store();
+    std::vector<Vec2> pts;
+    std::vector<double> vols;
+    double total = 0.0;
+    const double W = Dim == 2 ? c.section.release_width : std::lround(c.width / c.numerics.spacing) * c.numerics.spacing;
+    const int k = Dim == 2 ? std::max(1, static_cast<int>(std::lround(W / c.numerics.spacing))) : 1;
+    for (std::size_t i = 0; i < S.size(); ++i) {
+      if (S.template get<ParticleKind>()[i] != kSoil) continue;
+      if (S.template get<Displacement<Dim>>()[i].norm() <= c.failed_threshold) continue;
+      const Vec<Dim>& x = S.template get<Position<Dim>>()[i];
+      const double vol = S.template get<Mass>()[i] / rho0[static_cast<std::size_t>(S.template get<MaterialId>()[i])] *
+                         (Dim == 2 ? W / k : 1.0) * c.bulking_factor;
+      for (int q = 0; q < k; ++q) {
+        const double t = Dim == 2 ? -0.5 * W + (q + 0.5) * W / k : x[1] - 0.5 * W;
+        pts.push_back(section_map_point(P, x[0], t));
+        vols.push_back(vol);
+        total += vol;
       }
-      SnapshotWriter rel(out / "release.h5", "sph-slope-release", 2, c.resolved_config);
-      rel.set_attribute("crs_wkt", c.section.crs_wkt);
-      rel.set_attribute("total_volume", total);
-      std::ostringstream src;
-      src << c.config_source << "; displacement > " << c.failed_threshold << " m; width " << W << " m";
-      rel.set_attribute("source", src.str());
-      rel.set_attribute("bulking_factor", c.bulking_factor);
-      std::vector<FieldView> views{{"position", "m", ScalarType::Float64, pts.data(), pts.size(), 2, 1},
-                                   {"volume", "m^3", ScalarType::Float64, vols.data(), vols.size(), 1, 1}};
-      rel.write(solver.time(), solver.step_count(), views);
-      summary["release"] = {{"file", "release.h5"}, {"points", pts.size()}, {"total_volume_m3", total}, {"width_m", W}};
-      if (c.section.dsm) {
-        Raster th = c.section.dsm->like(0.0);
-        const double cell = th.cell_size_x() * th.cell_size_y();
-        double binned = 0.0;
-        for (std::size_t q = 0; q < pts.size(); ++q) {
-          const Vec2 px = th.to_pixel(pts[q]);
-          const int col = static_cast<int>(std::lround(px.x())), row = static_cast<int>(std::lround(px.y()));
-          if (col < 0 || row < 0 || col >= th.nx || row >= th.ny) continue;
-          th.at(col, row) += vols[q] / cell;
-          binned += vols[q];
-        }
-        write_geotiff(out / "release_thickness.tif", th);
-        summary["release"]["thickness_raster"] = "release_thickness.tif";
-        summary["release"]["volume_on_raster_m3"] = binned;
+    }
+    SnapshotWriter rel(out / "release.h5", "sph-slope-release", 2, c.resolved_config);
+    rel.set_attribute("crs_wkt", c.section.crs_wkt);
+    rel.set_attribute("total_volume", total);
+    std::ostringstream src;
+    src << c.config_source << "; " << Dim << "D section; displacement > " << c.failed_threshold << " m; width " << W
+        << " m";
+    rel.set_attribute("source", src.str());
+    rel.set_attribute("bulking_factor", c.bulking_factor);
+    std::vector<FieldView> views{{"position", "m", ScalarType::Float64, pts.data(), pts.size(), 2, 1},
+                                 {"volume", "m^3", ScalarType::Float64, vols.data(), vols.size(), 1, 1}};
+    rel.write(solver.time(), solver.step_count(), views);
+    summary["release"] = {{"file", "release.h5"}, {"points", pts.size()}, {"total_volume_m3", total}, {"width_m", W}};
+    if (c.section.dsm) {
+      Raster th = c.section.dsm->like(0.0);
+      const double cell = th.cell_size_x() * th.cell_size_y();
+      double binned = 0.0;
+      for (std::size_t q = 0; q < pts.size(); ++q) {
+        const Vec2 px = th.to_pixel(pts[q]);
+        const int col = static_cast<int>(std::lround(px.x())), row = static_cast<int>(std::lround(px.y()));
+        if (col < 0 || row < 0 || col >= th.nx || row >= th.ny) continue;
+        th.at(col, row) += vols[q] / cell;
+        binned += vols[q];
       }
+      write_geotiff(out / "release_thickness.tif", th);
+      summary["release"]["thickness_raster"] = "release_thickness.tif";
+      summary["release"]["volume_on_raster_m3"] = binned;
     }
   }
   summary["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
@@ -567,6 +582,18 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
 }
 
 }  // namespace
+
+Vec2 section_map_point(const std::vector<ProfilePoint>& P, double s, double t) {
+  s = std::clamp(s, P.front().s, P.back().s);
+  std::size_t seg = 1;
+  while (seg + 1 < P.size() && P[seg].s < s) ++seg;
+  const double ds = P[seg].s - P[seg - 1].s;
+  const double w = ds > 0 ? (s - P[seg - 1].s) / ds : 0.0;
+  const Vec2 a(P[seg - 1].x, P[seg - 1].y), b(P[seg].x, P[seg].y);
+  Vec2 tan = b - a;
+  tan = tan.norm() > 0 ? Vec2(tan / tan.norm()) : Vec2(1.0, 0.0);
+  return a + w * (b - a) + t * Vec2(-tan.y(), tan.x());
+}
 
 void validate(const RunConfig& c) {
   if (c.materials.empty()) throw InputError("at least one [[material]] is required", c.config_source, "material");

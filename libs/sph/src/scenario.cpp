@@ -28,7 +28,10 @@ struct Builder {
   SphStore<Dim> store;
   double dx;
   std::int64_t next_id = 0;
-  void add(const Vec<Dim>& p, Kind kind, int material, double density, const Vec<Dim>& normal) {
+  /// `layer` is the layering normal used to extrapolate stress into a boundary particle (default:
+  /// vertical, flat-lying soil); soil particles get none.
+  void add(const Vec<Dim>& p, Kind kind, int material, double density, const Vec<Dim>& normal,
+           const Vec<Dim>& layer = Vec<Dim>::Unit(Dim - 1)) {
     const std::size_t i = store.append(1);
     store.template get<Position<Dim>>()[i] = p;
     store.template get<Density>()[i] = density;
@@ -37,6 +40,7 @@ struct Builder {
     store.template get<MaterialId>()[i] = material;
     store.template get<ParticleKind>()[i] = static_cast<std::uint8_t>(kind);
     store.template get<WallNormal<Dim>>()[i] = normal;
+    store.template get<LayerNormal<Dim>>()[i] = kind == Kind::Soil ? Vec<Dim>::Zero() : layer;
     store.template get<ParticleId>()[i] = next_id++;
   }
 };
@@ -65,6 +69,10 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
     throw InputError("layer_materials must have one entry more than layer_tops");
   for (int m : dom.layer_materials) check_mat(m);
   if (dom.surface_layer_depth > 0.0) check_mat(dom.surface_material);
+  if (dom.surface_xy) {
+    if (Dim != 3 || !(dom.bedrock_depth > 0.0) || dom.periodic_width)
+      throw InputError("a surface z(x, y) needs a 3D, non-periodic domain on bedrock");
+  }
   if constexpr (Dim == 3) {
     if (!(dom.width >= 4.0 * h_factor * dx + 1e-12 * dx))
       throw InputError("the 3D width must be at least 4h = " + std::to_string(4.0 * h_factor * dx) +
@@ -75,19 +83,29 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
       throw InputError("piles need a 3D run: in 2D plane strain a pile row would be a continuous wall", "", "piles");
   }
   const int layers = static_cast<int>(std::ceil(2.0 * h_factor)) + 1;  // ≥ kernel support 2h
+  const int ny = Dim == 3 ? static_cast<int>(std::lround(dom.width / dx)) : 1;
+  // Surface elevation at (x, y): the profile, or the 3D surface clamped to the domain's extent.
+  const double y_max = ny * dx;
+  auto zs_at = [&](double x, double y) {
+    x = std::clamp(x, dom.x_left, dom.x_right);
+    if (dom.surface_xy) return dom.surface_xy(x, std::clamp(y, 0.0, y_max));
+    return surface_at(dom.surface, x);
+  };
   const double zmax_surface = [&] {
     double z = -1e300;
     for (auto& p : dom.surface) z = std::max(z, p[1]);
+    if (dom.surface_xy)
+      for (double x = dom.x_left; x <= dom.x_right + 0.5 * dx; x += dx)
+        for (double y = 0.0; y <= y_max + 0.5 * dx; y += dx) z = std::max(z, zs_at(x, y));
     return z;
   }();
   const double wall_top =
       dom.z_bottom + (dom.wall_height > 0.0 ? dom.wall_height : (zmax_surface - dom.z_bottom) + 3 * dx);
-  const int ny = Dim == 3 ? static_cast<int>(std::lround(dom.width / dx)) : 1;
 
   Builder<Dim> B;
   B.dx = dx;
-  auto material_at = [&](double x, double z) {
-    if (dom.surface_layer_depth > 0.0 && z > surface_at(dom.surface, x) - dom.surface_layer_depth)
+  auto material_at = [&](double x, double y, double z) {
+    if (dom.surface_layer_depth > 0.0 && z > zs_at(x, y) - dom.surface_layer_depth)
       return dom.surface_material;
     if (dom.layer_materials.empty()) return 0;
     std::size_t k = 0;
@@ -123,7 +141,7 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
     const double y = (j + 0.5) * dx;
     for (int i = 0; i < nx; ++i) {
       const double x = dom.x_left + (i + 0.5) * dx;
-      const double zs = surface_at(dom.surface, x);
+      const double zs = zs_at(x, y);
       const bool pile_here = in_pile(x, y);
       const double z0 = bedrock ? zs - dom.bedrock_depth : dom.z_bottom;
       for (int k = 0; k < nz; ++k) {
@@ -134,7 +152,7 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
           continue;
         }
         if (z >= zs) break;
-        const int m = material_at(x, z);
+        const int m = material_at(x, y, z);
         B.add(make(x, y, z), Kind::Soil, m, densities[static_cast<std::size_t>(m)], Vec<Dim>::Zero());
         soil_zmax = std::max(soil_zmax, z);
       }
@@ -153,17 +171,32 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
     if (bedrock) {
       // Bedrock: `layers` rows of boundary particles under the soil cover, following the surface
       // (beyond the ends at the end elevations); end walls rise from it to 3Δx above the surface.
+      // The cover is layered parallel to the surface, so each bedrock particle extrapolates stress
+      // along the surface normal, its slope taken as a central difference over the kernel support
+      // 2h (a DTM profile has kinks at every cell edge; the stress field does not).
+      const double wn = 2.0 * h_factor * dx;
+      auto layer_normal = [&](double x) {
+        Vec<Dim> nu = ez;
+        const double xa = std::clamp(x - wn, dom.x_left, dom.x_right);
+        const double xc = std::clamp(x + wn, dom.x_left, dom.x_right);
+        nu[0] = xc > xa ? -(zs_at(xc, y) - zs_at(xa, y)) / (xc - xa) : 0.0;
+        if constexpr (Dim == 3) {
+          const double ya = std::clamp(y - wn, 0.0, y_max), yc = std::clamp(y + wn, 0.0, y_max);
+          nu[1] = yc > ya ? -(zs_at(x, yc) - zs_at(x, ya)) / (yc - ya) : 0.0;
+        }
+        return Vec<Dim>(nu.normalized());
+      };
       for (int l = 0; l < layers; ++l)
         for (int i = 0; i < nbx; ++i) {
           const double x = xb0 + (i + 0.5) * dx;
-          const double zr = surface_at(dom.surface, std::clamp(x, dom.x_left, dom.x_right)) - dom.bedrock_depth;
-          B.add(make(x, y, zr - (l + 0.5) * dx), wall_kind(dom.bottom), material_floor, wall_rho, ez);
+          const double zr = zs_at(x, y) - dom.bedrock_depth;
+          B.add(make(x, y, zr - (l + 0.5) * dx), wall_kind(dom.bottom), material_floor, wall_rho, ez, layer_normal(x));
         }
       for (int side = 0; side < 2; ++side) {
         const WallType w = side == 0 ? dom.left : dom.right;
         if (w == WallType::None) continue;
         const double xe = side == 0 ? dom.x_left : dom.x_right;
-        const double ze = surface_at(dom.surface, xe);
+        const double ze = zs_at(xe, y);
         const int nzw = static_cast<int>(std::lround((dom.bedrock_depth + 3 * dx) / dx));
         for (int l = 0; l < layers; ++l)
           for (int k = 0; k < nzw; ++k)
@@ -188,7 +221,23 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
       }
   }
   if constexpr (Dim == 3) {
-    if (!dom.periodic_width) {
+    if (!dom.periodic_width && bedrock) {
+      // Roller side walls across the width, following the terrain from the bedrock to 3Δx above
+      // the surface along both edges (and under the end walls).
+      Vec<Dim> ey = Vec<Dim>::Zero();
+      ey[1] = 1.0;
+      const int nzw = static_cast<int>(std::lround((dom.bedrock_depth + 3 * dx) / dx)) + layers;
+      for (int side = 0; side < 2; ++side) {
+        const double y_edge = side == 0 ? 0.0 : y_max;
+        for (int l = 0; l < layers; ++l)
+          for (int i = 0; i < nbx; ++i) {
+            const double x = xb0 + (i + 0.5) * dx;
+            const double z0 = zs_at(x, y_edge) - dom.bedrock_depth - layers * dx;
+            const double yw = side == 0 ? -(l + 0.5) * dx : y_max + (l + 0.5) * dx;
+            for (int k = 0; k < nzw; ++k) B.add(make(x, yw, z0 + (k + 0.5) * dx), Kind::RollerWall, material_floor, wall_rho, ey);
+          }
+      }
+    } else if (!dom.periodic_width) {
       // Roller side walls across the width.
       Vec<Dim> ey = Vec<Dim>::Zero();
       ey[1] = 1.0;

@@ -140,6 +140,7 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
   const std::int32_t* mat = S.template get<MaterialId>().data();
   const std::uint8_t* kind = S.template get<ParticleKind>().data();
   const Vec<Dim>* nrm = S.template get<WallNormal<Dim>>().data();
+  const Vec<Dim>* lnrm = S.template get<LayerNormal<Dim>>().data();
   double* eps_p = S.template get<PlasticStrain>().data();
   std::uint8_t* sfree = S.template get<StressFree>().data();
   double* rsum = S.template get<SummationDensity>().data();
@@ -180,6 +181,16 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
   constexpr std::uint8_t kRoller = static_cast<std::uint8_t>(Kind::RollerWall);
 
   // 1. Boundary particles: ghost velocity and stress from the soil neighbours (Bui et al. 2008).
+  // The stress is extrapolated from each soil neighbour j to the boundary particle i so that the
+  // wall carries the stress gradient equilibrium demands, ∂σ_ik/∂x_k = −ρ ḡ_i, assuming the stress
+  // varies only along the layering normal ν (a layered deposit: flat ground, an infinite slope).
+  // With d = (x_i − x_j)·ν, ḡ_n = ḡ·ν and ḡ_t = ḡ − ḡ_n ν:
+  //   σ_i ← σ_j − ρ_j d [ḡ_n I + ḡ_t ⊗ ν + ν ⊗ ḡ_t],
+  // whose traction on the layering plane changes by −ρ_j ḡ d (normal and shear); the in-plane
+  // normal components take the isotropic part. Under flat ground (ν vertical) and vertical gravity
+  // this is the hydrostatic extrapolation of Adami et al. (2012); on a slope or under horizontal
+  // shaking it also supplies the shear the base must carry — without it, the soil next to an
+  // inclined wall misses the shear-stress gradient ρ g sin θ and creeps along the wall.
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
@@ -187,6 +198,12 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
       vI[i] = v[i];
       continue;
     }
+    Vec<Dim> nu = lnrm[i];
+    if (nu.squaredNorm() == 0.0) nu = Vec<Dim>::Unit(Dim - 1);  // snapshots written before the field existed
+    const double g_n = gbar.dot(nu);
+    const Vec<Dim> g_t = gbar - g_n * nu;
+    Mat<Dim> shear_dir = g_t * nu.transpose();
+    shear_dir += shear_dir.transpose().eval();
     double sw = 0.0;
     Vec<Dim> sv = Vec<Dim>::Zero();
     Mat3 ss = Mat3::Zero();
@@ -199,8 +216,10 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
       const double w = Kernel::value(std::sqrt(r2), h);
       sw += w;
       sv += w * v[j];
+      const double rd = rho[j] * xij.dot(nu);
       Mat3 sj = sig[j];
-      sj.diagonal().array() -= rho[j] * gbar.dot(xij);  // hydrostatic extrapolation (Adami et al. 2012)
+      sj.diagonal().array() -= rd * g_n;
+      sj.template topLeftCorner<Dim, Dim>() -= rd * shear_dir;
       ss += w * sj;
     }
     if (sw <= 0.0) {

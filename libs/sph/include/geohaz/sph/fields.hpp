@@ -75,6 +75,16 @@ struct WallNormal {
   static constexpr const char* label = "wall_normal";
   static constexpr const char* unit = "1";
 };
+/// Unit normal of the soil layering next to a fixed boundary particle (zero for soil). The stress a
+/// boundary particle carries is extrapolated from its soil neighbours assuming it varies along this
+/// direction only, as in a layered deposit: vertical for walls under flat-lying soil, the smoothed
+/// surface normal for bedrock under a DSM-section cover (see solver.cpp, step 1).
+template <int Dim>
+struct LayerNormal {
+  using type = Vec<Dim>;
+  static constexpr const char* label = "layer_normal";
+  static constexpr const char* unit = "1";
+};
 /// Accumulated plastic multiplier Σ Δλ (equals the engineering plastic shear strain for the √J2 potential).
 struct PlasticStrain {
   using type = double;
@@ -134,7 +144,8 @@ struct PositionAtBuild {
 template <int Dim>
 using SphStore =
     ParticleStore<Position<Dim>, Velocity<Dim>, Acceleration<Dim>, Displacement<Dim>, Stress, VelocityGradient<Dim>,
-                  Density, DensityRate, Mass, MaterialId, ParticleKind, WallNormal<Dim>, PlasticStrain, StressFree,
+                  Density, DensityRate, Mass, MaterialId, ParticleKind, WallNormal<Dim>, LayerNormal<Dim>,
+                  PlasticStrain, StressFree,
                   SummationDensity, InteractionVelocity<Dim>, XsphCorrection<Dim>, ArtificialStress<Dim>,
                   StressOverDensitySquared<Dim>, PositionAtBuild<Dim>, ParticleId>;
 

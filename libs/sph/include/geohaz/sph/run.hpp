@@ -31,11 +31,14 @@ struct PileRows {
   double spacing = 0.05;   ///< centre spacing across the width (m)
 };
 
-/// A DSM cross-section (2D) prepared by the app: the profile and its map geometry.
+/// A DSM cross-section prepared by the app: the profile and its map geometry. In 2D a plane-strain
+/// section along the polyline; in 3D a strip of the terrain `width` wide centred on the polyline
+/// (local x = distance s along the polyline, local y − width/2 = offset t to its left).
 struct SectionInput {
   std::vector<ProfilePoint> profile;  ///< s (m along the polyline), x, y (map), z (m)
   std::string crs_wkt;
   std::shared_ptr<const Raster> dsm;  ///< for release_thickness.tif (may be null)
+  std::shared_ptr<const Terrain> terrain;  ///< the DSM surface (3D sections; may be null in 2D)
   double soil_thickness = 2.0;        ///< m: soil layer (material `soil_material`) below the surface
   /// true: soil + base layers rest on fixed bedrock following the surface; false: the base fills
   /// down to a flat bottom base_thickness below the lowest point of the soil.
@@ -89,6 +92,10 @@ struct RunConfig {
   std::string resolved_config;  ///< TOML text of the resolved config (written and stored in HDF5)
   std::string config_source;    ///< config file name
 };
+
+/// Map position (DSM CRS) of the section point at distance s along the polyline and offset t to its
+/// left (perpendicular to the local segment). s is clamped to the polyline.
+Vec2 section_map_point(const std::vector<ProfilePoint>& profile, double s, double t);
 
 /// Check the cross-field consistency of a config that the per-key ranges cannot express and build
 /// the particles (dry run). Throws InputError naming the key. Called before any output is created.

@@ -10,6 +10,7 @@
 /// materials assigned by elevation (layers), optional walls at both ends and optional piles.
 
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,10 @@ struct ProfileDomain {
   /// fixed boundary particles that follow the surface ("bedrock"), instead of filling down to a flat
   /// z_bottom. A 500 m section through a mountainside then costs its soil cover, not its relief.
   double bedrock_depth = 0.0;
+  /// Optional (3D DSM sections): the surface elevation z_s(x, y) across the width, y ∈ [0, width];
+  /// replaces `surface` (which then still gives the along-section extent). Requires bedrock_depth
+  /// > 0 and non-periodic width: the side walls are roller walls that follow the terrain.
+  std::function<double(double, double)> surface_xy;
   std::vector<Pile> piles;
   double pile_top_margin = 0.0;  ///< piles stick out of the surface by this (m)
 };
