@@ -161,6 +161,9 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   // [output]
   c.failed_threshold = r.get("output.failed_threshold", 0.01, Range::positive(),
                              {"m", "displacement above which soil counts as failed (failed mass, slip surface)"});
+  c.front_thickness =
+      r.get("output.front_thickness", 0.0, Range::non_negative(),
+            {"m", "deposit thickness that defines the front (0: 2 spacings); fix it to compare resolutions"});
   c.bulking_factor =
       r.get("output.bulking_factor", 1.0, Range::closed(1.0, 3.0), {"1", "volume factor for release.h5"});
   c.write_release =

@@ -96,6 +96,26 @@ TEST(DruckerPragerReturn, TensionCutOffGoesToApex) {
   EXPECT_NEAR(t.norm(), 0.0, 1e-9);
 }
 
+// Density floor (parting): ρ0 for a cohesionless DP soil; ρ0/(1 + p_t/K) with the apex tension
+// p_t = k_c/(3α_φ) for c > 0; none for the models that carry tension.
+TEST(DruckerPrager, MinimumDensityIsTheDilationAtTheApex) {
+  MaterialParams p;
+  p.density = 1800.0;
+  p.young = 1e6;
+  p.poisson = 0.3;
+  p.friction = 30 * kDeg;
+  p.finalise();
+  EXPECT_DOUBLE_EQ(DruckerPrager::min_density(p), 1800.0);
+  p.cohesion = 10e3;
+  p.finalise();
+  const double pt = p.dp.kc / (3.0 * p.dp.alpha_phi);
+  EXPECT_NEAR(DruckerPrager::min_density(p), 1800.0 / (1.0 + pt / p.bulk), 1e-9);
+  EXPECT_LT(DruckerPrager::min_density(p), 1800.0);
+  EXPECT_EQ(LinearElastic::min_density(p), 0.0);
+  EXPECT_EQ(VonMises::min_density(p), 0.0);
+  EXPECT_EQ(NewtonianFluid::min_density(p), 0.0);
+}
+
 TEST(VonMises, RadialReturn) {
   MaterialParams p;
   p.young = 10e6;

@@ -184,6 +184,51 @@ TEST(ViscousShear, CouetteStartUpMatchesSeries) {
   }
 }
 
+// Parting (seed 000 "meeting and parting"): a free cohesionless block without gravity, given a
+// uniform expansion v = ε̇ (x − x_c), comes apart. Its particles carry no stress (nothing holds
+// them together) and their density stays at ρ0 (constitutive.hpp, `min_density`); without the floor
+// the continuity density follows ρ0/(1 + ε̇t)² (0.25ρ0 here) and m/ρ grows without bound, which is
+// how the fine column collapses blew up. Checks: min ρ ≥ ρ0 (1e-12), |σ| ≤ 1e-9 Pa once apart,
+// velocities unchanged (no spurious forces between parting particles, 1e-6 relative).
+TEST(Parting, CohesionlessParticlesKeepRestDensityAndCarryNoStress) {
+  const double dx = 0.005, rho = 1800.0, rate = 10.0;
+  ProfileDomain d;
+  d.surface = {{0.0, 0.05}, {0.05, 0.05}};
+  d.x_left = 0.0;
+  d.x_right = 0.05;
+  d.left = d.right = d.bottom = WallType::None;
+  auto sc = build_profile<2>(d, dx, {rho}, 1.2);
+  auto& v = sc.store.get<Velocity<2>>();
+  const auto& x0 = sc.store.get<Position<2>>();
+  const Vec2 centre(0.025, 0.025);
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = rate * (x0[i] - centre);
+  const std::vector<Vec2> v_start = v;
+  MaterialParams m;
+  m.density = rho;
+  m.young = 1e6;
+  m.poisson = 0.3;
+  m.friction = 30 * kDeg;
+  auto s = settings_for(sc);
+  s.gravity = 0.0;
+  s.domain_lo = Vec2(-1.0, -1.0);
+  s.domain_hi = Vec2(1.0, 1.0);
+  SphSolver<2> solver(std::move(sc.store), {m}, DruckerPrager{}, s);
+  while (solver.time() < 0.1) solver.step();  // (1 + ε̇t)² = 4: particles 2Δx apart
+  const auto& S = solver.store();
+  double rho_min = 1e300, sig_max = 0.0, dv_max = 0.0;
+  for (std::size_t i = 0; i < S.size(); ++i) {
+    rho_min = std::min(rho_min, S.get<Density>()[i]);
+    sig_max = std::max(sig_max, S.get<Stress>()[i].cwiseAbs().maxCoeff());
+    const auto id = static_cast<std::size_t>(S.get<ParticleId>()[i]);
+    dv_max = std::max(dv_max, (S.get<Velocity<2>>()[i] - v_start[id]).norm() / (rate * 0.025));
+  }
+  std::printf("parting block: min density %.6g kg/m3 (rho0 %.0f), max |sigma| %.3g Pa, max |dv|/v %.3g\n", rho_min, rho,
+              sig_max, dv_max);
+  EXPECT_GE(rho_min, rho * (1.0 - 1e-12));
+  EXPECT_LE(sig_max, 1e-9);
+  EXPECT_LT(dv_max, 1e-6);
+}
+
 // Cohesionless Drucker–Prager column collapse (a = H/L0 = 1) against a wall: the flow stops with a
 // finite run-out. Quasi-2D experiments give (L∞ − L0)/L0 ≈ 1.2 a for a ≲ 2–3 (Lube et al. 2005;
 // Lajeunesse et al. 2005); this coarse run (Δx = L0/20; front = last bin ≥ 2Δx thick) must land within ±25 % of it,

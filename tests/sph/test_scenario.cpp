@@ -145,6 +145,12 @@ TEST(Diagnostics, FrontSurfaceSlipAndFailedMass) {
   r = series_row(S, f);
   EXPECT_NEAR(r.front, 0.15, 1e-9);
   EXPECT_NEAR(r.normalised_runout, 0.5, 1e-9);
+  // A fixed physical front thickness replaces 2Δx: the moved block is 0.03 m thick.
+  f.front_thickness = 0.025;
+  EXPECT_NEAR(series_row(S, f).front, 0.15, 1e-9);
+  f.front_thickness = 0.035;
+  EXPECT_NEAR(series_row(S, f).front, 0.1, 1e-9);
+  f.front_thickness = 0.0;
   const auto fm = failed_mass(S, {2000.0}, 0.01);
   EXPECT_EQ(fm.count, 9u);
   EXPECT_NEAR(fm.volume, 9e-4, 1e-12);

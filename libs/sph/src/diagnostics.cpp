@@ -43,9 +43,9 @@ SeriesRow series_row(const SphStore<Dim>& s, const DiagnosticFrame& f) {
       if (!inserted) it->second = std::max(it->second, t);
     }
   }
+  const double t_min = f.front_thickness > 0.0 ? f.front_thickness : f.front_min_layers * f.spacing;
   for (const auto& [b, t] : top)
-    if (t >= f.front_min_layers * f.spacing * (1.0 - 1e-9))
-      r.front = std::max(r.front, (static_cast<double>(b) + 1.0) * f.spacing);
+    if (t >= t_min * (1.0 - 1e-9)) r.front = std::max(r.front, (static_cast<double>(b) + 1.0) * f.spacing);
   // The front is measured at the particle's outer edge; the initial toe particle sits Δx/2 inside.
   r.front = std::max(r.front, f.toe_x);
   r.tip = std::max(r.tip, r.front);

@@ -153,6 +153,7 @@ Built<Dim> build(const RunConfig& c) {
     }
   }
   b.frame.spacing = dx;
+  b.frame.front_thickness = c.front_thickness;
   return b;
 }
 
@@ -509,6 +510,8 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
   summary["final_max_speed_m_per_s"] = last.max_speed;
   summary["max_displacement_m"] = umax;
   summary["failed_threshold_m"] = c.failed_threshold;
+  summary["front_thickness_m"] =
+      b.frame.front_thickness > 0.0 ? b.frame.front_thickness : b.frame.front_min_layers * b.frame.spacing;
   summary["failed_particles"] = fm.count;
   if (Dim == 2)
     summary["failed_area_m2_per_m"] = fm.volume;

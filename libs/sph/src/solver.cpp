@@ -287,7 +287,8 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
       continue;
     }
     const MaterialParams& p = mats[mat[i]];
-    rho[i] += dt * drho[i];
+    // Continuity, floored at the model's parting density (constitutive.hpp, `min_density`).
+    rho[i] = std::max(rho[i] + dt * drho[i], Model::min_density(p));
     if (sf_frac > 0.0 && rsum[i] < sf_frac * p.density) {
       sfree[i] = 1;
       sig[i].setZero();

@@ -16,6 +16,12 @@
 /// i.e. the time-discrete form of the plastic term of seed 002 eqs. 21–22. Then Bui's two
 /// safeguards: tension cut-off (I1 > k_c/α_φ → hydrostatic shift to the apex) and scaling back
 /// (√J2 > k_c − α_φ I1 → s scaled by r = (k_c − α_φ I1)/√J2).
+/// Density floor (`min_density`): the continuity density of a material that cannot carry mean
+/// tension beyond p_t (Drucker–Prager: the apex, p_t = k_c/(3α_φ)) is bounded below by the density
+/// of the elastic dilation at p_t, ρ_min = ρ0/(1 + p_t/K) (ρ0 for c = 0). Beyond it the particles are
+/// parting (seed 000 "meeting and parting"), not dilating: the gap between them is not material
+/// volume. Without the floor m/ρ of separating particles grows without bound (ρ → 0), their
+/// neighbours' velocity gradients and σ/ρ² blow up (column collapses at Δx = L0/30–L0/40).
 /// The models are plain types with a static `update`; the solver picks one per run through a
 /// std::variant visited once per step, so the particle loop has no dispatch.
 
@@ -158,6 +164,8 @@ struct LinearElastic {
     sigma = elastic_trial(sigma, L, dt, p.bulk, p.shear);
     return 0.0;
   }
+  /// No floor: an elastic solid carries any tension.
+  static double min_density(const MaterialParams& /*p*/) noexcept { return 0.0; }
 };
 
 /// Elastic–perfectly plastic von Mises: f = √J2 − σ_y/√3, associated flow, radial return.
@@ -167,6 +175,8 @@ struct VonMises {
     sigma = elastic_trial(sigma, L, dt, p.bulk, p.shear);
     return drucker_prager_return(sigma, 0.0, 0.0, p.yield_stress / std::sqrt(3.0), p.bulk, p.shear);
   }
+  /// No floor: von Mises has no tension cut-off.
+  static double min_density(const MaterialParams& /*p*/) noexcept { return 0.0; }
 };
 
 /// Elastic–perfectly plastic Drucker–Prager, non-associated (dilatancy ψ), Jaumann rate,
@@ -176,6 +186,12 @@ struct DruckerPrager {
   static double update(Mat3& sigma, const Mat3& L, double dt, double /*rho*/, const MaterialParams& p) noexcept {
     sigma = elastic_trial(sigma, L, dt, p.bulk, p.shear);
     return drucker_prager_return(sigma, p.dp.alpha_phi, p.dp.alpha_psi, p.dp.kc, p.bulk, p.shear);
+  }
+  /// ρ0/(1 + p_t/K) with the apex tension p_t = k_c/(3α_φ): elastic dilation up to the tension
+  /// cut-off, parting beyond it (see the file comment). α_φ = 0 (φ = 0): no cut-off, no floor.
+  static double min_density(const MaterialParams& p) noexcept {
+    if (!(p.dp.alpha_phi > 0.0)) return 0.0;
+    return p.density / (1.0 + p.dp.kc / (3.0 * p.dp.alpha_phi * p.bulk));
   }
 };
 
@@ -191,6 +207,8 @@ struct NewtonianFluid {
     sigma.diagonal().array() -= p.bulk * (rho / p.density - 1.0);
     return 0.0;
   }
+  /// No floor: the equation of state reacts to ρ < ρ0 itself.
+  static double min_density(const MaterialParams& /*p*/) noexcept { return 0.0; }
 };
 
 /// The run-time choice of model (one per run; all materials of a run share the model type).

@@ -22,11 +22,15 @@ struct DiagnosticFrame {
   /// spacings thick: a layer one particle thick is below the resolution of the continuum (its
   /// particles are still reported by `tip`).
   double front_min_layers = 2.0;
+  /// If > 0: the front thickness threshold in metres instead of front_min_layers·Δx. A threshold
+  /// tied to Δx moves the front out as the resolution is refined (the thin outer sheet of a
+  /// deposit then counts), so comparisons across resolutions need a fixed physical thickness.
+  double front_thickness = 0.0;
 };
 
 /// One row of the time series.
 struct SeriesRow {
-  double front = 0.0;              ///< front of the soil ≥ front_min_layers·Δx thick (m)
+  double front = 0.0;              ///< front of the soil ≥ front_thickness (or front_min_layers·Δx) thick (m)
   double tip = 0.0;                ///< outer edge of the furthest soil particle (m), stress-free ones excluded
   double runout = 0.0;             ///< front − toe_x (m)
   double normalised_runout = 0.0;  ///< runout / base_length

@@ -85,6 +85,7 @@ struct RunConfig {
   double rest_speed = 0.005;               ///< m/s; "at rest" for time-to-rest
   bool stop_at_rest = false;
   double failed_threshold = 0.01;  ///< m: displacement above which soil counts as failed
+  double front_thickness = 0.0;    ///< m: deposit thickness that defines the front (0: 2Δx)
   double bulking_factor = 1.0;
   bool write_release = true;      ///< section scenario: release.h5 (+ release_thickness.tif)
   std::filesystem::path restart;  ///< snapshot file to restart from ("" none)
