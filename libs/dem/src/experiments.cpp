@@ -29,6 +29,33 @@ double ls_slope(const std::vector<double>& x, const std::vector<double>& y) {
   return sxx > 0 ? sxy / sxx : 0.0;
 }
 
+/// Width of an unconfined sample: the sample is cut into horizontal bands about two largest
+/// diameters thick between the platens (bottom y0, height h) and the width is the mean over the
+/// bands of (rightmost disc edge − leftmost disc edge) — what lateral walls or a lateral
+/// extensometer would see. The overall extent (max − min over all discs) is not used: it follows
+/// the one most bulging disc and gave ν ≈ 0.58 where this gives 0.39 (docs/validation/dem.md).
+double mean_envelope_width(const DiscStore& d, double y0, double h) {
+  const auto& x = d.get<Position<2>>();
+  const auto& R = d.get<Radius>();
+  double rmax = 0;
+  for (std::size_t i = 0; i < d.size(); ++i) rmax = std::max(rmax, R[i]);
+  const int nb = std::max(1, static_cast<int>(h / (4.0 * rmax)));
+  std::vector<double> lo(nb, 1e300), hi(nb, -1e300);
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const int b = std::clamp(static_cast<int>((x[i].y() - y0) / h * nb), 0, nb - 1);
+    lo[b] = std::min(lo[b], x[i].x() - R[i]);
+    hi[b] = std::max(hi[b], x[i].x() + R[i]);
+  }
+  double w = 0;
+  int used = 0;
+  for (int b = 0; b < nb; ++b)
+    if (hi[b] > lo[b]) {
+      w += hi[b] - lo[b];
+      ++used;
+    }
+  return used ? w / used : 0.0;
+}
+
 /// Inclination (degrees, 0–90 from horizontal) of the principal axis of a point cloud.
 double principal_inclination(const std::vector<Vec2>& p) {
   if (p.size() < 3) return 0.0;
@@ -135,7 +162,6 @@ LabTestResult run_lab_test(const LabTestSpec& spec, const BondedSample& sample, 
   const double v = spec.loading_velocity;
   const bool tension = spec.test == LabTest::BiaxialTension;
   const auto& x = s.discs.get<Position<2>>();
-  const auto& R = s.discs.get<Radius>();
 
   double Wl = W0, Hl = H0, grip_gap = H0;
   if (!tension) {
@@ -180,8 +206,8 @@ LabTestResult run_lab_test(const LabTestSpec& spec, const BondedSample& sample, 
       s.walls[q].control = WallControl::Velocity;
       s.walls[q].velocity = s.walls[q].servo_normal * v;
     }
-    Wl = s.walls[1].a.x() - s.walls[3].a.x();
     Hl = s.walls[2].a.y() - s.walls[0].a.y();
+    Wl = confined ? s.walls[1].a.x() - s.walls[3].a.x() : mean_envelope_width(s.discs, s.walls[0].a.y(), Hl);
   } else {
     s.walls.clear();
     auto& kin = s.discs.get<Kinematic>();
@@ -239,13 +265,8 @@ LabTestResult run_lab_test(const LabTestSpec& spec, const BondedSample& sample, 
       double Wc;
       if (s.walls[1].active) {
         Wc = s.walls[1].a.x() - s.walls[3].a.x();
-      } else {  // unconfined: width from the discs' extent
-        double lo = 1e300, hi = -1e300;
-        for (std::size_t i = 0; i < s.discs.size(); ++i) {
-          lo = std::min(lo, x[i].x() - R[i]);
-          hi = std::max(hi, x[i].x() + R[i]);
-        }
-        Wc = hi - lo;
+      } else {  // unconfined: width of the discs' envelope averaged over the height
+        Wc = mean_envelope_width(s.discs, s.walls[0].a.y(), Hc);
       }
       p.axial_strain = (H_start - Hc) / H_start;
       p.lateral_strain = (W_start - Wc) / W_start;

@@ -78,7 +78,7 @@ struct LabTestResult {
   double deviator_at_peak = 0;  ///< σ_1 − σ_3 at peak (Pa)
   double confining_stress = 0;  ///< mean lateral stress at peak (Pa)
   double youngs_modulus = 0;    ///< slope of (σ_a − σ_3) vs ε_a between 10 % and 50 % of the peak (Pa)
-  double poisson_ratio = 0;     ///< −Δε_l/Δε_a over the same range
+  double poisson_ratio = 0;     ///< −Δε_l/Δε_a over the same range (σ_3 = 0: ε_l from the disc envelope)
   double crack_plane_angle =
       0;  ///< inclination of the crack band to the horizontal (degrees, principal axis of crack positions after peak)
   std::size_t tensile_breaks = 0, shear_breaks = 0, bonds = 0;
