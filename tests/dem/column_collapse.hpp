@@ -1,6 +1,6 @@
 #pragma once
 // Test helper shared by the DEM regression and validation tests: the granular column collapse of
-// unbonded discs (docs/validation/column_collapse_laws.md), so the small regression case and the
+// unbonded discs (docs/validation/column_collapse.md), so the small regression case and the
 // validation series run the same set-up at two sizes.
 //
 // Set-up, as in the quasi-2D channel experiments (Lube et al. 2005; Lajeunesse et al. 2005): a

@@ -210,7 +210,7 @@ TEST(DemRegression, AngleOfReposeRisesWithRollingResistance) {
 }
 
 TEST(DemRegression, ColumnCollapseFollowsTheExperimentalScaling) {
-  // The validation column (docs/validation/column_collapse_laws.md) at half the width, L0 = 30 mm
+  // The validation column (docs/validation/column_collapse.md) at half the width, L0 = 30 mm
   // (15 mean diameters, 116 and 678 discs), μ = 0.5, μ_r = 0.3. Band: 0.7–1.6 × Lube et al. (2005)
   // (1.2 a for a ≲ 1.8, 1.9 a^{2/3} for a ≳ 2.8). Upper 1.6: glass beads in a channel run ≈ 1.5×
   // further than Lube's sand (Lajeunesse et al. 2005) and a 2D disc packing is round-grained;

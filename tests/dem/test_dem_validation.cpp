@@ -93,7 +93,7 @@ TEST(DemValidation, ModulusIndependentOfDiscSize) {
 
 namespace {
 
-/// Lube et al. (2005), quasi-2D channel, as quoted in docs/validation/column_collapse_laws.md:
+/// Lube et al. (2005), quasi-2D channel, as quoted in docs/validation/column_collapse.md:
 /// (L∞ − L0)/L0 ≈ 1.2 a for a ≲ 1.8 and ≈ 1.9 a^{2/3} for a ≳ 2.8; in between both are given.
 std::pair<double, double> lube_runout(double a) {
   if (a < 1.8) return {1.2 * a, 1.2 * a};
@@ -140,7 +140,7 @@ TEST(DemValidation, GranularColumnCollapse) {
   // Collapse of a column of unbonded discs against a back wall, L0 = 60 mm (30 mean diameters),
   // settled behind a gate, released without damping; material calibrated on its angle of repose
   // (μ = 0.5, μ_r = 0.3: quasi-static heap ≈ 31°, like sand, internal friction ≈ 30°), not on the
-  // run-out. See docs/validation/column_collapse_laws.md for the laws and their sources.
+  // run-out. See docs/validation/column_collapse.md for the laws and their sources.
   geohaz::dem::testing::ColumnSpec c;
   c.width = 0.06;
   c.rolling_friction = 0.3;
