@@ -235,9 +235,30 @@ void NeighbourList<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const
   }
 }
 
+template <int Dim>
+void CellPairScan<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const Periodicity<Dim>& periodic) {
+  for (int d = 0; d < Dim; ++d)
+    if (periodic.axis[d] && !(periodic.hi[d] - periodic.lo[d] >= 2.0 * cutoff))
+      throw std::invalid_argument("CellPairScan: a periodic axis must be at least twice the cut-off long");
+  cells_.build(x, cutoff / kReach, periodic);
+  cutoff_ = cutoff;
+  periodic_any_ = periodic.any();
+  const auto sorted = cells_.sorted();
+  const std::int64_t n = static_cast<std::int64_t>(x.size());
+  sorted_x_.resize(x.size());
+  rank_.resize(x.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t s = 0; s < n; ++s) {
+    sorted_x_[s] = x[sorted[s]];
+    rank_[sorted[s]] = static_cast<std::uint32_t>(s);
+  }
+}
+
 template class CellList<2>;
 template class CellList<3>;
 template class NeighbourList<2>;
 template class NeighbourList<3>;
+template class CellPairScan<2>;
+template class CellPairScan<3>;
 
 }  // namespace geohaz
