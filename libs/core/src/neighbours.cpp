@@ -91,8 +91,8 @@ void CellList<Dim>::build(std::span<const Vec<Dim>> x, double cell_size, const P
   for (std::uint32_t c : cell_of_) ++cell_start_[c + 1];
   for (std::size_t c = 0; c < ncell; ++c) cell_start_[c + 1] += cell_start_[c];
   sorted_.resize(x.size());
-  std::vector<std::uint32_t> fill(cell_start_.begin(), cell_start_.end() - 1);
-  for (std::size_t i = 0; i < x.size(); ++i) sorted_[fill[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+  fill_.assign(cell_start_.begin(), cell_start_.end() - 1);  // reused: no allocation per build
+  for (std::size_t i = 0; i < x.size(); ++i) sorted_[fill_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
 }
 
 template <int Dim>

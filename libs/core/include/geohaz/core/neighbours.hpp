@@ -86,6 +86,7 @@ private:
   Vec<Dim> edge_ = Vec<Dim>::Ones();
   std::array<int, Dim> dims_{};
   std::vector<std::uint32_t> cell_of_, sorted_, cell_start_;
+  std::vector<std::uint32_t> fill_;  // counting-sort cursors (scratch)
 };
 
 /// Full neighbour list in CSR form, built from a CellList.
