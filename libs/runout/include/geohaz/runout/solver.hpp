@@ -6,8 +6,9 @@
 ///  1. neighbours within 2·d0: by default visited straight from a cell scan rebuilt every step
 ///     (CellPairScan: the pairs are used once, so no list is written); with numerics.skin > 0 a
 ///     Verlet list within (2 + skin)·d0 (NeighbourList), rebuilt when a particle has moved more
-///     than skin·d0/2 since the last build and after removals. The particles are reordered by cell
-///     every reorder_interval steps. Both visit the same pairs in the same order;
+///     than skin·d0/2 since the last build and after removals. The scan visits exactly the pairs,
+///     in the same order, of a list without skin. The particles are reordered by cell every
+///     reorder_interval steps;
 ///  2. pair pass 1: flow depth h_i = Σ_j V_j W(r_ij, d0) (cubic spline, self included);
 ///     pair pass 2: head-pressure acceleration a_p,i = C g Σ_j (V_j/d0³) f(r_ij/d0) x̂_ij
 ///     (head_pressure.hpp) and the velocity smoothing Δv_i = ε Σ_j 2V_j/(h_i + h_j) (v_j − v_i) W_ij
