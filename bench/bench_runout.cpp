@@ -4,7 +4,9 @@
 //  2. wall time of the seed's case at the seed's scale: 10 simulated minutes of a ~5000-particle
 //     release (d0 = 5 m, h0 = 1 m, 2 m thick over 300 m × 200 m) on the synthetic 5 km valley DSM of 2000 × 1000 cells
 //     at 2.5 m, n = 0.06, i_cr = 0.15 (target < 10 s), with the hazard maps recorded every step as the app does.
-// Prints rates; never asserts. Usage: bench_runout [particles=100000] [steps=40]
+// Prints rates; never asserts. Usage: bench_runout [particles=100000] [steps=40] [all|plane|seed] [threads] [skin]
+// (the third argument runs one case only, the fourth one thread count only, the fifth sets
+// numerics.skin in units of d0: for profiling and for comparing list strategies).
 #include <omp.h>
 
 #include <chrono>
@@ -12,6 +14,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <string>
 
 #include "geohaz/runout/hazard_maps.hpp"
 #include "geohaz/runout/release.hpp"
@@ -35,12 +38,13 @@ struct Rate {
   double wall, cpu;
 };
 
-Rate plane_rate(std::size_t target, int steps, int threads) {
+Rate plane_rate(std::size_t target, int steps, int threads, double skin) {
   omp_set_num_threads(threads);
   RunoutParameters p;
   p.d0 = 5.0;
   p.h0 = 1.0;
   p.duration = 1e9;
+  p.skin = skin;
   p.friction = ModifiedManningFriction{0.06, 0.15, 0.0};
   InclinedPlane plane;
   plane.slope = Vec2(-0.3, 0.0);
@@ -69,16 +73,24 @@ Rate plane_rate(std::size_t target, int steps, int threads) {
 int main(int argc, char** argv) {
   const std::size_t n = argc > 1 ? std::strtoul(argv[1], nullptr, 10) : 100000;
   const int steps = argc > 2 ? std::atoi(argv[2]) : 40;
-  std::printf("bench_runout: %zu particles on a plane, %d steps\n", n, steps);
-  std::fflush(stdout);
-  for (int t : {1, 2}) {
-    const Rate r = plane_rate(n, steps, t);
-    std::printf("  %d thread(s): %.3g particle-steps/s (wall), %.3g per CPU-second\n", t, r.wall, r.cpu);
+  const std::string which = argc > 3 ? argv[3] : "all";
+  const int only_threads = argc > 4 ? std::atoi(argv[4]) : 0;
+  const double skin = argc > 5 ? std::atof(argv[5]) : RunoutParameters{}.skin;
+  if (which == "all" || which == "plane") {
+    std::printf("bench_runout: %zu particles on a plane, %d steps\n", n, steps);
     std::fflush(stdout);
+    for (int t : {1, 2}) {
+      if (only_threads > 0 && t != only_threads) continue;
+      const Rate r = plane_rate(n, steps, t, skin);
+      std::printf("  %d thread(s): %.3g particle-steps/s (wall), %.3g per CPU-second\n", t, r.wall, r.cpu);
+      std::fflush(stdout);
+    }
   }
+  if (which != "all" && which != "seed") return 0;
 
   // The seed's case.
-  omp_set_num_threads(2);
+  const int seed_threads = only_threads > 0 ? only_threads : 2;
+  omp_set_num_threads(seed_threads);
   const SyntheticValley v;
   const GridSurface surface = v.surface();
   const GridGeometry g = v.geometry();
@@ -94,6 +106,7 @@ int main(int argc, char** argv) {
   p.d0 = 5.0;
   p.h0 = 1.0;
   p.duration = 600.0;
+  p.skin = skin;
   p.friction = ModifiedManningFriction{0.06, 0.15, 0.0};
   RunoutSolver<GridSurface> s(surface, p);
   const SeedReport rep = seed_release(g, thick, p.d0, p.h0, s.particles());
@@ -110,9 +123,16 @@ int main(int argc, char** argv) {
   const auto row = series_row(s.particles(), s.budget(), s.time(), s.step_count());
   std::printf(
       "seed case: %zu particles (%.0f m^3), 2000 x 1000 DSM at 2.5 m, %.0f s simulated in %lld steps: "
-      "%.2f s wall, %.2f s CPU (2 threads, %.3g particle-steps/s); front travelled %.0f m (seed: 4800 m in 600 s)\n",
-      rep.particles, rep.volume_seeded, s.time(), static_cast<long long>(s.step_count()), wall, cpu_s,
+      "%.2f s wall, %.2f s CPU (%d thread(s), %.3g particle-steps/s); front travelled %.0f m (seed: 4800 m in 600 s)\n",
+      rep.particles, rep.volume_seeded, s.time(), static_cast<long long>(s.step_count()), wall, cpu_s, seed_threads,
       static_cast<double>(particle_steps) / wall, row.front_travel);
+  // Sum of the final positions in id order: equal sums mean the same run (to compare variants).
+  std::vector<Vec2> by_id(rep.particles, Vec2::Zero());
+  for (std::size_t i = 0; i < s.particles().size(); ++i)
+    by_id[static_cast<std::size_t>(s.particles().get<ParticleId>()[i])] = s.particles().get<Position<2>>()[i];
+  Vec2 sum = Vec2::Zero();
+  for (const Vec2& x : by_id) sum += x;
+  std::printf("final positions: sum %.17g %.17g\n", sum.x(), sum.y());
   std::printf("memory: %zu bytes per particle; DSM %zu MB\n", RunoutStore::bytes_per_particle(),
               g.cells() * sizeof(double) / (1024 * 1024));
   return 0;

@@ -164,5 +164,77 @@ TEST(NeighbourList, PairLoopSeesEveryPairWithMinimumImage) {
   EXPECT_NEAR(dx[1], -0.02, 1e-12);
 }
 
+// CellPairScan visits, for every i, exactly the neighbours NeighbourList stores, in the same
+// order, with the same displacement and r² (so a pair sum over either is bit-identical).
+template <int Dim>
+void check_scan(Layout layout, bool periodic, int threads) {
+  const double L = 1.0, rc = 0.09;
+  auto x = make_points<Dim>(1500, layout, 17 + Dim, L);
+  Periodicity<Dim> p;
+  if (periodic) {
+    p.axis.fill(false);
+    p.axis[0] = true;
+    p.axis[Dim - 1] = true;
+    p.lo.setZero();
+    p.hi.setConstant(L);
+    for (auto& xi : x) xi = p.wrap(xi);
+  }
+  NeighbourList<Dim> nl;
+  nl.build(x, rc, p);
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(threads);
+  CellPairScan<Dim> scan;
+  scan.build(x, rc, p);
+  omp_set_num_threads(saved);
+  ASSERT_EQ(scan.size(), x.size());
+  const auto order = scan.cell_order();
+  const auto list_order = nl.cell_order();
+  EXPECT_TRUE(std::equal(order.begin(), order.end(), list_order.begin(), list_order.end()));
+  std::size_t pairs = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const auto nb = nl.neighbours(i);
+    std::size_t k = 0;
+    scan.for_each_neighbour(i, [&](std::size_t j, const Vec<Dim>& xij, double r2) {
+      ASSERT_LT(k, nb.size()) << "particle " << i;
+      EXPECT_EQ(j, nb[k]) << "particle " << i << ", neighbour " << k;
+      const Vec<Dim> d = nl.displacement(x[i], x[j]);
+      EXPECT_EQ(xij, d);
+      EXPECT_EQ(r2, d.squaredNorm());
+      ++k;
+    });
+    EXPECT_EQ(k, nb.size()) << "particle " << i;
+    pairs += k;
+  }
+  EXPECT_GT(pairs, x.size());  // the test is not vacuous
+}
+
+TEST(CellPairScan, SameNeighboursInTheSameOrderAsTheList2D) { check_scan<2>(Layout::Uniform, false, 1); }
+TEST(CellPairScan, Clustered2DTwoThreads) { check_scan<2>(Layout::Clustered, false, 2); }
+TEST(CellPairScan, Periodic2D) { check_scan<2>(Layout::Uniform, true, 2); }
+TEST(CellPairScan, Clustered3D) { check_scan<3>(Layout::Clustered, false, 1); }
+TEST(CellPairScan, Periodic3D) { check_scan<3>(Layout::Uniform, true, 2); }
+
+TEST(CellPairScan, ShortPeriodicAxisAndTooShortAxis) {
+  // Period 2.5 × cutoff (the ±1 neighbour cells coincide) and a period below 2 × cutoff (rejected).
+  std::vector<Vec2> x;
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10; ++j) x.emplace_back(0.025 * i + 0.01, 0.1 * j);
+  Periodicity<2> p;
+  p.axis = {true, false};
+  p.lo = Vec2(0, 0);
+  p.hi = Vec2(0.25, 1);
+  CellPairScan<2> scan;
+  scan.build(x, 0.1, p);
+  const auto ref = brute_force<2>(x, 0.1, p);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    std::vector<std::uint32_t> got;
+    scan.for_each_neighbour(i, [&](std::size_t j, const Vec2&, double) { got.push_back(static_cast<std::uint32_t>(j)); });
+    EXPECT_EQ(std::set<std::uint32_t>(got.begin(), got.end()), ref[i]);
+    EXPECT_EQ(got.size(), ref[i].size());
+  }
+  p.hi = Vec2(0.15, 1);
+  EXPECT_THROW(scan.build(x, 0.1, p), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace geohaz

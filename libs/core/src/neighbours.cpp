@@ -91,8 +91,8 @@ void CellList<Dim>::build(std::span<const Vec<Dim>> x, double cell_size, const P
   for (std::uint32_t c : cell_of_) ++cell_start_[c + 1];
   for (std::size_t c = 0; c < ncell; ++c) cell_start_[c + 1] += cell_start_[c];
   sorted_.resize(x.size());
-  std::vector<std::uint32_t> fill(cell_start_.begin(), cell_start_.end() - 1);
-  for (std::size_t i = 0; i < x.size(); ++i) sorted_[fill[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+  fill_.assign(cell_start_.begin(), cell_start_.end() - 1);  // reused: no allocation per build
+  for (std::size_t i = 0; i < x.size(); ++i) sorted_[fill_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
 }
 
 template <int Dim>
@@ -235,9 +235,30 @@ void NeighbourList<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const
   }
 }
 
+template <int Dim>
+void CellPairScan<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const Periodicity<Dim>& periodic) {
+  for (int d = 0; d < Dim; ++d)
+    if (periodic.axis[d] && !(periodic.hi[d] - periodic.lo[d] >= 2.0 * cutoff))
+      throw std::invalid_argument("CellPairScan: a periodic axis must be at least twice the cut-off long");
+  cells_.build(x, cutoff / kReach, periodic);
+  cutoff_ = cutoff;
+  periodic_any_ = periodic.any();
+  const auto sorted = cells_.sorted();
+  const std::int64_t n = static_cast<std::int64_t>(x.size());
+  sorted_x_.resize(x.size());
+  rank_.resize(x.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t s = 0; s < n; ++s) {
+    sorted_x_[s] = x[sorted[s]];
+    rank_[sorted[s]] = static_cast<std::uint32_t>(s);
+  }
+}
+
 template class CellList<2>;
 template class CellList<3>;
 template class NeighbourList<2>;
 template class NeighbourList<3>;
+template class CellPairScan<2>;
+template class CellPairScan<3>;
 
 }  // namespace geohaz

@@ -1,5 +1,7 @@
 #include "geohaz/runout/hazard_maps.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -15,7 +17,6 @@ HazardMaps::HazardMaps(GridGeometry grid, double d0, double density)
       radius_(std::max({0.5 * d0, grid.dx, grid.dy})),
       max_depth_(grid.cells(), 0.0),
       max_speed_(grid.cells(), 0.0),
-      max_pressure_(grid.cells(), 0.0),
       arrival_(grid.cells(), std::numeric_limits<double>::quiet_NaN()) {}
 
 void HazardMaps::record(const RunoutStore& store, double t) {
@@ -25,20 +26,57 @@ void HazardMaps::record(const RunoutStore& store, double t) {
   const auto& moving = store.get<Moving>();
   const int rc = static_cast<int>(std::ceil(radius_ / g_.dx)), rr = static_cast<int>(std::ceil(radius_ / g_.dy));
   const double r2 = radius_ * radius_;
-  for (std::size_t i = 0; i < store.size(); ++i) {
+  const std::int64_t n = static_cast<std::int64_t>(store.size());
+  // Threads own bands of grid rows, split so that each has about as many particles; every thread
+  // runs over all particles and paints only the rows of its band. Maxima and the first arrival
+  // (one t per call) do not depend on the order of painting, so the maps are the same for any
+  // number of threads, and no two threads write the same cell.
+  const int threads = n >= kParallelMin ? omp_get_max_threads() : 1;
+  band_start_.assign(static_cast<std::size_t>(threads) + 1, 0);
+  band_start_.back() = g_.ny;
+  if (threads > 1) {
+    row_count_.assign(static_cast<std::size_t>(g_.ny), 0);
     int c0, r0;
-    if (!g_.cell_of(x[i], c0, r0)) continue;
-    const double p = density_ * s[i] * s[i];
-    for (int r = std::max(0, r0 - rr); r <= std::min(g_.ny - 1, r0 + rr); ++r)
-      for (int c = std::max(0, c0 - rc); c <= std::min(g_.nx - 1, c0 + rc); ++c) {
-        if ((c != c0 || r != r0) && (g_.centre(c, r) - x[i]).squaredNorm() > r2) continue;
-        const std::size_t k = g_.index(c, r);
-        max_depth_[k] = std::max(max_depth_[k], h[i]);
-        max_speed_[k] = std::max(max_speed_[k], s[i]);
-        max_pressure_[k] = std::max(max_pressure_[k], p);
-        if (std::isnan(arrival_[k]) && (moving[i] || t == 0.0)) arrival_[k] = t;
-      }
+    for (std::int64_t i = 0; i < n; ++i)
+      if (g_.cell_of(x[static_cast<std::size_t>(i)], c0, r0)) ++row_count_[static_cast<std::size_t>(r0)];
+    std::int64_t seen = 0;
+    int band = 1;
+    for (int r = 0; r < g_.ny && band < threads; ++r) {
+      seen += row_count_[static_cast<std::size_t>(r)];
+      while (band < threads && seen * threads >= n * band) band_start_[static_cast<std::size_t>(band++)] = r + 1;
+    }
+    for (; band < threads; ++band) band_start_[static_cast<std::size_t>(band)] = g_.ny;
   }
+#pragma omp parallel num_threads(threads) if (threads > 1)
+  {
+    const auto b = static_cast<std::size_t>(omp_get_thread_num());
+    const int row_lo = band_start_[b], row_hi = band_start_[b + 1] - 1;  // inclusive
+    for (std::int64_t ii = 0; ii < n && row_lo <= row_hi; ++ii) {
+      const auto i = static_cast<std::size_t>(ii);
+      int c0, r0;
+      if (!g_.cell_of(x[i], c0, r0)) continue;
+      const int r_first = std::max(row_lo, r0 - rr), r_last = std::min(row_hi, r0 + rr);
+      if (r_first > r_last) continue;
+      const double hi = h[i], si = s[i];
+      const bool arrives = moving[i] || t == 0.0;
+      for (int r = r_first; r <= r_last; ++r)
+        for (int c = std::max(0, c0 - rc); c <= std::min(g_.nx - 1, c0 + rc); ++c) {
+          if ((c != c0 || r != r0) && (g_.centre(c, r) - x[i]).squaredNorm() > r2) continue;
+          const std::size_t k = g_.index(c, r);
+          max_depth_[k] = std::max(max_depth_[k], hi);
+          max_speed_[k] = std::max(max_speed_[k], si);
+          if (arrives && std::isnan(arrival_[k])) arrival_[k] = t;
+        }
+    }
+  }
+}
+
+std::vector<double> HazardMaps::max_pressure() const {
+  // ρ S² is increasing in S ≥ 0 and rounding is monotone, so the maximum over time of ρ·S·S
+  // painted every step equals ρ·S_max·S_max exactly: the map is derived from max_speed.
+  std::vector<double> p(max_speed_.size());
+  for (std::size_t k = 0; k < p.size(); ++k) p[k] = density_ * max_speed_[k] * max_speed_[k];
+  return p;
 }
 
 double HazardMaps::affected_area() const {

@@ -12,10 +12,12 @@
 /// image, which requires the period to be at least 2 × cutoff (checked). Along non-periodic axes the
 /// grid covers the particles' bounding box, so a particle wandering far away costs nothing but its cell.
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include "geohaz/core/vec.hpp"
@@ -86,6 +88,7 @@ private:
   Vec<Dim> edge_ = Vec<Dim>::Ones();
   std::array<int, Dim> dims_{};
   std::vector<std::uint32_t> cell_of_, sorted_, cell_start_;
+  std::vector<std::uint32_t> fill_;  // counting-sort cursors (scratch)
 };
 
 /// Full neighbour list in CSR form, built from a CellList.
@@ -147,9 +150,140 @@ private:
   std::vector<Vec<Dim>> sorted_x_;                         // positions in cell order, reused
 };
 
+/// Pairs closer than a cut-off found on the fly from a cell list, without storing a list.
+///
+/// NeighbourList::build already scans every candidate cell to find the pairs; a model that
+/// rebuilds every step and reads its list only once (a single pair pass) then pays for writing
+/// the list and for reading it back. CellPairScan keeps only the cell list and the positions in
+/// cell order and visits each particle's neighbours directly in that scan, in exactly the order
+/// NeighbourList would store them (so a pair sum is bit-identical to the one over the list).
+/// Use NeighbourList when the pairs are read several times per build or with a Verlet skin.
+///
+/// Typical use, the parallel loop owned by the physics code (each i written by one thread):
+///
+///     scan.build(x, cutoff, periodic);
+///     #pragma omp parallel for
+///     for (i ...) scan.for_each_neighbour(i, [&](std::size_t j, const Vec<Dim>& xij, double r2) {...});
+namespace detail {
+/// b^e for small non-negative e (compile time).
+constexpr int ipow(int b, int e) noexcept {
+  return e == 0 ? 1 : b * ipow(b, e - 1);
+}
+}  // namespace detail
+
+template <int Dim>
+class CellPairScan {
+public:
+  /// Cells per cut-off length, as in NeighbourList (cells of edge cutoff/kReach scanned kReach deep).
+  static constexpr int kReach = NeighbourList<Dim>::kReach;
+
+  /// Bin the particles and gather their positions in cell order. x is copied: the pairs are those
+  /// of the positions given here. Throws std::invalid_argument if a periodic axis is shorter than
+  /// 2 × cutoff or a position is not finite.
+  void build(std::span<const Vec<Dim>> x, double cutoff, const Periodicity<Dim>& periodic = {});
+
+  std::size_t size() const noexcept { return rank_.size(); }
+  double cutoff() const noexcept { return cutoff_; }
+  /// Permutation sorting particles by cell (as NeighbourList::cell_order()).
+  std::span<const std::uint32_t> cell_order() const noexcept { return cells_.sorted(); }
+  const CellList<Dim>& cells() const noexcept { return cells_; }
+
+  /// Call f(j, xij, r2) for every j != i with r2 = |x_i − x_j|² < cutoff² (minimum image along
+  /// periodic axes), xij = x_i − x_j. Const and thread-safe: call it for different i from
+  /// different threads.
+  /// Always inlined, so the caller's accumulators stay in registers across the pairs.
+  template <class F>
+  [[gnu::always_inline]] inline void for_each_neighbour(std::size_t i, F&& f) const {
+    constexpr int R = kReach;
+    const auto& dims = cells_.dims();
+    const auto starts = cells_.cell_start();
+    const auto sorted = cells_.sorted();
+    const auto& per = cells_.periodicity();
+    const auto c = cells_.cell_coords(cells_.cell_of()[i]);
+    // The same candidate cells, in the same order, as NeighbourList::build: along axis 0 the
+    // neighbouring cells are contiguous (one range, two when a periodic axis 0 wraps); the other
+    // axes list distinct candidate coordinates.
+    std::array<std::array<int, 2 * R + 1>, Dim> cand{};
+    std::array<int, Dim> ncand{};
+    for (int d = 1; d < Dim; ++d) {
+      for (int o = -R; o <= R; ++o) {
+        int cc = c[d] + o;
+        if (per.axis[d]) {
+          cc = (cc % dims[d] + dims[d]) % dims[d];
+        } else if (cc < 0 || cc >= dims[d]) {
+          continue;
+        }
+        bool seen = false;
+        for (int k = 0; k < ncand[d]; ++k) seen = seen || cand[d][k] == cc;
+        if (!seen) cand[d][ncand[d]++] = cc;
+      }
+    }
+    int r0lo, r0hi, r1lo = 0, r1hi = -1;
+    if (!per.axis[0]) {
+      r0lo = std::max(c[0] - R, 0);
+      r0hi = std::min(c[0] + R, dims[0] - 1);
+    } else if (dims[0] <= 2 * R + 1) {
+      r0lo = 0, r0hi = dims[0] - 1;
+    } else if (c[0] - R < 0) {
+      r0lo = 0, r0hi = c[0] + R, r1lo = dims[0] + c[0] - R, r1hi = dims[0] - 1;
+    } else if (c[0] + R >= dims[0]) {
+      r0lo = c[0] - R, r0hi = dims[0] - 1, r1lo = 0, r1hi = c[0] + R - dims[0];
+    } else {
+      r0lo = c[0] - R, r0hi = c[0] + R;
+    }
+    // Slot ranges [first, last) of sorted() to scan, in scan order.
+    std::array<std::array<std::uint32_t, 2>, 2 * detail::ipow(2 * R + 1, Dim - 1)> ranges;
+    int nranges = 0;
+    std::array<int, Dim> k{};
+    for (;;) {
+      std::uint32_t base = 0, stride = static_cast<std::uint32_t>(dims[0]);
+      for (int d = 1; d < Dim; ++d) {
+        base += static_cast<std::uint32_t>(cand[d][k[d]]) * stride;
+        stride *= static_cast<std::uint32_t>(dims[d]);
+      }
+      ranges[nranges++] = {starts[base + r0lo], starts[base + r0hi + 1]};
+      if (r1hi >= r1lo) ranges[nranges++] = {starts[base + r1lo], starts[base + r1hi + 1]};
+      int d = 1;
+      while (d < Dim && ++k[d] == ncand[d]) k[d++] = 0;
+      if (d == Dim) break;
+    }
+    const std::uint32_t self = rank_[i];
+    const Vec<Dim> xi = sorted_x_[self];
+    const double rc2 = cutoff_ * cutoff_;
+    const Vec<Dim>* sx = sorted_x_.data();
+    const std::uint32_t* ids = sorted.data();
+    // The periodic test is hoisted out of the candidate loop (two instantiations of the loop).
+    const auto visit = [&](auto periodic) {
+      for (int q = 0; q < nranges; ++q)
+        for (std::uint32_t s = ranges[q][0]; s < ranges[q][1]; ++s) {
+          Vec<Dim> d;
+          if constexpr (decltype(periodic)::value)
+            d = per.min_image(xi - sx[s]);
+          else
+            d = xi - sx[s];
+          const double r2 = d.squaredNorm();
+          if (r2 < rc2 && s != self) f(static_cast<std::size_t>(ids[s]), d, r2);
+        }
+    };
+    if (periodic_any_)
+      visit(std::true_type{});
+    else
+      visit(std::false_type{});
+  }
+
+private:
+  CellList<Dim> cells_;
+  double cutoff_ = 0.0;
+  bool periodic_any_ = false;
+  std::vector<Vec<Dim>> sorted_x_;   // positions in cell order
+  std::vector<std::uint32_t> rank_;  // rank_[i]: slot of particle i in cell order
+};
+
 extern template class CellList<2>;
 extern template class CellList<3>;
 extern template class NeighbourList<2>;
 extern template class NeighbourList<3>;
+extern template class CellPairScan<2>;
+extern template class CellPairScan<3>;
 
 }  // namespace geohaz

@@ -6,9 +6,12 @@
 /// Maps: every recorded step each particle paints the cells whose centre lies within
 /// max(d0/2, cell size) of it (its own cell always) with its flow depth, surface speed and dynamic
 /// pressure ρ S² (maxima over time) and, if moving, the arrival time (first time painted).
+/// Painting is parallel over bands of grid rows (record()); the pressure map is ρ·(max S)², which
+/// is exactly the maximum of ρS² over the steps.
 /// The final deposit thickness is the cubic-spline kernel sum Σ V_j W(|x_c − x_j|, d0) at the cell
 /// centres, so it integrates to the volume left in the domain.
 
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -26,10 +29,10 @@ class HazardMaps {
   void record(const RunoutStore& store, double t);
 
   const GridGeometry& grid() const noexcept { return g_; }
-  const std::vector<double>& max_depth() const noexcept { return max_depth_; }        ///< m
-  const std::vector<double>& max_speed() const noexcept { return max_speed_; }        ///< m/s
-  const std::vector<double>& max_pressure() const noexcept { return max_pressure_; }  ///< Pa (ρ S²)
-  const std::vector<double>& arrival_time() const noexcept { return arrival_; }       ///< s, NaN: never
+  const std::vector<double>& max_depth() const noexcept { return max_depth_; }  ///< m
+  const std::vector<double>& max_speed() const noexcept { return max_speed_; }  ///< m/s
+  std::vector<double> max_pressure() const;  ///< Pa (ρ S²), from max_speed (exact: ρS² is monotone in S)
+  const std::vector<double>& arrival_time() const noexcept { return arrival_; }  ///< s, NaN: never
   /// Area (m²) of the cells reached by the flow (max depth > 0).
   double affected_area() const;
 
@@ -39,7 +42,9 @@ class HazardMaps {
  private:
   GridGeometry g_;
   double d0_, density_, radius_;
-  std::vector<double> max_depth_, max_speed_, max_pressure_, arrival_;
+  std::vector<double> max_depth_, max_speed_, arrival_;
+  std::vector<int> band_start_;          // first grid row of each thread's band (scratch)
+  std::vector<std::int64_t> row_count_;  // particles per grid row (scratch)
 };
 
 /// One row of the time series.

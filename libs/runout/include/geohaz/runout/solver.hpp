@@ -3,16 +3,20 @@
 /// RunoutSolver: one time step of the depth-averaged particle debris-flow model (seed 000 §3),
 /// readable top to bottom in step():
 ///
-///  1. neighbours within (2 + skin)·d0 (cell list → CSR list), rebuilt when a particle has moved
-///     more than skin·d0/2 since the last build, after removals, and when the particles are
-///     reordered by cell (every reorder_interval steps);
+///  1. neighbours within 2·d0: by default visited straight from a cell scan rebuilt every step
+///     (CellPairScan: the pairs are used once, so no list is written); with numerics.skin > 0 a
+///     Verlet list within (2 + skin)·d0 (NeighbourList), rebuilt when a particle has moved more
+///     than skin·d0/2 since the last build and after removals. The scan visits exactly the pairs,
+///     in the same order, of a list without skin. The particles are reordered by cell every
+///     reorder_interval steps;
 ///  2. pair pass 1: flow depth h_i = Σ_j V_j W(r_ij, d0) (cubic spline, self included);
 ///     pair pass 2: head-pressure acceleration a_p,i = C g Σ_j (V_j/d0³) f(r_ij/d0) x̂_ij
 ///     (head_pressure.hpp) and the velocity smoothing Δv_i = ε Σ_j 2V_j/(h_i + h_j) (v_j − v_i) W_ij
 ///     (the particle velocity correction of seed 000 §2, Monaghan 1994, with a symmetric weight so
 ///     momentum is conserved). Without it a particle lattice under the seed's force is unstable
 ///     (f rises with distance on 1 < x < 1.5), and round-off grows into a "thermal" noise;
-///  3. adaptive time step Δt = cfl · d0 / max_i(|v_i| + √(g h_i)), capped by dt_max and the end time;
+///  3. adaptive time step Δt = cfl · d0 / max_i(S_i + √(g h_i)) (the maximum taken in the pair
+///     pass), capped by dt_max and the end time;
 ///  4. per particle: driving acceleration in map view for a particle held on the surface z(x, y)
 ///         a_h = −g ∇z / (1 + |∇z|²) + a_p
 ///     (exact for a plane: the along-slope acceleration is g sin θ; bed curvature is neglected),
@@ -21,15 +25,17 @@
 ///     a particle, never reverse it; position x += Δt v (symplectic Euler);
 ///  5. particles whose new position is off the terrain (raster edge, nodata) are removed and their
 ///     volume is added to the lost volume.
-/// All per-particle loops are parallel over i with no order-dependent reduction, so 1 and N
-/// threads give bit-identical results.
+/// All per-particle loops are parallel over i with no order-dependent reduction (only maxima and
+/// "any" flags), so 1 and N threads give bit-identical results.
 
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 #include <vector>
 
 #include "geohaz/core/errors.hpp"
@@ -112,26 +118,11 @@ class RunoutSolver {
 
   /// Advance one adaptive step; returns Δt. SimulationError on NaN or time-step collapse.
   double step() {
-    // 1-2. Neighbours and the pair pass.
-    if (step_ % p_.reorder_interval == 0 && store_.size() > 1) {
-      build_neighbours();
-      store_.reorder(list_.cell_order());
-      list_valid_ = false;
-    }
-    compute_pair_terms();
+    // 1-2. Neighbours and the pair pass, which also returns the signal speed of the time step.
+    if (step_ % p_.reorder_interval == 0 && store_.size() > 1) reorder_by_cell();
+    const double signal = compute_pair_terms();
 
     // 3. Time step (max is exact in any order: thread-count independent).
-    const auto& v = store_.get<Velocity<2>>();
-    const auto& grad = store_.get<SurfaceGradient>();
-    const auto& h = store_.get<FlowDepth>();
-    const std::int64_t n = static_cast<std::int64_t>(store_.size());
-    double signal = 0.0;
-#pragma omp parallel for reduction(max : signal) schedule(static) if (n >= kParallelMin)
-    for (std::int64_t ii = 0; ii < n; ++ii) {
-      const auto i = static_cast<std::size_t>(ii);
-      const double vz = grad[i].dot(v[i]);
-      signal = std::max(signal, std::sqrt(v[i].squaredNorm() + vz * vz) + std::sqrt(p_.gravity * h[i]));
-    }
     double dt = signal > 0.0 ? p_.cfl * p_.d0 / signal : p_.dt_max;
     dt = std::min(dt, p_.dt_max);
     const double remaining = p_.duration - time_;
@@ -144,9 +135,9 @@ class RunoutSolver {
     }
 
     // 4-5. Integrate with the friction law resolved once for the whole loop.
-    std::visit([&](const auto& law) { integrate(law, dt); }, p_.friction);
-    check_finite();
-    remove_leaving();
+    const IntegrateFlags flags = std::visit([&](const auto& law) { return integrate(law, dt); }, p_.friction);
+    if (flags.non_finite) throw_non_finite();
+    if (flags.leaving) remove_leaving();
     dt_ = dt;
     time_ += dt;
     ++step_;
@@ -165,98 +156,140 @@ class RunoutSolver {
     return time_ >= p_.duration - 1e-12 * std::max(1.0, p_.duration) || store_.empty() || (step_ > 0 && all_stopped());
   }
 
-  const VolumeBudget& budget() const noexcept {
-    return budget_;
-  }
+  const VolumeBudget& budget() const noexcept { return budget_; }
 
   /// Recompute the depths and head-pressure accelerations for the current positions (also done
-  /// by step(); public for tests and outputs).
-  void compute_pair_terms() {
-    if (store_.empty()) return;
-    if (!list_valid_ || max_displacement() > 0.5 * p_.skin * p_.d0) {
-      build_neighbours();
-      list_valid_ = true;
-    }
-    const auto& x = store_.get<Position<2>>();
-    const auto& vol = store_.get<Volume>();
-    auto& h = store_.get<FlowDepth>();
-    auto& ap = store_.get<HeadAcceleration>();
-    const double d0 = p_.d0;
-    const double inv_d0 = 1.0 / d0;
-    const double w0 = CubicSpline<2>::value(0.0, d0);
-    const double coef = p_.pressure_scale * p_.gravity * inv_d0 * inv_d0 * inv_d0;
-    const std::int64_t n = static_cast<std::int64_t>(store_.size());
-    const auto offsets = list_.offsets();
-    const auto indices = list_.indices();
-    const bool periodic = periodic_.any();
-    const double support2 = 4.0 * d0 * d0, sigma = CubicSpline<2>::sigma(d0);
-    // Cubic spline W(q)/σ (kernels.hpp), inlined so σ is not recomputed per pair.
-    const auto spline_value = [](double q) {
-      if (q < 1.0) return 2.0 / 3.0 - q * q + 0.5 * q * q * q;
-      const double t = 2.0 - q;
-      return q < 2.0 ? t * t * t / 6.0 : 0.0;
-    };
-    const auto& v = store_.get<Velocity<2>>();
-    auto& dv = store_.get<VelocityCorrection>();
-    const double eps = p_.smoothing;
-    if (eps == 0.0) {
-      // One pass: depth and head pressure (the pressure does not need the neighbours' depths).
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-      for (std::int64_t ii = 0; ii < n; ++ii) {
-        const auto i = static_cast<std::size_t>(ii);
-        double depth = vol[i] * (2.0 / 3.0);
-        Vec2 acc = Vec2::Zero();
+  /// by step(); public for tests and outputs). Returns the signal speed of the time step,
+  /// max_i (S_i + √(g h_i)) (m/s), computed in the same pass.
+  double compute_pair_terms() {
+    if (store_.empty()) return 0.0;
+    if (p_.skin > 0.0) {
+      // Verlet list: rebuilt when a particle has moved more than half the skin since the build.
+      if (!list_valid_ || max_displacement() > 0.5 * p_.skin * p_.d0) {
+        build_list();
+        list_valid_ = true;
+      }
+      const auto& x = store_.get<Position<2>>();
+      const auto offsets = list_.offsets();
+      const auto indices = list_.indices();
+      const bool periodic = periodic_.any();
+      return pair_terms([&](std::size_t i, auto&& f) {
         const Vec2 xi = x[i];
         for (std::uint32_t k = offsets[i]; k < offsets[i + 1]; ++k) {
           const std::uint32_t j = indices[k];
           const Vec2 xij = periodic ? periodic_.min_image(xi - x[j]) : Vec2(xi - x[j]);
-          const double r2 = xij.squaredNorm();
-          if (r2 >= support2) continue;  // in the list's skin: no contribution
-          const double r = std::sqrt(r2);
-          depth += vol[j] * spline_value(r * inv_d0);
-          if (r > 0.0) acc += (coef * vol[j] * HeadPressureForce::shape(r * inv_d0) / r) * xij;
+          f(static_cast<std::size_t>(j), xij, xij.squaredNorm());
         }
+      });
+    }
+    // No skin: the pairs are used once per build, so they are visited straight from the cell scan
+    // (same pairs in the same order as the list, without writing and re-reading it).
+    const auto& x = store_.get<Position<2>>();
+    scan_.build(std::span<const Vec2>(x.data(), x.size()), HeadPressureForce::support * p_.d0, periodic_);
+    return pair_terms([&](std::size_t i, auto&& f) { scan_.for_each_neighbour(i, f); });
+  }
+
+ private:
+  /// The pair pass over the neighbours given by `neighbours(i, f)`, which calls f(j, xij, r²) for
+  /// every j ≠ i of particle i (possibly including skin pairs beyond the support). Returns the
+  /// signal speed max_i (S_i + √(g h_i)).
+  template <class Neighbours>
+  double pair_terms(Neighbours&& neighbours) {
+    const auto& vol = store_.get<Volume>();
+    auto& h = store_.get<FlowDepth>();
+    auto& ap = store_.get<HeadAcceleration>();
+    const auto& v = store_.get<Velocity<2>>();
+    const auto& grad = store_.get<SurfaceGradient>();
+    auto& dv = store_.get<VelocityCorrection>();
+    const double d0 = p_.d0;
+    const double inv_d0 = 1.0 / d0;
+    const double w0 = CubicSpline<2>::value(0.0, d0);
+    const double coef = p_.pressure_scale * p_.gravity * inv_d0 * inv_d0 * inv_d0;
+    const double g = p_.gravity;
+    const std::int64_t n = static_cast<std::int64_t>(store_.size());
+    const double support2 = 4.0 * d0 * d0, sigma = CubicSpline<2>::sigma(d0);
+    // Signal speed of particle i for the CFL condition: surface speed plus gravity-wave speed.
+    const auto signal_speed = [&](std::size_t i) {
+      const double vz = grad[i].dot(v[i]);
+      return std::sqrt(v[i].squaredNorm() + vz * vz) + std::sqrt(g * h[i]);
+    };
+    const double eps = p_.smoothing;
+    double signal = 0.0;
+    if (eps == 0.0) {
+      // One pass: depth and head pressure (the pressure does not need the neighbours' depths).
+#pragma omp parallel for reduction(max : signal) schedule(static) if (n >= kParallelMin)
+      for (std::int64_t ii = 0; ii < n; ++ii) {
+        const auto i = static_cast<std::size_t>(ii);
+        double depth = vol[i] * (2.0 / 3.0);
+        Vec2 acc = Vec2::Zero();
+        // W/σ (kernels.hpp) and f (head_pressure.hpp) written out per branch of q; the
+        // arithmetic is exactly that of CubicSpline and HeadPressureForce::shape (the steady-flow
+        // test's particle-scale fluctuation grows from round-off, so its order is kept).
+        neighbours(i, [&](std::size_t j, const Vec2& xij, double r2) {
+          if (r2 >= support2) return;  // in the list's skin: no contribution
+          const double r = std::sqrt(r2);
+          const double q = r * inv_d0;
+          const double vj = vol[j];
+          if (q < 1.0) {
+            depth += vj * (2.0 / 3.0 - q * q + 0.5 * q * q * q);
+            if (r > 0.0) acc += (coef * vj * ((1.0 - q) / (1.0 + q)) / r) * xij;
+          } else if (q < 2.0) {
+            const double t = 2.0 - q;
+            depth += vj * (t * t * t / 6.0);
+            acc += (coef * vj * (-0.5 * (q - 1.0) * (q - 2.0)) / r) * xij;
+          }
+        });
         depth *= sigma;
         h[i] = depth;
         ap[i] = acc;
         dv[i] = Vec2::Zero();
+        signal = std::max(signal, signal_speed(i));
       }
-      return;
+      return signal;
     }
     // Pass 1: depths.
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
       double depth = vol[i] * w0;
-      const Vec2 xi = x[i];
-      for (std::uint32_t k = offsets[i]; k < offsets[i + 1]; ++k) {
-        const std::uint32_t j = indices[k];
-        const Vec2 xij = periodic ? periodic_.min_image(xi - x[j]) : Vec2(xi - x[j]);
+      neighbours(i, [&](std::size_t j, const Vec2& xij, double /*r2*/) {
         depth += vol[j] * CubicSpline<2>::value(xij.norm(), d0);
-      }
+      });
       h[i] = depth;
     }
     // Pass 2: head pressure and velocity smoothing (needs every depth).
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+#pragma omp parallel for reduction(max : signal) schedule(static) if (n >= kParallelMin)
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
       Vec2 acc = Vec2::Zero(), corr = Vec2::Zero();
-      const Vec2 xi = x[i], vi = v[i];
+      const Vec2 vi = v[i];
       const double hi = h[i];
-      for (std::uint32_t k = offsets[i]; k < offsets[i + 1]; ++k) {
-        const std::uint32_t j = indices[k];
-        const Vec2 xij = periodic ? periodic_.min_image(xi - x[j]) : Vec2(xi - x[j]);
+      neighbours(i, [&](std::size_t j, const Vec2& xij, double /*r2*/) {
         const double r = xij.norm();
         if (r > 0.0) acc += (coef * vol[j] * HeadPressureForce::shape(r * inv_d0) / r) * xij;
-        if (eps > 0.0) corr += (2.0 * vol[j] / (hi + h[j]) * CubicSpline<2>::value(r, d0)) * (v[j] - vi);
-      }
+        corr += (2.0 * vol[j] / (hi + h[j]) * CubicSpline<2>::value(r, d0)) * (v[j] - vi);
+      });
       ap[i] = acc;
       dv[i] = eps * corr;
+      signal = std::max(signal, signal_speed(i));
     }
+    return signal;
   }
 
- private:
-  void build_neighbours() {
+  /// Sort the store by cell for memory locality (every reorder_interval steps); the pairs are
+  /// then rebuilt for the new order.
+  void reorder_by_cell() {
+    const auto& x = store_.get<Position<2>>();
+    if (p_.skin > 0.0) {
+      build_list();
+      store_.reorder(list_.cell_order());
+    } else {
+      scan_.build(std::span<const Vec2>(x.data(), x.size()), HeadPressureForce::support * p_.d0, periodic_);
+      store_.reorder(scan_.cell_order());
+    }
+    list_valid_ = false;
+  }
+  void build_list() {
     const auto& x = store_.get<Position<2>>();
     list_.build(std::span<const Vec2>(x.data(), x.size()), (HeadPressureForce::support + p_.skin) * p_.d0, periodic_);
     store_.get<ListPosition>() = x;
@@ -276,8 +309,14 @@ class RunoutSolver {
     return std::sqrt(m2);
   }
 
+  /// What the integration found, so the serial checks run only when needed.
+  struct IntegrateFlags {
+    bool leaving = false;     ///< a particle left the terrain
+    bool non_finite = false;  ///< a position or velocity is not finite
+  };
+
   template <class Law>
-  void integrate(const Law& law, double dt) {
+  IntegrateFlags integrate(const Law& law, double dt) {
     auto& x = store_.get<Position<2>>();
     auto& v = store_.get<Velocity<2>>();
     auto& grad = store_.get<SurfaceGradient>();
@@ -292,7 +331,8 @@ class RunoutSolver {
     const double g = p_.gravity;
     const bool periodic = periodic_.any();
     const std::int64_t n = static_cast<std::int64_t>(store_.size());
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+    int any_leaving = 0, any_non_finite = 0;
+#pragma omp parallel for reduction(max : any_leaving, any_non_finite) schedule(static) if (n >= kParallelMin)
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
       const Vec2 gz = grad[i];
@@ -313,6 +353,8 @@ class RunoutSolver {
       if (!surface_.sample(x_new, smp)) {
         leaving[i] = 1;
         v[i] = v_new;
+        any_leaving = 1;
+        if (!(x[i].allFinite() && v_new.allFinite())) any_non_finite = 1;
         continue;
       }
       leaving[i] = 0;
@@ -323,10 +365,13 @@ class RunoutSolver {
       grad[i] = smp.grad;
       speed[i] = s;
       moving[i] = s > 0.0 ? 1 : 0;
+      if (!(x_new.allFinite() && v_new.allFinite())) any_non_finite = 1;
     }
+    return {any_leaving != 0, any_non_finite != 0};
   }
 
-  void check_finite() const {
+  /// Name the first particle with a non-finite state (integrate() found one).
+  void throw_non_finite() const {
     const auto& x = store_.get<Position<2>>();
     const auto& v = store_.get<Velocity<2>>();
     for (std::size_t i = 0; i < store_.size(); ++i) {
@@ -337,6 +382,7 @@ class RunoutSolver {
           << ", " << v[i].y() << ") m/s; reduce cfl or check the DSM for spikes";
       throw SimulationError(msg.str());
     }
+    throw std::logic_error("throw_non_finite: no particle has a non-finite state");
   }
 
   void remove_leaving() {
@@ -366,7 +412,8 @@ class RunoutSolver {
   RunoutParameters p_;
   Periodicity<2> periodic_;
   RunoutStore store_;
-  NeighbourList<2> list_;
+  NeighbourList<2> list_;  // with a skin (numerics.skin > 0)
+  CellPairScan<2> scan_;   // without (the default)
   VolumeBudget budget_;
   bool list_valid_ = false;
   double time_ = 0.0, dt_ = 0.0;
