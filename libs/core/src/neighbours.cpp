@@ -139,8 +139,6 @@ void NeighbourList<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const
   const std::size_t n = x.size();
   offsets_.assign(n + 1, 0);
 
-  const auto& dims = cells_.dims();
-  const auto starts = cells_.cell_start();
   const auto sorted = cells_.sorted();
   const auto cell_of = cells_.cell_of();
   const auto& per = cells_.periodicity();
@@ -164,65 +162,16 @@ void NeighbourList<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const
     auto& buf = thread_buffers_[t];
     buf.clear();
 
-    // Along axis 0 neighbouring cells are contiguous in the linear index, so each (axis 1.., axis 2..)
-    // combination is scanned as at most two contiguous ranges of sorted particles (two only when a
-    // periodic axis 0 wraps). The other axes use distinct candidate coordinates (short periodic
-    // axes would otherwise visit a cell twice).
-    std::array<std::array<int, 2 * R + 1>, Dim> cand{};
-    std::array<int, Dim> ncand{};
+    typename CellList<Dim>::template ScanRanges<R> ranges;
     for (std::size_t i = begin; i < end; ++i) {
-      const auto c = cells_.cell_coords(cell_of[i]);
-      for (int d = 1; d < Dim; ++d) {
-        ncand[d] = 0;
-        for (int o = -R; o <= R; ++o) {
-          int cc = c[d] + o;
-          if (per.axis[d]) {
-            cc = (cc % dims[d] + dims[d]) % dims[d];
-          } else if (cc < 0 || cc >= dims[d]) {
-            continue;
-          }
-          bool seen = false;
-          for (int k = 0; k < ncand[d]; ++k) seen = seen || cand[d][k] == cc;
-          if (!seen) cand[d][ncand[d]++] = cc;
-        }
-      }
-      // Ranges along axis 0: [lo, hi] inclusive cell coordinates.
-      int r0lo, r0hi, r1lo = 0, r1hi = -1;
-      if (!per.axis[0]) {
-        r0lo = std::max(c[0] - R, 0);
-        r0hi = std::min(c[0] + R, dims[0] - 1);
-      } else if (dims[0] <= 2 * R + 1) {
-        r0lo = 0, r0hi = dims[0] - 1;
-      } else if (c[0] - R < 0) {
-        r0lo = 0, r0hi = c[0] + R, r1lo = dims[0] + c[0] - R, r1hi = dims[0] - 1;
-      } else if (c[0] + R >= dims[0]) {
-        r0lo = c[0] - R, r0hi = dims[0] - 1, r1lo = 0, r1hi = c[0] + R - dims[0];
-      } else {
-        r0lo = c[0] - R, r0hi = c[0] + R;
-      }
-
+      const int nranges = cells_.template scan_ranges<R>(cell_of[i], ranges);
       const Vec<Dim> xi = x[i];
       const std::size_t before = buf.size();
-      auto scan = [&](std::uint32_t first_cell, std::uint32_t last_cell) {
-        const std::uint32_t s_end = starts[last_cell + 1];
-        for (std::uint32_t s = starts[first_cell]; s < s_end; ++s) {
+      for (int q = 0; q < nranges; ++q)
+        for (std::uint32_t s = ranges[q][0]; s < ranges[q][1]; ++s) {
           const Vec<Dim> d = periodic_any_ ? per.min_image(xi - sorted_x_[s]) : Vec<Dim>(xi - sorted_x_[s]);
           if (d.squaredNorm() < rc2 && sorted[s] != i) buf.push_back(sorted[s]);
         }
-      };
-      std::array<int, Dim> k{};
-      for (;;) {
-        std::uint32_t base = 0, stride = static_cast<std::uint32_t>(dims[0]);
-        for (int d = 1; d < Dim; ++d) {
-          base += static_cast<std::uint32_t>(cand[d][k[d]]) * stride;
-          stride *= static_cast<std::uint32_t>(dims[d]);
-        }
-        scan(base + r0lo, base + r0hi);
-        if (r1hi >= r1lo) scan(base + r1lo, base + r1hi);
-        int d = 1;
-        while (d < Dim && ++k[d] == ncand[d]) k[d++] = 0;
-        if (d == Dim) break;
-      }
       offsets_[i + 1] = static_cast<std::uint32_t>(buf.size() - before);
     }
 #pragma omp barrier

@@ -58,10 +58,73 @@ struct Periodicity {
   }
 };
 
+namespace detail {
+/// b^e for small non-negative e (compile time).
+constexpr int ipow(int b, int e) noexcept {
+  return e == 0 ? 1 : b * ipow(b, e - 1);
+}
+}  // namespace detail
+
 /// Cell-linked list: particles binned into cubic cells of edge ≥ cell_size, sorted by cell.
 template <int Dim>
 class CellList {
 public:
+  /// Slot ranges [first, last) of sorted() to scan for the neighbours of a particle in `cell`,
+  /// R cells deep, and how many of them. Along axis 0 neighbouring cells are contiguous in the
+  /// linear index, so each combination of the other axes is one range (two when a periodic axis
+  /// 0 wraps); the other axes list distinct candidate coordinates (a short periodic axis would
+  /// otherwise visit a cell twice). NeighbourList and CellPairScan both scan these, in this order.
+  template <int R>
+  using ScanRanges = std::array<std::array<std::uint32_t, 2>, 2 * detail::ipow(2 * R + 1, Dim - 1)>;
+  template <int R>
+  int scan_ranges(std::uint32_t cell, ScanRanges<R>& ranges) const noexcept {
+    const auto c = cell_coords(cell);
+    std::array<std::array<int, 2 * R + 1>, Dim> cand{};
+    std::array<int, Dim> ncand{};
+    for (int d = 1; d < Dim; ++d) {
+      for (int o = -R; o <= R; ++o) {
+        int cc = c[d] + o;
+        if (periodic_.axis[d]) {
+          cc = (cc % dims_[d] + dims_[d]) % dims_[d];
+        } else if (cc < 0 || cc >= dims_[d]) {
+          continue;
+        }
+        bool seen = false;
+        for (int k = 0; k < ncand[d]; ++k) seen = seen || cand[d][k] == cc;
+        if (!seen) cand[d][ncand[d]++] = cc;
+      }
+    }
+    // Ranges along axis 0: [lo, hi] inclusive cell coordinates.
+    int r0lo, r0hi, r1lo = 0, r1hi = -1;
+    if (!periodic_.axis[0]) {
+      r0lo = std::max(c[0] - R, 0);
+      r0hi = std::min(c[0] + R, dims_[0] - 1);
+    } else if (dims_[0] <= 2 * R + 1) {
+      r0lo = 0, r0hi = dims_[0] - 1;
+    } else if (c[0] - R < 0) {
+      r0lo = 0, r0hi = c[0] + R, r1lo = dims_[0] + c[0] - R, r1hi = dims_[0] - 1;
+    } else if (c[0] + R >= dims_[0]) {
+      r0lo = c[0] - R, r0hi = dims_[0] - 1, r1lo = 0, r1hi = c[0] + R - dims_[0];
+    } else {
+      r0lo = c[0] - R, r0hi = c[0] + R;
+    }
+    int n = 0;
+    std::array<int, Dim> k{};
+    for (;;) {
+      std::uint32_t base = 0, stride = static_cast<std::uint32_t>(dims_[0]);
+      for (int d = 1; d < Dim; ++d) {
+        base += static_cast<std::uint32_t>(cand[d][k[d]]) * stride;
+        stride *= static_cast<std::uint32_t>(dims_[d]);
+      }
+      ranges[n++] = {cell_start_[base + r0lo], cell_start_[base + r0hi + 1]};
+      if (r1hi >= r1lo) ranges[n++] = {cell_start_[base + r1lo], cell_start_[base + r1hi + 1]};
+      int d = 1;
+      while (d < Dim && ++k[d] == ncand[d]) k[d++] = 0;
+      if (d == Dim) break;
+    }
+    return n;
+  }
+
   /// Bin the particles. Throws std::invalid_argument if cell_size ≤ 0, a position is not finite,
   /// or a periodic axis is shorter than 2 × cell_size.
   void build(std::span<const Vec<Dim>> x, double cell_size, const Periodicity<Dim>& periodic = {});
@@ -164,12 +227,6 @@ private:
 ///     scan.build(x, cutoff, periodic);
 ///     #pragma omp parallel for
 ///     for (i ...) scan.for_each_neighbour(i, [&](std::size_t j, const Vec<Dim>& xij, double r2) {...});
-namespace detail {
-/// b^e for small non-negative e (compile time).
-constexpr int ipow(int b, int e) noexcept {
-  return e == 0 ? 1 : b * ipow(b, e - 1);
-}
-}  // namespace detail
 
 template <int Dim>
 class CellPairScan {
@@ -195,58 +252,10 @@ public:
   template <class F>
   [[gnu::always_inline]] inline void for_each_neighbour(std::size_t i, F&& f) const {
     constexpr int R = kReach;
-    const auto& dims = cells_.dims();
-    const auto starts = cells_.cell_start();
     const auto sorted = cells_.sorted();
     const auto& per = cells_.periodicity();
-    const auto c = cells_.cell_coords(cells_.cell_of()[i]);
-    // The same candidate cells, in the same order, as NeighbourList::build: along axis 0 the
-    // neighbouring cells are contiguous (one range, two when a periodic axis 0 wraps); the other
-    // axes list distinct candidate coordinates.
-    std::array<std::array<int, 2 * R + 1>, Dim> cand{};
-    std::array<int, Dim> ncand{};
-    for (int d = 1; d < Dim; ++d) {
-      for (int o = -R; o <= R; ++o) {
-        int cc = c[d] + o;
-        if (per.axis[d]) {
-          cc = (cc % dims[d] + dims[d]) % dims[d];
-        } else if (cc < 0 || cc >= dims[d]) {
-          continue;
-        }
-        bool seen = false;
-        for (int k = 0; k < ncand[d]; ++k) seen = seen || cand[d][k] == cc;
-        if (!seen) cand[d][ncand[d]++] = cc;
-      }
-    }
-    int r0lo, r0hi, r1lo = 0, r1hi = -1;
-    if (!per.axis[0]) {
-      r0lo = std::max(c[0] - R, 0);
-      r0hi = std::min(c[0] + R, dims[0] - 1);
-    } else if (dims[0] <= 2 * R + 1) {
-      r0lo = 0, r0hi = dims[0] - 1;
-    } else if (c[0] - R < 0) {
-      r0lo = 0, r0hi = c[0] + R, r1lo = dims[0] + c[0] - R, r1hi = dims[0] - 1;
-    } else if (c[0] + R >= dims[0]) {
-      r0lo = c[0] - R, r0hi = dims[0] - 1, r1lo = 0, r1hi = c[0] + R - dims[0];
-    } else {
-      r0lo = c[0] - R, r0hi = c[0] + R;
-    }
-    // Slot ranges [first, last) of sorted() to scan, in scan order.
-    std::array<std::array<std::uint32_t, 2>, 2 * detail::ipow(2 * R + 1, Dim - 1)> ranges;
-    int nranges = 0;
-    std::array<int, Dim> k{};
-    for (;;) {
-      std::uint32_t base = 0, stride = static_cast<std::uint32_t>(dims[0]);
-      for (int d = 1; d < Dim; ++d) {
-        base += static_cast<std::uint32_t>(cand[d][k[d]]) * stride;
-        stride *= static_cast<std::uint32_t>(dims[d]);
-      }
-      ranges[nranges++] = {starts[base + r0lo], starts[base + r0hi + 1]};
-      if (r1hi >= r1lo) ranges[nranges++] = {starts[base + r1lo], starts[base + r1hi + 1]};
-      int d = 1;
-      while (d < Dim && ++k[d] == ncand[d]) k[d++] = 0;
-      if (d == Dim) break;
-    }
+    typename CellList<Dim>::template ScanRanges<R> ranges;
+    const int nranges = cells_.template scan_ranges<R>(cells_.cell_of()[i], ranges);
     const std::uint32_t self = rank_[i];
     const Vec<Dim> xi = sorted_x_[self];
     const double rc2 = cutoff_ * cutoff_;
