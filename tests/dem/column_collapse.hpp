@@ -150,22 +150,16 @@ inline ColumnResult run_column(const ColumnSpec& c, DemSolver& s) {
   return res;
 }
 
-/// Angle of repose (degrees) of the material of `c`: a column of aspect ratio 1 slumps
-/// quasi-statically (local damping 0.7, so inertia plays no part) and the free surface of the heap
-/// between 20 % and 80 % of its length is fitted by a straight line.
-inline double repose_angle(ColumnSpec c) {
-  c.aspect_ratio = 1.0;
-  c.release_damping = 0.7;
-  DemSolver s;
-  const ColumnResult r = run_column(c, s);
-  const auto& x = s.discs.get<Position<2>>();
-  const auto& R = s.discs.get<Radius>();
-  const int nb = 10;
+/// Angle (degrees) of a heap's free surface falling towards +x: the top of the highest disc in
+/// each of `nb` bins of [0, length), fitted by a straight line over bins first..last−1.
+inline double surface_angle(const DiscStore& d, double length, int nb, int first, int last) {
+  const auto& x = d.get<Position<2>>();
+  const auto& R = d.get<Radius>();
   std::vector<double> xs, zs;
-  for (int b = 2; b < 8; ++b) {
-    const double x0 = r.front * b / nb, x1 = r.front * (b + 1) / nb;
+  for (int b = first; b < last; ++b) {
+    const double x0 = length * b / nb, x1 = length * (b + 1) / nb;
     double top = 0;
-    for (std::size_t i = 0; i < s.discs.size(); ++i)
+    for (std::size_t i = 0; i < d.size(); ++i)
       if (x[i].x() >= x0 && x[i].x() < x1) top = std::max(top, x[i].y() + R[i]);
     xs.push_back(0.5 * (x0 + x1));
     zs.push_back(top);
@@ -181,6 +175,17 @@ inline double repose_angle(ColumnSpec c) {
     sxx += (xs[k] - mx) * (xs[k] - mx);
   }
   return std::atan(-sxy / sxx) * 180.0 / 3.141592653589793;
+}
+
+/// Angle of repose (degrees) of the material of `c`: a column of aspect ratio 1 slumps
+/// quasi-statically (local damping 0.7, so inertia plays no part) and the free surface of the heap
+/// between 20 % and 80 % of its length is fitted by a straight line.
+inline double repose_angle(ColumnSpec c) {
+  c.aspect_ratio = 1.0;
+  c.release_damping = 0.7;
+  DemSolver s;
+  const ColumnResult r = run_column(c, s);
+  return surface_angle(s.discs, r.front, 10, 2, 8);
 }
 
 }  // namespace geohaz::dem::testing

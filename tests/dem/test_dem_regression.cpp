@@ -176,30 +176,9 @@ TEST(DemRegression, AngleOfReposeRisesWithRollingResistance) {
     s.run_until(1.0);
     // Angle of the free surface: the slope of the highest disc top against x over the pile.
     const auto& x = s.discs.get<Position<2>>();
-    const auto& R = s.discs.get<Radius>();
     double xmax = 0;
     for (std::size_t i = 0; i < s.discs.size(); ++i) xmax = std::max(xmax, x[i].x());
-    std::vector<double> xs, zs;
-    const int nb = 10;
-    for (int b = 1; b < nb - 1; ++b) {
-      const double x0 = xmax * b / nb, x1 = xmax * (b + 1) / nb;
-      double top = 0;
-      for (std::size_t i = 0; i < s.discs.size(); ++i)
-        if (x[i].x() >= x0 && x[i].x() < x1) top = std::max(top, x[i].y() + R[i]);
-      xs.push_back(0.5 * (x0 + x1));
-      zs.push_back(top);
-    }
-    double mx = 0, mz = 0;
-    for (std::size_t k = 0; k < xs.size(); ++k) {
-      mx += xs[k] / xs.size();
-      mz += zs[k] / zs.size();
-    }
-    double sxy = 0, sxx = 0;
-    for (std::size_t k = 0; k < xs.size(); ++k) {
-      sxy += (xs[k] - mx) * (zs[k] - mz);
-      sxx += (xs[k] - mx) * (xs[k] - mx);
-    }
-    return std::atan(-sxy / sxx) * 180 / std::numbers::pi;
+    return geohaz::dem::testing::surface_angle(s.discs, xmax, 10, 1, 9);
   };
   const double a0 = repose(0.0), a1 = repose(0.3);
   RecordProperty("repose_angle_mu_r_0", std::to_string(a0));

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 
+#include "plot.hpp"
 #include "geohaz/dem/experiments.hpp"
 #include "geohaz/dem/output.hpp"
 #include "bonded_lab_spec.hpp"
@@ -103,36 +104,8 @@ std::pair<double, double> lube_runout(double a) {
 /// Lube et al. (2005): H∞/L0 ≈ a for a ≲ 1.15 (the top is not reached by the failure), a^{0.4} beyond.
 double lube_height(double a) { return a < 1.15 ? a : std::pow(a, 0.4); }
 
-/// A bare line plot for docs/validation/dem.md (axes ranges are given there): frame, grid lines
-/// at every tick, curves as lines, measurements as dots.
-struct Curve {
-  std::vector<double> x, y;
-  std::array<std::uint8_t, 3> colour;
-  bool dots = false;
-};
-void plot(const fs::path& path, const std::vector<Curve>& curves, double x0, double x1, double y0, double y1,
-          double xtick, double ytick) {
-  const int W = 640, H = 420, m = 40;
-  geohaz::Image img(W, H);
-  auto px = [&](double x) { return m + (x - x0) / (x1 - x0) * (W - 2 * m); };
-  auto py = [&](double y) { return H - m - (y - y0) / (y1 - y0) * (H - 2 * m); };
-  const std::array<std::uint8_t, 3> grid{220, 220, 220}, black{0, 0, 0};
-  for (double x = x0; x <= x1 + 1e-9; x += xtick) img.line(px(x), py(y0), px(x), py(y1), grid);
-  for (double y = y0; y <= y1 + 1e-9; y += ytick) img.line(px(x0), py(y), px(x1), py(y), grid);
-  img.line(px(x0), py(y0), px(x1), py(y0), black);
-  img.line(px(x0), py(y0), px(x0), py(y1), black);
-  img.line(px(x1), py(y0), px(x1), py(y1), black);
-  img.line(px(x0), py(y1), px(x1), py(y1), black);
-  for (const auto& c : curves)
-    for (std::size_t i = 0; i < c.x.size(); ++i) {
-      if (c.dots)
-        img.fill_circle(px(c.x[i]), py(c.y[i]), 5, c.colour);
-      else if (i)
-        img.line(px(c.x[i - 1]), py(c.y[i - 1]), px(c.x[i]), py(c.y[i]), c.colour);
-    }
-  fs::create_directories(path.parent_path());
-  geohaz::write_png(path, img);
-}
+using geohaz::testing::Curve;
+using geohaz::testing::plot;
 
 }  // namespace
 
@@ -147,15 +120,8 @@ TEST(DemValidation, GranularColumnCollapse) {
   nlohmann::json j;
   j["repose_angle"] = geohaz::dem::testing::repose_angle(c);
   std::printf("column material: quasi-static heap angle %.1f deg\n", j["repose_angle"].get<double>());
-  Curve law{{}, {}, {0, 0, 0}, false}, law2{{}, {}, {130, 130, 130}, false}, model{{}, {}, {30, 90, 200}, true};
-  for (double a = 0.0; a <= 2.8 + 1e-9; a += 0.05) {
-    law.x.push_back(a);
-    law.y.push_back(1.2 * a);
-  }
-  for (double a = 1.8; a <= 3.5 + 1e-9; a += 0.05) {
-    law2.x.push_back(a);
-    law2.y.push_back(1.9 * std::pow(a, 2.0 / 3.0));
-  }
+  auto [law, law2] = geohaz::testing::lube_runout_curves();
+  Curve model{{}, {}, {30, 90, 200}, true};
   for (double a : {0.5, 1.0, 2.0, 3.0}) {
     c.aspect_ratio = a;
     DemSolver s;
