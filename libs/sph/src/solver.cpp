@@ -87,7 +87,7 @@ template <int Dim>
 double SphSolver<Dim>::bytes_per_particle() const {
   const double n = std::max<double>(1.0, static_cast<double>(store_.size()));
   return static_cast<double>(SphStore<Dim>::bytes_per_particle()) + 4.0 * static_cast<double>(list_.pair_count()) / n +
-         4.0 + 3.0 * 4.0;  // CSR indices + offsets + cell data
+         4.0 + 3.0 * 4.0 + 1.0;  // CSR indices + offsets + cell data + artificial-stress flag
 }
 
 template <int Dim>
@@ -126,6 +126,8 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
     max_drift_ = 0.0;
   }
   const double cutoff2 = cutoff * cutoff;
+  // Kernel constants for the pair loops: W = σ w(q), ∇W = x_ij σ/h w'(q)/r with q = r/h.
+  const double inv_h = 1.0 / h, sigma = Kernel::sigma(h), sigma_h = sigma * inv_h;
 
   const std::int64_t n = static_cast<std::int64_t>(S.size());
   Vec<Dim>* x = S.template get<Position<Dim>>().data();
@@ -259,12 +261,13 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
       const double r2 = xij.squaredNorm();
       if (r2 >= cutoff2) continue;
       const double r = std::sqrt(r2);
-      const Vec<Dim> gw = Kernel::gradient(xij, r, h);
+      const double q = r * inv_h;
+      const Vec<Dim> gw = xij * (r > 0.0 ? sigma_h * Kernel::shape_derivative(q) / r : 0.0);
       const double Vj = m[j] / rho[j];
       const Vec<Dim> dv = vI[j] - vi;
       Li.noalias() += (Vj * dv) * gw.transpose();
       dr -= m[j] * dv.dot(gw);
-      const double w = Kernel::value(r, h);
+      const double w = sigma * Kernel::shape(q);
       rs += m[j] * w;
       xi_sum += (Vj * w) * dv;
     }
@@ -278,9 +281,12 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
   const double eps_as = settings_.artificial_stress;
   const double sf_frac = settings_.stress_free_fraction;
   double plastic_sum = 0.0;
+  has_as_.resize(static_cast<std::size_t>(n));
+  std::uint8_t* has_as = has_as_.data();
 #pragma omp parallel for schedule(static) reduction(+ : plastic_sum)
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
+    has_as[i] = 0;
     if (kind[i] != kSoil) {
       R[i].setZero();
       sr2[i] = sig[i].template topLeftCorner<Dim, Dim>() / (rho[i] * rho[i]);
@@ -303,6 +309,7 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
     if (eps_as > 0.0) {
       const Mat<Dim> s2 = sig[i].template topLeftCorner<Dim, Dim>();
       R[i] = artificial_stress<Dim>(s2, eps_as, rho[i]);
+      has_as[i] = R[i].squaredNorm() > 0.0;
     }
     sr2[i] = sig[i].template topLeftCorner<Dim, Dim>() / (rho[i] * rho[i]);
   }
@@ -321,7 +328,7 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
     if (kind[i] != kSoil) continue;
     const Mat<Dim> si = sr2[i];
     const Mat<Dim> Ri = R[i];
-    const bool has_Ri = Ri.squaredNorm() > 0.0;
+    const bool has_Ri = has_as[i];
     const MaterialParams& pi = mats[mat[i]];
     const double ci = fluid ? std::sqrt(pi.bulk / pi.density) : pi.p_wave_speed;
     Vec<Dim> ai = Vec<Dim>::Zero();
@@ -331,7 +338,8 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
       const double r2 = xij.squaredNorm();
       if (r2 >= cutoff2) continue;
       const double r = std::sqrt(r2);
-      const Vec<Dim> gw = Kernel::gradient(xij, r, h);
+      const double q = r * inv_h;
+      const Vec<Dim> gw = xij * (r > 0.0 ? sigma_h * Kernel::shape_derivative(q) / r : 0.0);
       Mat<Dim> T = si + sr2[j];
       const Vec<Dim> vij = v[i] - vI[j];
       const double vr = vij.dot(xij);
@@ -342,8 +350,8 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
         const double Pi = (-alpha * 0.5 * (ci + cj) * mu + beta * mu * mu) / (0.5 * (rho[i] + rho[j]));
         T.diagonal().array() -= Pi;
       }
-      if (has_Ri || R[j].squaredNorm() > 0.0) {
-        const double f = Kernel::value(r, h) / w_dx;
+      if (has_Ri || has_as[j]) {
+        const double f = sigma * Kernel::shape(q) / w_dx;
         T += std::pow(f, n_as) * (Ri + R[j]);
       }
       ai.noalias() += m[j] * (T * gw);

@@ -30,24 +30,22 @@ struct CubicSpline {
     else if constexpr (Dim == 2) return 15.0 / (7.0 * std::numbers::pi * h * h);
     else return 3.0 / (2.0 * std::numbers::pi * h * h * h);
   }
+  /// Dimensionless shape w(q) and its derivative dw/dq: W = σ_d w(r/h), dW/dr = σ_d w'(r/h)/h.
+  /// Pair loops that precompute σ_d and 1/h call these directly (no division per pair).
+  static double shape(double q) noexcept {
+    if (q < 1.0) return 2.0 / 3.0 - q * q + 0.5 * q * q * q;
+    if (q < 2.0) { const double t = 2.0 - q; return t * t * t / 6.0; }
+    return 0.0;
+  }
+  static double shape_derivative(double q) noexcept {
+    if (q < 1.0) return -2.0 * q + 1.5 * q * q;
+    if (q < 2.0) { const double t = 2.0 - q; return -0.5 * t * t; }
+    return 0.0;
+  }
   /// W(r, h)
-  static double value(double r, double h) noexcept {
-    const double q = r / h;
-    double w;
-    if (q < 1.0) w = 2.0 / 3.0 - q * q + 0.5 * q * q * q;
-    else if (q < 2.0) { const double t = 2.0 - q; w = t * t * t / 6.0; }
-    else w = 0.0;
-    return sigma(h) * w;
-  }
+  static double value(double r, double h) noexcept { return sigma(h) * shape(r / h); }
   /// dW/dr (r, h)
-  static double derivative(double r, double h) noexcept {
-    const double q = r / h;
-    double dw;
-    if (q < 1.0) dw = -2.0 * q + 1.5 * q * q;
-    else if (q < 2.0) { const double t = 2.0 - q; dw = -0.5 * t * t; }
-    else dw = 0.0;
-    return sigma(h) * dw / h;
-  }
+  static double derivative(double r, double h) noexcept { return sigma(h) * shape_derivative(r / h) / h; }
   /// ∇_i W(x_i − x_j) given xij = x_i − x_j and r = |xij| > 0.
   static Vec<Dim> gradient(const Vec<Dim>& xij, double r, double h) noexcept {
     if (r <= 0.0) return Vec<Dim>::Zero();
@@ -66,20 +64,20 @@ struct WendlandC2 {
     if constexpr (Dim == 2) return 7.0 / (4.0 * std::numbers::pi * h * h);
     else return 21.0 / (16.0 * std::numbers::pi * h * h * h);
   }
-  static double value(double r, double h) noexcept {
-    const double q = r / h;
+  /// Dimensionless shape w(q) = (1 − q/2)⁴(2q + 1) and dw/dq = −5q(1 − q/2)³ (see CubicSpline).
+  static double shape(double q) noexcept {
     if (q >= 2.0) return 0.0;
     const double t = 1.0 - 0.5 * q;
     const double t2 = t * t;
-    return sigma(h) * t2 * t2 * (2.0 * q + 1.0);
+    return t2 * t2 * (2.0 * q + 1.0);
   }
-  static double derivative(double r, double h) noexcept {
-    const double q = r / h;
+  static double shape_derivative(double q) noexcept {
     if (q >= 2.0) return 0.0;
     const double t = 1.0 - 0.5 * q;
-    // d/dq [(1 − q/2)^4 (2q + 1)] = −5 q (1 − q/2)^3
-    return sigma(h) * (-5.0 * q * t * t * t) / h;
+    return -5.0 * q * t * t * t;
   }
+  static double value(double r, double h) noexcept { return sigma(h) * shape(r / h); }
+  static double derivative(double r, double h) noexcept { return sigma(h) * shape_derivative(r / h) / h; }
   static Vec<Dim> gradient(const Vec<Dim>& xij, double r, double h) noexcept {
     if (r <= 0.0) return Vec<Dim>::Zero();
     return xij * (derivative(r, h) / r);

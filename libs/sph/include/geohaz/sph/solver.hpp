@@ -147,6 +147,9 @@ class SphSolver {
   double max_wave_speed_ = 0.0;
   double max_kinematic_viscosity_ = 0.0;
   double max_drift_ = 0.0;  // largest displacement since the last neighbour build (m)
+  // Scratch, rewritten every step (not particle state): 1 where the artificial stress R_i ≠ 0, so
+  // the momentum pass need not read a neighbour's R (as big as its stress) to find it is zero.
+  std::vector<std::uint8_t> has_as_;
   std::int64_t last_reorder_ = -1000000;
   std::int64_t builds_ = 0;
   bool fluid_ = false;
