@@ -471,35 +471,24 @@ int run_avalanche_case(const RunConfig& c, const std::filesystem::path& out, boo
 }  // namespace
 
 int main(int argc, char** argv) {
-  return run_main("dem-avalanche", [&]() -> int {
-    CommonOptions opts;
-    boost::program_options::options_description desc(
-        "Options (SI units throughout: m, s, kg, Pa; discs are 1 m thick, so forces are N/m and energies J/m; "
-        "angles in the config in degrees)");
-    add_common_options(desc, opts, "dem-avalanche-out");
-    if (!parse_command_line(
-            argc, argv, "dem-avalanche",
-            "bonded-disc DEM (parallel bonds, Potyondy & Cundall 2004) of rock: biaxial compression "
-            "and tension tests of a bonded sample, and rock avalanches of a jointed rock mass on a "
-            "terrain profile.\n"
-            "Usage: dem-avalanche --config case.toml [--set key=value ...] [--out DIR] [--threads N] [--quiet]",
-            desc))
-      return kExitOk;
-    if (opts.help_config) {
-      auto r = ConfigReader::describe();
-      (void)read_config(r, true);
-      std::cout << ConfigReader::format_reference(r.reference());
-      return kExitOk;
-    }
-    if (opts.config.empty())
-      throw InputError("--config FILE is required (see dem-avalanche --help)", "command line", "--config");
-    setup_threads(opts.threads);
-    auto reader = load_config(opts);
+  ConfigApp app;
+  app.name = "dem-avalanche";
+  app.summary =
+      "bonded-disc DEM (parallel bonds, Potyondy & Cundall 2004) of rock: biaxial compression "
+      "and tension tests of a bonded sample, and rock avalanches of a jointed rock mass on a "
+      "terrain profile.\n"
+      "Usage: dem-avalanche --config case.toml [--set key=value ...] [--out DIR] [--threads N] [--quiet]";
+  app.options_caption =
+      "Options (SI units throughout: m, s, kg, Pa; discs are 1 m thick, so forces are N/m and energies J/m; "
+      "angles in the config in degrees)";
+  app.describe = [](ConfigReader& r) { (void)read_config(r, true); };
+  app.run = [](ConfigReader& reader, const CommonOptions& opts) {
     RunConfig cfg = read_config(reader, false);
     reader.finish();
     cfg.resolved = reader.resolved();
     // Everything is validated before the output directory is created.
     return cfg.kind == TestKind::Avalanche ? run_avalanche_case(cfg, opts.out, opts.quiet)
                                            : run_lab(cfg, opts.out, opts.quiet);
-  });
+  };
+  return run_config_app(argc, argv, app);
 }

@@ -259,32 +259,20 @@ RunConfig read_config(ConfigReader& r, bool describe) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  return run_main("sph-slope", [&]() -> int {
-    CommonOptions opts;
-    boost::program_options::options_description desc(
-        "Options (all physical quantities in SI units: m, s, kg, Pa; angles in the config in degrees)");
-    add_common_options(desc, opts, "sph-slope-out");
-    if (!parse_command_line(
-            argc, argv, "sph-slope",
-            "SPH simulation of slope failure and post-failure flow of elasto-plastic soil "
-            "(2D plane strain / 3D) under gravity and earthquake shaking.\n"
-            "Usage: sph-slope --config slope.toml [--set key=value ...] [--out DIR] [--threads N] [--quiet]",
-            desc))
-      return kExitOk;
-    if (opts.help_config) {
-      auto r = ConfigReader::describe();
-      (void)read_config(r, true);
-      std::cout << ConfigReader::format_reference(r.reference());
-      return kExitOk;
-    }
-    if (opts.config.empty())
-      throw InputError("--config FILE is required (see sph-slope --help)", "command line", "--config");
-    setup_threads(opts.threads);
-    auto reader = load_config(opts);
+  ConfigApp app;
+  app.name = "sph-slope";
+  app.summary =
+      "SPH simulation of slope failure and post-failure flow of elasto-plastic soil "
+      "(2D plane strain / 3D) under gravity and earthquake shaking.\n"
+      "Usage: sph-slope --config slope.toml [--set key=value ...] [--out DIR] [--threads N] [--quiet]";
+  app.options_caption = "Options (all physical quantities in SI units: m, s, kg, Pa; angles in the config in degrees)";
+  app.describe = [](ConfigReader& r) { (void)read_config(r, true); };
+  app.run = [](ConfigReader& reader, const CommonOptions& opts) {
     RunConfig cfg = read_config(reader, false);
     reader.finish();
     cfg.resolved_config = reader.resolved();
     validate(cfg);  // everything checked before the output directory is created
     return run(cfg, opts.out, opts.quiet);
-  });
+  };
+  return run_config_app(argc, argv, app);
 }

@@ -73,4 +73,24 @@ int run_main(const std::string& app, const std::function<int()>& body) {
   }
 }
 
+int run_config_app(int argc, const char* const* argv, const ConfigApp& app) {
+  return run_main(app.name, [&]() -> int {
+    CommonOptions opts;
+    boost::program_options::options_description desc(app.options_caption);
+    add_common_options(desc, opts, app.name + "-out");
+    if (!parse_command_line(argc, argv, app.name, app.summary, desc)) return kExitOk;
+    if (opts.help_config) {
+      auto r = ConfigReader::describe();
+      app.describe(r);
+      std::cout << ConfigReader::format_reference(r.reference());
+      return kExitOk;
+    }
+    if (opts.config.empty())
+      throw InputError("--config FILE is required (see " + app.name + " --help)", "command line", "--config");
+    setup_threads(opts.threads);
+    auto reader = load_config(opts);
+    return app.run(reader, opts);
+  });
+}
+
 }  // namespace geohaz

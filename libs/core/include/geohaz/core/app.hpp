@@ -45,4 +45,21 @@ int setup_threads(int threads);
 /// any other exception → 1 ("app: error: ...").
 int run_main(const std::string& app, const std::function<int()>& body);
 
+/// What a config-driven app (`APP --config case.toml [--set ...] [--out DIR] ...`) tells main().
+struct ConfigApp {
+  std::string name;             ///< program name, also the default output directory "<name>-out"
+  std::string summary;          ///< --help text: what it does and its usage line
+  std::string options_caption;  ///< heading of the option list (state the units)
+  /// Read every key in describe mode, for --help-config (the app's own key reader).
+  std::function<void(ConfigReader&)> describe;
+  /// Read the loaded config (the caller calls finish() and resolved()), check it and run; returns
+  /// the exit code. Called with the overrides applied and the threads set up.
+  std::function<int(ConfigReader&, const CommonOptions&)> run;
+};
+
+/// main() of a config-driven app: the common options, --help / --version / --help-config,
+/// --config required, threads, config loaded, then `app.run`, all inside run_main's exit-code
+/// mapping.
+int run_config_app(int argc, const char* const* argv, const ConfigApp& app);
+
 }  // namespace geohaz
