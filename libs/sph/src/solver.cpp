@@ -5,6 +5,8 @@
 #include <cmath>
 #include <sstream>
 
+#include <omp.h>
+
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/kernels.hpp"
 
@@ -87,7 +89,8 @@ template <int Dim>
 double SphSolver<Dim>::bytes_per_particle() const {
   const double n = std::max<double>(1.0, static_cast<double>(store_.size()));
   return static_cast<double>(SphStore<Dim>::bytes_per_particle()) + 4.0 * static_cast<double>(list_.pair_count()) / n +
-         4.0 + 3.0 * 4.0 + 1.0;  // CSR indices + offsets + cell data + artificial-stress flag
+         4.0 + 3.0 * 4.0 + 1.0 +  // CSR indices + offsets + cell data + artificial-stress flag
+         static_cast<double>(pair_acc_.size() * sizeof(Vec<Dim>)) / n;  // per-thread pair reactions
 }
 
 template <int Dim>
@@ -322,48 +325,75 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
   const double eta2 = 0.01 * h * h;
   const double r_rep = settings_.wall_repulsion * settings_.spacing;
   const bool fluid = fluid_;
-#pragma omp parallel for schedule(static)
-  for (std::int64_t ii = 0; ii < n; ++ii) {
-    const auto i = static_cast<std::size_t>(ii);
-    if (kind[i] != kSoil) continue;
-    const Mat<Dim> si = sr2[i];
-    const Mat<Dim> Ri = R[i];
-    const bool has_Ri = has_as[i];
-    const MaterialParams& pi = mats[mat[i]];
-    const double ci = fluid ? std::sqrt(pi.bulk / pi.density) : pi.p_wave_speed;
-    Vec<Dim> ai = Vec<Dim>::Zero();
-    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
-      const std::uint32_t j = idx[k];
-      const Vec<Dim> xij = displacement(x[i], x[j]);
-      const double r2 = xij.squaredNorm();
-      if (r2 >= cutoff2) continue;
-      const double r = std::sqrt(r2);
-      const double q = r * inv_h;
-      const Vec<Dim> gw = xij * (r > 0.0 ? sigma_h * Kernel::shape_derivative(q) / r : 0.0);
-      Mat<Dim> T = si + sr2[j];
-      const Vec<Dim> vij = v[i] - vI[j];
-      const double vr = vij.dot(xij);
-      if (vr < 0.0 && alpha + beta > 0.0) {
-        const MaterialParams& pj = mats[mat[j]];
-        const double cj = fluid ? std::sqrt(pj.bulk / pj.density) : pj.p_wave_speed;
-        const double mu = h * vr / (r * r + eta2);
-        const double Pi = (-alpha * 0.5 * (ci + cj) * mu + beta * mu * mu) / (0.5 * (rho[i] + rho[j]));
-        T.diagonal().array() -= Pi;
+  // Each soil–soil pair is evaluated once, by the particle of lower index: the pair term is
+  // symmetric (T_ij = T_ji, ∇W_ji = −∇W_ij), so j receives −m_i T ∇W_ij. Those reactions go to a
+  // per-thread buffer (no two threads write the same slot) summed after the pass; soil–boundary
+  // pairs act on the soil particle only.
+  const std::size_t nn = static_cast<std::size_t>(n);
+  pair_acc_.resize(static_cast<std::size_t>(omp_get_max_threads()) * nn);
+#pragma omp parallel
+  {
+    const int nthreads = omp_get_num_threads();
+    Vec<Dim>* mine = pair_acc_.data() + static_cast<std::size_t>(omp_get_thread_num()) * nn;
+    std::fill(mine, mine + nn, Vec<Dim>::Zero());
+#pragma omp for schedule(static)
+    for (std::int64_t ii = 0; ii < n; ++ii) {
+      const auto i = static_cast<std::size_t>(ii);
+      if (kind[i] != kSoil) continue;
+      const Mat<Dim> si = sr2[i];
+      const Mat<Dim> Ri = R[i];
+      const bool has_Ri = has_as[i];
+      const MaterialParams& pi = mats[mat[i]];
+      const double ci = fluid ? std::sqrt(pi.bulk / pi.density) : pi.p_wave_speed;
+      const double mi = m[i];
+      Vec<Dim> ai = Vec<Dim>::Zero();
+      for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+        const std::uint32_t j = idx[k];
+        const bool soil_j = kind[j] == kSoil;
+        if (soil_j && j < i) continue;  // evaluated from j's side
+        const Vec<Dim> xij = displacement(x[i], x[j]);
+        const double r2 = xij.squaredNorm();
+        if (r2 >= cutoff2) continue;
+        const double r = std::sqrt(r2);
+        const double q = r * inv_h;
+        const Vec<Dim> gw = xij * (r > 0.0 ? sigma_h * Kernel::shape_derivative(q) / r : 0.0);
+        Mat<Dim> T = si + sr2[j];
+        const Vec<Dim> vij = v[i] - vI[j];
+        const double vr = vij.dot(xij);
+        if (vr < 0.0 && alpha + beta > 0.0) {
+          const MaterialParams& pj = mats[mat[j]];
+          const double cj = fluid ? std::sqrt(pj.bulk / pj.density) : pj.p_wave_speed;
+          const double mu = h * vr / (r * r + eta2);
+          const double Pi = (-alpha * 0.5 * (ci + cj) * mu + beta * mu * mu) / (0.5 * (rho[i] + rho[j]));
+          T.diagonal().array() -= Pi;
+        }
+        if (has_Ri || has_as[j]) {
+          const double f = sigma * Kernel::shape(q) / w_dx;
+          T += std::pow(f, n_as) * (Ri + R[j]);
+        }
+        const Vec<Dim> Tg = T * gw;
+        ai.noalias() += m[j] * Tg;
+        if (soil_j) {
+          mine[j].noalias() -= mi * Tg;
+        } else if (r < r_rep) {
+          // Last-resort wall repulsion (Monaghan 1994 form, exponents 4 and 2): only a soil
+          // particle closer than r0 = wall_repulsion·Δx to a boundary particle feels it — nothing
+          // in a normal configuration (spacing ≈ Δx) — and it stops particles from being squeezed
+          // through walls.
+          const double q2 = (r_rep * r_rep) / r2;
+          ai.noalias() += (ci * ci * (q2 * q2 - q2) / r2) * xij;
+        }
       }
-      if (has_Ri || has_as[j]) {
-        const double f = sigma * Kernel::shape(q) / w_dx;
-        T += std::pow(f, n_as) * (Ri + R[j]);
-      }
-      ai.noalias() += m[j] * (T * gw);
-      // Last-resort wall repulsion (Monaghan 1994 form, exponents 4 and 2): only a soil particle
-      // closer than r0 = wall_repulsion·Δx to a boundary particle feels it — nothing in a normal
-      // configuration (spacing ≈ Δx) — and it stops particles from being squeezed through walls.
-      if (kind[j] != kSoil && r < r_rep) {
-        const double q2 = (r_rep * r_rep) / r2;
-        ai.noalias() += (ci * ci * (q2 * q2 - q2) / r2) * xij;
-      }
+      acc[i] = ai;
     }
-    acc[i] = ai;
+#pragma omp for schedule(static)
+    for (std::int64_t ii = 0; ii < n; ++ii) {
+      const auto i = static_cast<std::size_t>(ii);
+      if (kind[i] != kSoil) continue;
+      Vec<Dim> a = acc[i];
+      for (int t = 0; t < nthreads; ++t) a += pair_acc_[static_cast<std::size_t>(t) * nn + i];
+      acc[i] = a;
+    }
   }
 
   // 5. Body force, local damping, leap-frog update.

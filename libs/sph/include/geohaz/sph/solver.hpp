@@ -150,6 +150,8 @@ class SphSolver {
   // Scratch, rewritten every step (not particle state): 1 where the artificial stress R_i ≠ 0, so
   // the momentum pass need not read a neighbour's R (as big as its stress) to find it is zero.
   std::vector<std::uint8_t> has_as_;
+  // Scratch of the momentum pass: per-thread reactions m_i T ∇W of the soil–soil pairs (threads × n).
+  std::vector<Vec<Dim>> pair_acc_;
   std::int64_t last_reorder_ = -1000000;
   std::int64_t builds_ = 0;
   bool fluid_ = false;
