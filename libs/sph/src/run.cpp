@@ -41,6 +41,12 @@ struct Built {
   DiagnosticFrame frame;
 };
 
+/// Width of a 3D DSM strip as built: a whole number of spacings (the builder's ny·Δx), centred on
+/// the polyline. The builder and the release export must agree on it.
+double strip_width(const RunConfig& c) {
+  return static_cast<double>(std::lround(c.width / c.numerics.spacing)) * c.numerics.spacing;
+}
+
 /// The particles of the configured scenario.
 template <int Dim>
 Built<Dim> build(const RunConfig& c) {
@@ -134,7 +140,7 @@ Built<Dim> build(const RunConfig& c) {
         d.width = c.width;
         d.periodic_width = false;
         const Terrain* terrain = c.section.terrain.get();
-        const double half = 0.5 * std::lround(c.width / dx) * dx;
+        const double half = 0.5 * strip_width(c);
         d.surface_xy = [terrain, &P, half, &c](double s, double y) {
           const Vec2 q = section_map_point(P, s, y - half);
           const double z = terrain->elevation(q.x(), q.y());
@@ -532,7 +538,7 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
     std::vector<Vec2> pts;
     std::vector<double> vols;
     double total = 0.0;
-    const double W = Dim == 2 ? c.section.release_width : std::lround(c.width / c.numerics.spacing) * c.numerics.spacing;
+    const double W = Dim == 2 ? c.section.release_width : strip_width(c);
     const int k = Dim == 2 ? std::max(1, static_cast<int>(std::lround(W / c.numerics.spacing))) : 1;
     for (std::size_t i = 0; i < S.size(); ++i) {
       if (S.template get<ParticleKind>()[i] != kSoil) continue;
