@@ -90,7 +90,8 @@ double SphSolver<Dim>::bytes_per_particle() const {
   const double n = std::max<double>(1.0, static_cast<double>(store_.size()));
   return static_cast<double>(SphStore<Dim>::bytes_per_particle()) + 4.0 * static_cast<double>(list_.pair_count()) / n +
          4.0 + 3.0 * 4.0 + 1.0 +  // CSR indices + offsets + cell data + artificial-stress flag
-         static_cast<double>(pair_acc_.size() * sizeof(Vec<Dim>)) / n;  // per-thread pair reactions
+         static_cast<double>(pair_acc_.size() * sizeof(Vec<Dim>) + pair_grad_.size() * sizeof(GradientReaction)) /
+             n;  // per-thread pair reactions
 }
 
 template <int Dim>
@@ -152,7 +153,8 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
   Vec<Dim>* vI = S.template get<InteractionVelocity<Dim>>().data();
   Vec<Dim>* xs = S.template get<XsphCorrection<Dim>>().data();
   Mat<Dim>* R = S.template get<ArtificialStress<Dim>>().data();
-  Mat<Dim>* sr2 = S.template get<StressOverDensitySquared<Dim>>().data();
+  Mat<Dim>* ps = S.template get<PairStress<Dim>>().data();
+  double* vol = S.template get<Volume>().data();
   const Vec<Dim>* xb = S.template get<PositionAtBuild<Dim>>().data();
   const std::uint32_t* off = list_.offsets().data();
   const std::uint32_t* idx = list_.indices().data();
@@ -185,99 +187,106 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
   constexpr std::uint8_t kSoil = static_cast<std::uint8_t>(Kind::Soil);
   constexpr std::uint8_t kRoller = static_cast<std::uint8_t>(Kind::RollerWall);
 
-  // 1. Boundary particles: ghost velocity and stress from the soil neighbours (Bui et al. 2008).
-  // The stress is extrapolated from each soil neighbour j to the boundary particle i so that the
-  // wall carries the stress gradient equilibrium demands, ∂σ_ik/∂x_k = −ρ ḡ_i, assuming the stress
-  // varies only along the layering normal ν (a layered deposit: flat ground, an infinite slope).
-  // With d = (x_i − x_j)·ν, ḡ_n = ḡ·ν and ḡ_t = ḡ − ḡ_n ν:
-  //   σ_i ← σ_j − ρ_j d [ḡ_n I + ḡ_t ⊗ ν + ν ⊗ ḡ_t],
-  // whose traction on the layering plane changes by −ρ_j ḡ d (normal and shear); the in-plane
-  // normal components take the isotropic part. Under flat ground (ν vertical) and vertical gravity
-  // this is the hydrostatic extrapolation of Adami et al. (2012); on a slope or under horizontal
-  // shaking it also supplies the shear the base must carry — without it, the soil next to an
-  // inclined wall misses the shear-stress gradient ρ g sin θ and creeps along the wall.
+  // 1. Boundary particles: ghost velocity from the soil neighbours (Bui et al. 2008): no slip
+  //    mirrors the Shepard-averaged soil velocity through the wall's, free slip only its normal
+  //    component. Their stress is set after the soil's update (step 3b).
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
+    vol[i] = m[i] / rho[i];  // for the pair sums of step 2
     if (kind[i] == kSoil) {
       vI[i] = v[i];
       continue;
     }
-    Vec<Dim> nu = lnrm[i];
-    if (nu.squaredNorm() == 0.0) nu = Vec<Dim>::Unit(Dim - 1);  // snapshots written before the field existed
-    const double g_n = gbar.dot(nu);
-    const Vec<Dim> g_t = gbar - g_n * nu;
-    Mat<Dim> shear_dir = g_t * nu.transpose();
-    shear_dir += shear_dir.transpose().eval();
     double sw = 0.0;
     Vec<Dim> sv = Vec<Dim>::Zero();
-    Mat3 ss = Mat3::Zero();
     for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
       const std::uint32_t j = idx[k];
       if (kind[j] != kSoil) continue;
-      const Vec<Dim> xij = displacement(x[i], x[j]);
-      const double r2 = xij.squaredNorm();
+      const double r2 = displacement(x[i], x[j]).squaredNorm();
       if (r2 >= cutoff2) continue;
       const double w = Kernel::value(std::sqrt(r2), h);
       sw += w;
       sv += w * v[j];
-      const double rd = rho[j] * xij.dot(nu);
-      Mat3 sj = sig[j];
-      sj.diagonal().array() -= rd * g_n;
-      sj.template topLeftCorner<Dim, Dim>() -= rd * shear_dir;
-      ss += w * sj;
     }
     if (sw <= 0.0) {
       vI[i] = v[i];
-      sig[i].setZero();
-      continue;
-    }
-    sv /= sw;
-    ss /= sw;
-    if (kind[i] == kRoller) {
-      // Free slip: mirror the normal component of the relative velocity and the shear stress.
+    } else if (kind[i] == kRoller) {
+      sv /= sw;
       const Vec<Dim>& nn = nrm[i];
       vI[i] = sv - 2.0 * (sv - v[i]).dot(nn) * nn;
-      Mat3 M = Mat3::Identity();
-      M.template topLeftCorner<Dim, Dim>() -= 2.0 * nn * nn.transpose();
-      sig[i] = M * ss * M;
     } else {
-      vI[i] = 2.0 * v[i] - sv;  // no slip
-      sig[i] = ss;
+      vI[i] = 2.0 * v[i] - sv / sw;
     }
     rsum[i] = rho[i];
   }
 
-  // 2. Velocity gradient, continuity, summation density, XSPH (soil particles).
+  // 2. Velocity gradient, continuity, summation density, XSPH (soil particles):
+  //    L_i = Σ_j V_j (v_j − v_i) ⊗ ∇W_ij, dρ_i/dt = −Σ_j m_j (v_j − v_i)·∇W_ij,
+  //    ρ̃_i = Σ_j m_j W_ij, ξ_i = Σ_j V_j W_ij (v_j − v_i), v_j the ghost velocity of a boundary j.
+  //    As in step 4, each soil–soil pair is evaluated once; j's share (V_i dv ⊗ ∇W_ij,
+  //    −m_i dv·∇W_ij, m_i W_ij, −V_i W_ij dv with dv = v_j − v_i) goes to a per-thread buffer.
   const double w_self = Kernel::value(0.0, h);
-#pragma omp parallel for schedule(static)
-  for (std::int64_t ii = 0; ii < n; ++ii) {
-    const auto i = static_cast<std::size_t>(ii);
-    if (kind[i] != kSoil) continue;
-    Mat<Dim> Li = Mat<Dim>::Zero();
-    Vec<Dim> xi_sum = Vec<Dim>::Zero();
-    double dr = 0.0, rs = m[i] * w_self;
-    const Vec<Dim> vi = v[i];
-    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
-      const std::uint32_t j = idx[k];
-      const Vec<Dim> xij = displacement(x[i], x[j]);
-      const double r2 = xij.squaredNorm();
-      if (r2 >= cutoff2) continue;
-      const double r = std::sqrt(r2);
-      const double q = r * inv_h;
-      const Vec<Dim> gw = xij * (r > 0.0 ? sigma_h * Kernel::shape_derivative(q) / r : 0.0);
-      const double Vj = m[j] / rho[j];
-      const Vec<Dim> dv = vI[j] - vi;
-      Li.noalias() += (Vj * dv) * gw.transpose();
-      dr -= m[j] * dv.dot(gw);
-      const double w = sigma * Kernel::shape(q);
-      rs += m[j] * w;
-      xi_sum += (Vj * w) * dv;
+  const std::size_t nn = static_cast<std::size_t>(n);
+  pair_grad_.resize(static_cast<std::size_t>(omp_get_max_threads()) * nn);
+#pragma omp parallel
+  {
+    const int nthreads = omp_get_num_threads();
+    GradientReaction* mine = pair_grad_.data() + static_cast<std::size_t>(omp_get_thread_num()) * nn;
+    std::fill(mine, mine + nn, GradientReaction{Mat<Dim>::Zero(), Vec<Dim>::Zero(), 0.0, 0.0});
+#pragma omp for schedule(static)
+    for (std::int64_t ii = 0; ii < n; ++ii) {
+      const auto i = static_cast<std::size_t>(ii);
+      if (kind[i] != kSoil) continue;
+      Mat<Dim> Li = Mat<Dim>::Zero();
+      Vec<Dim> xi_sum = Vec<Dim>::Zero();
+      double dr = 0.0, rs = m[i] * w_self;
+      const Vec<Dim> vi = v[i];
+      const double Vi = vol[i], mi = m[i];
+      for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+        const std::uint32_t j = idx[k];
+        const bool soil_j = kind[j] == kSoil;
+        if (soil_j && j < i) continue;  // evaluated from j's side
+        const Vec<Dim> xij = displacement(x[i], x[j]);
+        const double r2 = xij.squaredNorm();
+        if (r2 >= cutoff2) continue;
+        const double r = std::sqrt(r2);
+        const double q = r * inv_h;
+        const Vec<Dim> gw = xij * (r > 0.0 ? sigma_h * Kernel::shape_derivative(q) / r : 0.0);
+        const double w = sigma * Kernel::shape(q);
+        const Vec<Dim> dv = vI[j] - vi;
+        const Mat<Dim> dvg = dv * gw.transpose();
+        const double dvgw = dv.dot(gw);
+        const double Vj = vol[j];
+        Li.noalias() += Vj * dvg;
+        dr -= m[j] * dvgw;
+        rs += m[j] * w;
+        xi_sum += (Vj * w) * dv;
+        if (soil_j) {
+          GradientReaction& g = mine[j];
+          g.L.noalias() += Vi * dvg;
+          g.drho -= mi * dvgw;
+          g.rsum += mi * w;
+          g.xs -= (Vi * w) * dv;
+        }
+      }
+      L[i] = Li;
+      drho[i] = dr;
+      rsum[i] = rs;
+      xs[i] = xi_sum;
     }
-    L[i] = Li;
-    drho[i] = dr;
-    rsum[i] = rs;
-    xs[i] = xi_sum;
+#pragma omp for schedule(static)
+    for (std::int64_t ii = 0; ii < n; ++ii) {
+      const auto i = static_cast<std::size_t>(ii);
+      if (kind[i] != kSoil) continue;
+      for (int t = 0; t < nthreads; ++t) {
+        const GradientReaction& g = pair_grad_[static_cast<std::size_t>(t) * nn + i];
+        L[i] += g.L;
+        drho[i] += g.drho;
+        rsum[i] += g.rsum;
+        xs[i] += g.xs;
+      }
+    }
   }
 
   // 3. Density, stress (constitutive model), stress vanishing, artificial stress.
@@ -290,19 +299,20 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
     has_as[i] = 0;
+    vol[i] = m[i] / rho[i];
     if (kind[i] != kSoil) {
       R[i].setZero();
-      sr2[i] = sig[i].template topLeftCorner<Dim, Dim>() / (rho[i] * rho[i]);
       continue;
     }
     const MaterialParams& p = mats[mat[i]];
     // Continuity, floored at the model's parting density (constitutive.hpp, `min_density`).
     rho[i] = std::max(rho[i] + dt * drho[i], Model::min_density(p));
+    vol[i] = m[i] / rho[i];
     if (sf_frac > 0.0 && rsum[i] < sf_frac * p.density) {
       sfree[i] = 1;
       sig[i].setZero();
       R[i].setZero();
-      sr2[i].setZero();
+      ps[i].setZero();
       continue;
     }
     sfree[i] = 0;
@@ -314,11 +324,69 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
       R[i] = artificial_stress<Dim>(s2, eps_as, rho[i]);
       has_as[i] = R[i].squaredNorm() > 0.0;
     }
-    sr2[i] = sig[i].template topLeftCorner<Dim, Dim>() / (rho[i] * rho[i]);
+    ps[i] = sig[i].template topLeftCorner<Dim, Dim>();
   }
   stats_.plastic_increment = plastic_sum;
 
-  // 4. Momentum (seed 002 eq. 12) with artificial viscosity and artificial stress.
+  // 3b. Boundary particles: stress from the soil neighbours' updated stress (Bui et al. 2008),
+  // extrapolated so that the wall carries the stress gradient equilibrium demands,
+  // ∂σ_ik/∂x_k = −ρ ḡ_i, assuming the stress varies only along the layering normal ν (a layered
+  // deposit: flat ground, an infinite slope). With d = (x_i − x_j)·ν, ḡ_n = ḡ·ν and ḡ_t = ḡ − ḡ_n ν:
+  //   σ_i ← σ_j − ρ_j d [ḡ_n I + ḡ_t ⊗ ν + ν ⊗ ḡ_t],
+  // whose traction on the layering plane changes by −ρ_j ḡ d (normal and shear); the in-plane
+  // normal components take the isotropic part. Under flat ground (ν vertical) and vertical gravity
+  // this is the hydrostatic extrapolation of Adami et al. (2012); on a slope or under horizontal
+  // shaking it also supplies the shear the base must carry — without it, the soil next to an
+  // inclined wall misses the shear-stress gradient ρ g sin θ and creeps along the wall. Free slip
+  // mirrors the shear stress through the wall. The soil stress used is this step's (σⁿ⁺¹, the one
+  // the momentum sum uses): taking the previous step's lags the wall one step behind the soil, and
+  // that lag feeds a high-frequency oscillation next to the wall that grows at any Δt
+  // (docs/sph.md, "Boundary stress").
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    if (kind[i] == kSoil) continue;
+    Vec<Dim> nu = lnrm[i];
+    if (nu.squaredNorm() == 0.0) nu = Vec<Dim>::Unit(Dim - 1);  // snapshots written before the field existed
+    const double g_n = gbar.dot(nu);
+    const Vec<Dim> g_t = gbar - g_n * nu;
+    Mat<Dim> shear_dir = g_t * nu.transpose();
+    shear_dir += shear_dir.transpose().eval();
+    double sw = 0.0;
+    Mat3 ss = Mat3::Zero();
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+      const std::uint32_t j = idx[k];
+      if (kind[j] != kSoil) continue;
+      const Vec<Dim> xij = displacement(x[i], x[j]);
+      const double r2 = xij.squaredNorm();
+      if (r2 >= cutoff2) continue;
+      const double w = Kernel::value(std::sqrt(r2), h);
+      sw += w;
+      const double rd = rho[j] * xij.dot(nu);
+      Mat3 sj = sig[j];
+      sj.diagonal().array() -= rd * g_n;
+      sj.template topLeftCorner<Dim, Dim>() -= rd * shear_dir;
+      ss += w * sj;
+    }
+    if (sw <= 0.0) {
+      sig[i].setZero();
+    } else if (kind[i] == kRoller) {
+      const Vec<Dim>& nn = nrm[i];
+      Mat3 M = Mat3::Identity();
+      M.template topLeftCorner<Dim, Dim>() -= 2.0 * nn * nn.transpose();
+      sig[i] = M * (ss / sw) * M;
+    } else {
+      sig[i] = ss / sw;
+    }
+    ps[i] = sig[i].template topLeftCorner<Dim, Dim>();
+  }
+
+  // 4. Momentum: a_i = Σ_j m_j [(σ_i + σ_j)/(ρ_i ρ_j) − Π_ij I + f_ij^n (R_i + R_j)] ∇W_ij + ḡ
+  //    (seed 002 eq. 12 with the stress pair in the form that pairs with the velocity gradient of
+  //    step 2, L_i = Σ_j V_j (v_j − v_i) ⊗ ∇W_ij: together they conserve energy also where the
+  //    density jumps between materials; the seed's σ_i/ρ_i² + σ_j/ρ_j² does not, and a layered
+  //    slope then oscillates at its interfaces, docs/sph.md). Summed as a force density
+  //    f_i = Σ_j V_j [σ_i + σ_j + ρ_i ρ_j (f^n (R_i + R_j) − Π_ij I)] ∇W_ij, a_i = f_i/ρ_i.
   const double w_dx = Kernel::value(settings_.spacing, h);
   const double n_as = settings_.artificial_stress_n > 0.0 ? settings_.artificial_stress_n : w_self / w_dx;
   const double alpha = settings_.viscosity_alpha, beta = settings_.viscosity_beta;
@@ -326,10 +394,9 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
   const double r_rep = settings_.wall_repulsion * settings_.spacing;
   const bool fluid = fluid_;
   // Each soil–soil pair is evaluated once, by the particle of lower index: the pair term is
-  // symmetric (T_ij = T_ji, ∇W_ji = −∇W_ij), so j receives −m_i T ∇W_ij. Those reactions go to a
+  // symmetric (T_ij = T_ji, ∇W_ji = −∇W_ij), so j receives −V_i T ∇W_ij. Those reactions go to a
   // per-thread buffer (no two threads write the same slot) summed after the pass; soil–boundary
   // pairs act on the soil particle only.
-  const std::size_t nn = static_cast<std::size_t>(n);
   pair_acc_.resize(static_cast<std::size_t>(omp_get_max_threads()) * nn);
 #pragma omp parallel
   {
@@ -340,12 +407,12 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
       if (kind[i] != kSoil) continue;
-      const Mat<Dim> si = sr2[i];
+      const Mat<Dim> si = ps[i];
       const Mat<Dim> Ri = R[i];
       const bool has_Ri = has_as[i];
       const MaterialParams& pi = mats[mat[i]];
       const double ci = fluid ? std::sqrt(pi.bulk / pi.density) : pi.p_wave_speed;
-      const double mi = m[i];
+      const double Vi = vol[i], rhoi = rho[i];
       Vec<Dim> ai = Vec<Dim>::Zero();
       for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
         const std::uint32_t j = idx[k];
@@ -357,31 +424,32 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
         const double r = std::sqrt(r2);
         const double q = r * inv_h;
         const Vec<Dim> gw = xij * (r > 0.0 ? sigma_h * Kernel::shape_derivative(q) / r : 0.0);
-        Mat<Dim> T = si + sr2[j];
+        Mat<Dim> T = si + ps[j];
         const Vec<Dim> vij = v[i] - vI[j];
         const double vr = vij.dot(xij);
         if (vr < 0.0 && alpha + beta > 0.0) {
           const MaterialParams& pj = mats[mat[j]];
           const double cj = fluid ? std::sqrt(pj.bulk / pj.density) : pj.p_wave_speed;
           const double mu = h * vr / (r * r + eta2);
-          const double Pi = (-alpha * 0.5 * (ci + cj) * mu + beta * mu * mu) / (0.5 * (rho[i] + rho[j]));
+          // ρ_i ρ_j Π_ij with Π_ij = (−α c̄ μ + β μ²)/ρ̄.
+          const double Pi = (-alpha * 0.5 * (ci + cj) * mu + beta * mu * mu) * (rhoi * rho[j]) / (0.5 * (rhoi + rho[j]));
           T.diagonal().array() -= Pi;
         }
         if (has_Ri || has_as[j]) {
           const double f = sigma * Kernel::shape(q) / w_dx;
-          T += std::pow(f, n_as) * (Ri + R[j]);
+          T += (std::pow(f, n_as) * rhoi * rho[j]) * (Ri + R[j]);
         }
         const Vec<Dim> Tg = T * gw;
-        ai.noalias() += m[j] * Tg;
+        ai.noalias() += vol[j] * Tg;
         if (soil_j) {
-          mine[j].noalias() -= mi * Tg;
+          mine[j].noalias() -= Vi * Tg;
         } else if (r < r_rep) {
           // Last-resort wall repulsion (Monaghan 1994 form, exponents 4 and 2): only a soil
           // particle closer than r0 = wall_repulsion·Δx to a boundary particle feels it — nothing
           // in a normal configuration (spacing ≈ Δx) — and it stops particles from being squeezed
           // through walls.
           const double q2 = (r_rep * r_rep) / r2;
-          ai.noalias() += (ci * ci * (q2 * q2 - q2) / r2) * xij;
+          ai.noalias() += (rhoi * ci * ci * (q2 * q2 - q2) / r2) * xij;
         }
       }
       acc[i] = ai;
@@ -392,7 +460,7 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
       if (kind[i] != kSoil) continue;
       Vec<Dim> a = acc[i];
       for (int t = 0; t < nthreads; ++t) a += pair_acc_[static_cast<std::size_t>(t) * nn + i];
-      acc[i] = a;
+      acc[i] = a / rho[i];
     }
   }
 

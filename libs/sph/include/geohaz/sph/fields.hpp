@@ -125,12 +125,19 @@ struct ArtificialStress {
   static constexpr const char* unit = "m^2/s^2";
 };
 
-/// In-plane stress divided by ρ² (scratch for the momentum sum), m²/s².
+/// In-plane stress for the momentum sum (scratch: the soil's after its update, the boundary's
+/// extrapolated from it), Pa.
 template <int Dim>
-struct StressOverDensitySquared {
+struct PairStress {
   using type = Mat<Dim>;
-  static constexpr const char* label = "stress_over_density_squared";
-  static constexpr const char* unit = "m^2/s^2";
+  static constexpr const char* label = "pair_stress";
+  static constexpr const char* unit = "Pa";
+};
+/// Particle volume m/ρ for the pair sums (scratch), m³ (m² in 2D, per unit thickness).
+struct Volume {
+  using type = double;
+  static constexpr const char* label = "volume";
+  static constexpr const char* unit = "m^3";
 };
 /// Position when the neighbour list was last built (Verlet skin bookkeeping), m.
 template <int Dim>
@@ -147,6 +154,6 @@ using SphStore =
                   Density, DensityRate, Mass, MaterialId, ParticleKind, WallNormal<Dim>, LayerNormal<Dim>,
                   PlasticStrain, StressFree,
                   SummationDensity, InteractionVelocity<Dim>, XsphCorrection<Dim>, ArtificialStress<Dim>,
-                  StressOverDensitySquared<Dim>, PositionAtBuild<Dim>, ParticleId>;
+                  PairStress<Dim>, Volume, PositionAtBuild<Dim>, ParticleId>;
 
 }  // namespace geohaz::sph

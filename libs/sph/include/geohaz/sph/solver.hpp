@@ -150,8 +150,16 @@ class SphSolver {
   // Scratch, rewritten every step (not particle state): 1 where the artificial stress R_i ≠ 0, so
   // the momentum pass need not read a neighbour's R (as big as its stress) to find it is zero.
   std::vector<std::uint8_t> has_as_;
-  // Scratch of the momentum pass: per-thread reactions m_i T ∇W of the soil–soil pairs (threads × n).
+  // Scratch of the momentum pass: per-thread reactions V_i T ∇W of the soil–soil pairs (threads × n).
   std::vector<Vec<Dim>> pair_acc_;
+  // Scratch of the velocity-gradient pass: per-thread reactions of the soil–soil pairs (threads × n).
+  struct GradientReaction {
+    Mat<Dim> L;    // Σ V_i (v_i − v_j) ⊗ ∇W_ji
+    Vec<Dim> xs;   // XSPH sum
+    double drho;   // continuity
+    double rsum;   // summation density
+  };
+  std::vector<GradientReaction> pair_grad_;
   std::int64_t last_reorder_ = -1000000;
   std::int64_t builds_ = 0;
   bool fluid_ = false;
