@@ -150,7 +150,6 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
   double* eps_p = S.template get<PlasticStrain>().data();
   std::uint8_t* sfree = S.template get<StressFree>().data();
   double* rsum = S.template get<SummationDensity>().data();
-  Vec<Dim>* vI = S.template get<InteractionVelocity<Dim>>().data();
   Vec<Dim>* xs = S.template get<XsphCorrection<Dim>>().data();
   Mat<Dim>* R = S.template get<ArtificialStress<Dim>>().data();
   Mat<Dim>* ps = S.template get<PairStress<Dim>>().data();
@@ -187,43 +186,62 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
   constexpr std::uint8_t kSoil = static_cast<std::uint8_t>(Kind::Soil);
   constexpr std::uint8_t kRoller = static_cast<std::uint8_t>(Kind::RollerWall);
 
-  // 1. Boundary particles: ghost velocity from the soil neighbours (Bui et al. 2008): no slip
-  //    mirrors the Shepard-averaged soil velocity through the wall's, free slip only its normal
-  //    component. Their stress is set after the soil's update (step 3b).
+  // 1. Particle volumes for the pair sums; boundary particles: the extrapolation matrix of their
+  //    stress (below) in the pair-stress slot.
+  //
+  // Boundary particles (Bui et al. 2008) act on each soil particle i as its mirror image: in the
+  // pair (i, b) the wall particle b takes
+  //   velocity  2 v_b − v_i (no slip: zero relative velocity halfway between i and b), or
+  //             v_i − 2 ((v_i − v_b)·n) n (free slip: only the normal component mirrored);
+  //   stress    σ_b = σ_i − ρ_i d [ḡ_n I + ḡ_t ⊗ ν + ν ⊗ ḡ_t], d = (x_b − x_i)·ν,
+  //             shear mirrored through the wall (M σ_b M, M = I − 2nn) for free slip.
+  // The stress extrapolation lets the wall carry the stress gradient equilibrium demands,
+  // ∂σ_ik/∂x_k = −ρ ḡ_i, assuming the stress varies only along the layering normal ν (flat
+  // ground, an infinite slope): its traction on the layering plane changes by −ρ_i ḡ d (normal and
+  // shear), the in-plane normal components take the isotropic part. On flat ground under gravity
+  // this is the hydrostatic term of Adami et al. (2012); on a slope or under horizontal shaking it
+  // also supplies the shear the base must carry.
+  // Why per pair and not a Shepard average over the wall particle's soil neighbours (Adami's
+  // form, used before 2026-11-22): the average couples a soil particle to every soil particle
+  // within 2h of the wall, one-way (no reaction), and with a stiffness or density contrast within
+  // that distance — a thin stiff base under a soft cover, or any layering near an inclined wall —
+  // the coupling made an oscillation grow until the soil failed, at any Δt. The mirror pair is
+  // local and, with the pair forms of steps 2 and 4, conserves energy (docs/sph.md, "Boundary
+  // particles").
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
-    vol[i] = m[i] / rho[i];  // for the pair sums of step 2
-    if (kind[i] == kSoil) {
-      vI[i] = v[i];
-      continue;
-    }
-    double sw = 0.0;
-    Vec<Dim> sv = Vec<Dim>::Zero();
-    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
-      const std::uint32_t j = idx[k];
-      if (kind[j] != kSoil) continue;
-      const double r2 = displacement(x[i], x[j]).squaredNorm();
-      if (r2 >= cutoff2) continue;
-      const double w = Kernel::value(std::sqrt(r2), h);
-      sw += w;
-      sv += w * v[j];
-    }
-    if (sw <= 0.0) {
-      vI[i] = v[i];
-    } else if (kind[i] == kRoller) {
-      sv /= sw;
-      const Vec<Dim>& nn = nrm[i];
-      vI[i] = sv - 2.0 * (sv - v[i]).dot(nn) * nn;
-    } else {
-      vI[i] = 2.0 * v[i] - sv / sw;
-    }
+    vol[i] = m[i] / rho[i];
+    if (kind[i] == kSoil) continue;
+    Vec<Dim> nu = lnrm[i];
+    if (nu.squaredNorm() == 0.0) nu = Vec<Dim>::Unit(Dim - 1);  // snapshots written before the field existed
+    const double g_n = gbar.dot(nu);
+    const Vec<Dim> g_t = gbar - g_n * nu;
+    Mat<Dim> G = g_t * nu.transpose();
+    G += G.transpose().eval();
+    G.diagonal().array() += g_n;
+    ps[i] = G;
     rsum[i] = rho[i];
   }
+  // The boundary partner of soil particle i in a pair: velocity and stress as above.
+  auto wall_velocity = [&](std::size_t i, std::size_t b) -> Vec<Dim> {
+    if (kind[b] == kRoller) return v[i] - 2.0 * (v[i] - v[b]).dot(nrm[b]) * nrm[b];
+    return 2.0 * v[b] - v[i];
+  };
+  auto wall_stress = [&](const Mat<Dim>& si, double rhoi, std::size_t b, const Vec<Dim>& xib) -> Mat<Dim> {
+    Vec<Dim> nu = lnrm[b];
+    if (nu.squaredNorm() == 0.0) nu = Vec<Dim>::Unit(Dim - 1);
+    Mat<Dim> sb = si + (rhoi * xib.dot(nu)) * ps[b];  // d = (x_b − x_i)·ν = −x_ib·ν
+    if (kind[b] == kRoller) {
+      const Mat<Dim> M = Mat<Dim>::Identity() - 2.0 * nrm[b] * nrm[b].transpose();
+      sb = M * sb * M;
+    }
+    return sb;
+  };
 
   // 2. Velocity gradient, continuity, summation density, XSPH (soil particles):
   //    L_i = Σ_j V_j (v_j − v_i) ⊗ ∇W_ij, dρ_i/dt = −Σ_j m_j (v_j − v_i)·∇W_ij,
-  //    ρ̃_i = Σ_j m_j W_ij, ξ_i = Σ_j V_j W_ij (v_j − v_i), v_j the ghost velocity of a boundary j.
+  //    ρ̃_i = Σ_j m_j W_ij, ξ_i = Σ_j V_j W_ij (v_j − v_i), v_j the mirror velocity of a boundary j.
   //    As in step 4, each soil–soil pair is evaluated once; j's share (V_i dv ⊗ ∇W_ij,
   //    −m_i dv·∇W_ij, m_i W_ij, −V_i W_ij dv with dv = v_j − v_i) goes to a per-thread buffer.
   const double w_self = Kernel::value(0.0, h);
@@ -254,7 +272,7 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
         const double q = r * inv_h;
         const Vec<Dim> gw = xij * (r > 0.0 ? sigma_h * Kernel::shape_derivative(q) / r : 0.0);
         const double w = sigma * Kernel::shape(q);
-        const Vec<Dim> dv = vI[j] - vi;
+        const Vec<Dim> dv = (soil_j ? v[j] : wall_velocity(i, j)) - vi;
         const Mat<Dim> dvg = dv * gw.transpose();
         const double dvgw = dv.dot(gw);
         const double Vj = vol[j];
@@ -299,7 +317,6 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
     has_as[i] = 0;
-    vol[i] = m[i] / rho[i];
     if (kind[i] != kSoil) {
       R[i].setZero();
       continue;
@@ -327,59 +344,6 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
     ps[i] = sig[i].template topLeftCorner<Dim, Dim>();
   }
   stats_.plastic_increment = plastic_sum;
-
-  // 3b. Boundary particles: stress from the soil neighbours' updated stress (Bui et al. 2008),
-  // extrapolated so that the wall carries the stress gradient equilibrium demands,
-  // ∂σ_ik/∂x_k = −ρ ḡ_i, assuming the stress varies only along the layering normal ν (a layered
-  // deposit: flat ground, an infinite slope). With d = (x_i − x_j)·ν, ḡ_n = ḡ·ν and ḡ_t = ḡ − ḡ_n ν:
-  //   σ_i ← σ_j − ρ_j d [ḡ_n I + ḡ_t ⊗ ν + ν ⊗ ḡ_t],
-  // whose traction on the layering plane changes by −ρ_j ḡ d (normal and shear); the in-plane
-  // normal components take the isotropic part. Under flat ground (ν vertical) and vertical gravity
-  // this is the hydrostatic extrapolation of Adami et al. (2012); on a slope or under horizontal
-  // shaking it also supplies the shear the base must carry — without it, the soil next to an
-  // inclined wall misses the shear-stress gradient ρ g sin θ and creeps along the wall. Free slip
-  // mirrors the shear stress through the wall. The soil stress used is this step's (σⁿ⁺¹, the one
-  // the momentum sum uses): taking the previous step's lags the wall one step behind the soil, and
-  // that lag feeds a high-frequency oscillation next to the wall that grows at any Δt
-  // (docs/sph.md, "Boundary stress").
-#pragma omp parallel for schedule(static)
-  for (std::int64_t ii = 0; ii < n; ++ii) {
-    const auto i = static_cast<std::size_t>(ii);
-    if (kind[i] == kSoil) continue;
-    Vec<Dim> nu = lnrm[i];
-    if (nu.squaredNorm() == 0.0) nu = Vec<Dim>::Unit(Dim - 1);  // snapshots written before the field existed
-    const double g_n = gbar.dot(nu);
-    const Vec<Dim> g_t = gbar - g_n * nu;
-    Mat<Dim> shear_dir = g_t * nu.transpose();
-    shear_dir += shear_dir.transpose().eval();
-    double sw = 0.0;
-    Mat3 ss = Mat3::Zero();
-    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
-      const std::uint32_t j = idx[k];
-      if (kind[j] != kSoil) continue;
-      const Vec<Dim> xij = displacement(x[i], x[j]);
-      const double r2 = xij.squaredNorm();
-      if (r2 >= cutoff2) continue;
-      const double w = Kernel::value(std::sqrt(r2), h);
-      sw += w;
-      const double rd = rho[j] * xij.dot(nu);
-      Mat3 sj = sig[j];
-      sj.diagonal().array() -= rd * g_n;
-      sj.template topLeftCorner<Dim, Dim>() -= rd * shear_dir;
-      ss += w * sj;
-    }
-    if (sw <= 0.0) {
-      sig[i].setZero();
-    } else if (kind[i] == kRoller) {
-      const Vec<Dim>& nn = nrm[i];
-      Mat3 M = Mat3::Identity();
-      M.template topLeftCorner<Dim, Dim>() -= 2.0 * nn * nn.transpose();
-      sig[i] = M * (ss / sw) * M;
-    } else {
-      sig[i] = ss / sw;
-    }
-    ps[i] = sig[i].template topLeftCorner<Dim, Dim>();
-  }
 
   // 4. Momentum: a_i = Σ_j m_j [(σ_i + σ_j)/(ρ_i ρ_j) − Π_ij I + f_ij^n (R_i + R_j)] ∇W_ij + ḡ
   //    (seed 002 eq. 12 with the stress pair in the form that pairs with the velocity gradient of
@@ -424,8 +388,8 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
         const double r = std::sqrt(r2);
         const double q = r * inv_h;
         const Vec<Dim> gw = xij * (r > 0.0 ? sigma_h * Kernel::shape_derivative(q) / r : 0.0);
-        Mat<Dim> T = si + ps[j];
-        const Vec<Dim> vij = v[i] - vI[j];
+        Mat<Dim> T = si + (soil_j ? ps[j] : wall_stress(si, rhoi, j, xij));
+        const Vec<Dim> vij = v[i] - (soil_j ? v[j] : wall_velocity(i, j));
         const double vr = vij.dot(xij);
         if (vr < 0.0 && alpha + beta > 0.0) {
           const MaterialParams& pj = mats[mat[j]];

@@ -76,8 +76,8 @@ struct WallNormal {
   static constexpr const char* unit = "1";
 };
 /// Unit normal of the soil layering next to a fixed boundary particle (zero for soil). The stress a
-/// boundary particle carries is extrapolated from its soil neighbours assuming it varies along this
-/// direction only, as in a layered deposit: vertical for walls under flat-lying soil, the smoothed
+/// boundary particle carries in a pair is extrapolated from the soil particle assuming it varies
+/// along this direction only, as in a layered deposit: vertical for walls under flat-lying soil, the smoothed
 /// surface normal for bedrock under a DSM-section cover (see solver.cpp, step 1).
 template <int Dim>
 struct LayerNormal {
@@ -103,13 +103,6 @@ struct SummationDensity {
   static constexpr const char* label = "summation_density";
   static constexpr const char* unit = "kg/m^3";
 };
-/// Velocity seen by neighbours: soil = own velocity; boundary = extrapolated ghost velocity, m/s.
-template <int Dim>
-struct InteractionVelocity {
-  using type = Vec<Dim>;
-  static constexpr const char* label = "interaction_velocity";
-  static constexpr const char* unit = "m/s";
-};
 /// XSPH velocity correction Σ (m_j/ρ_j)(v_j − v_i) W_ij (scratch), m/s.
 template <int Dim>
 struct XsphCorrection {
@@ -125,13 +118,13 @@ struct ArtificialStress {
   static constexpr const char* unit = "m^2/s^2";
 };
 
-/// In-plane stress for the momentum sum (scratch: the soil's after its update, the boundary's
-/// extrapolated from it), Pa.
+/// Scratch for the pair sums: a soil particle's in-plane stress after its update (Pa); a boundary
+/// particle's stress-extrapolation matrix ḡ_n I + ḡ_t ⊗ ν + ν ⊗ ḡ_t (m/s², solver.cpp step 1).
 template <int Dim>
 struct PairStress {
   using type = Mat<Dim>;
   static constexpr const char* label = "pair_stress";
-  static constexpr const char* unit = "Pa";
+  static constexpr const char* unit = "Pa (soil), m/s^2 (boundary)";
 };
 /// Particle volume m/ρ for the pair sums (scratch), m³ (m² in 2D, per unit thickness).
 struct Volume {
@@ -153,7 +146,7 @@ using SphStore =
     ParticleStore<Position<Dim>, Velocity<Dim>, Acceleration<Dim>, Displacement<Dim>, Stress, VelocityGradient<Dim>,
                   Density, DensityRate, Mass, MaterialId, ParticleKind, WallNormal<Dim>, LayerNormal<Dim>,
                   PlasticStrain, StressFree,
-                  SummationDensity, InteractionVelocity<Dim>, XsphCorrection<Dim>, ArtificialStress<Dim>,
+                  SummationDensity, XsphCorrection<Dim>, ArtificialStress<Dim>,
                   PairStress<Dim>, Volume, PositionAtBuild<Dim>, ParticleId>;
 
 }  // namespace geohaz::sph
