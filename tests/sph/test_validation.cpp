@@ -157,21 +157,29 @@ TEST(Validation, Seed001LayeredSlopes) {
   EXPECT_GT(r[1], r[2]);
 }
 
-// Seed 001 upper cut (50 mm at 2H:1V): run-out reduced (seed: 6–8 %).
+// Seed 001 upper cut (50 mm at 2H:1V): run-out reduced (seed: 6–8 %). The cut removes 0.6 % of the
+// soil; at Δx = 10 mm its effect on the front is below one front bin (no reduction measured), so
+// both runs use Δx = 5 mm (7,400 particles, ~6 min each on one thread).
 TEST(Validation, Seed001UpperCut) {
-  auto base = run_case("seed001_nocut", "slope_2d_granular.toml", "--set run.end_time=3 --set run.stop_at_rest=false");
-  auto cut = run_case("seed001_cut", "slope_upper_cut.toml", "--set run.end_time=3 --set run.stop_at_rest=false");
+  const std::string sets = "--set run.end_time=3 --set run.stop_at_rest=false --set numerics.spacing=0.005";
+  auto base = run_case("seed001_nocut_5mm", "slope_2d_granular.toml", sets);
+  auto cut = run_case("seed001_cut_5mm", "slope_upper_cut.toml", sets);
   const double b = base.value("normalised_runout", 0.0), c = cut.value("normalised_runout", 0.0);
-  std::printf("seed 001 upper cut: run-out %.3f -> %.3f (%.1f %% reduction; seed 6-8 %%)\n", b, c, 100 * (b - c) / b);
-  EXPECT_LT(c, b);
-  copy_figure("seed001_cut", "final_displacement.png", "seed001_upper_cut_final.png");
+  const double reduction = (b - c) / b;
+  std::printf("seed 001 upper cut (dx = 5 mm): run-out %.3f -> %.3f (%.1f %% reduction; seed 6-8 %%)\n", b, c,
+              100 * reduction);
+  EXPECT_GT(reduction, 0.03);  // a clear effect: the front moves by several 5 mm bins
+  copy_figure("seed001_cut_5mm", "final_displacement.png", "seed001_upper_cut_final.png");
 }
 
-// Seed 001 piles (3D, coarse): a row at mid-slope reduces run-out more than a row at the top.
+// Seed 001 piles (3D at the seed's Δx = 10 mm: 37,080 soil particles, ~30 min per case on one
+// thread; the config's 20 mm default cannot tell the middle row from the upper one): a row at
+// mid-slope reduces run-out more than a row at the top.
 TEST(Validation, Seed001Piles) {
-  auto none = run_case("seed001_piles_none", "slope_piles_3d.toml", "--set piles.enabled=false");
-  auto mid = run_case("seed001_piles_middle", "slope_piles_3d.toml", "--set piles.position=middle");
-  auto top = run_case("seed001_piles_upper", "slope_piles_3d.toml", "--set piles.position=upper");
+  const std::string dx = " --set numerics.spacing=0.01";
+  auto none = run_case("seed001_piles_none", "slope_piles_3d.toml", "--set piles.enabled=false" + dx);
+  auto mid = run_case("seed001_piles_middle", "slope_piles_3d.toml", "--set piles.position=middle" + dx);
+  auto top = run_case("seed001_piles_upper", "slope_piles_3d.toml", "--set piles.position=upper" + dx);
   const double n = none.value("normalised_runout", 0.0), m = mid.value("normalised_runout", 0.0),
                u = top.value("normalised_runout", 0.0);
   std::printf("seed 001 piles (3D): none %.3f, middle %.3f, upper %.3f\n", n, m, u);
@@ -257,17 +265,22 @@ TEST(Validation, Figures) {
     }
     plot(kFigures / "column_runout_vs_aspect_ratio.png", {law, law2, model}, 0.0, 3.5, 0.0, 7.0, 0.5, 1.0);
   }
-  // Seed 001: normalised run-out vs time, granular (blue), cohesive (red), upper cut (green).
-  {
+  // Seed 001: normalised run-out vs time, granular (blue) and cohesive (red) at Δx = 10 mm; the
+  // upper cut at Δx = 5 mm, without (blue) and with the cut (green).
+  for (const auto& [file, runs] :
+       {std::pair{"seed001_runout_vs_time.png",
+                  std::vector<std::pair<const char*, std::array<std::uint8_t, 3>>>{{"seed001_granular", {30, 90, 200}},
+                                                                                   {"seed001_cohesive", {200, 40, 40}}}},
+        std::pair{"seed001_upper_cut_runout_vs_time.png",
+                  std::vector<std::pair<const char*, std::array<std::uint8_t, 3>>>{
+                      {"seed001_nocut_5mm", {30, 90, 200}}, {"seed001_cut_5mm", {40, 160, 60}}}}}) {
     std::vector<Curve> cs;
-    const std::pair<const char*, std::array<std::uint8_t, 3>> runs[] = {
-        {"seed001_granular", {30, 90, 200}}, {"seed001_cohesive", {200, 40, 40}}, {"seed001_cut", {40, 160, 60}}};
     for (const auto& [name, col] : runs) {
       const auto f = kWork / name / "series.csv";
       if (!fs::exists(f)) continue;
       cs.push_back({csv_column(f, 0), csv_column(f, 4), col, false});
     }
-    plot(kFigures / "seed001_runout_vs_time.png", cs, 0.0, 3.0, 0.0, 0.8, 0.5, 0.1);
+    plot(kFigures / file, cs, 0.0, 3.0, 0.0, 0.8, 0.5, 0.1);
   }
   // Seed 002 Masa: max displacement (blue) and run-out (green) vs time, input acceleration/10 (grey).
   {
