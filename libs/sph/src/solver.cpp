@@ -207,7 +207,7 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
   // that distance — a thin stiff base under a soft cover, or any layering near an inclined wall —
   // the coupling made an oscillation grow until the soil failed, at any Δt. The mirror pair is
   // local and, with the pair forms of steps 2 and 4, conserves energy (docs/sph.md, "Boundary
-  // particles").
+  // particles and material interfaces").
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
