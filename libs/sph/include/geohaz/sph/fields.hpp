@@ -16,10 +16,10 @@
 namespace geohaz::sph {
 
 /// What a particle is. Soil particles carry the continuum; the others are boundary particles
-/// (Bui et al. 2008) whose velocity and stress are extrapolated from the soil each step.
+/// (Bui et al. 2008) that act in each pair as the soil particle's mirror image (solver.cpp, step 1).
 enum class Kind : std::uint8_t {
   Soil = 0,
-  FixedWall = 1,   ///< full fixity (no slip): ghost velocity 2 v_wall − ⟨v⟩, stress ⟨σ⟩
+  FixedWall = 1,   ///< full fixity (no slip): velocity 2 v_wall − v_i, stress σ_i extrapolated along ν
   RollerWall = 2,  ///< free roller (free slip): normal velocity mirrored, shear stress mirrored
   Pile = 3         ///< rigid pile: treated as full fixity
 };
