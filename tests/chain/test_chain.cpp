@@ -30,6 +30,16 @@ int run(const std::string& cmd) {
   return r.code;
 }
 
+/// Runs sph-slope (`cmd` writes to out/slope) and reads its summary and the volume it handed over,
+/// which must be positive (else the chain test would be vacuous).
+void run_slope(const std::string& cmd, const fs::path& out, nlohmann::json& slope, double& handed) {
+  ASSERT_EQ(run(cmd), 0) << cmd;
+  slope = read_json(out / "slope" / "summary.json");
+  ASSERT_TRUE(slope.contains("release")) << slope.dump(2);
+  handed = slope["release"]["total_volume_m3"].get<double>();
+  ASSERT_GT(handed, 0.0) << "no failed mass: the chain test would be vacuous";
+}
+
 TEST(Chain, SectionFailureRunsOutWithTheSameVolume) {
   const fs::path src = GEOHAZ_SOURCE_DIR;
   const fs::path out = fs::temp_directory_path() / ("geohaz_chain_" + std::to_string(getpid()));
@@ -38,11 +48,9 @@ TEST(Chain, SectionFailureRunsOutWithTheSameVolume) {
   const std::string sph = std::string(SPH_SLOPE_EXE) + " --config " + (src / "data/sph/section_dsm.toml").string() +
                           " --set run.end_time=1.5 --set run.stop_at_rest=false --set run.snapshot_interval=0" +
                           " --threads 2 --quiet --out " + (out / "slope").string();
-  ASSERT_EQ(run(sph), 0) << sph;
-  const auto slope = read_json(out / "slope" / "summary.json");
-  ASSERT_TRUE(slope.contains("release")) << slope.dump(2);
-  const double handed = slope["release"]["total_volume_m3"].get<double>();
-  ASSERT_GT(handed, 0.0) << "no failed mass: the chain test would be vacuous";
+  nlohmann::json slope;
+  double handed = 0.0;
+  ASSERT_NO_FATAL_FAILURE(run_slope(sph, out, slope, handed));
 
   // The release file itself sums to the same volume.
   geohaz::SnapshotReader rel(out / "slope" / "release.h5");
@@ -84,11 +92,9 @@ TEST(Chain, ThreeDStripOnTheDsmHandsOverItsParticles) {
                           " --set material[1].friction=20 --set material[1].cohesion=1e3" +
                           " --set run.end_time=1.0 --set run.stop_at_rest=false --set run.snapshot_interval=0" +
                           " --threads 2 --quiet --out " + (out / "slope").string();
-  ASSERT_EQ(run(sph), 0) << sph;
-  const auto slope = read_json(out / "slope" / "summary.json");
-  ASSERT_TRUE(slope.contains("release")) << slope.dump(2);
-  const double handed = slope["release"]["total_volume_m3"].get<double>();
-  ASSERT_GT(handed, 0.0) << "no failed mass: the chain test would be vacuous";
+  nlohmann::json slope;
+  double handed = 0.0;
+  ASSERT_NO_FATAL_FAILURE(run_slope(sph, out, slope, handed));
   // One point per failed particle of volume Δx³ = 1 m³, all on the strip.
   EXPECT_NEAR(handed, slope["failed_volume_m3"].get<double>(), 1e-9 * handed);
   geohaz::SnapshotReader rel(out / "slope" / "release.h5");

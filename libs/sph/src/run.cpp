@@ -244,6 +244,10 @@ double load_restart(const std::filesystem::path& path, SphStore<Dim>& s, std::in
   } catch (const std::invalid_argument& e) {
     throw InputError(e.what(), path.string());
   }
+  if (!r.has_field(k, LayerNormal<Dim>::label)) {
+    s.template get<LayerNormal<Dim>>().assign(s.size(), Vec<Dim>::Zero());
+    fill_missing_layer_normals(s);
+  }
   step = r.step(k);
   return r.time(k);
 }

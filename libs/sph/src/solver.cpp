@@ -74,6 +74,7 @@ SphSolver<Dim>::SphSolver(SphStore<Dim> store, std::vector<MaterialParams> mater
     if (mat[i] < 0 || static_cast<std::size_t>(mat[i]) >= materials_.size())
       throw InputError("particle " + std::to_string(i) + " names material " + std::to_string(mat[i]) + " but only " +
                        std::to_string(materials_.size()) + " are defined");
+  fill_missing_layer_normals(store_);
   h_ = settings_.h_factor * settings_.spacing;
   damping_ = settings_.damping;
   dt_ = std::min(settings_.dt_max, settings_.cfl * h_ / max_wave_speed_);
@@ -213,15 +214,13 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
     const auto i = static_cast<std::size_t>(ii);
     vol[i] = m[i] / rho[i];
     if (kind[i] == kSoil) continue;
-    Vec<Dim> nu = lnrm[i];
-    if (nu.squaredNorm() == 0.0) nu = Vec<Dim>::Unit(Dim - 1);  // snapshots written before the field existed
+    const Vec<Dim>& nu = lnrm[i];
     const double g_n = gbar.dot(nu);
     const Vec<Dim> g_t = gbar - g_n * nu;
     Mat<Dim> G = g_t * nu.transpose();
     G += G.transpose().eval();
     G.diagonal().array() += g_n;
     ps[i] = G;
-    rsum[i] = rho[i];
   }
   // The boundary partner of soil particle i in a pair: velocity and stress as above.
   auto wall_velocity = [&](std::size_t i, std::size_t b) -> Vec<Dim> {
@@ -229,9 +228,7 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
     return 2.0 * v[b] - v[i];
   };
   auto wall_stress = [&](const Mat<Dim>& si, double rhoi, std::size_t b, const Vec<Dim>& xib) -> Mat<Dim> {
-    Vec<Dim> nu = lnrm[b];
-    if (nu.squaredNorm() == 0.0) nu = Vec<Dim>::Unit(Dim - 1);
-    Mat<Dim> sb = si + (rhoi * xib.dot(nu)) * ps[b];  // d = (x_b − x_i)·ν = −x_ib·ν
+    Mat<Dim> sb = si + (rhoi * xib.dot(lnrm[b])) * ps[b];  // d = (x_b − x_i)·ν = −x_ib·ν
     if (kind[b] == kRoller) {
       const Mat<Dim> M = Mat<Dim>::Identity() - 2.0 * nrm[b] * nrm[b].transpose();
       sb = M * sb * M;

@@ -149,4 +149,14 @@ using SphStore =
                   SummationDensity, XsphCorrection<Dim>, ArtificialStress<Dim>,
                   PairStress<Dim>, Volume, PositionAtBuild<Dim>, ParticleId>;
 
+/// Boundary particles without a layering normal (stores built by hand, snapshots written before the
+/// field existed) take the vertical one, the flat-lying-soil default of the scenario builders.
+template <int Dim>
+void fill_missing_layer_normals(SphStore<Dim>& s) {
+  const auto& kind = s.template get<ParticleKind>();
+  auto& nu = s.template get<LayerNormal<Dim>>();
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (kind[i] != static_cast<std::uint8_t>(Kind::Soil) && nu[i].squaredNorm() == 0.0) nu[i] = Vec<Dim>::Unit(Dim - 1);
+}
+
 }  // namespace geohaz::sph
