@@ -13,7 +13,10 @@
 #include <vector>
 
 #include "geohaz/core/raster.hpp"
+#include "geohaz/core/handoff.hpp"
 #include "geohaz/core/snapshot.hpp"
+#include "geohaz/core/config.hpp"
+#include "geohaz/runout/run.hpp"
 #include "geohaz/runout/synthetic_terrain.hpp"
 #include "run_command.hpp"
 
@@ -151,29 +154,20 @@ TEST(DebrisRunoutApp, BadInputsExitTwoAndWriteNothing) {
 }
 
 TEST(DebrisRunoutApp, ReleaseFromSphSlopeFileMatchesVolume) {
-  // A release.h5 as sph-slope writes it (handoff spec): one snapshot of 2D map points with
-  // volumes, in the DSM's CRS. The app must report the volume read and seed exactly that volume.
+  // A release.h5 as sph-slope writes it (docs/handoff.md): 2D map points with volumes, in the
+  // DSM's CRS. The app must report the volume read and seed exactly that volume.
   const fs::path dsm = tiny_dsm();
   const fs::path h5 = work_dir() / "release.h5";
-  std::vector<geohaz::Vec2> pos;
-  std::vector<double> vol;
-  double total = 0.0;
+  geohaz::Handoff h;
+  h.crs_wkt = geohaz::runout::kSyntheticValleyCrsWkt;
+  h.source = "test: displacement > 0.5 m";
   for (int k = 0; k < 300; ++k) {
     // Points spread over 20 m × 15 m around (480045, 4309875), volumes 0.5–1.4 m³.
-    pos.emplace_back(480035.0 + 20.0 * ((k * 37) % 100) / 100.0, 4309868.0 + 15.0 * ((k * 61) % 100) / 100.0);
-    vol.push_back(0.5 + 0.1 * (k % 10));
-    total += vol.back();
+    h.points.emplace_back(480035.0 + 20.0 * ((k * 37) % 100) / 100.0, 4309868.0 + 15.0 * ((k * 61) % 100) / 100.0);
+    h.volumes.push_back(0.5 + 0.1 * (k % 10));
   }
-  {
-    geohaz::SnapshotWriter w(h5, "sph-slope-release", 2, "");
-    w.set_attribute("crs_wkt", geohaz::runout::kSyntheticValleyCrsWkt);
-    w.set_attribute("total_volume", total);
-    w.set_attribute("source", "test: displacement > 0.5 m");
-    w.set_attribute("bulking_factor", 1.0);
-    const geohaz::FieldView views[] = {{"position", "m", geohaz::ScalarType::Float64, pos.data(), pos.size(), 2, 1},
-                                       {"volume", "m^3", geohaz::ScalarType::Float64, vol.data(), vol.size(), 1, 1}};
-    w.write(12.5, 100, views);
-  }
+  const double total = h.total_volume();
+  geohaz::write_handoff(h5, h, "");
   const fs::path out = work_dir() / "handoff_out";
   fs::remove_all(out);
   const auto r = run(dsm.string() + " --release-from " + h5.string() + " --d0 2.5 --h0 0.5 --duration 5 --out " +
@@ -185,18 +179,20 @@ TEST(DebrisRunoutApp, ReleaseFromSphSlopeFileMatchesVolume) {
   EXPECT_NEAR(j["volumes_m3"]["seeded"].get<double>(), total, 1e-12 * total);
   EXPECT_NE(r.output.find("m^3 read"), std::string::npos) << r.output;
   // A point outside the DSM is rejected (exit 2), nothing written.
-  pos.back() = geohaz::Vec2(0.0, 0.0);
-  {
-    geohaz::SnapshotWriter w(h5, "sph-slope-release", 2, "");
-    w.set_attribute("crs_wkt", geohaz::runout::kSyntheticValleyCrsWkt);
-    const geohaz::FieldView views[] = {{"position", "m", geohaz::ScalarType::Float64, pos.data(), pos.size(), 2, 1},
-                                       {"volume", "m^3", geohaz::ScalarType::Float64, vol.data(), vol.size(), 1, 1}};
-    w.write(12.5, 100, views);
-  }
+  h.points.back() = geohaz::Vec2(0.0, 0.0);
+  geohaz::write_handoff(h5, h, "");
   fs::remove_all(out);
   const auto bad = run(dsm.string() + " --release-from " + h5.string() + " --out " + out.string() + " --quiet");
   EXPECT_EQ(bad.code, 2) << bad.output;
   EXPECT_NE(bad.output.find("outside the DSM"), std::string::npos) << bad.output;
+  EXPECT_FALSE(dir_has_files(out));
+  // sph-slope found nothing failed: an empty hand-off is bad input (exit 2), not all-zero maps.
+  h.points.clear();
+  h.volumes.clear();
+  geohaz::write_handoff(h5, h, "");
+  const auto empty = run(dsm.string() + " --release-from " + h5.string() + " --out " + out.string() + " --quiet");
+  EXPECT_EQ(empty.code, 2) << empty.output;
+  EXPECT_NE(empty.output.find("holds no volume"), std::string::npos) << empty.output;
   EXPECT_FALSE(dir_has_files(out));
 }
 
@@ -216,14 +212,7 @@ TEST(DebrisRunoutApp, ReleaseInAnotherCrsIsReprojected) {
   const auto lonlat = geohaz::transform_points(utm, geohaz::runout::kSyntheticValleyCrsWkt, wgs84);
   ASSERT_GT(lonlat[0].x(), 140.0);  // degrees east: really geographic
   const fs::path h5 = work_dir() / "release_wgs84.h5";
-  {
-    geohaz::SnapshotWriter w(h5, "sph-slope-release", 2, "");
-    w.set_attribute("crs_wkt", wgs84);
-    const geohaz::FieldView views[] = {
-        {"position", "m", geohaz::ScalarType::Float64, lonlat.data(), lonlat.size(), 2, 1},
-        {"volume", "m^3", geohaz::ScalarType::Float64, vol.data(), vol.size(), 1, 1}};
-    w.write(0.0, 0, views);
-  }
+  geohaz::write_handoff(h5, {lonlat, vol, wgs84, "test: WGS 84 points"}, "");
   const fs::path out = work_dir() / "reproject_out";
   fs::remove_all(out);
   const auto r = run(dsm.string() + " --release-from " + h5.string() + " --d0 2.5 --h0 0.5 --duration 2 --out " +
@@ -232,4 +221,39 @@ TEST(DebrisRunoutApp, ReleaseInAnotherCrsIsReprojected) {
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
   EXPECT_NEAR(j["volumes_m3"]["seeded"].get<double>(), 100.0, 1e-10);
+}
+
+TEST(DebrisRunoutApp, LibraryRunInProcessGivesTheAppsNumbers) {
+  // The same case through the app (a subprocess) and through runout::run.hpp in this process, as
+  // the ensemble runner and the Python module call it: identical figures, bit for bit (same code,
+  // one thread), and the observer sees every step.
+  const fs::path dsm = tiny_dsm();
+  const fs::path rel = work_dir() / "tiny_release.tif";
+  const fs::path out = work_dir() / "inprocess_out";
+  fs::remove_all(out);
+  const auto r = run(dsm.string() + " --release " + rel.string() + " --d0 2.5 --h0 0.75 --duration 20 --out " +
+                     out.string() + " --quiet --threads 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::ifstream in(out / "summary.json");
+  const auto j = nlohmann::json::parse(in);
+
+  auto cfg = geohaz::ConfigReader::from_string("[model]\nd0 = 2.5\nh0 = 0.75\n[run]\nduration = 20\n[terrain]\ndsm = \"" +
+                                               dsm.string() + "\"\n[release]\nfile = \"" + rel.string() + "\"\n");
+  const geohaz::runout::RunoutCase c = geohaz::runout::read_case(cfg);
+  cfg.finish();
+  const geohaz::runout::RunoutInputs inputs = geohaz::runout::load_inputs(c);
+  geohaz::runout::RunoutSimulation sim(inputs, c.params, c.output);
+  struct Counter : geohaz::runout::RunObserver {
+    std::int64_t steps = 0;
+    void stepped(const geohaz::runout::RunoutSimulation&) override { ++steps; }
+  } counter;
+  sim.run(&counter);
+  const auto res = sim.result();
+  EXPECT_EQ(counter.steps, res.steps);
+  EXPECT_EQ(res.steps, j["steps"].get<std::int64_t>());
+  EXPECT_EQ(res.path.runout_length, j["runout_length_along_path_m"].get<double>());
+  EXPECT_EQ(res.path.fahrboeschung, j["fahrboeschung"]["ratio_H_over_L"].get<double>());
+  EXPECT_EQ(res.max_speed, j["max_speed_m_s"].get<double>());
+  EXPECT_EQ(res.volumes.deposited, j["volumes_m3"]["deposited"].get<double>());
+  EXPECT_EQ(std::string(geohaz::runout::to_string(res.ended)), j["ended_by"].get<std::string>());
 }

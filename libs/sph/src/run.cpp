@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "geohaz/core/errors.hpp"
+#include "geohaz/core/handoff.hpp"
 #include "geohaz/core/output.hpp"
 #include "geohaz/core/progress.hpp"
 #include "geohaz/core/snapshot.hpp"
@@ -532,7 +533,7 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
   summary["rest_speed_m_per_s"] = c.rest_speed;
   summary["bytes_per_particle"] = solver.bytes_per_particle();
 
-  // Failed mass for debris-runout (handoff spec): only when the section is georeferenced.
+  // Failed mass for debris-runout (docs/handoff.md): only when the section is georeferenced.
   // 2D: each plane-strain particle of area A becomes k = W/Δx map points spread across the width W,
   // each of volume A·W/k. 3D: each particle is one map point (its position on the strip) carrying
   // its own volume m/ρ0.
@@ -557,17 +558,11 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
         total += vol;
       }
     }
-    SnapshotWriter rel(out / "release.h5", "sph-slope-release", 2, c.resolved_config);
-    rel.set_attribute("crs_wkt", c.section.crs_wkt);
-    rel.set_attribute("total_volume", total);
     std::ostringstream src;
     src << c.config_source << "; " << Dim << "D section; displacement > " << c.failed_threshold << " m; width " << W
         << " m";
-    rel.set_attribute("source", src.str());
-    rel.set_attribute("bulking_factor", c.bulking_factor);
-    std::vector<FieldView> views{{"position", "m", ScalarType::Float64, pts.data(), pts.size(), 2, 1},
-                                 {"volume", "m^3", ScalarType::Float64, vols.data(), vols.size(), 1, 1}};
-    rel.write(solver.time(), solver.step_count(), views);
+    const Handoff handoff{pts, vols, c.section.crs_wkt, src.str(), c.bulking_factor, solver.time(), solver.step_count()};
+    write_handoff(out / "release.h5", handoff, c.resolved_config);
     summary["release"] = {{"file", "release.h5"}, {"points", pts.size()}, {"total_volume_m3", total}, {"width_m", W}};
     if (c.section.dsm) {
       Raster th = c.section.dsm->like(0.0);

@@ -3,7 +3,7 @@
 /// A complete sph-slope run from a typed configuration: build the scenario, apply gravity
 /// gradually (geostatic phase), run the main phase with optional earthquake loading, and write the
 /// outputs (snapshots, time series, free surface, slip surface, summary, quick-look PNGs, failed-mass
-/// release file for debris-runout per docs/handoff-spec). The app fills RunConfig from TOML; this
+/// release file for debris-runout per docs/handoff.md). The app fills RunConfig from TOML; this
 /// library never sees the config reader.
 
 #include <filesystem>

@@ -1,0 +1,165 @@
+#pragma once
+/// \file run.hpp
+/// A complete debris-runout run, callable from C++ without a subprocess (the app, the ensemble
+/// runner and the Python module all go through it). Three steps, each with one job:
+///
+///  1. `load_inputs(case)`: read and validate the DSM and the release (polygons, thickness raster
+///     or a hand-off file from sph-slope, docs/handoff.md) as a thickness on the DSM grid. Throws
+///     InputError (file, key, value); writes nothing.
+///  2. `RunoutSimulation sim(inputs, params)`: seeds the particles (volume-exact) and checks that
+///     they are on the terrain (InputError otherwise); `sim.run(observer)` steps to the end while
+///     painting the hazard maps and the time series; the observer sees every step (progress,
+///     snapshots). SimulationError on a blow-up, with the state so far kept in the object.
+///  3. `write_outputs(...)`: the rasters, pictures, series and summary into a directory.
+///
+/// `run_case(case, out, quiet)` chains them the way `debris-runout` does (outputs created only
+/// after every input is valid; snapshots during the run; progress on stderr).
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "geohaz/core/raster.hpp"
+#include "geohaz/runout/hazard_maps.hpp"
+#include "geohaz/runout/release.hpp"
+#include "geohaz/runout/solver.hpp"
+#include "geohaz/runout/surface.hpp"
+
+namespace geohaz {
+class ConfigReader;
+}
+
+namespace geohaz::runout {
+
+/// Where the release comes from (exactly one of `file` and `handoff` is set).
+struct ReleaseSpec {
+  std::string file;                     ///< polygons (Shapefile, GeoJSON, GPKG, …) or a thickness raster (m)
+  std::string handoff;                  ///< hand-off file with points and volumes (sph-slope's release.h5)
+  std::string attribute = "thickness";  ///< polygon attribute holding the thickness (m)
+  double depth = 0.0;                   ///< uniform polygon thickness (m); 0: use the attribute
+};
+
+/// What to write besides the maps and the summary.
+struct OutputSettings {
+  double series_interval = 1.0;     ///< s between rows of series.csv
+  double snapshot_interval = 30.0;  ///< s between particle snapshots
+  bool snapshots = true;            ///< snapshots.h5 + .xmf
+  bool pngs = true;                 ///< quick-look PNGs
+};
+
+/// Everything a run needs, in SI units. Defaults are those of the structs it holds.
+struct RunoutCase {
+  std::string dsm;  ///< terrain raster (projected CRS, metres)
+  ReleaseSpec release;
+  RunoutParameters params;
+  OutputSettings output;
+  std::string resolved_config;  ///< TOML text of the resolved configuration (written beside the outputs)
+  std::string config_source;    ///< config file the case came from ("" for none), for messages
+};
+
+/// Read every debris-runout key from `cfg` (defaults from RunoutCase's structs; ranges, units and
+/// help text declared here once, so the app, the ensemble runner and `--help-config` agree).
+/// Does not call cfg.finish(). Relative paths are resolved against the config file's folder when
+/// they do not exist as given.
+RunoutCase read_case(ConfigReader& cfg);
+
+/// The DSM and the release, read and checked.
+struct RunoutInputs {
+  Raster dsm;                     ///< the terrain raster as read (nodata marked in `dsm.nodata`)
+  GridSurface surface;            ///< bilinear surface through the DSM (NaN = nodata)
+  std::vector<double> thickness;  ///< release thickness on the DSM grid (m, vertical)
+  double volume = 0.0;            ///< release volume read (m³)
+  std::string description;        ///< "polygons relAlr.shp", "points from release.h5 (…)"
+  std::string source;             ///< the release file (for messages)
+
+  const GridGeometry& grid() const noexcept { return surface.geometry(); }
+};
+
+/// Read and validate the DSM and the release of `c` (InputError naming file, key and value).
+RunoutInputs load_inputs(const RunoutCase& c);
+
+/// North-up grid geometry of a raster.
+GridGeometry geometry_of(const Raster& r);
+
+class RunoutSimulation;
+
+/// Sees a run as it goes (progress bars, snapshot writers). Default: nothing.
+class RunObserver {
+ public:
+  virtual ~RunObserver() = default;
+  /// After seeding, before the first step.
+  virtual void started(const RunoutSimulation&) {}
+  /// After every step.
+  virtual void stepped(const RunoutSimulation&) {}
+  /// After the last step.
+  virtual void finished(const RunoutSimulation&) {}
+};
+
+/// How a run ended.
+enum class RunEnd { Running, Duration, AllStopped, NoParticles };
+const char* to_string(RunEnd e) noexcept;
+
+/// The key figures of a finished (or interrupted) run.
+struct RunoutResult {
+  RunoutSummary path;  ///< run-out, fahrböschung, centre of mass
+  VolumeBudget volumes;
+  double max_speed = 0.0;              ///< m/s, over the whole map
+  double max_pressure = 0.0;           ///< Pa, ρ·(max speed)²
+  double affected_area = 0.0;          ///< m², cells with max depth > 0
+  double deposit_raster_volume = 0.0;  ///< m³, integral of the deposit raster
+  std::size_t particles_released = 0, particles_left = 0;
+  double simulated_time = 0.0;  ///< s
+  std::int64_t steps = 0;
+  double wall_time = 0.0;  ///< s spent in run()
+  RunEnd ended = RunEnd::Running;
+};
+
+/// One run: particles seeded from the inputs, the solver, the hazard maps and the time series.
+class RunoutSimulation {
+ public:
+  /// Seed the release of `in` with `params`; InputError when a particle would start off the terrain
+  /// or the release needs more than `max_particles`. Keeps a reference to `in`'s surface: `in`
+  /// must outlive the simulation.
+  RunoutSimulation(const RunoutInputs& in, RunoutParameters params, OutputSettings output = {},
+                   std::size_t max_particles = 20'000'000);
+
+  /// Step until the run ends (duration, all at rest, no particles left). Rows of the time series
+  /// are taken every output.series_interval. SimulationError on a blow-up (the state so far, maps
+  /// and series included, stays readable).
+  void run(RunObserver* observer = nullptr);
+
+  const RunoutSolver<GridSurface>& solver() const noexcept { return solver_; }
+  const RunoutParameters& parameters() const noexcept { return solver_.parameters(); }
+  const OutputSettings& output() const noexcept { return output_; }
+  const HazardMaps& maps() const noexcept { return maps_; }
+  const std::vector<SeriesRow>& series() const noexcept { return series_; }
+  const SeedReport& seeded() const noexcept { return seeded_; }
+  const RunoutInputs& inputs() const noexcept { return in_; }
+  /// Final deposit thickness on the DSM grid (m).
+  std::vector<double> deposit() const { return maps_.deposit(solver_.particles()); }
+  /// The key figures now.
+  RunoutResult result() const;
+
+ private:
+  const RunoutInputs& in_;
+  OutputSettings output_;
+  RunoutSolver<GridSurface> solver_;
+  SeedReport seeded_;
+  HazardMaps maps_;
+  ReleaseTop top_;
+  std::vector<SeriesRow> series_;
+  double next_series_ = 0.0;
+  double wall_time_ = 0.0;
+};
+
+/// Write the maps (GeoTIFF on the DSM grid and CRS), the quick-look PNGs, series.csv and
+/// summary.json of `sim` into the existing directory `out`.
+void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const std::filesystem::path& out, int threads);
+
+/// The whole `debris-runout` run: load and check the inputs, seed, and only then create `out`,
+/// write the resolved config, run with snapshots and progress (stderr, unless quiet), and write the
+/// outputs. Returns the result.
+RunoutResult run_case(const RunoutCase& c, const std::filesystem::path& out, bool quiet, int threads);
+
+}  // namespace geohaz::runout

@@ -1,0 +1,91 @@
+// The debris-runout configuration keys: declared once here (unit, default, range, help), read into
+// RunoutCase. Defaults come from the structs of run.hpp / solver.hpp / basal_friction.hpp.
+#include "geohaz/core/config.hpp"
+
+#include <filesystem>
+
+#include "geohaz/runout/run.hpp"
+
+namespace geohaz::runout {
+
+namespace {
+
+/// The friction law named in the config, with its coefficients (defaults from the law structs).
+BasalFriction read_friction(ConfigReader& cfg) {
+  const ModifiedManningFriction manning;
+  const VoellmyFriction voellmy;
+  const std::string law = cfg.get_choice("model.friction", ModifiedManningFriction::name,
+                                         {ModifiedManningFriction::name, VoellmyFriction::name, CoulombFriction::name},
+                                         {"", "basal shear law: modified Manning (debris flow), Voellmy or Coulomb"});
+  const double n = cfg.get("model.n", manning.n, Range::closed(0.005, 0.5),
+                           {"s/m^(1/3)", "Manning roughness (manning); 0.02–0.1 for natural channels"});
+  const double icr = cfg.get("model.icr", manning.i_cr, Range::closed(0.0, 2.0),
+                             {"1", "critical slope gradient i_cr (manning; tan of the stopping angle)"});
+  const double m =
+      cfg.get("model.m", manning.m, Range::closed(0.0, 2.0), {"1", "exponent of |v| in the yield term (manning)"});
+  const double mu =
+      cfg.get("model.mu", voellmy.mu, Range::closed(0.0, 2.0), {"1", "Coulomb coefficient (voellmy, coulomb)"});
+  const double xi = cfg.get("model.xi", voellmy.xi, Range::open_closed(0.0, 1e5),
+                            {"m/s^2", "Voellmy turbulence coefficient (voellmy)"});
+  if (law == VoellmyFriction::name) return VoellmyFriction{mu, xi};
+  if (law == CoulombFriction::name) return CoulombFriction{mu};
+  return ModifiedManningFriction{n, icr, m};
+}
+
+/// A path given in the config: relative to the config file's folder when it does not exist as
+/// given (so a case file can name its inputs beside it).
+std::string resolve(const ConfigReader& cfg, std::string p) {
+  namespace fs = std::filesystem;
+  if (!p.empty() && !cfg.source().empty() && fs::path(p).is_relative() && !fs::exists(p))
+    return (cfg.base_dir() / p).string();
+  return p;
+}
+
+}  // namespace
+
+RunoutCase read_case(ConfigReader& cfg) {
+  RunoutCase c;
+  c.config_source = cfg.source();
+  c.dsm = resolve(cfg, cfg.get_string("terrain.dsm", "",
+                                      {"",
+                                       "DSM raster (any GDAL format, projected CRS); the positional "
+                                       "argument overrides it"}));
+  auto& r = c.release;
+  r.file = resolve(cfg, cfg.get_string("release.file", "",
+                                       {"", "release polygons (Shapefile/GeoJSON/GPKG) or thickness raster (m)"}));
+  r.handoff = resolve(cfg, cfg.get_string("release.from", "", {"", "release points from sph-slope (release.h5)"}));
+  r.attribute = cfg.get_string("release.attribute", r.attribute, {"", "polygon attribute holding the thickness (m)"});
+  r.depth = cfg.get("release.depth", r.depth, Range::closed(0.0, 200.0),
+                    {"m", "uniform polygon release thickness; 0: use the attribute"});
+
+  auto& p = c.params;
+  p.friction = read_friction(cfg);
+  p.density = cfg.get("model.density", p.density, Range::closed(500.0, 5000.0), {"kg/m^3", "mixture density ρ"});
+  p.gravity = cfg.get("model.gravity", p.gravity, Range::open_closed(0.0, 100.0), {"m/s^2", "gravity g"});
+  p.d0 = cfg.get("model.d0", p.d0, Range::open_closed(0.0, 1000.0), {"m", "reference particle spacing d0"});
+  p.h0 = cfg.get("model.h0", p.h0, Range::open_closed(0.0, 100.0),
+                 {"m", "reference depth h0; particle volume V0 = h0·d0^2 (choose ≲ ¼ of the flow depth)"});
+  p.duration = cfg.get("run.duration", p.duration, Range::open_closed(0.0, 1e6), {"s", "simulated time"});
+  p.cfl = cfg.get("numerics.cfl", p.cfl, Range::open_closed(0.0, 1.0), {"1", "Courant number on d0 with |v|+√(gh)"});
+  p.dt_max = cfg.get("numerics.dt_max", p.dt_max, Range::open_closed(0.0, 100.0), {"s", "largest time step"});
+  p.min_depth = cfg.get("numerics.min_depth", p.min_depth, Range::open_closed(0.0, 10.0),
+                        {"m", "floor on the depth in the friction law"});
+  p.skin = cfg.get("numerics.skin", p.skin, Range::closed(0.0, 2.0),
+                   {"1", "neighbour-list skin in units of d0 (list rebuilt after skin·d0/2 of motion)"});
+  p.smoothing = cfg.get("numerics.smoothing", p.smoothing, Range::closed(0.0, 1.0),
+                        {"1", "velocity smoothing ε per step (Monaghan 1994 XSPH); 0: off"});
+  const std::string norm = cfg.get_choice("numerics.pressure_normalisation", "consistent", {"consistent", "seed"},
+                                          {"", "head-pressure constant: consistent (continuum −g∇h) or seed (1)"});
+  p.pressure_scale = norm == "seed" ? 1.0 : HeadPressureForce::consistent_normalisation();
+
+  auto& o = c.output;
+  o.series_interval = cfg.get("output.series_interval", o.series_interval, Range::open_closed(0.0, 1e6),
+                              {"s", "time between rows of series.csv"});
+  o.snapshot_interval = cfg.get("output.snapshot_interval", o.snapshot_interval, Range::open_closed(0.0, 1e6),
+                                {"s", "time between particle snapshots"});
+  o.snapshots = cfg.get_bool("output.snapshots", o.snapshots, {"", "write snapshots.h5 + .xmf"});
+  o.pngs = cfg.get_bool("output.png", o.pngs, {"", "write the quick-look PNGs"});
+  return c;
+}
+
+}  // namespace geohaz::runout

@@ -1,0 +1,421 @@
+#include "geohaz/runout/run.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "geohaz/core/errors.hpp"
+#include "geohaz/core/handoff.hpp"
+#include "geohaz/core/output.hpp"
+#include "geohaz/core/progress.hpp"
+#include "geohaz/core/snapshot.hpp"
+
+namespace fs = std::filesystem;
+
+namespace geohaz::runout {
+
+namespace {
+
+constexpr const char* kModel = "debris-runout";
+
+std::string fmt(double v, int prec = 6) {
+  std::ostringstream o;
+  o << std::setprecision(prec) << v;
+  return o.str();
+}
+
+void check_inside(const Raster& dsm, const std::vector<Vec2>& pts, const std::string& file, const char* what) {
+  const auto ext = dsm.extent();
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const Vec2& p = pts[i];
+    if (p.x() < ext[0].x() || p.x() > ext[1].x() || p.y() < ext[0].y() || p.y() > ext[1].y()) {
+      std::ostringstream m;
+      m << "the release lies (partly) outside the DSM: " << what << " " << i << " at (" << std::fixed
+        << std::setprecision(1) << p.x() << ", " << p.y() << ") is outside the DSM extent [" << ext[0].x() << ", "
+        << ext[1].x() << "] × [" << ext[0].y() << ", " << ext[1].y() << "] (check the CRS of both files)";
+      throw InputError(m.str(), file);
+    }
+  }
+}
+
+/// Point volumes (m³) → thickness on the DSM grid, reprojected from `crs` when it differs.
+void thickness_from_points(const Raster& dsm, std::vector<Vec2> pts, const std::vector<double>& vol,
+                           const std::string& crs, const std::string& file, RunoutInputs& in) {
+  if (!crs.empty() && !dsm.crs_wkt.empty() && !crs_equal(crs, dsm.crs_wkt))
+    pts = transform_points(pts, crs, dsm.crs_wkt);
+  check_inside(dsm, pts, file, "point");
+  in.volume = 0.0;
+  for (double v : vol) {
+    if (!(v >= 0.0) || !std::isfinite(v)) throw InputError("negative or non-finite volume in the release", file);
+    in.volume += v;
+  }
+  std::size_t outside;
+  in.thickness = bin_point_volumes(geometry_of(dsm), pts, vol, outside);
+  if (outside != std::numeric_limits<std::size_t>::max())
+    throw InputError("release point " + std::to_string(outside) + " is outside the DSM", file);
+}
+
+bool is_vector_file(const std::string& path) {
+  const std::string ext = fs::path(path).extension().string();
+  return ext == ".shp" || ext == ".geojson" || ext == ".json" || ext == ".gpkg" || ext == ".kml" || ext == ".gml" ||
+         ext == ".sqlite";
+}
+
+void read_release(const ReleaseSpec& r, const Raster& dsm, RunoutInputs& in) {
+  const GridGeometry g = geometry_of(dsm);
+  if (!r.handoff.empty()) {
+    in.source = r.handoff;
+    const Handoff h = read_handoff(r.handoff);
+    thickness_from_points(dsm, h.points, h.volumes, h.crs_wkt, r.handoff, in);
+    in.description = "points from " + r.handoff + " (source: " + h.source + ")";
+    return;
+  }
+  if (r.file.empty())
+    throw InputError("no release given: use --release FILE (polygons or thickness raster) or --release-from release.h5",
+                     "command line");
+  in.source = r.file;
+  if (!is_vector_file(r.file)) {
+    // A thickness raster: its positive cells become point volumes binned into the DSM cells.
+    const Raster t = read_raster(r.file, CrsPolicy::Any);
+    std::vector<Vec2> pts;
+    std::vector<double> vol;
+    const double area = t.cell_size_x() * t.cell_size_y();
+    for (int row = 0; row < t.ny; ++row)
+      for (int col = 0; col < t.nx; ++col) {
+        const double v = t.at(col, row);
+        if (t.is_nodata(v) || !(v > 0.0)) continue;
+        if (v > 500.0) throw InputError("release thickness " + std::to_string(v) + " m is absurd (> 500 m)", r.file);
+        pts.push_back(t.cell_centre(col, row));
+        vol.push_back(v * area);
+      }
+    if (pts.empty()) throw InputError("the release raster holds no positive thickness (empty release)", r.file);
+    thickness_from_points(dsm, std::move(pts), vol, t.crs_wkt, r.file, in);
+    in.description = "thickness raster " + r.file;
+    return;
+  }
+  const std::string attribute = r.depth > 0.0 ? "" : r.attribute;
+  const auto polys = read_polygons(r.file, attribute, dsm.crs_wkt);
+  in.thickness.assign(g.cells(), 0.0);
+  for (const auto& poly : polys) {
+    check_inside(dsm, poly.outer, r.file, "polygon vertex");
+    const double t = r.depth > 0.0 ? r.depth : poly.attribute;
+    if (!std::isfinite(t) || t < 0.0 || t > 500.0)
+      throw InputError("release thickness must be in [0, 500] m (attribute '" + attribute + "' or --release-depth)",
+                       r.file, attribute, std::to_string(t));
+    double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
+    for (const auto& p : poly.outer) {
+      xmin = std::min(xmin, p.x());
+      xmax = std::max(xmax, p.x());
+      ymin = std::min(ymin, p.y());
+      ymax = std::max(ymax, p.y());
+    }
+    const int c0 = std::max(0, static_cast<int>((xmin - g.x0) / g.dx)),
+              c1 = std::min(g.nx - 1, static_cast<int>((xmax - g.x0) / g.dx));
+    const int r0 = std::max(0, static_cast<int>((g.y0 - ymax) / g.dy)),
+              r1 = std::min(g.ny - 1, static_cast<int>((g.y0 - ymin) / g.dy));
+    for (int row = r0; row <= r1; ++row)
+      for (int col = c0; col <= c1; ++col)
+        if (poly.contains(g.centre(col, row))) in.thickness[g.index(col, row)] = t;
+  }
+  in.volume = 0.0;
+  for (double t : in.thickness) in.volume += t * g.cell_area();
+  if (!(in.volume > 0.0))
+    throw InputError("the release polygons cover no DSM cell with a positive thickness (empty release)", r.file);
+  in.description = "polygons " + r.file;
+}
+
+/// Writes particle snapshots every output.snapshot_interval (and at the end) while a run goes.
+class SnapshotObserver : public RunObserver {
+ public:
+  SnapshotObserver(const fs::path& path, const RunoutCase& c, const RunoutInputs& in)
+      : w_(path, kModel, 2, c.resolved_config), interval_(c.output.snapshot_interval) {
+    w_.set_attribute("crs_wkt", in.dsm.crs_wkt);
+    w_.set_attribute("release_volume", in.volume);
+  }
+  void started(const RunoutSimulation& sim) override {
+    write(sim);
+    next_ = interval_;
+  }
+  void stepped(const RunoutSimulation& sim) override {
+    const auto& s = sim.solver();
+    if (s.time() >= next_ - 1e-9 || s.finished()) {
+      write(sim);
+      while (next_ <= s.time() + 1e-9) next_ += interval_;
+    }
+  }
+
+ private:
+  void write(const RunoutSimulation& sim) {
+    const auto& s = sim.solver();
+    w_.write(s.particles(), s.time(), s.step_count());
+  }
+  SnapshotWriter w_;
+  double interval_, next_ = 0.0;
+};
+
+/// Progress on stderr (a redrawn line on a terminal, occasional lines in logs, none when quiet).
+class ProgressObserver : public RunObserver {
+ public:
+  ProgressObserver(double end_time, bool quiet) : p_(kModel, end_time, quiet) {}
+  void stepped(const RunoutSimulation& sim) override {
+    const auto& s = sim.solver();
+    p_.update(s.time(), s.step_count(), s.particles().size());
+  }
+  void finished(const RunoutSimulation& sim) override {
+    const auto& s = sim.solver();
+    p_.finish(s.time(), s.step_count(), s.particles().size());
+  }
+
+ private:
+  ProgressReporter p_;
+};
+
+/// Several observers as one.
+class Observers : public RunObserver {
+ public:
+  void add(RunObserver* o) {
+    if (o) list_.push_back(o);
+  }
+  void started(const RunoutSimulation& s) override {
+    for (auto* o : list_) o->started(s);
+  }
+  void stepped(const RunoutSimulation& s) override {
+    for (auto* o : list_) o->stepped(s);
+  }
+  void finished(const RunoutSimulation& s) override {
+    for (auto* o : list_) o->finished(s);
+  }
+
+ private:
+  std::vector<RunObserver*> list_;
+};
+
+}  // namespace
+
+GridGeometry geometry_of(const Raster& r) {
+  return {r.nx, r.ny, r.geotransform[0], r.geotransform[3], r.cell_size_x(), r.cell_size_y()};
+}
+
+const char* to_string(RunEnd e) noexcept {
+  switch (e) {
+    case RunEnd::Running:
+      return "running";
+    case RunEnd::Duration:
+      return "duration reached";
+    case RunEnd::AllStopped:
+      return "all stopped";
+    case RunEnd::NoParticles:
+      return "no particles left";
+  }
+  return "?";
+}
+
+RunoutInputs load_inputs(const RunoutCase& c) {
+  if (c.dsm.empty()) throw InputError("no DSM given (positional argument or terrain.dsm)", "command line");
+  if (!c.release.file.empty() && !c.release.handoff.empty())
+    throw InputError("give either --release or --release-from, not both", "command line");
+  RunoutInputs in;
+  in.dsm = read_raster(c.dsm, CrsPolicy::RequireProjected);
+  if (in.dsm.nx < 3 || in.dsm.ny < 3) throw InputError("the DSM needs at least 3 × 3 cells", c.dsm);
+  const GridGeometry grid = geometry_of(in.dsm);
+  if (std::abs(grid.dx - grid.dy) > 1e-6 * grid.dx)
+    std::cerr << kModel << ": note: non-square DSM cells (" << grid.dx << " × " << grid.dy << " m)\n";
+  std::vector<double> z(in.dsm.data);
+  for (double& v : z)
+    if (in.dsm.is_nodata(v) || !std::isfinite(v)) v = std::numeric_limits<double>::quiet_NaN();
+  in.surface = GridSurface(grid, std::move(z));
+  read_release(c.release, in.dsm, in);
+  return in;
+}
+
+RunoutSimulation::RunoutSimulation(const RunoutInputs& in, RunoutParameters params, OutputSettings output,
+                                   std::size_t max_particles)
+    : in_(in),
+      output_(output),
+      solver_(in.surface, std::move(params)),
+      maps_(in.grid(), solver_.parameters().d0, solver_.parameters().density) {
+  const auto& p = solver_.parameters();
+  auto& store = solver_.particles();
+  // The particle count is known from the volume before seeding allocates anything.
+  const double estimate = in.volume / p.nominal_volume();
+  if (estimate > static_cast<double>(max_particles))
+    throw InputError("the release would need about " + fmt(estimate, 3) + " particles (more than " +
+                         std::to_string(max_particles) + "): increase model.d0 or model.h0",
+                     "config", "model.h0", fmt(p.h0));
+  seeded_ = seed_release(in.grid(), in.thickness, p.d0, p.h0, store);
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    SurfaceSample smp;
+    const Vec2 x = store.get<Position<2>>()[i];
+    if (!in.surface.sample(x, smp))
+      throw InputError("release particle at (" + fmt(x.x(), 10) + ", " + fmt(x.y(), 10) +
+                           ") lies on DSM nodata or in the outermost half cell",
+                       in.source);
+  }
+  solver_.initialise();
+  const double rel_err = std::abs(seeded_.volume_seeded - in.volume) / in.volume;
+  if (rel_err > 1e-9)
+    throw std::logic_error("seeded volume " + fmt(seeded_.volume_seeded, 15) + " differs from the release " +
+                           fmt(in.volume, 15));
+  maps_.record(store, 0.0);
+  top_ = release_top(store);
+  series_.push_back(series_row(store, solver_.budget(), 0.0, 0));
+  next_series_ = output_.series_interval;
+}
+
+void RunoutSimulation::run(RunObserver* observer) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  if (observer) observer->started(*this);
+  const auto& store = solver_.particles();
+  while (!solver_.finished()) {
+    solver_.step();
+    maps_.record(store, solver_.time());
+    const bool last = solver_.finished();
+    if (solver_.time() >= next_series_ - 1e-9 || last) {
+      series_.push_back(series_row(store, solver_.budget(), solver_.time(), solver_.step_count()));
+      while (next_series_ <= solver_.time() + 1e-9) next_series_ += output_.series_interval;
+    }
+    if (observer) observer->stepped(*this);
+  }
+  if (observer) observer->finished(*this);
+  wall_time_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+}
+
+RunoutResult RunoutSimulation::result() const {
+  RunoutResult r;
+  const auto& store = solver_.particles();
+  r.path = summarise(store, top_);
+  r.volumes = solver_.budget();
+  for (double v : maps_.max_speed()) r.max_speed = std::max(r.max_speed, v);
+  r.max_pressure = r.max_speed * r.max_speed * parameters().density;
+  r.affected_area = maps_.affected_area();
+  for (double v : deposit()) r.deposit_raster_volume += v * in_.grid().cell_area();
+  r.particles_released = seeded_.particles;
+  r.particles_left = store.size();
+  r.simulated_time = solver_.time();
+  r.steps = solver_.step_count();
+  r.wall_time = wall_time_;
+  if (!solver_.finished())
+    r.ended = RunEnd::Running;
+  else
+    r.ended = store.empty() ? RunEnd::NoParticles : solver_.all_stopped() ? RunEnd::AllStopped : RunEnd::Duration;
+  return r;
+}
+
+void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::path& out, int threads) {
+  const Raster& dsm = sim.inputs().dsm;
+  // Maps on the DSM's grid and CRS; nodata where the DSM has none.
+  auto map_raster = [&](const std::vector<double>& v, double fill_unreached) {
+    Raster r = dsm.like(0.0, -9999.0);
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      if (dsm.is_nodata(dsm.data[k]))
+        r.data[k] = -9999.0;
+      else
+        r.data[k] = std::isnan(v[k]) ? fill_unreached : v[k];
+    }
+    return r;
+  };
+  const HazardMaps& maps = sim.maps();
+  const Raster r_depth = map_raster(maps.max_depth(), 0.0), r_speed = map_raster(maps.max_speed(), 0.0),
+               r_press = map_raster(maps.max_pressure(), 0.0), r_dep = map_raster(sim.deposit(), 0.0),
+               r_arr = map_raster(maps.arrival_time(), -9999.0);
+  write_geotiff(out / "max_depth.tif", r_depth);
+  write_geotiff(out / "max_speed.tif", r_speed);
+  write_geotiff(out / "max_pressure.tif", r_press);
+  write_geotiff(out / "deposit.tif", r_dep);
+  write_geotiff(out / "arrival_time.tif", r_arr);
+  if (c.output.pngs) {
+    write_quicklook_png(out / "deposit.png", dsm, &r_dep, ColourRamp::Viridis, "deposit thickness (m)", 0.0, 0.0, 0.01);
+    write_quicklook_png(out / "max_speed.png", dsm, &r_speed, ColourRamp::Magma, "maximum speed (m/s)", 0.0, 0.0, 0.01);
+  }
+
+  {
+    AtomicTextFile csv(out / "series.csv");
+    csv << "time_s,step,particles,front_x_m,front_y_m,front_travel_m,front_drop_m,mean_speed_m_s,max_speed_m_s,"
+           "mobile_volume_m3,deposited_volume_m3,lost_volume_m3,balance_error_m3\n";
+    csv.stream() << std::setprecision(10);
+    for (const auto& r : sim.series())
+      csv << r.time << ',' << r.step << ',' << r.particles << ',' << r.front.x() << ',' << r.front.y() << ','
+          << r.front_travel << ',' << r.front_drop << ',' << r.mean_speed << ',' << r.max_speed << ','
+          << r.volumes.mobile << ',' << r.volumes.deposited << ',' << r.volumes.lost << ',' << r.volumes.balance_error()
+          << '\n';
+    csv.commit();
+  }
+
+  const RunoutResult res = sim.result();
+  const auto& sum = res.path;
+  const VolumeBudget& b = res.volumes;
+  nlohmann::json j;
+  j["model"] = kModel;
+  j["version"] = GEOHAZ_VERSION;
+  j["dsm"] = c.dsm;
+  j["release"] = sim.inputs().description;
+  j["friction"] = friction_name(sim.parameters().friction);
+  j["particles_released"] = res.particles_released;
+  j["particles_left"] = res.particles_left;
+  j["simulated_time_s"] = res.simulated_time;
+  j["steps"] = res.steps;
+  j["wall_time_s"] = res.wall_time;
+  j["threads"] = threads;
+  j["ended_by"] = to_string(res.ended);
+  j["runout_length_along_path_m"] = sum.runout_length;
+  j["fahrboeschung"] = {
+      {"drop_height_m", sum.drop_height},   {"reach_m", sum.reach},   {"ratio_H_over_L", sum.fahrboeschung},
+      {"angle_deg", sum.fahrboeschung_deg}, {"toe_x_m", sum.toe.x()}, {"toe_y_m", sum.toe.y()}};
+  j["centre_of_mass"] = {{"drop_m", sum.com_drop}, {"travel_m", sum.com_travel}, {"angle_deg", sum.com_angle_deg}};
+  j["max_speed_m_s"] = res.max_speed;
+  j["max_pressure_pa"] = res.max_pressure;
+  j["area_affected_m2"] = res.affected_area;
+  j["volumes_m3"] = {{"release_read", sim.inputs().volume},
+                     {"seeded", sim.seeded().volume_seeded},
+                     {"deposited", b.deposited},
+                     {"mobile", b.mobile},
+                     {"lost", b.lost},
+                     {"deposit_raster", res.deposit_raster_volume}};
+  j["lost_particles"] = b.lost_particles;
+  j["mass_balance_error_relative"] = b.balance_error() / b.initial;
+  write_text_file(out / "summary.json", j.dump(2) + "\n");
+}
+
+RunoutResult run_case(const RunoutCase& c, const fs::path& out, bool quiet, int threads) {
+  // 1-2. Inputs and particles, all checked before anything is written.
+  const RunoutInputs in = load_inputs(c);
+  RunoutSimulation sim(in, c.params, c.output);
+
+  // 3. Outputs: only now is anything created.
+  make_output_dir(out);
+  write_text_file(out / "config.resolved.toml", c.resolved_config);
+  const auto& p = sim.parameters();
+  if (!quiet)
+    std::cerr << kModel << ": " << in.description << ": volume " << fmt(in.volume, 12) << " m^3 read, "
+              << fmt(sim.seeded().volume_seeded, 12) << " m^3 seeded in " << sim.seeded().particles
+              << " particles (V0 = " << p.nominal_volume() << " m^3, d0 = " << p.d0 << " m), "
+              << friction_name(p.friction) << " friction, " << threads << " thread(s)\n";
+  std::unique_ptr<SnapshotObserver> snap;
+  if (c.output.snapshots) snap = std::make_unique<SnapshotObserver>(out / "snapshots.h5", c, in);
+  ProgressObserver progress(p.duration, quiet);
+  Observers obs;
+  obs.add(snap.get());
+  obs.add(&progress);
+  sim.run(&obs);
+
+  // 4-5. Maps, series and summary.
+  write_outputs(c, sim, out, threads);
+  const RunoutResult r = sim.result();
+  if (!quiet)
+    std::cerr << kModel << ": " << to_string(r.ended) << " at t = " << fmt(r.simulated_time, 5) << " s after "
+              << r.steps << " steps (" << fmt(r.wall_time, 3) << " s wall); run-out " << fmt(r.path.runout_length, 5)
+              << " m along the path, H/L = " << fmt(r.path.fahrboeschung, 3) << " (" << fmt(r.path.fahrboeschung_deg, 3)
+              << "°), max speed " << fmt(r.max_speed, 3) << " m/s; deposited " << fmt(r.volumes.deposited, 8)
+              << " m^3, mobile " << fmt(r.volumes.mobile, 8) << " m^3, lost " << fmt(r.volumes.lost, 8)
+              << " m^3; outputs in " << out.string() << "\n";
+  return r;
+}
+
+}  // namespace geohaz::runout
