@@ -50,6 +50,9 @@ const DamBreakState& dam_break() {
     p.duration = kT;
     p.cfl = 0.25;
     p.friction = CoulombFriction{0.0};
+    // Ritter's solution is of the inviscid system: no artificial viscosity (as AvaFrame's own
+    // dam-break test, viscOption = 0); its effect and convergence: test_terrain.cpp.
+    p.lateral_mixing = 0.0;
     const double d = p.d0 * std::sqrt(p.h0 / kH);  // lattice spacing of depth H
     const int nx = static_cast<int>(std::lround(50.0 / d)), ny = static_cast<int>(std::lround(4.0 / d));
     Periodicity<2> across;

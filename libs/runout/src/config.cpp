@@ -65,13 +65,22 @@ RunoutCase read_case(ConfigReader& cfg) {
   p.d0 = cfg.get("model.d0", p.d0, Range::open_closed(0.0, 1000.0), {"m", "reference particle spacing d0"});
   p.h0 = cfg.get("model.h0", p.h0, Range::open_closed(0.0, 100.0),
                  {"m", "reference depth h0; particle volume V0 = h0·d0^2 (choose ≲ ¼ of the flow depth)"});
-  p.duration = cfg.get("run.duration", p.duration, Range::open_closed(0.0, 1e6), {"s", "simulated time"});
+  p.duration = cfg.get("run.duration", p.duration, Range::open_closed(0.0, 1e6),
+                       {"s", "longest simulated time (the run may end earlier: run.stop_energy_fraction)"});
+  p.stop_energy_fraction =
+      cfg.get("run.stop_energy_fraction", p.stop_energy_fraction, Range::closed_open(0.0, 1.0),
+              {"1", "end the run when the kinetic energy falls below this fraction of its peak; 0: never"});
+  p.curvature = cfg.get_bool("model.curvature", p.curvature,
+                             {"", "bed curvature along the velocity in the normal force and the bed constraint"});
   p.cfl = cfg.get("numerics.cfl", p.cfl, Range::open_closed(0.0, 1.0), {"1", "Courant number on d0 with |v|+√(gh)"});
   p.dt_max = cfg.get("numerics.dt_max", p.dt_max, Range::open_closed(0.0, 100.0), {"s", "largest time step"});
   p.min_depth = cfg.get("numerics.min_depth", p.min_depth, Range::open_closed(0.0, 10.0),
                         {"m", "floor on the depth in the friction law"});
   p.skin = cfg.get("numerics.skin", p.skin, Range::closed(0.0, 2.0),
                    {"1", "neighbour-list skin in units of d0 (list rebuilt after skin·d0/2 of motion)"});
+  p.lateral_mixing = cfg.get("numerics.lateral_mixing", p.lateral_mixing, Range::closed(0.0, 1e4),
+                             {"1", "C_mix of the lateral-mixing artificial viscosity (AvaFrame com1DFA's "
+                                   "subgridMixingFactor); 0: off"});
   p.smoothing = cfg.get("numerics.smoothing", p.smoothing, Range::closed(0.0, 1.0),
                         {"1", "velocity smoothing ε per step (Monaghan 1994 XSPH); 0: off"});
   const std::string norm = cfg.get_choice("numerics.pressure_normalisation", "consistent", {"consistent", "seed"},

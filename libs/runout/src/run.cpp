@@ -197,6 +197,12 @@ class Observers : public RunObserver {
   std::vector<RunObserver*> list_;
 };
 
+/// The DSM surface with its curvature taken at the particle scale d0 (a copy either way: the
+/// solver owns its surface).
+GridSurface surface_for(const GridSurface& s, double d0) {
+  return s.curvature_cells_for(d0) == s.curvature_cells() ? s : s.with_curvature_scale(d0);
+}
+
 }  // namespace
 
 GridGeometry geometry_of(const Raster& r) {
@@ -213,6 +219,8 @@ const char* to_string(RunEnd e) noexcept {
       return "all stopped";
     case RunEnd::NoParticles:
       return "no particles left";
+    case RunEnd::KineticEnergy:
+      return "kinetic energy below the stop fraction of its peak";
   }
   return "?";
 }
@@ -230,7 +238,7 @@ RunoutInputs load_inputs(const RunoutCase& c) {
   std::vector<double> z(in.dsm.data);
   for (double& v : z)
     if (in.dsm.is_nodata(v) || !std::isfinite(v)) v = std::numeric_limits<double>::quiet_NaN();
-  in.surface = GridSurface(grid, std::move(z));
+  in.surface = GridSurface(grid, std::move(z), c.params.d0);
   read_release(c.release, in.dsm, in);
   return in;
 }
@@ -239,7 +247,7 @@ RunoutSimulation::RunoutSimulation(const RunoutInputs& in, RunoutParameters para
                                    std::size_t max_particles)
     : in_(in),
       output_(output),
-      solver_(in.surface, std::move(params)),
+      solver_(surface_for(in.surface, params.d0), params),
       maps_(in.grid(), solver_.parameters().d0, solver_.parameters().density) {
   const auto& p = solver_.parameters();
   auto& store = solver_.particles();
@@ -304,7 +312,10 @@ RunoutResult RunoutSimulation::result() const {
   if (!solver_.finished())
     r.ended = RunEnd::Running;
   else
-    r.ended = store.empty() ? RunEnd::NoParticles : solver_.all_stopped() ? RunEnd::AllStopped : RunEnd::Duration;
+    r.ended = store.empty()                   ? RunEnd::NoParticles
+              : solver_.all_stopped()         ? RunEnd::AllStopped
+              : solver_.stopped_by_energy()   ? RunEnd::KineticEnergy
+                                              : RunEnd::Duration;
   return r;
 }
 

@@ -19,7 +19,9 @@ struct Volume {
   static constexpr const char* label = "volume";
   static constexpr const char* unit = "m^3";
 };
-/// Vertical flow thickness at the particle, h = Σ_j V_j W(|x_i − x_j|, d0) (m), cubic spline.
+/// Flow thickness normal to the bed at the particle, h = Σ_j V_j W(r_ij, d0) (m), cubic spline
+/// over the 3D distances r_ij = |(x_i − x_j, z_i − z_j)| of particles on the bed (the volume per
+/// unit bed area).
 struct FlowDepth {
   using type = double;
   static constexpr const char* label = "depth";
@@ -61,6 +63,27 @@ struct SurfaceGradient {
   static constexpr const char* label = "surface_gradient";
   static constexpr const char* unit = "1";
 };
+/// Terrain Hessian (∂²z/∂x², ∂²z/∂x∂y, ∂²z/∂y²) under the particle, smoothed at the particle scale
+/// (1/m): the bed curvature of the centripetal terms.
+struct SurfaceCurvature {
+  using type = Vec3;
+  static constexpr const char* label = "surface_curvature";
+  static constexpr const char* unit = "1/m";
+};
+/// cos θ of the bed under the particle, 1/√(1 + |∇z|²) (1): the hydrostatic pressure on a slope
+/// comes from g cos θ.
+struct BedCos {
+  using type = double;
+  static constexpr const char* label = "bed_cos";
+  static constexpr const char* unit = "1";
+};
+/// Kernel mean of the neighbours' velocities, Σ_j V_j W_ij v_j / h_i, map view (m/s): what the
+/// lateral-mixing viscosity relaxes a particle towards (scratch of one step).
+struct MeanVelocity {
+  using type = Vec2;
+  static constexpr const char* label = "mean_velocity";
+  static constexpr const char* unit = "m/s";
+};
 /// Head-pressure acceleration from the neighbours, map view (m/s²): scratch of one step.
 struct HeadAcceleration {
   using type = Vec2;
@@ -94,8 +117,9 @@ struct Leaving {
 };
 
 /// The particle store of the debris-runout model.
-using RunoutStore = ParticleStore<Position<2>, Velocity<2>, ParticleId, Volume, FlowDepth, Speed, Elevation,
-                                  StartElevation, StartPosition, PathLength, SurfaceGradient, HeadAcceleration,
-                                  VelocityCorrection, ListPosition, Moving, Leaving>;
+using RunoutStore =
+    ParticleStore<Position<2>, Velocity<2>, ParticleId, Volume, FlowDepth, Speed, Elevation, StartElevation,
+                  StartPosition, PathLength, SurfaceGradient, SurfaceCurvature, BedCos, MeanVelocity,
+                  HeadAcceleration, VelocityCorrection, ListPosition, Moving, Leaving>;
 
 }  // namespace geohaz::runout

@@ -97,7 +97,7 @@ class RunObserver {
 };
 
 /// How a run ended.
-enum class RunEnd { Running, Duration, AllStopped, NoParticles };
+enum class RunEnd { Running, Duration, AllStopped, NoParticles, KineticEnergy };
 const char* to_string(RunEnd e) noexcept;
 
 /// The key figures of a finished (or interrupted) run.

@@ -1,30 +1,40 @@
 #pragma once
 /// \file solver.hpp
-/// RunoutSolver: one time step of the depth-averaged particle debris-flow model (seed 000 §3),
-/// readable top to bottom in step():
+/// RunoutSolver: one time step of the depth-averaged particle debris-flow model, readable top to
+/// bottom in step(). Particles move in map view (x, y) on the terrain z(x, y); p = ∇z, cos²θ =
+/// 1/(1 + |p|²), P = I − p pᵀ/(1 + |p|²) (the inverse metric of the surface: it turns a map-view
+/// force into the map-view acceleration of a particle held on the bed). docs/runout.md derives it.
 ///
 ///  1. neighbours within 2·d0: by default visited straight from a cell scan rebuilt every step
 ///     (CellPairScan: the pairs are used once, so no list is written); with numerics.skin > 0 a
 ///     Verlet list within (2 + skin)·d0 (NeighbourList), rebuilt when a particle has moved more
-///     than skin·d0/2 since the last build and after removals. The scan visits exactly the pairs,
-///     in the same order, of a list without skin. The particles are reordered by cell every
-///     reorder_interval steps;
-///  2. pair pass 1: flow depth h_i = Σ_j V_j W(r_ij, d0) (cubic spline, self included);
-///     pair pass 2: head-pressure acceleration a_p,i = C g Σ_j (V_j/d0³) f(r_ij/d0) x̂_ij
-///     (head_pressure.hpp) and the velocity smoothing Δv_i = ε Σ_j 2V_j/(h_i + h_j) (v_j − v_i) W_ij
-///     (the particle velocity correction of seed 000 §2, Monaghan 1994, with a symmetric weight so
-///     momentum is conserved). Without it a particle lattice under the seed's force is unstable
-///     (f rises with distance on 1 < x < 1.5), and round-off grows into a "thermal" noise;
+///     than skin·d0/2 since the last build and after removals. The particles are reordered by cell
+///     every reorder_interval steps;
+///  2. pair pass: vertical depth h_i = Σ_j V_j W(r_ij, d0) (cubic spline, self included), the
+///     neighbours' mean velocity ṽ_i = Σ_j V_j W_ij v_j / h_i, and the head-pressure force
+///         F_i = C g Σ_j ½(cos²θ_i + cos²θ_j) (V_j/d0³) f(r_ij/d0) x̂_ij        (head_pressure.hpp)
+///     whose continuum limit is −∇(g cos²θ h): the map gradient of the hydrostatic energy
+///     ½ g cos θ h_n² per unit bed area (h_n = h cos θ); with the optional velocity smoothing
+///     (numerics.smoothing = ε) a second pass adds Δv_i = ε Σ_j 2V_j/(h_i + h_j) (v_j − v_i) W_ij;
 ///  3. adaptive time step Δt = cfl · d0 / max_i(S_i + √(g h_i)) (the maximum taken in the pair
 ///     pass), capped by dt_max and the end time;
-///  4. per particle: driving acceleration in map view for a particle held on the surface z(x, y)
-///         a_h = −g ∇z / (1 + |∇z|²) + a_p
-///     (exact for a plane: the along-slope acceleration is g sin θ; bed curvature is neglected),
-///     predicted velocity v* = v + Δt a_h, then basal friction applied implicitly on the surface
-///     speed S = |(v, ∇z·v)| with g_n = g cos θ and h_n = h cos θ (basal_friction.hpp): it may stop
-///     a particle, never reverse it; position x += Δt v (symplectic Euler);
+///  4. per particle:
+///     a. lateral mixing (an artificial viscosity, Sampl & Zwinger 2004 as in AvaFrame com1DFA),
+///        implicit: v ← (v + kΔt ṽ)/(1 + kΔt), k = C_mix |ṽ − v|_s √(h_n/V);
+///     b. driving acceleration along the bed: a = −g cos²θ p + P F_i;
+///     c. basal friction applied implicitly on the surface speed S = |(v, p·v)| with the bed-normal
+///        stress of g_n = cos θ (g + vᵀHv)⁺ (gravity plus the centripetal acceleration of the bed
+///        curvature along the velocity, H the Hessian of z; zero when the particle would leave the
+///        bed) and the depth h_n = h cos θ (basal_friction.hpp): it may stop a particle, never
+///        reverse it; position x += Δt v (symplectic Euler);
+///     d. the bed constraint: the velocity is turned into the tangent plane at the new position
+///        keeping its magnitude S (the normal reaction does no work), as AvaFrame com1DFA
+///        reprojects it;
 ///  5. particles whose new position is off the terrain (raster edge, nodata) are removed and their
-///     volume is added to the lost volume.
+///     volume is added to the lost volume;
+///  6. the volume budget and the kinetic energy Σ ½ ρ V S²; the run ends at the duration, when
+///     every particle is at rest, or when the kinetic energy has fallen below
+///     stop_energy_fraction of its peak (AvaFrame com1DFA / RAMMS practice).
 /// All per-particle loops are parallel over i with no order-dependent reduction (only maxima and
 /// "any" flags), so 1 and N threads give bit-identical results.
 
@@ -61,6 +71,14 @@ struct RunoutParameters {
   double min_depth = 0.01;  ///< floor on the bed-normal depth in the friction law (m)
   double smoothing = 0.0;   ///< ε of the velocity correction per step (1), 0 switches it off
   double pressure_scale = HeadPressureForce::consistent_normalisation();  ///< C (1)
+  /// C_mix of the lateral-mixing viscosity (1), 0 switches it off. AvaFrame com1DFA's default
+  /// subgridMixingFactor, 100; the relaxation vanishes with the velocity differences at the
+  /// particle scale, so results converge as d0 shrinks (docs/validation/runout.md).
+  double lateral_mixing = 100.0;
+  /// Bed curvature in the normal force (friction) and in the bed constraint (acceleration).
+  bool curvature = true;
+  /// The run ends when the kinetic energy falls below this fraction of its peak (1); 0: never.
+  double stop_energy_fraction = 0.01;
   int reorder_interval = 25;  ///< steps between cell reorderings of the store
   double skin = 0.0;          ///< neighbour-list skin in units of d0 (list cutoff (2 + skin)·d0)
   BasalFriction friction = ModifiedManningFriction{};
@@ -72,6 +90,8 @@ struct RunoutParameters {
 struct VolumeBudget {
   double initial = 0.0, mobile = 0.0, deposited = 0.0, lost = 0.0;
   std::size_t lost_particles = 0;
+  double kinetic_energy = 0.0;       ///< Σ ½ ρ V S² now (J)
+  double peak_kinetic_energy = 0.0;  ///< its maximum so far (J)
   double balance_error() const noexcept { return mobile + deposited + lost - initial; }
 };
 
@@ -108,10 +128,15 @@ class RunoutSolver {
       store_.get<StartElevation>()[i] = s.z;
       store_.get<StartPosition>()[i] = x[i];
       store_.get<SurfaceGradient>()[i] = s.grad;
+      store_.get<SurfaceCurvature>()[i] = s.hess;
+      store_.get<BedCos>()[i] = 1.0 / std::sqrt(1.0 + s.grad.squaredNorm());
+      const Vec2 v = store_.get<Velocity<2>>()[i];
+      store_.get<Speed>()[i] = std::hypot(v.norm(), s.grad.dot(v));
       store_.get<Moving>()[i] = 1;
     }
     budget_ = {};
     for (double v : vol) budget_.initial += v;
+    energy_stop_ = false;
     compute_pair_terms();
     update_budget();
   }
@@ -151,10 +176,14 @@ class RunoutSolver {
       if (m) return false;
     return true;
   }
-  /// Whether the run is over: duration reached, all stopped, or no particle left.
+  /// Whether the run is over: duration reached, all stopped, no particle left, or the kinetic
+  /// energy below stop_energy_fraction of its peak.
   bool finished() const noexcept {
-    return time_ >= p_.duration - 1e-12 * std::max(1.0, p_.duration) || store_.empty() || (step_ > 0 && all_stopped());
+    return time_ >= p_.duration - 1e-12 * std::max(1.0, p_.duration) || store_.empty() ||
+           (step_ > 0 && all_stopped()) || energy_stop_;
   }
+  /// True when the run ended (or would end) by the kinetic-energy criterion.
+  bool stopped_by_energy() const noexcept { return energy_stop_; }
 
   const VolumeBudget& budget() const noexcept { return budget_; }
 
@@ -199,12 +228,24 @@ class RunoutSolver {
     auto& h = store_.get<FlowDepth>();
     auto& ap = store_.get<HeadAcceleration>();
     const auto& v = store_.get<Velocity<2>>();
+    const auto& x = store_.get<Position<2>>();
+    const auto& z = store_.get<Elevation>();
     const auto& grad = store_.get<SurfaceGradient>();
+    const auto& cb = store_.get<BedCos>();
+    auto& vmean = store_.get<MeanVelocity>();
+    // Height difference of a pair. In a periodic domain (tests on an infinite plane) a neighbour
+    // across the boundary is an image: its height is continued with i's bed slope.
+    const bool periodic = periodic_.any();
+    const auto dz = [&](std::size_t i, std::size_t j, const Vec2& xij) {
+      const double d = z[i] - z[j];
+      return periodic ? d + grad[i].dot(xij - (x[i] - x[j])) : d;
+    };
     auto& dv = store_.get<VelocityCorrection>();
     const double d0 = p_.d0;
     const double inv_d0 = 1.0 / d0;
     const double w0 = CubicSpline<2>::value(0.0, d0);
-    const double coef = p_.pressure_scale * p_.gravity * inv_d0 * inv_d0 * inv_d0;
+    // ½ of the pair average ½(cos θ_i + cos θ_j) is folded into the constant.
+    const double coef = 0.5 * p_.pressure_scale * p_.gravity * inv_d0 * inv_d0 * inv_d0;
     const double g = p_.gravity;
     const std::int64_t n = static_cast<std::int64_t>(store_.size());
     const double support2 = 4.0 * d0 * d0, sigma = CubicSpline<2>::sigma(d0);
@@ -213,63 +254,104 @@ class RunoutSolver {
       const double vz = grad[i].dot(v[i]);
       return std::sqrt(v[i].squaredNorm() + vz * vz) + std::sqrt(g * h[i]);
     };
+    // The head-pressure force F = (F_h, F_z) along the 3D chords, as the map-view acceleration of a
+    // particle held on the bed: P (F_h + p F_z) (docs/runout.md).
+    const auto on_bed = [&](std::size_t i, const Vec2& fh, double fz) {
+      const Vec2 p = grad[i];
+      const Vec2 f = fh + fz * p;
+      return Vec2(f - (p.dot(f) / (1.0 + p.squaredNorm())) * p);
+    };
+    // The neighbours' mean 3D velocity ū = (ū_h, ū_z), with its normal component at i removed, as a
+    // map velocity: ū_h + p (ū_z − p·ū_h)/(1 + |p|²). (Averaging map velocities of particles on
+    // beds of different slope would hand a steep particle a larger surface speed than any of them.)
+    const auto tangent_mean = [&](std::size_t i, const Vec2& uh, double uz) {
+      const Vec2 p = grad[i];
+      return Vec2(uh + ((uz - p.dot(uh)) / (1.0 + p.squaredNorm())) * p);
+    };
     const double eps = p_.smoothing;
     double signal = 0.0;
     if (eps == 0.0) {
-      // One pass: depth and head pressure (the pressure does not need the neighbours' depths).
+      // One pass: depth, mean velocity and head pressure (none needs the neighbours' depths). The
+      // pressure sums Σ cos θ_j V_j f ê and Σ V_j f ê apart, so the pair average costs one load.
 #pragma omp parallel for reduction(max : signal) schedule(static) if (n >= kParallelMin)
       for (std::int64_t ii = 0; ii < n; ++ii) {
         const auto i = static_cast<std::size_t>(ii);
         double depth = vol[i] * (2.0 / 3.0);
-        Vec2 acc = Vec2::Zero();
+        Vec2 vsum = depth * v[i];
+        double vzsum = depth * grad[i].dot(v[i]);
+        Vec2 acc = Vec2::Zero(), acc_c = Vec2::Zero();
+        double accz = 0.0, accz_c = 0.0;
         // W/σ (kernels.hpp) and f (head_pressure.hpp) written out per branch of q; the
-        // arithmetic is exactly that of CubicSpline and HeadPressureForce::shape (the steady-flow
-        // test's particle-scale fluctuation grows from round-off, so its order is kept).
+        // arithmetic is exactly that of CubicSpline and HeadPressureForce::shape.
         neighbours(i, [&](std::size_t j, const Vec2& xij, double r2) {
-          if (r2 >= support2) return;  // in the list's skin: no contribution
-          const double r = std::sqrt(r2);
+          const double zij = dz(i, j, xij);
+          const double r3 = r2 + zij * zij;
+          if (r3 >= support2) return;  // beyond the support on the bed (or in the list's skin)
+          const double r = std::sqrt(r3);
           const double q = r * inv_d0;
           const double vj = vol[j];
+          double w, fr;
           if (q < 1.0) {
-            depth += vj * (2.0 / 3.0 - q * q + 0.5 * q * q * q);
-            if (r > 0.0) acc += (coef * vj * ((1.0 - q) / (1.0 + q)) / r) * xij;
-          } else if (q < 2.0) {
+            w = vj * (2.0 / 3.0 - q * q + 0.5 * q * q * q);
+            fr = r > 0.0 ? coef * vj * ((1.0 - q) / (1.0 + q)) / r : 0.0;
+          } else {
             const double t = 2.0 - q;
-            depth += vj * (t * t * t / 6.0);
-            acc += (coef * vj * (-0.5 * (q - 1.0) * (q - 2.0)) / r) * xij;
+            w = vj * (t * t * t / 6.0);
+            fr = coef * vj * (-0.5 * (q - 1.0) * (q - 2.0)) / r;
           }
+          depth += w;
+          vsum += w * v[j];
+          vzsum += w * grad[j].dot(v[j]);
+          acc += fr * xij;
+          accz += fr * zij;
+          acc_c += (cb[j] * fr) * xij;
+          accz_c += cb[j] * fr * zij;
         });
+        vmean[i] = tangent_mean(i, vsum / depth, vzsum / depth);
         depth *= sigma;
         h[i] = depth;
-        ap[i] = acc;
+        ap[i] = on_bed(i, cb[i] * acc + acc_c, cb[i] * accz + accz_c);
         dv[i] = Vec2::Zero();
         signal = std::max(signal, signal_speed(i));
       }
       return signal;
     }
-    // Pass 1: depths.
+    // Pass 1: depths and mean velocities.
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
       double depth = vol[i] * w0;
+      Vec2 vsum = depth * v[i];
+      double vzsum = depth * grad[i].dot(v[i]);
       neighbours(i, [&](std::size_t j, const Vec2& xij, double /*r2*/) {
-        depth += vol[j] * CubicSpline<2>::value(xij.norm(), d0);
+        const double zij = dz(i, j, xij);
+        const double w = vol[j] * CubicSpline<2>::value(std::sqrt(xij.squaredNorm() + zij * zij), d0);
+        depth += w;
+        vsum += w * v[j];
+        vzsum += w * grad[j].dot(v[j]);
       });
       h[i] = depth;
+      vmean[i] = tangent_mean(i, vsum / depth, vzsum / depth);
     }
     // Pass 2: head pressure and velocity smoothing (needs every depth).
 #pragma omp parallel for reduction(max : signal) schedule(static) if (n >= kParallelMin)
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
       Vec2 acc = Vec2::Zero(), corr = Vec2::Zero();
+      double accz = 0.0;
       const Vec2 vi = v[i];
-      const double hi = h[i];
+      const double hi = h[i], ci = cb[i];
       neighbours(i, [&](std::size_t j, const Vec2& xij, double /*r2*/) {
-        const double r = xij.norm();
-        if (r > 0.0) acc += (coef * vol[j] * HeadPressureForce::shape(r * inv_d0) / r) * xij;
+        const double zij = dz(i, j, xij);
+        const double r = std::sqrt(xij.squaredNorm() + zij * zij);
+        if (r > 0.0) {
+          const double fr = (ci + cb[j]) * coef * vol[j] * HeadPressureForce::shape(r * inv_d0) / r;
+          acc += fr * xij;
+          accz += fr * zij;
+        }
         corr += (2.0 * vol[j] / (hi + h[j]) * CubicSpline<2>::value(r, d0)) * (v[j] - vi);
       });
-      ap[i] = acc;
+      ap[i] = on_bed(i, acc, accz);
       dv[i] = eps * corr;
       signal = std::max(signal, signal_speed(i));
     }
@@ -320,15 +402,20 @@ class RunoutSolver {
     auto& x = store_.get<Position<2>>();
     auto& v = store_.get<Velocity<2>>();
     auto& grad = store_.get<SurfaceGradient>();
+    auto& hess = store_.get<SurfaceCurvature>();
+    auto& cb = store_.get<BedCos>();
     auto& z = store_.get<Elevation>();
     auto& speed = store_.get<Speed>();
     auto& path = store_.get<PathLength>();
     auto& moving = store_.get<Moving>();
     auto& leaving = store_.get<Leaving>();
+    const auto& vol = store_.get<Volume>();
     const auto& h = store_.get<FlowDepth>();
     const auto& ap = store_.get<HeadAcceleration>();
     const auto& dv = store_.get<VelocityCorrection>();
-    const double g = p_.gravity;
+    const auto& vmean = store_.get<MeanVelocity>();
+    const double g = p_.gravity, mix = p_.lateral_mixing;
+    const bool curvature = p_.curvature;
     const bool periodic = periodic_.any();
     const std::int64_t n = static_cast<std::int64_t>(store_.size());
     int any_leaving = 0, any_non_finite = 0;
@@ -336,17 +423,31 @@ class RunoutSolver {
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
       const Vec2 gz = grad[i];
-      const double p2 = gz.squaredNorm();
-      const double cos_theta = 1.0 / std::sqrt(1.0 + p2);
-      // Gravity's component along the surface, projected on the map: −g∇z/(1+|∇z|²).
-      const Vec2 a = (-g / (1.0 + p2)) * gz + ap[i];
-      const Vec2 v_star = v[i] + dv[i] + dt * a;
+      const double cos_theta = cb[i];
+      const double h_n = std::max(h[i], p_.min_depth);
+      // a. Lateral mixing: implicit relaxation towards the neighbours' mean velocity at the rate
+      //    k = C_mix |ṽ − v|_s √(h_n/V) (com1DFA: C·½ρ|Δv|A_lat/m with A_lat = 2√(V h_n)).
+      Vec2 vi = v[i] + dv[i];
+      if (mix > 0.0) {
+        const Vec2 dm = vmean[i] - vi;
+        const double dmz = gz.dot(dm);
+        const double kdt = mix * std::sqrt(dm.squaredNorm() + dmz * dmz) * std::sqrt(h_n / vol[i]) * dt;
+        vi = (vi + kdt * vmean[i]) / (1.0 + kdt);
+      }
+      // b. Gravity along the bed and the head pressure: a = −g cos²θ p + a_p.
+      const Vec2 a = (-g * cos_theta * cos_theta) * gz + ap[i];
+      const Vec2 v_star = vi + dt * a;
+      // c. Basal friction on the surface speed with the bed-normal stress ρ g_n h_n,
+      //    g_n = cos θ (g + vᵀHv)⁺: gravity plus the centripetal acceleration of the bed curvature
+      //    along the velocity, zero when the particle would leave the bed.
+      const Vec3& H = hess[i];
+      const double kv = curvature ? H[0] * vi.x() * vi.x() + 2.0 * H[1] * vi.x() * vi.y() + H[2] * vi.y() * vi.y() : 0.0;
       const double vz = gz.dot(v_star);
       const double s_star = std::sqrt(v_star.squaredNorm() + vz * vz);
-      const double h_n = std::max(h[i] * cos_theta, p_.min_depth);
-      const FrictionTerms t = law.terms(g, g * cos_theta, h_n, s_star);
+      const FrictionTerms t = law.terms(g, std::max(g + kv, 0.0) * cos_theta, h_n, s_star);
       const double s = speed_after_friction(s_star, dt, t);
-      const Vec2 v_new = s > 0.0 ? Vec2(v_star * (s / s_star)) : Vec2::Zero();
+      Vec2 v_new = s > 0.0 ? Vec2(v_star * (s / s_star)) : Vec2::Zero();
+      const double moved = dt * v_new.norm();
       Vec2 x_new = x[i] + dt * v_new;
       if (periodic) x_new = periodic_.wrap(x_new);
       SurfaceSample smp;
@@ -357,12 +458,25 @@ class RunoutSolver {
         if (!(x[i].allFinite() && v_new.allFinite())) any_non_finite = 1;
         continue;
       }
+      // d. The bed constraint: the velocity, tangent to the bed at the old position, is turned into
+      //    the tangent plane at the new one keeping its magnitude S (the normal reaction does no
+      //    work; AvaFrame com1DFA's reprojection). In map view, with p' the new gradient:
+      //        v' ∝ v + p' ((p − p')·v)/(1 + |p'|²),   scaled so that |(v', p'·v')| = S.
+      if (s > 0.0) {
+        const Vec2 pn = smp.grad;
+        const Vec2 vt = v_new + (((gz - pn).dot(v_new)) / (1.0 + pn.squaredNorm())) * pn;
+        const double vtz = pn.dot(vt);
+        const double st = std::sqrt(vt.squaredNorm() + vtz * vtz);
+        if (st > 1e-12 * s) v_new = vt * (s / st);
+      }
       leaving[i] = 0;
-      path[i] += dt * v_new.norm();
+      path[i] += moved;
       x[i] = x_new;
       v[i] = v_new;
       z[i] = smp.z;
       grad[i] = smp.grad;
+      hess[i] = smp.hess;
+      cb[i] = 1.0 / std::sqrt(1.0 + smp.grad.squaredNorm());
       speed[i] = s;
       moving[i] = s > 0.0 ? 1 : 0;
       if (!(x_new.allFinite() && v_new.allFinite())) any_non_finite = 1;
@@ -404,8 +518,17 @@ class RunoutSolver {
   void update_budget() {
     const auto& vol = store_.get<Volume>();
     const auto& moving = store_.get<Moving>();
+    const auto& speed = store_.get<Speed>();
     budget_.mobile = budget_.deposited = 0.0;
-    for (std::size_t i = 0; i < store_.size(); ++i) (moving[i] ? budget_.mobile : budget_.deposited) += vol[i];
+    double ke = 0.0;
+    for (std::size_t i = 0; i < store_.size(); ++i) {
+      (moving[i] ? budget_.mobile : budget_.deposited) += vol[i];
+      ke += vol[i] * speed[i] * speed[i];
+    }
+    budget_.kinetic_energy = 0.5 * p_.density * ke;
+    budget_.peak_kinetic_energy = std::max(budget_.peak_kinetic_energy, budget_.kinetic_energy);
+    energy_stop_ = p_.stop_energy_fraction > 0.0 && budget_.peak_kinetic_energy > 0.0 &&
+                   budget_.kinetic_energy < p_.stop_energy_fraction * budget_.peak_kinetic_energy;
   }
 
   Surface surface_;
@@ -416,6 +539,7 @@ class RunoutSolver {
   CellPairScan<2> scan_;   // without (the default)
   VolumeBudget budget_;
   bool list_valid_ = false;
+  bool energy_stop_ = false;
   double time_ = 0.0, dt_ = 0.0;
   std::int64_t step_ = 0;
 };
