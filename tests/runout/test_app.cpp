@@ -3,6 +3,7 @@
 // the input, no output written).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -73,21 +74,24 @@ TEST(DebrisRunoutApp, TinyValleyRunsAndBalancesVolume) {
                      " --d0 2.5 --h0 0.75 --duration 60 --out " + out.string() + " --quiet --threads 1");
   ASSERT_EQ(r.code, 0) << r.output;
   for (const char* f :
-       {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "arrival_time.tif", "snapshots.h5",
-        "snapshots.xmf", "series.csv", "summary.json", "config.resolved.toml", "deposit.png", "max_speed.png"})
+       {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "mobile_at_end.tif", "arrival_time.tif",
+        "snapshots.h5",
+        "snapshots.xmf", "series.csv", "summary.json", "config.resolved.toml", "deposit.png", "max_speed.png", "max_depth.png"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
   const double read = j["volumes_m3"]["release_read"], seeded = j["volumes_m3"]["seeded"];
-  // Release: 3 m over the block 30–60 m down-valley, ±10 m across: about 3 × 30 × 20 m³ (cells
-  // whose centres fall inside).
+  // Release: 3 m (normal to the slope, the default) over the block 30–60 m down-valley, ±10 m
+  // across: about 3 × 30 × 20 m³ (cells whose centres fall inside; up to 10 % more for the slope).
   EXPECT_NEAR(read, 1800.0, 0.15 * 1800.0);
   EXPECT_NEAR(seeded, read, 1e-9 * read);
   EXPECT_LT(std::abs(j["mass_balance_error_relative"].get<double>()), 1e-12);
   const double dep = j["volumes_m3"]["deposited"], mob = j["volumes_m3"]["mobile"], lost = j["volumes_m3"]["lost"];
   EXPECT_NEAR(dep + mob + lost, read, 1e-9 * read);
-  // The kernel deposit map integrates to the volume still in the domain (grid quadrature, 2 %).
-  EXPECT_NEAR(j["volumes_m3"]["deposit_raster"].get<double>(), dep + mob, 0.02 * (dep + mob));
+  // The kernel deposit map (with the mass still moving at the end, if the run ended at its
+  // duration) integrates to the volume still in the domain (grid quadrature, 2 %).
+  EXPECT_NEAR(j["volumes_m3"]["deposit_raster"].get<double>() + j["volumes_m3"]["mobile_raster"].get<double>(),
+              dep + mob, 0.02 * (dep + mob));
   // Down a ≥ 0.24 gradient channel with i_cr = 0.15 the flow must travel far beyond its release
   // (≥ 100 m in 60 s), and the fahrböschung must be steeper than the energy line atan(0.15) = 8.5°
   // and gentler than the head slope atan(0.45) = 24°.
@@ -140,6 +144,9 @@ TEST(DebrisRunoutApp, BadInputsExitTwoAndWriteNothing) {
       {dsm.string() + " --release " + rel + " --duration 0", "run.duration"},
       {dsm.string() + " --release " + rel + " --set model.nonsense=3", "nonsense"},
       {dsm.string() + " --release " + rel + " --friction magic", "model.friction"},
+      {dsm.string() + " --release " + rel + " --set release.thickness_direction=sideways", "release.thickness_direction"},
+      {dsm.string() + " --release " + rel + " --set run.stop_energy_fraction=-0.1", "run.stop_energy_fraction"},
+      {dsm.string() + " --release " + rel + " --set numerics.lateral_mixing=-1", "numerics.lateral_mixing"},
       {dsm.string() + " --release " + far.string(), "outside the DSM"},
       {dsm.string() + " --release " + empty_poly.string(), "empty release"},
       {dsm.string(), "no release"},
@@ -256,4 +263,82 @@ TEST(DebrisRunoutApp, LibraryRunInProcessGivesTheAppsNumbers) {
   EXPECT_EQ(res.max_speed, j["max_speed_m_s"].get<double>());
   EXPECT_EQ(res.volumes.deposited, j["volumes_m3"]["deposited"].get<double>());
   EXPECT_EQ(std::string(geohaz::runout::to_string(res.ended)), j["ended_by"].get<std::string>());
+}
+
+TEST(DebrisRunoutApp, RunEndingAtItsDurationWithMassMovingSaysSo) {
+  // 5 s of flow and no energy criterion: most of the mass still moves. The run must say so on
+  // stdout and in summary.json, keep the moving mass out of deposit.tif and put it in
+  // mobile_at_end.tif (the two integrate to the volume in the domain).
+  const fs::path dsm = tiny_dsm();
+  const fs::path out = work_dir() / "unfinished_out";
+  fs::remove_all(out);
+  const auto r = run(dsm.string() + " --release " + (work_dir() / "tiny_release.tif").string() +
+                     " --d0 2.5 --h0 0.75 --duration 5 --set run.stop_energy_fraction=0 --out " + out.string() +
+                     " --quiet --threads 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("warning: the run ended at its duration"), std::string::npos) << r.output;
+  std::ifstream in(out / "summary.json");
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["ended_by"], "duration reached");
+  ASSERT_EQ(j["warnings"].size(), 1u);
+  EXPECT_GT(j["mobile_at_end"]["fraction"].get<double>(), 0.5);
+  EXPECT_FALSE(j["mobile_at_end"]["in_deposit_raster"].get<bool>());
+  const double dep = j["volumes_m3"]["deposited"], mob = j["volumes_m3"]["mobile"];
+  EXPECT_NEAR(j["volumes_m3"]["mobile_raster"].get<double>(), mob, 0.02 * mob);
+  EXPECT_NEAR(j["volumes_m3"]["deposit_raster"].get<double>(), dep, 0.02 * dep + 1e-9);
+}
+
+TEST(DebrisRunoutApp, KineticEnergyCriterionEndsTheRun) {
+  // With the default criterion (1 % of the peak kinetic energy) the tiny flow ends long before a
+  // 1000 s duration, by that criterion, and says which.
+  const fs::path dsm = tiny_dsm();
+  const fs::path out = work_dir() / "energy_out";
+  fs::remove_all(out);
+  const auto r = run(dsm.string() + " --release " + (work_dir() / "tiny_release.tif").string() +
+                     " --d0 2.5 --h0 0.75 --duration 1000 --out " + out.string() + " --quiet --threads 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::ifstream in(out / "summary.json");
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["ended_by"], "kinetic energy below the stop fraction of its peak");
+  EXPECT_LT(j["simulated_time_s"].get<double>(), 1000.0);
+  const double ke = j["kinetic_energy_j"]["at_end"], peak = j["kinetic_energy_j"]["peak"];
+  EXPECT_LT(ke, 0.01 * peak);
+  EXPECT_GT(peak, 0.0);
+  EXPECT_TRUE(j["warnings"].empty());
+}
+
+TEST(DebrisRunoutApp, ThicknessNormalToTheSlopeHoldsMoreVolume) {
+  // A plane falling 1:2 (cos θ = 2/√5) and a 40 m × 40 m polygon 1 m thick: measured vertically
+  // it holds 1600 m³ (64 cells of 25 m²), normal to the slope 1600/cos θ = 1788.9 m³.
+  const fs::path plane = work_dir() / "plane.tif";
+  {
+    geohaz::Raster r;
+    r.nx = r.ny = 40;
+    r.geotransform = {480000.0, 5.0, 0.0, 4310000.0, 0.0, -5.0};
+    r.crs_wkt = geohaz::runout::kSyntheticValleyCrsWkt;
+    r.data.resize(1600);
+    for (int row = 0; row < 40; ++row)
+      for (int col = 0; col < 40; ++col) r.data[static_cast<std::size_t>(row * 40 + col)] = 1000.0 - 0.5 * 5.0 * col;
+    geohaz::write_geotiff(plane, r);
+  }
+  const fs::path poly = work_dir() / "square.geojson";
+  {
+    std::ofstream f(poly);
+    f << R"({"type":"FeatureCollection","crs":{"type":"name","properties":{"name":"urn:ogc:def:crs:EPSG::32654"}},)"
+      << R"("features":[{"type":"Feature","properties":{"thickness":1.0},"geometry":{"type":"Polygon","coordinates":)"
+      << R"([[[480050,4309950],[480090,4309950],[480090,4309910],[480050,4309910],[480050,4309950]]]}}]})";
+  }
+  const auto volume = [&](const std::string& direction) {
+    const fs::path out = work_dir() / ("direction_" + direction);
+    fs::remove_all(out);
+    const auto r = run(plane.string() + " --release " + poly.string() + " --set release.thickness_direction=" +
+                       direction + " --duration 0.1 --out " + out.string() + " --quiet --threads 1");
+    EXPECT_EQ(r.code, 0) << r.output;
+    std::ifstream in(out / "summary.json");
+    const auto j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["release_thickness_direction"], direction);
+    return j["volumes_m3"]["release_read"].get<double>();
+  };
+  EXPECT_NEAR(volume("vertical"), 1600.0, 1e-9);
+  EXPECT_NEAR(volume("normal"), 1600.0 * std::sqrt(1.25), 1e-9);
 }

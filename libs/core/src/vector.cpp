@@ -1,5 +1,5 @@
 /// \file vector.cpp
-/// Polygons from OGR data sources (Shapefile, GeoJSON, GeoPackage, ...), see raster.hpp.
+/// Polygons and lines from OGR data sources (Shapefile, GeoJSON, GeoPackage, ...), see raster.hpp.
 
 #include <gdal_priv.h>
 #include <ogr_spatialref.h>
@@ -66,67 +66,86 @@ bool Polygon::contains(const Vec2& p) const noexcept {
   return true;
 }
 
+namespace {
+
+/// The first layer of an OGR data source, the index of a numeric attribute, and the transformation
+/// to a target CRS (null when the layer is already in it), shared by the polygon and line readers.
+struct VectorLayer {
+  std::unique_ptr<GDALDataset> ds;
+  OGRLayer* layer = nullptr;
+  int field = -1;
+  std::unique_ptr<OGRCoordinateTransformation> ct;
+
+  VectorLayer(const std::string& file, const std::string& attribute, const std::string& target_wkt,
+              const char* what) {
+    ds.reset(GDALDataset::Open(file.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
+    if (!ds) throw InputError("cannot read as a vector data source" + detail::gdal_last_error(), file);
+    if (ds->GetLayerCount() < 1) throw InputError("the data source has no layer", file);
+    layer = ds->GetLayer(0);
+    if (!layer) throw InputError("cannot open the first layer" + detail::gdal_last_error(), file);
+    if (!attribute.empty()) {
+      OGRFeatureDefn* defn = layer->GetLayerDefn();
+      field = defn->GetFieldIndex(attribute.c_str());
+      if (field < 0) {
+        std::string fields;
+        for (int i = 0; i < defn->GetFieldCount(); ++i)
+          fields += (i ? ", " : "") + std::string(defn->GetFieldDefn(i)->GetNameRef());
+        throw InputError("no attribute '" + attribute + "' in layer '" + layer->GetName() +
+                             "'; available fields: " + (fields.empty() ? "(none)" : fields),
+                         file, "attribute", attribute);
+      }
+      const OGRFieldType type = defn->GetFieldDefn(field)->GetType();
+      if (type != OFTInteger && type != OFTInteger64 && type != OFTReal)
+        throw InputError("attribute '" + attribute + "' is not numeric (" + OGRFieldDefn::GetFieldTypeName(type) + ")",
+                         file, "attribute", attribute);
+    }
+    // Reprojection to the target CRS when the layer's differs.
+    const OGRSpatialReference* layer_srs = layer->GetSpatialRef();
+    OGRSpatialReference target;
+    if (target_wkt.empty()) return;
+    if (!detail::parse_srs(target_wkt, target)) throw InputError("the target CRS cannot be interpreted", file, "", target_wkt);
+    if (!layer_srs || layer_srs->IsEmpty()) {
+      std::cerr << "warning: " << file << ": the " << what << " have no CRS; taken to be in the target CRS\n";
+      return;
+    }
+    const char* options[] = {"IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES", "CRITERION=EQUIVALENT_EXCEPT_AXIS_ORDER_GEOGCRS",
+                             nullptr};
+    if (layer_srs->IsSame(&target, options)) return;
+    OGRSpatialReference source(*layer_srs);
+    source.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    target.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    ct.reset(OGRCreateCoordinateTransformation(&source, &target));
+    if (!ct) throw InputError(std::string("cannot transform the ") + what + " to the target CRS" + detail::gdal_last_error(), file);
+  }
+
+  double value(const OGRFeature& f) const {
+    return (field >= 0 && f.IsFieldSetAndNotNull(field)) ? f.GetFieldAsDouble(field)
+                                                         : std::numeric_limits<double>::quiet_NaN();
+  }
+};
+
+void add_line(const OGRLineString* line, double attribute, std::vector<Polyline>& out) {
+  if (!line || line->getNumPoints() < 2) return;
+  Polyline p;
+  for (int i = 0; i < line->getNumPoints(); ++i) p.vertices.emplace_back(line->getX(i), line->getY(i));
+  p.attribute = attribute;
+  out.push_back(std::move(p));
+}
+
+}  // namespace
+
 std::vector<Polygon> read_polygons(const std::filesystem::path& path, const std::string& attribute,
                                    const std::string& target_wkt) {
   detail::ensure_gdal_registered();
   const std::string file = path.string();
   detail::QuietGdalErrors quiet;
-
-  std::unique_ptr<GDALDataset> ds(
-      GDALDataset::Open(file.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
-  if (!ds) throw InputError("cannot read as a vector data source" + detail::gdal_last_error(), file);
-  if (ds->GetLayerCount() < 1) throw InputError("the data source has no layer", file);
-  OGRLayer* layer = ds->GetLayer(0);
-  if (!layer) throw InputError("cannot open the first layer" + detail::gdal_last_error(), file);
-
-  int field = -1;
-  if (!attribute.empty()) {
-    OGRFeatureDefn* defn = layer->GetLayerDefn();
-    field = defn->GetFieldIndex(attribute.c_str());
-    if (field < 0) {
-      std::string fields;
-      for (int i = 0; i < defn->GetFieldCount(); ++i)
-        fields += (i ? ", " : "") + std::string(defn->GetFieldDefn(i)->GetNameRef());
-      throw InputError("no attribute '" + attribute + "' in layer '" + layer->GetName() +
-                           "'; available fields: " + (fields.empty() ? "(none)" : fields),
-                       file, "attribute", attribute);
-    }
-    const OGRFieldType type = defn->GetFieldDefn(field)->GetType();
-    if (type != OFTInteger && type != OFTInteger64 && type != OFTReal)
-      throw InputError("attribute '" + attribute + "' is not numeric (" + OGRFieldDefn::GetFieldTypeName(type) + ")",
-                       file, "attribute", attribute);
-  }
-
-  // Reprojection to the target CRS when the layer's differs.
-  std::unique_ptr<OGRCoordinateTransformation> ct;
-  const OGRSpatialReference* layer_srs = layer->GetSpatialRef();
-  OGRSpatialReference target;
-  if (!target_wkt.empty()) {
-    if (!detail::parse_srs(target_wkt, target))
-      throw InputError("the target CRS cannot be interpreted", file, "", target_wkt);
-    if (!layer_srs || layer_srs->IsEmpty()) {
-      std::cerr << "warning: " << file << ": the polygons have no CRS; taken to be in the target CRS\n";
-    } else {
-      const char* options[] = {"IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES",
-                               "CRITERION=EQUIVALENT_EXCEPT_AXIS_ORDER_GEOGCRS", nullptr};
-      if (!layer_srs->IsSame(&target, options)) {
-        OGRSpatialReference source(*layer_srs);
-        source.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-        target.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-        ct.reset(OGRCreateCoordinateTransformation(&source, &target));
-        if (!ct) throw InputError("cannot transform the polygons to the target CRS" + detail::gdal_last_error(), file);
-      }
-    }
-  }
-
+  VectorLayer v(file, attribute, target_wkt, "polygons");
   std::vector<Polygon> out;
-  layer->ResetReading();
-  for (auto& feature : *layer) {
+  v.layer->ResetReading();
+  for (auto& feature : *v.layer) {
     const OGRGeometry* g0 = feature->GetGeometryRef();
     if (!g0) continue;
-    const double value = (field >= 0 && feature->IsFieldSetAndNotNull(field))
-                             ? feature->GetFieldAsDouble(field)
-                             : std::numeric_limits<double>::quiet_NaN();
+    const double value = v.value(*feature);
     std::unique_ptr<OGRGeometry> g(g0->clone());
     const auto type = wkbFlatten(g->getGeometryType());
     if (type != wkbPolygon && type != wkbMultiPolygon) {
@@ -138,7 +157,7 @@ std::vector<Polygon> read_polygons(const std::filesystem::path& path, const std:
         continue;
       }
     }
-    if (ct && g->transform(ct.get()) != OGRERR_NONE)
+    if (v.ct && g->transform(v.ct.get()) != OGRERR_NONE)
       throw InputError("polygon " + std::to_string(feature->GetFID()) + " cannot be transformed to the target CRS" +
                            detail::gdal_last_error(),
                        file);
@@ -149,7 +168,44 @@ std::vector<Polygon> read_polygons(const std::filesystem::path& path, const std:
       for (const OGRPolygon* part : *g->toMultiPolygon()) add_polygon(part, value, out);
     }
   }
-  if (out.empty()) throw InputError("no polygon in the first layer ('" + std::string(layer->GetName()) + "')", file);
+  if (out.empty()) throw InputError("no polygon in the first layer ('" + std::string(v.layer->GetName()) + "')", file);
+  return out;
+}
+
+std::vector<Polyline> read_lines(const std::filesystem::path& path, const std::string& attribute,
+                                 const std::string& target_wkt) {
+  detail::ensure_gdal_registered();
+  const std::string file = path.string();
+  detail::QuietGdalErrors quiet;
+  VectorLayer v(file, attribute, target_wkt, "lines");
+  std::vector<Polyline> out;
+  v.layer->ResetReading();
+  for (auto& feature : *v.layer) {
+    const OGRGeometry* g0 = feature->GetGeometryRef();
+    if (!g0) continue;
+    std::unique_ptr<OGRGeometry> g(g0->clone());
+    auto type = wkbFlatten(g->getGeometryType());
+    if (type == wkbCircularString || type == wkbCompoundCurve || type == wkbMultiCurve) {
+      g.reset(g->getLinearGeometry());
+      if (!g) continue;
+      type = wkbFlatten(g->getGeometryType());
+    }
+    if (type != wkbLineString && type != wkbMultiLineString)
+      throw InputError("feature " + std::to_string(feature->GetFID()) + " is a " + OGRGeometryTypeToName(type) +
+                           ", not a line",
+                       file);
+    if (v.ct && g->transform(v.ct.get()) != OGRERR_NONE)
+      throw InputError("line " + std::to_string(feature->GetFID()) + " cannot be transformed to the target CRS" +
+                           detail::gdal_last_error(),
+                       file);
+    const double value = v.value(*feature);
+    if (type == wkbLineString) {
+      add_line(g->toLineString(), value, out);
+    } else {
+      for (const OGRLineString* part : *g->toMultiLineString()) add_line(part, value, out);
+    }
+  }
+  if (out.empty()) throw InputError("no line in the first layer ('" + std::string(v.layer->GetName()) + "')", file);
   return out;
 }
 

@@ -57,6 +57,12 @@ RunoutCase read_case(ConfigReader& cfg) {
   r.attribute = cfg.get_string("release.attribute", r.attribute, {"", "polygon attribute holding the thickness (m)"});
   r.depth = cfg.get("release.depth", r.depth, Range::closed(0.0, 200.0),
                     {"m", "uniform polygon release thickness; 0: use the attribute"});
+  const std::string dir =
+      cfg.get_choice("release.thickness_direction", to_string(r.direction), {"normal", "vertical"},
+                     {"",
+                      "how release thicknesses (attribute, release.depth, raster) are measured: normal to the "
+                      "slope (com1DFA, RAMMS) or vertically"});
+  r.direction = dir == "vertical" ? ThicknessDirection::Vertical : ThicknessDirection::Normal;
 
   auto& p = c.params;
   p.friction = read_friction(cfg);
@@ -79,8 +85,9 @@ RunoutCase read_case(ConfigReader& cfg) {
   p.skin = cfg.get("numerics.skin", p.skin, Range::closed(0.0, 2.0),
                    {"1", "neighbour-list skin in units of d0 (list rebuilt after skin·d0/2 of motion)"});
   p.lateral_mixing = cfg.get("numerics.lateral_mixing", p.lateral_mixing, Range::closed(0.0, 1e4),
-                             {"1", "C_mix of the lateral-mixing artificial viscosity (AvaFrame com1DFA's "
-                                   "subgridMixingFactor); 0: off"});
+                             {"1",
+                              "C_mix of the lateral-mixing artificial viscosity (AvaFrame com1DFA's "
+                              "subgridMixingFactor); 0: off"});
   p.smoothing = cfg.get("numerics.smoothing", p.smoothing, Range::closed(0.0, 1.0),
                         {"1", "velocity smoothing ε per step (Monaghan 1994 XSPH); 0: off"});
   const std::string norm = cfg.get_choice("numerics.pressure_normalisation", "consistent", {"consistent", "seed"},

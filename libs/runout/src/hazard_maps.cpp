@@ -86,14 +86,17 @@ double HazardMaps::affected_area() const {
   return static_cast<double>(n) * g_.cell_area();
 }
 
-std::vector<double> HazardMaps::deposit(const RunoutStore& store) const {
+std::vector<double> HazardMaps::deposit(const RunoutStore& store, ParticleSelection which) const {
   std::vector<double> t(g_.cells(), 0.0);
   const auto& x = store.get<Position<2>>();
   const auto& vol = store.get<Volume>();
+  const auto& moving = store.get<Moving>();
   const double support = 2.0 * d0_;
   const int rc = static_cast<int>(std::ceil(support / g_.dx)) + 1,
             rr = static_cast<int>(std::ceil(support / g_.dy)) + 1;
   for (std::size_t i = 0; i < store.size(); ++i) {
+    if ((which == ParticleSelection::Resting && moving[i]) || (which == ParticleSelection::Moving && !moving[i]))
+      continue;
     const double fc = (x[i].x() - g_.x0) / g_.dx, fr = (g_.y0 - x[i].y()) / g_.dy;
     const int c0 = static_cast<int>(std::floor(fc)), r0 = static_cast<int>(std::floor(fr));
     for (int r = std::max(0, r0 - rr); r <= std::min(g_.ny - 1, r0 + rr); ++r)

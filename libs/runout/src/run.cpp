@@ -62,6 +62,38 @@ void thickness_from_points(const Raster& dsm, std::vector<Vec2> pts, const std::
     throw InputError("release point " + std::to_string(outside) + " is outside the DSM", file);
 }
 
+/// cos θ of the DSM at the centre of cell (c, r): central differences (one-sided at edges and next
+/// to nodata; 1 where no neighbour holds data).
+double cell_cos(const Raster& dsm, int c, int r) {
+  const auto z = [&](int cc, int rr) {
+    if (cc < 0 || rr < 0 || cc >= dsm.nx || rr >= dsm.ny) return std::numeric_limits<double>::quiet_NaN();
+    const double v = dsm.at(cc, rr);
+    return dsm.is_nodata(v) ? std::numeric_limits<double>::quiet_NaN() : v;
+  };
+  const auto derivative = [&](double lo, double mid, double hi, double step) {
+    if (std::isfinite(lo) && std::isfinite(hi)) return (hi - lo) / (2.0 * step);
+    if (std::isfinite(hi) && std::isfinite(mid)) return (hi - mid) / step;
+    if (std::isfinite(lo) && std::isfinite(mid)) return (mid - lo) / step;
+    return 0.0;
+  };
+  const double zc = z(c, r);
+  const double gx = derivative(z(c - 1, r), zc, z(c + 1, r), dsm.cell_size_x());
+  const double gy = derivative(z(c, r + 1), zc, z(c, r - 1), dsm.cell_size_y());  // rows run south
+  return 1.0 / std::sqrt(1.0 + gx * gx + gy * gy);
+}
+
+/// A thickness measured normal to the slope becomes the vertical thickness t/cos θ of each cell.
+void normal_to_vertical(const Raster& dsm, RunoutInputs& in) {
+  const GridGeometry g = geometry_of(dsm);
+  in.volume = 0.0;
+  for (int r = 0; r < g.ny; ++r)
+    for (int c = 0; c < g.nx; ++c) {
+      double& t = in.thickness[g.index(c, r)];
+      if (t > 0.0) t /= cell_cos(dsm, c, r);
+      in.volume += t * g.cell_area();
+    }
+}
+
 bool is_vector_file(const std::string& path) {
   const std::string ext = fs::path(path).extension().string();
   return ext == ".shp" || ext == ".geojson" || ext == ".json" || ext == ".gpkg" || ext == ".kml" || ext == ".gml" ||
@@ -73,6 +105,7 @@ void read_release(const ReleaseSpec& r, const Raster& dsm, RunoutInputs& in) {
   if (!r.handoff.empty()) {
     in.source = r.handoff;
     const Handoff h = read_handoff(r.handoff);
+    in.from_handoff = true;
     thickness_from_points(dsm, h.points, h.volumes, h.crs_wkt, r.handoff, in);
     in.description = "points from " + r.handoff + " (source: " + h.source + ")";
     return;
@@ -97,7 +130,9 @@ void read_release(const ReleaseSpec& r, const Raster& dsm, RunoutInputs& in) {
       }
     if (pts.empty()) throw InputError("the release raster holds no positive thickness (empty release)", r.file);
     thickness_from_points(dsm, std::move(pts), vol, t.crs_wkt, r.file, in);
-    in.description = "thickness raster " + r.file;
+    if (r.direction == ThicknessDirection::Normal) normal_to_vertical(dsm, in);
+    in.description = "thickness raster " + r.file + " (thickness " +
+                     (r.direction == ThicknessDirection::Normal ? "normal to the slope)" : "vertical)");
     return;
   }
   const std::string attribute = r.depth > 0.0 ? "" : r.attribute;
@@ -126,9 +161,18 @@ void read_release(const ReleaseSpec& r, const Raster& dsm, RunoutInputs& in) {
   }
   in.volume = 0.0;
   for (double t : in.thickness) in.volume += t * g.cell_area();
+  if (r.direction == ThicknessDirection::Normal) normal_to_vertical(dsm, in);
   if (!(in.volume > 0.0))
     throw InputError("the release polygons cover no DSM cell with a positive thickness (empty release)", r.file);
-  in.description = "polygons " + r.file;
+  in.description = "polygons " + r.file + " (thickness " +
+                   (r.direction == ThicknessDirection::Normal ? "normal to the slope)" : "vertical)");
+}
+
+/// The message of a run that ended at its duration with mass still moving.
+std::string unfinished_warning(const RunoutResult& r) {
+  return "the run ended at its duration (" + fmt(r.simulated_time, 6) + " s) with " +
+         fmt(100.0 * r.mobile_fraction(), 3) + " % of the volume still moving (fastest " + fmt(r.max_speed_at_end, 3) +
+         " m/s): deposit.tif holds the resting mass only, the moving mass is in mobile_at_end.tif; raise run.duration";
 }
 
 /// Writes particle snapshots every output.snapshot_interval (and at the end) while a run goes.
@@ -207,6 +251,10 @@ GridSurface surface_for(const GridSurface& s, double d0) {
 
 GridGeometry geometry_of(const Raster& r) {
   return {r.nx, r.ny, r.geotransform[0], r.geotransform[3], r.cell_size_x(), r.cell_size_y()};
+}
+
+const char* to_string(ThicknessDirection d) noexcept {
+  return d == ThicknessDirection::Vertical ? "vertical" : "normal";
 }
 
 const char* to_string(RunEnd e) noexcept {
@@ -295,6 +343,17 @@ void RunoutSimulation::run(RunObserver* observer) {
   wall_time_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 }
 
+std::vector<double> RunoutSimulation::deposit() const {
+  const bool split = solver_.finished() && !solver_.stopped_by_energy() && !solver_.all_stopped();
+  return maps_.deposit(solver_.particles(), split ? ParticleSelection::Resting : ParticleSelection::All);
+}
+
+std::vector<double> RunoutSimulation::mobile_at_end() const {
+  const bool split = solver_.finished() && !solver_.stopped_by_energy() && !solver_.all_stopped();
+  if (!split) return std::vector<double>(in_.grid().cells(), 0.0);
+  return maps_.deposit(solver_.particles(), ParticleSelection::Moving);
+}
+
 RunoutResult RunoutSimulation::result() const {
   RunoutResult r;
   const auto& store = solver_.particles();
@@ -304,6 +363,8 @@ RunoutResult RunoutSimulation::result() const {
   r.max_pressure = r.max_speed * r.max_speed * parameters().density;
   r.affected_area = maps_.affected_area();
   for (double v : deposit()) r.deposit_raster_volume += v * in_.grid().cell_area();
+  for (double v : mobile_at_end()) r.mobile_raster_volume += v * in_.grid().cell_area();
+  for (double v : store.get<Speed>()) r.max_speed_at_end = std::max(r.max_speed_at_end, v);
   r.particles_released = seeded_.particles;
   r.particles_left = store.size();
   r.simulated_time = solver_.time();
@@ -312,10 +373,10 @@ RunoutResult RunoutSimulation::result() const {
   if (!solver_.finished())
     r.ended = RunEnd::Running;
   else
-    r.ended = store.empty()                   ? RunEnd::NoParticles
-              : solver_.all_stopped()         ? RunEnd::AllStopped
-              : solver_.stopped_by_energy()   ? RunEnd::KineticEnergy
-                                              : RunEnd::Duration;
+    r.ended = store.empty()                 ? RunEnd::NoParticles
+              : solver_.all_stopped()       ? RunEnd::AllStopped
+              : solver_.stopped_by_energy() ? RunEnd::KineticEnergy
+                                            : RunEnd::Duration;
   return r;
 }
 
@@ -335,13 +396,16 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
   const HazardMaps& maps = sim.maps();
   const Raster r_depth = map_raster(maps.max_depth(), 0.0), r_speed = map_raster(maps.max_speed(), 0.0),
                r_press = map_raster(maps.max_pressure(), 0.0), r_dep = map_raster(sim.deposit(), 0.0),
-               r_arr = map_raster(maps.arrival_time(), -9999.0);
+               r_mob = map_raster(sim.mobile_at_end(), 0.0), r_arr = map_raster(maps.arrival_time(), -9999.0);
   write_geotiff(out / "max_depth.tif", r_depth);
   write_geotiff(out / "max_speed.tif", r_speed);
   write_geotiff(out / "max_pressure.tif", r_press);
   write_geotiff(out / "deposit.tif", r_dep);
+  write_geotiff(out / "mobile_at_end.tif", r_mob);
   write_geotiff(out / "arrival_time.tif", r_arr);
   if (c.output.pngs) {
+    write_quicklook_png(out / "max_depth.png", dsm, &r_depth, ColourRamp::Viridis, "peak flow thickness (m)", 0.0, 0.0,
+                        0.01);
     write_quicklook_png(out / "deposit.png", dsm, &r_dep, ColourRamp::Viridis, "deposit thickness (m)", 0.0, 0.0, 0.01);
     write_quicklook_png(out / "max_speed.png", dsm, &r_speed, ColourRamp::Magma, "maximum speed (m/s)", 0.0, 0.0, 0.01);
   }
@@ -375,6 +439,16 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
   j["wall_time_s"] = res.wall_time;
   j["threads"] = threads;
   j["ended_by"] = to_string(res.ended);
+  j["stop_energy_fraction"] = sim.parameters().stop_energy_fraction;
+  j["kinetic_energy_j"] = {{"at_end", b.kinetic_energy}, {"peak", b.peak_kinetic_energy}};
+  j["mobile_at_end"] = {{"volume_m3", b.mobile},
+                        {"fraction", res.mobile_fraction()},
+                        {"max_speed_m_s", res.max_speed_at_end},
+                        {"in_deposit_raster", res.ended != RunEnd::Duration}};
+  j["release_thickness_direction"] = sim.inputs().from_handoff ? "volumes (hand-off)" : to_string(c.release.direction);
+  nlohmann::json warnings = nlohmann::json::array();
+  if (res.unfinished()) warnings.push_back(unfinished_warning(res));
+  j["warnings"] = warnings;
   j["runout_length_along_path_m"] = sum.runout_length;
   j["fahrboeschung"] = {
       {"drop_height_m", sum.drop_height},   {"reach_m", sum.reach},   {"ratio_H_over_L", sum.fahrboeschung},
@@ -388,7 +462,8 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
                      {"deposited", b.deposited},
                      {"mobile", b.mobile},
                      {"lost", b.lost},
-                     {"deposit_raster", res.deposit_raster_volume}};
+                     {"deposit_raster", res.deposit_raster_volume},
+                     {"mobile_raster", res.mobile_raster_volume}};
   j["lost_particles"] = b.lost_particles;
   j["mass_balance_error_relative"] = b.balance_error() / b.initial;
   write_text_file(out / "summary.json", j.dump(2) + "\n");
@@ -426,6 +501,7 @@ RunoutResult run_case(const RunoutCase& c, const fs::path& out, bool quiet, int 
               << "°), max speed " << fmt(r.max_speed, 3) << " m/s; deposited " << fmt(r.volumes.deposited, 8)
               << " m^3, mobile " << fmt(r.volumes.mobile, 8) << " m^3, lost " << fmt(r.volumes.lost, 8)
               << " m^3; outputs in " << out.string() << "\n";
+  if (r.unfinished()) std::cout << kModel << ": warning: " << unfinished_warning(r) << "\n";
   return r;
 }
 

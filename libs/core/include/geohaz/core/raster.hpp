@@ -106,6 +106,19 @@ struct Polygon {
 std::vector<Polygon> read_polygons(const std::filesystem::path& path, const std::string& attribute,
                                    const std::string& target_wkt);
 
+/// A polyline and the value of a requested attribute (NaN if not requested/absent).
+struct Polyline {
+  std::vector<Vec2> vertices;
+  double attribute = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// Read all lines (LineString, MultiLineString parts; curves linearised) of the first layer of an
+/// OGR data source, reprojected to `target_wkt` when it differs (and is not empty). `attribute`
+/// names a numeric field to read per line ("" for none). InputError when unreadable, empty, or
+/// when a feature is not a line (naming it).
+std::vector<Polyline> read_lines(const std::filesystem::path& path, const std::string& attribute,
+                                 const std::string& target_wkt);
+
 /// Colour ramps for quick-look pictures.
 enum class ColourRamp { Viridis, Magma, Terrain, BlueRed };
 

@@ -21,6 +21,9 @@
 
 namespace geohaz::runout {
 
+/// Which particles a thickness map is made of.
+enum class ParticleSelection { All, Resting, Moving };
+
 class HazardMaps {
  public:
   HazardMaps(GridGeometry grid, double d0, double density);
@@ -29,15 +32,16 @@ class HazardMaps {
   void record(const RunoutStore& store, double t);
 
   const GridGeometry& grid() const noexcept { return g_; }
-  const std::vector<double>& max_depth() const noexcept { return max_depth_; }  ///< m
+  const std::vector<double>& max_depth() const noexcept { return max_depth_; }  ///< m, normal to the bed
   const std::vector<double>& max_speed() const noexcept { return max_speed_; }  ///< m/s
   std::vector<double> max_pressure() const;  ///< Pa (ρ S²), from max_speed (exact: ρS² is monotone in S)
   const std::vector<double>& arrival_time() const noexcept { return arrival_; }  ///< s, NaN: never
   /// Area (m²) of the cells reached by the flow (max depth > 0).
   double affected_area() const;
 
-  /// Final deposit thickness (m) on the grid from the particles left (kernel sum).
-  std::vector<double> deposit(const RunoutStore& store) const;
+  /// Vertical thickness (m) on the grid of the particles selected (kernel sum; integrates to their
+  /// volume): the final deposit, or the mass still moving at the end.
+  std::vector<double> deposit(const RunoutStore& store, ParticleSelection which = ParticleSelection::All) const;
 
  private:
   GridGeometry g_;

@@ -32,12 +32,21 @@ class ConfigReader;
 
 namespace geohaz::runout {
 
+/// How a release thickness (polygon attribute, uniform depth or raster) is measured.
+enum class ThicknessDirection {
+  Normal,   ///< normal to the slope (AvaFrame com1DFA, RAMMS): a cell holds t/cos θ vertically
+  Vertical  ///< vertically: a cell holds t
+};
+const char* to_string(ThicknessDirection d) noexcept;
+
 /// Where the release comes from (exactly one of `file` and `handoff` is set).
 struct ReleaseSpec {
   std::string file;                     ///< polygons (Shapefile, GeoJSON, GPKG, …) or a thickness raster (m)
   std::string handoff;                  ///< hand-off file with points and volumes (sph-slope's release.h5)
   std::string attribute = "thickness";  ///< polygon attribute holding the thickness (m)
   double depth = 0.0;                   ///< uniform polygon thickness (m); 0: use the attribute
+  /// How `file`'s thicknesses are measured (a hand-off carries volumes: no direction).
+  ThicknessDirection direction = ThicknessDirection::Normal;
 };
 
 /// What to write besides the maps and the summary.
@@ -72,6 +81,7 @@ struct RunoutInputs {
   double volume = 0.0;            ///< release volume read (m³)
   std::string description;        ///< "polygons relAlr.shp", "points from release.h5 (…)"
   std::string source;             ///< the release file (for messages)
+  bool from_handoff = false;      ///< the release came as points with volumes
 
   const GridGeometry& grid() const noexcept { return surface.geometry(); }
 };
@@ -108,6 +118,13 @@ struct RunoutResult {
   double max_pressure = 0.0;           ///< Pa, ρ·(max speed)²
   double affected_area = 0.0;          ///< m², cells with max depth > 0
   double deposit_raster_volume = 0.0;  ///< m³, integral of the deposit raster
+  double mobile_raster_volume = 0.0;   ///< m³, integral of mobile_at_end
+  double max_speed_at_end = 0.0;       ///< m/s, fastest particle when the run ended
+  /// Fraction of the released volume still moving at the end (1).
+  double mobile_fraction() const noexcept { return volumes.initial > 0.0 ? volumes.mobile / volumes.initial : 0.0; }
+  /// The run ended at its duration with more than 1 % of the volume moving: the maps are of an
+  /// unfinished flow.
+  bool unfinished() const noexcept { return ended == RunEnd::Duration && mobile_fraction() > 0.01; }
   std::size_t particles_released = 0, particles_left = 0;
   double simulated_time = 0.0;  ///< s
   std::int64_t steps = 0;
@@ -136,8 +153,14 @@ class RunoutSimulation {
   const std::vector<SeriesRow>& series() const noexcept { return series_; }
   const SeedReport& seeded() const noexcept { return seeded_; }
   const RunoutInputs& inputs() const noexcept { return in_; }
-  /// Final deposit thickness on the DSM grid (m).
-  std::vector<double> deposit() const { return maps_.deposit(solver_.particles()); }
+  /// Final deposit thickness on the DSM grid (m, vertical). When the run ended at its duration with
+  /// mass still moving, only the resting particles: the moving ones are mobile_at_end(). Ended by
+  /// the kinetic-energy criterion (the flow has come to rest in the sense of practice), at rest, or
+  /// still running: every particle.
+  std::vector<double> deposit() const;
+  /// Thickness (m, vertical) of the particles still moving when the run ended at its duration
+  /// (zero otherwise).
+  std::vector<double> mobile_at_end() const;
   /// The key figures now.
   RunoutResult result() const;
 
