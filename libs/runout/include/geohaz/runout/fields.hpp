@@ -77,6 +77,13 @@ struct BedCos {
   static constexpr const char* label = "bed_cos";
   static constexpr const char* unit = "1";
 };
+/// Vertical component of the velocity along the bed, ∇z·v (m/s): with the map velocity, the 3D
+/// velocity of the particle.
+struct VerticalVelocity {
+  using type = double;
+  static constexpr const char* label = "vertical_velocity";
+  static constexpr const char* unit = "m/s";
+};
 /// Kernel mean of the neighbours' velocities, Σ_j V_j W_ij v_j / h_i, map view (m/s): what the
 /// lateral-mixing viscosity relaxes a particle towards (scratch of one step).
 struct MeanVelocity {
@@ -119,7 +126,7 @@ struct Leaving {
 /// The particle store of the debris-runout model.
 using RunoutStore =
     ParticleStore<Position<2>, Velocity<2>, ParticleId, Volume, FlowDepth, Speed, Elevation, StartElevation,
-                  StartPosition, PathLength, SurfaceGradient, SurfaceCurvature, BedCos, MeanVelocity,
+                  StartPosition, PathLength, SurfaceGradient, SurfaceCurvature, BedCos, VerticalVelocity, MeanVelocity,
                   HeadAcceleration, VelocityCorrection, ListPosition, Moving, Leaving>;
 
 }  // namespace geohaz::runout

@@ -132,6 +132,7 @@ class RunoutSolver {
       store_.get<BedCos>()[i] = 1.0 / std::sqrt(1.0 + s.grad.squaredNorm());
       const Vec2 v = store_.get<Velocity<2>>()[i];
       store_.get<Speed>()[i] = std::hypot(v.norm(), s.grad.dot(v));
+      store_.get<VerticalVelocity>()[i] = s.grad.dot(v);
       store_.get<Moving>()[i] = 1;
     }
     budget_ = {};
@@ -232,6 +233,7 @@ class RunoutSolver {
     const auto& z = store_.get<Elevation>();
     const auto& grad = store_.get<SurfaceGradient>();
     const auto& cb = store_.get<BedCos>();
+    const auto& vz = store_.get<VerticalVelocity>();
     auto& vmean = store_.get<MeanVelocity>();
     // Height difference of a pair. In a periodic domain (tests on an infinite plane) a neighbour
     // across the boundary is an image: its height is continued with i's bed slope.
@@ -244,7 +246,7 @@ class RunoutSolver {
     const double d0 = p_.d0;
     const double inv_d0 = 1.0 / d0;
     const double w0 = CubicSpline<2>::value(0.0, d0);
-    // ½ of the pair average ½(cos θ_i + cos θ_j) is folded into the constant.
+    // The ½ of the pair average ½(cos θ_i + cos θ_j) is folded into the constant.
     const double coef = 0.5 * p_.pressure_scale * p_.gravity * inv_d0 * inv_d0 * inv_d0;
     const double g = p_.gravity;
     const std::int64_t n = static_cast<std::int64_t>(store_.size());
@@ -271,16 +273,16 @@ class RunoutSolver {
     const double eps = p_.smoothing;
     double signal = 0.0;
     if (eps == 0.0) {
-      // One pass: depth, mean velocity and head pressure (none needs the neighbours' depths). The
-      // pressure sums Σ cos θ_j V_j f ê and Σ V_j f ê apart, so the pair average costs one load.
+      // One pass: depth, mean velocity and head pressure (none needs the neighbours' depths).
 #pragma omp parallel for reduction(max : signal) schedule(static) if (n >= kParallelMin)
       for (std::int64_t ii = 0; ii < n; ++ii) {
         const auto i = static_cast<std::size_t>(ii);
         double depth = vol[i] * (2.0 / 3.0);
         Vec2 vsum = depth * v[i];
-        double vzsum = depth * grad[i].dot(v[i]);
-        Vec2 acc = Vec2::Zero(), acc_c = Vec2::Zero();
-        double accz = 0.0, accz_c = 0.0;
+        double vzsum = depth * vz[i];
+        Vec2 acc = Vec2::Zero();
+        double accz = 0.0;
+        const double ci = cb[i];
         // W/σ (kernels.hpp) and f (head_pressure.hpp) written out per branch of q; the
         // arithmetic is exactly that of CubicSpline and HeadPressureForce::shape.
         neighbours(i, [&](std::size_t j, const Vec2& xij, double r2) {
@@ -301,16 +303,15 @@ class RunoutSolver {
           }
           depth += w;
           vsum += w * v[j];
-          vzsum += w * grad[j].dot(v[j]);
+          vzsum += w * vz[j];
+          fr *= ci + cb[j];
           acc += fr * xij;
           accz += fr * zij;
-          acc_c += (cb[j] * fr) * xij;
-          accz_c += cb[j] * fr * zij;
         });
         vmean[i] = tangent_mean(i, vsum / depth, vzsum / depth);
         depth *= sigma;
         h[i] = depth;
-        ap[i] = on_bed(i, cb[i] * acc + acc_c, cb[i] * accz + accz_c);
+        ap[i] = on_bed(i, acc, accz);
         dv[i] = Vec2::Zero();
         signal = std::max(signal, signal_speed(i));
       }
@@ -322,13 +323,13 @@ class RunoutSolver {
       const auto i = static_cast<std::size_t>(ii);
       double depth = vol[i] * w0;
       Vec2 vsum = depth * v[i];
-      double vzsum = depth * grad[i].dot(v[i]);
+      double vzsum = depth * vz[i];
       neighbours(i, [&](std::size_t j, const Vec2& xij, double /*r2*/) {
         const double zij = dz(i, j, xij);
         const double w = vol[j] * CubicSpline<2>::value(std::sqrt(xij.squaredNorm() + zij * zij), d0);
         depth += w;
         vsum += w * v[j];
-        vzsum += w * grad[j].dot(v[j]);
+        vzsum += w * vz[j];
       });
       h[i] = depth;
       vmean[i] = tangent_mean(i, vsum / depth, vzsum / depth);
@@ -404,6 +405,7 @@ class RunoutSolver {
     auto& grad = store_.get<SurfaceGradient>();
     auto& hess = store_.get<SurfaceCurvature>();
     auto& cb = store_.get<BedCos>();
+    auto& vzf = store_.get<VerticalVelocity>();
     auto& z = store_.get<Elevation>();
     auto& speed = store_.get<Speed>();
     auto& path = store_.get<PathLength>();
@@ -477,6 +479,7 @@ class RunoutSolver {
       grad[i] = smp.grad;
       hess[i] = smp.hess;
       cb[i] = 1.0 / std::sqrt(1.0 + smp.grad.squaredNorm());
+      vzf[i] = smp.grad.dot(v_new);
       speed[i] = s;
       moving[i] = s > 0.0 ? 1 : 0;
       if (!(x_new.allFinite() && v_new.allFinite())) any_non_finite = 1;
