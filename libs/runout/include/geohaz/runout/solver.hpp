@@ -295,7 +295,7 @@ class RunoutSolver {
           double w, fr;
           if (q < 1.0) {
             w = vj * (2.0 / 3.0 - q * q + 0.5 * q * q * q);
-            fr = r > 0.0 ? coef * vj * ((1.0 - q) / (1.0 + q)) / r : 0.0;
+            fr = r > 0.0 ? coef * vj * (1.0 - q) / ((1.0 + q) * r) : 0.0;  // one division
           } else {
             const double t = 2.0 - q;
             w = vj * (t * t * t / 6.0);
