@@ -151,6 +151,44 @@ TEST(Flows, SteadyUniformManningFlow) {
   EXPECT_NEAR(hmean, 2.0 * std::cos(th), 0.05);
 }
 
+TEST(Flows, SteadyUniformVoellmyFlow) {
+  // As above with Voellmy μ = 0.05, ξ = 500 m/s² on a steeper plane (tan θ = 0.3): the terminal
+  // speed balances g (sin θ − μ cos θ) = g S²/(ξ h_n), i.e. S = √(ξ h_n (sin θ − μ cos θ)) with h_n
+  // the bed-normal kernel depth (mean of g/(ξ h_n) over the particles for the momentum balance).
+  RunoutParameters p;
+  p.d0 = 2.0;
+  p.h0 = 1.0;
+  p.duration = 120.0;
+  const double mu = 0.05, xi = 500.0, tn = 0.3;
+  p.friction = VoellmyFriction{mu, xi};
+  const double d = p.d0 * std::sqrt(p.h0 / 2.0 * 2.0 / std::sqrt(3.0));
+  const int nx = 16, ny = 8;
+  InclinedPlane plane;
+  plane.slope = Vec2(-tn, 0.0);
+  // The lattice is laid on the bed: map spacing along the fall line d cos θ.
+  const double th = std::atan(tn);
+  RunoutSolver<InclinedPlane> s(
+      plane, p, box(Vec2(0, 0), Vec2(nx * d * std::cos(th), ny * d * std::sqrt(3.0) / 2.0), true, true));
+  hex_lattice(s.particles(), nx, ny, d, Vec2::Zero(), p.h0 * p.d0 * p.d0);
+  for (auto& x : s.particles().get<Position<2>>()) x.x() *= std::cos(th);
+  s.initialise();
+  while (!s.finished()) s.step();
+  const auto& hk = s.particles().get<FlowDepth>();
+  const auto& sp = s.particles().get<Speed>();
+  double kmean = 0.0, hmean = 0.0;
+  for (double h : hk) {
+    kmean += 1.0 / (xi * h) / static_cast<double>(hk.size());
+    hmean += h / static_cast<double>(hk.size());
+  }
+  const double v = std::sqrt((std::sin(th) - mu * std::cos(th)) / kmean);
+  const double v_voellmy = std::sqrt(xi * hmean * (std::sin(th) - mu * std::cos(th)));
+  std::printf("steady Voellmy: S = %.4f m/s (momentum balance %.4f, mean-depth formula %.4f), h_n %.4f m\n", sp[0], v,
+              v_voellmy, hmean);
+  for (std::size_t i = 0; i < sp.size(); ++i) EXPECT_NEAR(sp[i], v, 5e-3 * v);
+  EXPECT_NEAR(v, v_voellmy, 0.01 * v_voellmy);
+  EXPECT_NEAR(hmean, 2.0, 0.05);  // the layer keeps its bed-normal depth
+}
+
 namespace {
 // Dam break on a flat frictionless bed: reservoir of depth h for −L < x < 0, periodic across y.
 struct DamBreak {
