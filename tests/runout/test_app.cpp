@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "geohaz/core/raster.hpp"
-#include "geohaz/core/handoff.hpp"
-#include "geohaz/core/snapshot.hpp"
 #include "geohaz/core/config.hpp"
+#include "geohaz/core/handoff.hpp"
+#include "geohaz/core/raster.hpp"
+#include "geohaz/core/snapshot.hpp"
 #include "geohaz/runout/run.hpp"
 #include "geohaz/runout/synthetic_terrain.hpp"
 #include "run_command.hpp"
@@ -28,7 +28,9 @@ namespace {
 using Result = geohaz::testing::CommandResult;
 
 // Run the app through the shell, capturing stdout+stderr.
-Result run(const std::string& args) { return geohaz::testing::run_command(std::string(DEBRIS_RUNOUT_EXE) + " " + args); }
+Result run(const std::string& args) {
+  return geohaz::testing::run_command(std::string(DEBRIS_RUNOUT_EXE) + " " + args);
+}
 
 fs::path work_dir() {
   const fs::path d = fs::path(GEOHAZ_BINARY_DIR) / "tests" / "runout" / "app_work";
@@ -73,10 +75,9 @@ TEST(DebrisRunoutApp, TinyValleyRunsAndBalancesVolume) {
   const auto r = run(dsm.string() + " --release " + (work_dir() / "tiny_release.tif").string() +
                      " --d0 2.5 --h0 0.75 --duration 60 --out " + out.string() + " --quiet --threads 1");
   ASSERT_EQ(r.code, 0) << r.output;
-  for (const char* f :
-       {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "mobile_at_end.tif", "arrival_time.tif",
-        "snapshots.h5",
-        "snapshots.xmf", "series.csv", "summary.json", "config.resolved.toml", "deposit.png", "max_speed.png", "max_depth.png"})
+  for (const char* f : {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "mobile_at_end.tif",
+                        "arrival_time.tif", "snapshots.h5", "snapshots.xmf", "series.csv", "summary.json",
+                        "config.resolved.toml", "deposit.png", "max_speed.png", "max_depth.png"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
@@ -144,7 +145,8 @@ TEST(DebrisRunoutApp, BadInputsExitTwoAndWriteNothing) {
       {dsm.string() + " --release " + rel + " --duration 0", "run.duration"},
       {dsm.string() + " --release " + rel + " --set model.nonsense=3", "nonsense"},
       {dsm.string() + " --release " + rel + " --friction magic", "model.friction"},
-      {dsm.string() + " --release " + rel + " --set release.thickness_direction=sideways", "release.thickness_direction"},
+      {dsm.string() + " --release " + rel + " --set release.thickness_direction=sideways",
+       "release.thickness_direction"},
       {dsm.string() + " --release " + rel + " --set run.stop_energy_fraction=-0.1", "run.stop_energy_fraction"},
       {dsm.string() + " --release " + rel + " --set numerics.lateral_mixing=-1", "numerics.lateral_mixing"},
       {dsm.string() + " --release " + far.string(), "outside the DSM"},
@@ -244,8 +246,9 @@ TEST(DebrisRunoutApp, LibraryRunInProcessGivesTheAppsNumbers) {
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
 
-  auto cfg = geohaz::ConfigReader::from_string("[model]\nd0 = 2.5\nh0 = 0.75\n[run]\nduration = 20\n[terrain]\ndsm = \"" +
-                                               dsm.string() + "\"\n[release]\nfile = \"" + rel.string() + "\"\n");
+  auto cfg =
+      geohaz::ConfigReader::from_string("[model]\nd0 = 2.5\nh0 = 0.75\n[run]\nduration = 20\n[terrain]\ndsm = \"" +
+                                        dsm.string() + "\"\n[release]\nfile = \"" + rel.string() + "\"\n");
   const geohaz::runout::RunoutCase c = geohaz::runout::read_case(cfg);
   cfg.finish();
   const geohaz::runout::RunoutInputs inputs = geohaz::runout::load_inputs(c);
@@ -331,8 +334,9 @@ TEST(DebrisRunoutApp, ThicknessNormalToTheSlopeHoldsMoreVolume) {
   const auto volume = [&](const std::string& direction) {
     const fs::path out = work_dir() / ("direction_" + direction);
     fs::remove_all(out);
-    const auto r = run(plane.string() + " --release " + poly.string() + " --set release.thickness_direction=" +
-                       direction + " --duration 0.1 --out " + out.string() + " --quiet --threads 1");
+    const auto r =
+        run(plane.string() + " --release " + poly.string() + " --set release.thickness_direction=" + direction +
+            " --duration 0.1 --out " + out.string() + " --quiet --threads 1");
     EXPECT_EQ(r.code, 0) << r.output;
     std::ifstream in(out / "summary.json");
     const auto j = nlohmann::json::parse(in);

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "geohaz/runout/solver.hpp"
+#include "line_fit.hpp"
 
 using namespace geohaz;
 using namespace geohaz::runout;
@@ -123,21 +124,13 @@ TEST(DamBreakRitter, RarefactionTravelsBackAtSqrtGH) {
   // slope, −1/(3t), checks the whole fan.
   const auto& s = dam_break();
   const double c = std::sqrt(kG * kH), t = s.t;
-  double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
-  int n = 0;
+  geohaz::testing::LineFit fan;
   for (std::size_t i = 0; i < s.x.size(); ++i) {
     const double x = s.x[i].x();
-    if (x <= -0.7 * c * t || x >= 0.4 * c * t) continue;
-    const double y = std::sqrt(kG * s.h[i]);
-    sx += x;
-    sy += y;
-    sxx += x * x;
-    sxy += x * y;
-    ++n;
+    if (x > -0.7 * c * t && x < 0.4 * c * t) fan.add(x, std::sqrt(kG * s.h[i]));
   }
-  ASSERT_GT(n, 300);
-  const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx), intercept = (sy - slope * sx) / n;
-  const double head = (c - intercept) / slope;
+  ASSERT_GT(fan.count(), 300u);
+  const double slope = fan.slope(), head = fan.x_at(c);
   std::printf("fan: head at %.3f m = %.4f (-c t), slope %.5f 1/s = %.4f (-1/(3t))\n", head, head / (-c * t), slope,
               slope / (-1.0 / (3.0 * t)));
   EXPECT_NEAR(head / (-c * t), 1.0, 0.05);

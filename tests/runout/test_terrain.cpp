@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "geohaz/runout/solver.hpp"
+#include "line_fit.hpp"
 
 using namespace geohaz;
 using namespace geohaz::runout;
@@ -77,25 +78,18 @@ FanEdges dam_break_on_incline(double theta_deg, double tan_delta, double t_end, 
   const double c0 = std::sqrt(kG * std::cos(th) * H);
   const double m = kG * (std::sin(th) - std::cos(th) * tan_delta);
   const double shift = 0.5 * m * t * t;
-  double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
-  int n = 0;
+  geohaz::testing::LineFit fan;
   const auto& x = st.get<Position<2>>();
   const auto& h = st.get<FlowDepth>();
   for (std::size_t i = 0; i < st.size(); ++i) {
     const double sp = x[i].x() / std::cos(th) - shift;
-    if (sp <= -0.7 * c0 * t || sp >= 0.4 * c0 * t) continue;
-    const double y = std::sqrt(kG * std::cos(th) * h[i]);  // √(g cos θ h_n), h is bed-normal
-    sx += sp;
-    sy += y;
-    sxx += sp * sp;
-    sxy += sp * y;
-    ++n;
+    // √(g cos θ h_n); h is bed-normal.
+    if (sp > -0.7 * c0 * t && sp < 0.4 * c0 * t) fan.add(sp, std::sqrt(kG * std::cos(th) * h[i]));
   }
-  EXPECT_GT(n, 300);
-  const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx), intercept = (sy - slope * sx) / n;
+  EXPECT_GT(fan.count(), 300u);
   FanEdges e;
-  e.back = (c0 - intercept) / slope / (-c0 * t);
-  e.front = -intercept / slope / (2.0 * c0 * t);
+  e.back = fan.x_at(c0) / (-c0 * t);
+  e.front = fan.x_at(0.0) / (2.0 * c0 * t);
   std::printf(
       "dam break at %.0f°, tan δ = %.2f, C_mix = %g, d0 = %g m, t = %.2f s: back edge %.4f, front edge %.4f of the "
       "analytic\n",
