@@ -3,6 +3,10 @@
 #include "geohaz/core/config.hpp"
 
 #include <filesystem>
+#include <initializer_list>
+#include <string>
+
+#include "geohaz/core/errors.hpp"
 
 #include "geohaz/runout/run.hpp"
 
@@ -27,6 +31,22 @@ BasalFriction read_friction(ConfigReader& cfg) {
       cfg.get("model.mu", voellmy.mu, Range::closed(0.0, 2.0), {"1", "Coulomb coefficient (voellmy, coulomb)"});
   const double xi = cfg.get("model.xi", voellmy.xi, Range::open_closed(0.0, 1e5),
                             {"m/s^2", "Voellmy turbulence coefficient (voellmy)"});
+  // A coefficient the chosen law does not use is a mistake, not something to ignore silently.
+  const auto used_by = [&](const char* key, std::initializer_list<const char*> laws) {
+    if (!cfg.has(key)) return;
+    for (const char* l : laws)
+      if (law == l) return;
+    std::string names;
+    for (const char* l : laws) names += (names.empty() ? "" : " or ") + std::string(l);
+    throw InputError(std::string(key) + " is given but model.friction = " + law + " does not use it (it belongs to " +
+                         names + "; set model.friction or --friction)",
+                     cfg.source().empty() ? "command line" : cfg.source(), key);
+  };
+  used_by("model.n", {ModifiedManningFriction::name});
+  used_by("model.icr", {ModifiedManningFriction::name});
+  used_by("model.m", {ModifiedManningFriction::name});
+  used_by("model.mu", {VoellmyFriction::name, CoulombFriction::name});
+  used_by("model.xi", {VoellmyFriction::name});
   if (law == VoellmyFriction::name) return VoellmyFriction{mu, xi};
   if (law == CoulombFriction::name) return CoulombFriction{mu};
   return ModifiedManningFriction{n, icr, m};
