@@ -6,6 +6,12 @@
 #include "geohaz/core/app.hpp"
 #include "geohaz/core/config.hpp"
 #include "geohaz/core/errors.hpp"
+#include "geohaz/core/resources.hpp"
+
+#include <omp.h>
+
+#include <limits>
+#include <new>
 
 namespace geohaz {
 namespace {
@@ -215,6 +221,127 @@ TEST(InputError, MessageCarriesContext) {
   InputError e("must be positive", "run.toml", "duration", "-3");
   EXPECT_EQ(std::string(e.what()), "run.toml: 'duration' = '-3': must be positive");
   EXPECT_EQ(e.reason(), "must be positive");
+}
+
+
+// ---- issue #12: what the fuzzer found in the config reader, the command line and run_main ----
+
+/// The message of the InputError `f` throws ("" when it throws none).
+template <class F>
+std::string input_error_of(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(App, IoAndSystemFailuresExitWithThree) {
+  EXPECT_EQ(run_main("t", []() -> int { throw IoError("No space left on device", "out/a.tif"); }), kExitIoError);
+  EXPECT_EQ(run_main("t", []() -> int { throw std::bad_alloc(); }), kExitIoError);
+  EXPECT_EQ(run_main("t", []() -> int {
+              throw std::filesystem::filesystem_error("rename", std::make_error_code(std::errc::no_space_on_device));
+            }),
+            kExitIoError);
+  EXPECT_EQ(kExitIoError, 3);
+}
+
+TEST(App, ThreadsAboveTheHardwareAreCapped) {
+  // 99999 threads crashed the OpenMP runtime; 2147483647 ran it out of memory.
+  const int hw = omp_get_num_procs();
+  EXPECT_EQ(setup_threads(99999), hw);
+  EXPECT_EQ(setup_threads(2147483647), hw);
+  EXPECT_EQ(setup_threads(1), 1);
+  EXPECT_THROW(setup_threads(-1), InputError);
+  setup_threads(hw);
+}
+
+TEST(App, StrayPositionalArgumentIsRejected) {
+  boost::program_options::options_description desc;
+  CommonOptions o;
+  add_common_options(desc, o, "out");
+  const char* argv[] = {"app", "--config", "a.toml", "extra"};
+  EXPECT_THROW(parse_command_line(4, argv, "app", "", desc), InputError);
+}
+
+TEST(Config, InfinityIsOutsideEveryRange) {
+  for (const char* text : {"t = inf", "t = +inf", "t = -inf", "t = nan"}) {
+    EXPECT_THROW(ConfigReader::from_string(text).get("t", 1.0, Range::positive(), {"s", ""}), InputError) << text;
+    EXPECT_THROW(ConfigReader::from_string(text).get("t", 1.0, Range::non_negative(), {"s", ""}), InputError) << text;
+    EXPECT_THROW(ConfigReader::from_string(text).get("t", 1.0, Range{}, {"s", ""}), InputError) << text;
+  }
+  const std::string msg = input_error_of(
+      [] { ConfigReader::from_string("[run]\nend_time = inf").get("run.end_time", 1.0, Range::positive(), {"s", ""}); });
+  EXPECT_NE(msg.find("not a finite number"), std::string::npos) << msg;
+  EXPECT_THROW(ConfigReader::from_string("a = [1.0, inf]").get_array("a", {}, Range{}, {"m", ""}), InputError);
+}
+
+TEST(Config, MalformedIndexInSetIsAnInputErrorNamingTheKey) {
+  // Each of these ended in "error: stol", exit 1.
+  for (const char* set : {"material[abc].density=1", "material[].density=1", "material[99999999999999999999].density=1",
+                          "material[-1].density=1", "material[0.density=1", "material]0[.density=1", ".density=1",
+                          "material..density=1"}) {
+    auto r = ConfigReader::from_string("[[material]]\ndensity = 1800.0\n", "case.toml");
+    const std::string msg = input_error_of([&] { r.apply_override(set); });
+    EXPECT_NE(msg.find("command line (--set)"), std::string::npos) << set << ": " << msg;
+    EXPECT_EQ(msg.find("case.toml"), std::string::npos) << set << ": " << msg;
+  }
+  auto r = ConfigReader::from_string("[[material]]\ndensity = 1800.0\n", "case.toml");
+  r.apply_override("material[0].density=2000");
+  EXPECT_EQ(r.tables("material", {"", ""})[0].get("density", 1.0, Range::positive(), {"", ""}), 2000.0);
+}
+
+TEST(Config, SetErrorsNameTheCommandLine) {
+  auto r = ConfigReader::from_string("[run]\nend_time = 1.0\n", "case.toml");
+  r.apply_override("run.end_time=-5");
+  const std::string range = input_error_of([&] { r.get("run.end_time", 1.0, Range::positive(), {"s", ""}); });
+  EXPECT_NE(range.find("command line (--set)"), std::string::npos) << range;
+  auto r2 = ConfigReader::from_string("[run]\nend_time = 1.0\n", "case.toml");
+  r2.apply_override("run.typo=1");
+  r2.get("run.end_time", 1.0, Range::positive(), {"s", ""});
+  const std::string unknown = input_error_of([&] { r2.finish(); });
+  EXPECT_NE(unknown.find("command line (--set)"), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("run.typo"), std::string::npos) << unknown;
+  // A value from the file still names the file.
+  auto r3 = ConfigReader::from_string("[run]\nend_time = -1.0\n", "case.toml");
+  EXPECT_NE(input_error_of([&] { r3.get("run.end_time", 1.0, Range::positive(), {"s", ""}); }).find("case.toml"),
+            std::string::npos);
+}
+
+TEST(Config, SetCannotReplaceATableByAValueOrAValueByATable) {
+  // "--set run=5" used to drop the whole [run] table and fail later on an unrelated key.
+  auto r = ConfigReader::from_string("[run]\nend_time = 1.0\nscenario = \"column\"\n", "case.toml");
+  const std::string msg = input_error_of([&] { r.apply_override("run=5"); });
+  EXPECT_NE(msg.find("'run'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("is a table"), std::string::npos) << msg;
+  EXPECT_THROW(r.apply_override("run.end_time.x=1"), InputError);
+  EXPECT_THROW(r.apply_override("run={end_time=2}"), InputError);
+  auto m = ConfigReader::from_string("[[material]]\ndensity = 1.0\n");
+  EXPECT_THROW(m.apply_override("material=5"), InputError);
+  EXPECT_THROW(m.apply_override("material[0]=5"), InputError);
+}
+
+TEST(Config, EmptyArrayMayBeSetWhenTheDefaultIsEmpty) {
+  auto r = ConfigReader::from_string("[run]\nvelocity_png_times = [0.1]\n");
+  r.apply_override("run.velocity_png_times=[]");
+  EXPECT_TRUE(r.get_array("run.velocity_png_times", {}, Range::non_negative(), {"s", ""}).empty());
+  auto r2 = ConfigReader::from_string("a = []");
+  EXPECT_THROW(r2.get_array("a", {1.0, 2.0}, Range{}, {"", ""}), InputError);  // non-empty default
+  auto r3 = ConfigReader::from_string("a = []");
+  EXPECT_THROW(r3.require_array("a", Range{}, {"", ""}), InputError);
+}
+
+TEST(Resources, MemoryBeyondTheMachineIsAnInputErrorNamingKeyAndEstimate) {
+  EXPECT_GT(available_memory_bytes(), 0.0);
+  EXPECT_NO_THROW(check_memory(1e6, "a little", "case.toml", "numerics.spacing"));
+  const std::string msg =
+      input_error_of([] { check_memory(1e18, "1e15 particles × 1 kB", "case.toml", "numerics.spacing", "1e-6"); });
+  EXPECT_NE(msg.find("numerics.spacing"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("1.0 EB"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("1e15 particles"), std::string::npos) << msg;
+  EXPECT_THROW(check_memory(std::numeric_limits<double>::infinity(), "", "", "k"), InputError);
+  EXPECT_THROW(check_memory(std::numeric_limits<double>::quiet_NaN(), "", "", "k"), InputError);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
 #include "geohaz/core/progress.hpp"
+#include "child_process.hpp"
 
 namespace fs = std::filesystem;
 
@@ -90,6 +91,36 @@ TEST(Progress, DurationFormat) {
   EXPECT_EQ(format_duration(185), "3m05s");
   EXPECT_EQ(format_duration(3720), "1h02m");
   EXPECT_EQ(format_duration(-1), "--");
+}
+
+
+// A full disk (simulated by a 1 kB file size limit in a child process): the write fails with an
+// IoError naming the file, and neither the file nor its ".partial" is left behind.
+TEST(AtomicTextFile, FullDiskIsAnIoErrorAndLeavesNothing) {
+  const auto d = temp_dir("full");
+  testing::ChildLimits lim;
+  lim.file_size = 1000;
+  const auto r = testing::run_in_child(
+      [&] {
+        try {
+          write_text_file(d / "big.csv", std::string(100000, 'x'));
+        } catch (const IoError& e) {
+          return e.file() == (d / "big.csv").string() ? 3 : 4;
+        }
+        return 0;
+      },
+      lim);
+  ASSERT_TRUE(r.exited) << r.describe();
+  EXPECT_EQ(r.code, 3);
+  EXPECT_FALSE(fs::exists(d / "big.csv"));
+  EXPECT_FALSE(fs::exists(d / "big.csv.partial"));
+  EXPECT_THROW(AtomicTextFile(d / "no_such_dir" / "a.csv"), IoError);
+}
+
+TEST(Progress, EtaOfAVeryLongRunDoesNotOverflow) {
+  // An end time of 1e30 s gave an ETA beyond INT_MAX hours (undefined behaviour, garbage text).
+  EXPECT_EQ(format_duration(1e30), ">99999h");
+  EXPECT_EQ(format_duration(99998.0 * 3600.0), "99998h00m");
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include "geohaz/core/particles.hpp"
 #include "geohaz/core/snapshot.hpp"
 #include "geohaz/core/vec.hpp"
+#include "child_process.hpp"
 
 namespace geohaz {
 namespace {
@@ -544,6 +545,57 @@ TEST(Snapshot, ReadableWhileWriterInAnotherProcessIsAlive) {
   for (int fd : {to_parent[0], to_parent[1], to_child[0], to_child[1]}) ::close(fd);
   EXPECT_EQ(count, 1u);
   EXPECT_EQ(density, make_store(4, 0).get<Density>());
+}
+
+
+// A full disk mid-run (a 300 kB file size limit in a child process; each big snapshot needs about
+// 1.3 MB): the writer refuses the snapshot that does not fit with an IoError before touching the
+// file, so the snapshots written before stay readable, the .xmf lists exactly them, and the
+// process ends normally (with HDF5 1.10 a failed flush used to crash in HDF5's atexit clean-up).
+TEST(Snapshot, FullDiskKeepsTheSnapshotsSoFarReadable) {
+  TempDir tmp("full");
+  const fs::path h5 = tmp.path() / "full.h5";
+  testing::ChildLimits lim;
+  lim.file_size = 300 * 1000;
+  const auto r = testing::run_in_child(
+      [&] {
+        SnapshotWriter w(h5, "sph-slope", 2, "[run]\n");
+        w.write(make_store(8, 0), 0.0, 0);
+        w.write(make_store(8, 1), 0.5, 50);
+        try {
+          for (int k = 2; k < 10; ++k) w.write(make_store(20000, k), k, 100 * k);
+        } catch (const IoError&) {
+          return 3;
+        }
+        return 0;
+      },
+      lim);
+  ASSERT_TRUE(r.exited) << r.describe() << "\n" << r.err;
+  ASSERT_EQ(r.code, 3) << r.err;
+  SnapshotReader rd(h5);
+  ASSERT_EQ(rd.snapshot_count(), 2u);
+  expect_snapshot_equals(rd, 1, make_store(8, 1));
+  expect_xdmf_consistent(tmp.path() / "full.xmf", rd, "full.h5");
+  EXPECT_FALSE(fs::exists(tmp.path() / "full.xmf.partial"));
+}
+
+// A run whose end time falls on a snapshot time wrote its last state twice (every particle listed
+// twice at that time in ParaView): the same step and time is written once.
+TEST(Snapshot, SameStepAndTimeIsWrittenOnce) {
+  TempDir tmp("twice");
+  const fs::path h5 = tmp.path() / "twice.h5";
+  {
+    SnapshotWriter w(h5, "dem-avalanche", 2, "");
+    w.write(make_store(4, 0), 0.0, 0);
+    w.write(make_store(4, 1), 1.0, 10);
+    w.write(make_store(4, 1), 1.0, 10);
+    EXPECT_EQ(w.snapshot_count(), 2u);
+    w.write(make_store(4, 2), 1.0, 11);  // a later step at the same time is a new state
+    EXPECT_EQ(w.snapshot_count(), 3u);
+  }
+  SnapshotReader rd(h5);
+  EXPECT_EQ(rd.snapshot_count(), 3u);
+  expect_xdmf_consistent(tmp.path() / "twice.xmf", rd, "twice.h5");
 }
 
 }  // namespace

@@ -2,7 +2,10 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <iostream>
+#include <new>
+#include <system_error>
 
 #include "geohaz/core/errors.hpp"
 
@@ -27,11 +30,13 @@ bool parse_command_line(int argc, const char* const* argv, const std::string& ap
                         po::options_description& desc, po::positional_options_description* positional) {
   po::variables_map vm;
   try {
-    auto parser = po::command_line_parser(argc, argv).options(desc);
-    if (positional) parser.positional(*positional);
+    // Without a positional description of its own an app takes no positional argument: an empty
+    // one makes Boost reject a stray word ("too many positional options") instead of ignoring it.
+    const po::positional_options_description none;
+    auto parser = po::command_line_parser(argc, argv).options(desc).positional(positional ? *positional : none);
     po::store(parser.run(), vm);
     if (vm.count("help")) {
-      std::cout << app << " " << GEOHAZ_VERSION << ": " << summary << "\n\n" << desc << "\n";
+      std::cout << app << " " << GEOHAZ_VERSION << ": " << summary << "\n\n" << desc << "\n" << kExitCodesHelp << "\n";
       return false;
     }
     if (vm.count("version")) {
@@ -54,6 +59,14 @@ ConfigReader load_config(const CommonOptions& opts) {
 
 int setup_threads(int threads) {
   if (threads < 0) throw InputError("must be ≥ 0 (0 uses all cores)", "command line", "--threads", std::to_string(threads));
+  // More threads than the machine has only slow a run down, and tens of thousands make the OpenMP
+  // runtime crash or run out of memory while starting them (issue #12), so they are capped.
+  const int hardware = std::max(1, omp_get_num_procs());
+  if (threads > hardware) {
+    std::cerr << "note: --threads " << threads << " is more than the " << hardware
+              << " hardware threads of this machine; using " << hardware << "\n";
+    threads = hardware;
+  }
   if (threads > 0) omp_set_num_threads(threads);
   return omp_get_max_threads();
 }
@@ -67,6 +80,17 @@ int run_main(const std::string& app, const std::function<int()>& body) {
   } catch (const SimulationError& e) {
     std::cerr << app << ": simulation stopped: " << e.what() << "\n";
     return kExitFailure;
+  } catch (const IoError& e) {
+    std::cerr << app << ": I/O error: " << e.what() << "\n";
+    return kExitIoError;
+  } catch (const std::bad_alloc&) {
+    // Inputs are checked against the memory they need before anything is allocated
+    // (resources.hpp); this is what is left: the machine ran short while the run was under way.
+    std::cerr << app << ": system error: out of memory\n";
+    return kExitIoError;
+  } catch (const std::system_error& e) {  // includes std::filesystem::filesystem_error
+    std::cerr << app << ": system error: " << e.what() << "\n";
+    return kExitIoError;
   } catch (const std::exception& e) {
     std::cerr << app << ": error: " << e.what() << "\n";
     return kExitFailure;

@@ -15,7 +15,9 @@
 namespace geohaz {
 
 bool Range::contains(double v) const noexcept {
-  if (std::isnan(v)) return false;
+  // No key takes an infinite or NaN value: "[0, inf)" means "no upper bound", not "inf allowed"
+  // (run.end_time = inf never ended, young = inf blew up at step 1; issue #12).
+  if (!std::isfinite(v)) return false;
   if (min_open ? !(v > min) : !(v >= min)) return false;
   if (max_open ? !(v < max) : !(v <= max)) return false;
   return true;
@@ -57,21 +59,45 @@ std::vector<std::string> split_path(std::string_view path) {
   return out;
 }
 
-/// Parse a segment "name[3]" into ("name", 3) or ("name", -1).
-std::pair<std::string, long> parse_segment(const std::string& seg) {
+/// Largest array index a key may address (far beyond any config; keeps the index a small number).
+constexpr long kMaxIndex = 100000;
+
+/// Parse a segment "name[3]" into ("name", 3) or ("name", -1). InputError (key = `path`) for an
+/// empty name or a malformed index ("a[]", "a[x]", "a[-1]", "a[99999999999999999999]", "a[1").
+std::pair<std::string, long> parse_segment(const std::string& seg, std::string_view path) {
   const auto lb = seg.find('[');
-  if (lb == std::string::npos || seg.back() != ']') return {seg, -1};
-  return {seg.substr(0, lb), std::stol(seg.substr(lb + 1, seg.size() - lb - 2))};
+  const bool has_bracket = lb != std::string::npos || seg.find(']') != std::string::npos;
+  if (seg.empty() || lb == 0)
+    throw InputError("malformed key: empty name in a dotted key (expected e.g. run.end_time or material[0].density)",
+                     {}, std::string(path));
+  if (!has_bracket) return {seg, -1};
+  const std::string digits = lb == std::string::npos ? "" : seg.substr(lb + 1, seg.size() - lb - 2);
+  const bool ok = lb != std::string::npos && seg.back() == ']' && !digits.empty() && digits.size() <= 6 &&
+                  std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }) &&
+                  std::stol(digits) <= kMaxIndex;
+  if (!ok)
+    throw InputError("malformed array index in '" + seg + "': expected name[N] with N an integer in [0, " +
+                         std::to_string(kMaxIndex) + "]",
+                     {}, std::string(path));
+  return {seg.substr(0, lb), std::stol(digits)};
 }
 
 /// Insert (or replace) the node at a dotted path, creating tables and array-of-table elements.
+/// With create_elements false (a --set override), the path must fit the file's structure: a value
+/// is not replaced by a table nor a table by a value (InputError naming the key), and array
+/// elements must exist.
 void insert_path(toml::table& root, std::string_view path, const toml::node& value, bool create_elements) {
   const auto segs = split_path(path);
   toml::table* t = &root;
+  std::string walked;  // the key so far, for messages
   for (std::size_t s = 0; s + 1 < segs.size(); ++s) {
-    auto [name, index] = parse_segment(segs[s]);
+    auto [name, index] = parse_segment(segs[s], path);
+    walked += (walked.empty() ? "" : ".") + name;
     if (index < 0) {
       auto* child = t->get(name);
+      if (child && !child->is_table() && !create_elements)
+        throw InputError("'" + walked + "' is a value, not a table, so it has no key '" + segs[s + 1] + "'", {},
+                         std::string(path));
       if (!child || !child->is_table()) {
         t->insert_or_assign(name, toml::table{});
         child = t->get(name);
@@ -94,9 +120,27 @@ void insert_path(toml::table& root, std::string_view path, const toml::node& val
       auto* elem = arr->get(static_cast<std::size_t>(index));
       if (!elem->is_table()) throw InputError("not a table", {}, std::string(path));
       t = elem->as_table();
+      walked += "[" + std::to_string(index) + "]";
     }
   }
-  value.visit([&](auto&& v) { t->insert_or_assign(segs.back(), v); });
+  const auto [last, last_index] = parse_segment(segs.back(), path);
+  if (last_index >= 0)
+    throw InputError("an element of an array of tables is a table: set one of its keys, e.g. " + last + "[" +
+                         std::to_string(last_index) + "].<key>=value",
+                     {}, std::string(path));
+  if (!create_elements) {
+    const auto* old = t->get(last);
+    const bool old_is_table = old && (old->is_table() || (old->is_array() && old->as_array()->is_array_of_tables()));
+    if (old_is_table)
+      throw InputError("is a table (or array of tables) in the config: set its keys one at a time, e.g. " +
+                           std::string(path) + ".<key>=value",
+                       {}, std::string(path));
+    if (value.is_table())
+      throw InputError("a table cannot be set with --set: set its keys one at a time, e.g. " + std::string(path) +
+                           ".<key>=value",
+                       {}, std::string(path));
+  }
+  value.visit([&](auto&& v) { t->insert_or_assign(last, v); });
 }
 
 std::string describe_path(std::string p) {
@@ -123,6 +167,18 @@ struct ConfigReader::State {
   std::set<std::string> accessed;  // full paths of leaves and arrays of tables read
   std::vector<KeyReference> refs;
   std::set<std::string> ref_keys;
+  /// Keys set on the command line (--set), with the label errors about them carry.
+  std::map<std::string, std::string> overrides;
+
+  /// Where the value of `full` came from: the command line when it (or a table above it) was set
+  /// there, else the config file.
+  const std::string& origin(const std::string& full) const {
+    for (const auto& [key, label] : overrides)
+      if (full == key || (full.size() > key.size() && full.compare(0, key.size(), key) == 0 &&
+                          (full[key.size()] == '.' || full[key.size()] == '[')))
+        return label;
+    return source;
+  }
 
   void record(const std::string& full, std::string type, std::string_view unit, std::string def, std::string range,
               std::string_view help) {
@@ -174,18 +230,17 @@ ConfigReader ConfigReader::describe() {
   return ConfigReader(st, "");
 }
 
-void ConfigReader::apply_override(std::string_view assignment) {
+void ConfigReader::apply_override(std::string_view assignment, const std::string& origin) {
   const auto eq = assignment.find('=');
   auto trim = [](std::string_view s) {
     while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
     while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
     return std::string(s);
   };
-  if (eq == std::string_view::npos)
-    throw InputError("--set expects key=value", "command line", "", std::string(assignment));
+  if (eq == std::string_view::npos) throw InputError("--set expects key=value", origin, "", std::string(assignment));
   const std::string key = trim(assignment.substr(0, eq));
   const std::string value = trim(assignment.substr(eq + 1));
-  if (key.empty()) throw InputError("--set expects key=value (empty key)", "command line", "", std::string(assignment));
+  if (key.empty()) throw InputError("--set expects key=value (empty key)", origin, "", std::string(assignment));
   toml::table parsed;
   try {
     parsed = toml::parse("v = " + value);
@@ -196,8 +251,10 @@ void ConfigReader::apply_override(std::string_view assignment) {
   try {
     insert_path(state_->root, key, *parsed.get("v"), false);
   } catch (const InputError& e) {
-    throw InputError(e.reason(), "command line (--set)", key, value);
+    throw InputError(e.reason(), origin, key, value);
   }
+  // Errors about this key (range, type, unknown key) then name the command line, not the file.
+  state_->overrides[key] = origin;
 }
 
 namespace {
@@ -217,11 +274,12 @@ double ConfigReader::get(std::string_view key, double def, Range range, KeyDoc d
       if (auto d = node.value<double>(); d && (node.is_floating_point() || node.is_integer())) {
         v = *d;
       } else {
-        type_error(state_->source, full, *node.node(), "a number");
+        type_error(state_->origin(full), full, *node.node(), "a number");
       }
       if (!range.contains(v))
-        throw InputError("out of range: allowed " + range.str() + (doc.unit.empty() ? "" : " " + std::string(doc.unit)),
-                         state_->source, full, node_text(*node.node()));
+        throw InputError(std::string(std::isfinite(v) ? "out of range" : "not a finite number") + ": allowed " +
+                             range.str() + (doc.unit.empty() ? "" : " " + std::string(doc.unit)),
+                         state_->origin(full), full, node_text(*node.node()));
     }
   }
   insert_path(state_->resolved, full, toml::value<double>(v), true);
@@ -254,10 +312,10 @@ std::int64_t ConfigReader::get_int(std::string_view key, std::int64_t def, Range
   if (!state_->describe) {
     auto node = state_->root.at_path(full);
     if (node) {
-      if (!node.is_integer()) type_error(state_->source, full, *node.node(), "an integer");
+      if (!node.is_integer()) type_error(state_->origin(full), full, *node.node(), "an integer");
       v = *node.value<std::int64_t>();
       if (!range.contains(static_cast<double>(v)))
-        throw InputError("out of range: allowed " + range.str(), state_->source, full, std::to_string(v));
+        throw InputError("out of range: allowed " + range.str(), state_->origin(full), full, std::to_string(v));
     }
   }
   insert_path(state_->resolved, full, toml::value<std::int64_t>(v), true);
@@ -272,7 +330,7 @@ bool ConfigReader::get_bool(std::string_view key, bool def, KeyDoc doc) {
   if (!state_->describe) {
     auto node = state_->root.at_path(full);
     if (node) {
-      if (!node.is_boolean()) type_error(state_->source, full, *node.node(), "true or false");
+      if (!node.is_boolean()) type_error(state_->origin(full), full, *node.node(), "true or false");
       v = *node.value<bool>();
     }
   }
@@ -288,7 +346,7 @@ std::string ConfigReader::get_string(std::string_view key, std::string_view def,
   if (!state_->describe) {
     auto node = state_->root.at_path(full);
     if (node) {
-      if (!node.is_string()) type_error(state_->source, full, *node.node(), "a string");
+      if (!node.is_string()) type_error(state_->origin(full), full, *node.node(), "a string");
       v = *node.value<std::string>();
     }
   }
@@ -313,7 +371,7 @@ std::string ConfigReader::get_choice(std::string_view key, std::string_view def,
   state_->refs.back().range = list;
   if (std::find(choices.begin(), choices.end(), v) == choices.end()) {
     const std::string full = full_key(key);
-    throw InputError("unknown choice; allowed: " + list, state_->source, full, v);
+    throw InputError("unknown choice; allowed: " + list, state_->origin(full), full, v);
   }
   return v;
 }
@@ -331,20 +389,25 @@ std::vector<double> ConfigReader::get_array(std::string_view key, const std::vec
   if (!state_->describe) {
     auto node = state_->root.at_path(full);
     if (node) {
+      const std::string& from = state_->origin(full);
       auto* arr = node.as_array();
-      if (!arr) type_error(state_->source, full, *node.node(), "an array of numbers");
+      if (!arr) type_error(from, full, *node.node(), "an array of numbers");
       v.clear();
       for (auto& e : *arr) {
         auto d = e.value<double>();
-        if (!d || !(e.is_floating_point() || e.is_integer())) type_error(state_->source, full, e, "numbers in the array");
+        if (!d || !(e.is_floating_point() || e.is_integer())) type_error(from, full, e, "numbers in the array");
         if (!range.contains(*d))
-          throw InputError("array element out of range: allowed " + range.str(), state_->source, full, num(*d));
+          throw InputError(std::string(std::isfinite(*d) ? "array element out of range" : "array element not finite") +
+                               ": allowed " + range.str(),
+                           from, full, num(*d));
         v.push_back(*d);
       }
       if (expected_size && v.size() != expected_size)
         throw InputError("expected " + std::to_string(expected_size) + " numbers, got " + std::to_string(v.size()),
-                         state_->source, full, node_text(*node.node()));
-      if (v.empty()) throw InputError("the array is empty", state_->source, full);
+                         from, full, node_text(*node.node()));
+      // An empty array is what an optional list defaults to, so it may be given explicitly (e.g.
+      // --set run.velocity_png_times=[]); a list that has a non-empty default must not be emptied.
+      if (v.empty() && !def.empty()) throw InputError("the array is empty", from, full);
     }
   }
   toml::array out;
@@ -363,6 +426,7 @@ std::vector<double> ConfigReader::require_array(std::string_view key, Range rang
     throw InputError("required key is missing (" + std::string(doc.help) + ", " + std::string(doc.unit) + ")",
                      state_->source, full);
   auto v = get_array(key, {}, range, doc, expected_size);
+  if (v.empty()) throw InputError("the array is empty", state_->origin(full), full);
   state_->refs.back().default_value = "(required)";
   return v;
 }
@@ -385,7 +449,7 @@ std::vector<ConfigReader> ConfigReader::tables(std::string_view key, KeyDoc doc)
   if (!node) return out;
   auto* arr = node.as_array();
   if (!arr || !arr->is_array_of_tables())
-    type_error(state_->source, full, *node.node(), "an array of tables ([[...]] blocks)");
+    type_error(state_->origin(full), full, *node.node(), "an array of tables ([[...]] blocks)");
   for (std::size_t i = 0; i < arr->size(); ++i) {
     out.push_back(ConfigReader(state_, full + "[" + std::to_string(i) + "]"));
     insert_path(state_->resolved, full + "[" + std::to_string(i) + "].__placeholder", toml::value<bool>(true), true);
@@ -436,7 +500,7 @@ void ConfigReader::finish() const {
       }
       throw InputError("unknown key" + std::string(parent.empty() ? "" : " in [" + parent + "]") +
                            "; valid keys here: " + (valid.empty() ? "(none)" : valid),
-                       state_->source, path);
+                       state_->origin(path), path);
     }
   };
   walk(state_->root, "");

@@ -20,4 +20,7 @@ InputError::InputError(const std::string& what, std::string file, std::string ke
       key_(std::move(key)),
       value_(std::move(value)) {}
 
+IoError::IoError(const std::string& what, std::string file)
+    : std::runtime_error(file.empty() ? what : file + ": " + what), file_(std::move(file)) {}
+
 }  // namespace geohaz

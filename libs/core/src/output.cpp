@@ -1,5 +1,7 @@
 #include "geohaz/core/output.hpp"
 
+#include <cerrno>
+#include <cstring>
 #include <stdexcept>
 
 #include "geohaz/core/errors.hpp"
@@ -7,8 +9,10 @@
 namespace geohaz {
 
 AtomicTextFile::AtomicTextFile(std::filesystem::path final_path)
-    : final_(std::move(final_path)), tmp_(final_.string() + ".partial"), out_(tmp_) {
-  if (!out_) throw std::runtime_error("cannot write " + tmp_.string());
+    : final_(std::move(final_path)), tmp_(final_.string() + ".partial") {
+  errno = 0;
+  out_.open(tmp_);
+  if (!out_) throw IoError(std::string("cannot create the file: ") + std::strerror(errno ? errno : EIO), final_.string());
   out_.precision(10);
 }
 
@@ -21,11 +25,25 @@ AtomicTextFile::~AtomicTextFile() {
 }
 
 void AtomicTextFile::commit() {
+  errno = 0;
   out_.flush();
-  const bool ok = static_cast<bool>(out_);
-  out_.close();
-  if (!ok) throw std::runtime_error("write failed: " + final_.string());
-  std::filesystem::rename(tmp_, final_);
+  bool ok = static_cast<bool>(out_);
+  out_.close();  // the last buffered bytes are written here: a full disk can show only now
+  ok = ok && !out_.fail();
+  const int err = errno;
+  if (!ok) {
+    std::error_code ec;
+    std::filesystem::remove(tmp_, ec);
+    committed_ = true;  // nothing left to clean up
+    throw IoError(std::string("writing failed: ") + std::strerror(err ? err : EIO), final_.string());
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp_, final_, ec);
+  if (ec) {
+    std::filesystem::remove(tmp_, ec);
+    committed_ = true;
+    throw IoError("cannot move the file into place: " + ec.message(), final_.string());
+  }
   committed_ = true;
 }
 

@@ -241,13 +241,13 @@ void write_rgb_png(const std::filesystem::path& path, int w, int h, const std::v
     const std::string msg = detail::gdal_last_error();
     std::filesystem::remove(tmp, ec);
     std::filesystem::remove(tmp + ".aux.xml", ec);
-    throw InputError("cannot write the PNG" + msg, file);
+    throw IoError("cannot write the PNG" + msg, file);
   }
   std::filesystem::remove(tmp + ".aux.xml", ec);  // nothing worth keeping in a side-car
   std::filesystem::rename(tmp, path, ec);
   if (ec) {
     std::filesystem::remove(tmp, ec);
-    throw InputError("cannot move the PNG into place: " + ec.message(), file);
+    throw IoError("cannot move the PNG into place: " + ec.message(), file);
   }
 }
 

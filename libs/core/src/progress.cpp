@@ -10,6 +10,8 @@ namespace geohaz {
 
 std::string format_duration(double s) {
   if (!std::isfinite(s) || s < 0) return "--";
+  // Beyond this the hours no longer fit an int (a run with end_time 1e30 s; issue #12).
+  if (s >= 99999.0 * 3600.0) return ">99999h";
   char buf[32];
   if (s < 60) {
     std::snprintf(buf, sizeof buf, "%.1fs", s);

@@ -17,6 +17,7 @@
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster_extra.hpp"
+#include "geohaz/core/resources.hpp"
 #include "gdal_common.hpp"
 
 namespace geohaz {
@@ -206,6 +207,11 @@ Raster read_raster(const std::filesystem::path& path, CrsPolicy policy) {
   const double nd = band->GetNoDataValue(&has_nodata);
   if (has_nodata) r.nodata = nd;
 
+  // The header alone may declare any size (a 1.8 MB sparse GeoTIFF can declare 10^10 cells): check
+  // before allocating. Two copies of 8-byte values: the Raster and the model's own grid or Terrain.
+  const double cells = static_cast<double>(r.nx) * static_cast<double>(r.ny);
+  check_memory(2.0 * 8.0 * cells,
+               std::to_string(r.nx) + " × " + std::to_string(r.ny) + " cells, two copies of 8 bytes each", file, "");
   r.data.resize(static_cast<std::size_t>(r.nx) * static_cast<std::size_t>(r.ny));
   if (band->RasterIO(GF_Read, 0, 0, r.nx, r.ny, r.data.data(), r.nx, r.ny, GDT_Float64, 0, 0, nullptr) != CE_None)
     throw InputError("cannot read band 1" + gdal_last_error(), file);
@@ -240,12 +246,18 @@ void write_geotiff(const std::filesystem::path& path, const Raster& r, bool floa
   QuietGdalErrors quiet;
   GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
   if (!driver) throw std::runtime_error("GDAL has no GTiff driver");
+  // From here on a failure is the file system's (full disk, size limit, permission): IoError.
   const char* options[] = {"COMPRESS=DEFLATE", "PREDICTOR=1", "TILED=NO", nullptr};
   bool ok = true;
   {
     std::unique_ptr<GDALDataset> ds(
         driver->Create(tmp.c_str(), r.nx, r.ny, 1, float64 ? GDT_Float64 : GDT_Float32, const_cast<char**>(options)));
-    if (!ds) throw InputError("cannot create the GeoTIFF" + gdal_last_error(), file);
+    if (!ds) {
+      const std::string msg = gdal_last_error();
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);
+      throw IoError("cannot create the GeoTIFF" + msg, file);
+    }
     std::array<double, 6> gt = r.geotransform;
     ok = ds->SetGeoTransform(gt.data()) == CE_None;
     if (ok && !r.crs_wkt.empty()) ok = ds->SetSpatialRef(&srs) == CE_None;
@@ -262,12 +274,12 @@ void write_geotiff(const std::filesystem::path& path, const Raster& r, bool floa
   if (!ok) {
     const std::string msg = gdal_last_error();
     std::filesystem::remove(tmp, ec);
-    throw InputError("writing the GeoTIFF failed" + msg, file);
+    throw IoError("writing the GeoTIFF failed" + msg, file);
   }
   std::filesystem::rename(tmp, path, ec);
   if (ec) {
     std::filesystem::remove(tmp, ec);
-    throw InputError("cannot move the GeoTIFF into place: " + ec.message(), file);
+    throw IoError("cannot move the GeoTIFF into place: " + ec.message(), file);
   }
 }
 

@@ -4,8 +4,16 @@
 /// Choices worth knowing:
 ///  - HDF5's automatic error printing is switched off; every failing call becomes an exception naming
 ///    the file and the object (dataset/attribute) with HDF5's innermost error description. The writer
-///    throws std::runtime_error (an environment failure: disk full, permissions), the reader InputError
-///    (the file is user input for restarts and chained runs).
+///    throws IoError (an environment failure: disk full, permissions; exit code 3), the reader
+///    InputError (the file is user input for restarts and chained runs).
+///  - A full disk: before each snapshot the writer checks that the file system (statvfs) and the
+///    file size limit (RLIMIT_FSIZE) leave room for it, with a margin for HDF5's metadata, and
+///    throws IoError before touching the file when they do not. The file then holds exactly the
+///    snapshots flushed so far and stays readable. Should a write fail anyway (another process
+///    filled the disk in between), the file is left unclosed and HDF5's own clean-up at exit is
+///    switched off (H5dont_atexit): HDF5 1.10 cannot close a file whose flush failed, and its atexit
+///    clean-up then dereferences a null pointer (H5F__close_cb, issue #12). The descriptor goes
+///    with the process; that file may then lack its last snapshot or be unreadable.
 ///  - Every identifier is owned by an Hid (RAII), so an exception never leaks a handle.
 ///  - Snapshot completeness: the group attribute "particle_count" is written last, after every dataset;
 ///    the reader lists only groups that carry it, so a snapshot cut off by a kill is ignored rather
@@ -22,6 +30,8 @@
 #include "geohaz/core/snapshot.hpp"
 
 #include <hdf5.h>
+#include <sys/resource.h>
+#include <sys/statvfs.h>
 
 #include <algorithm>
 #include <charconv>
@@ -37,6 +47,7 @@
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
+#include "geohaz/core/resources.hpp"
 
 namespace geohaz {
 namespace {
@@ -65,6 +76,8 @@ class Hid {
   }
   hid_t get() const noexcept { return id_; }
   bool valid() const noexcept { return id_ >= 0; }
+  /// Give the identifier up without closing it (see the file comment on failed writes).
+  void release() noexcept { id_ = H5I_INVALID_HID; }
 
  private:
   hid_t id_ = H5I_INVALID_HID;
@@ -86,20 +99,23 @@ std::string hdf5_error_detail() {
       },
       &detail);
   H5Eclear2(H5E_DEFAULT);
+  std::replace(detail.begin(), detail.end(), '\n', ' ');  // one line per message
   return detail;
 }
 
 /// Turns failing HDF5 calls into exceptions naming the file and the object.
 struct Hdf5Context {
   std::string file;
-  bool input = false;  ///< reader: InputError; writer: std::runtime_error
+  bool input = false;           ///< reader: InputError; writer: IoError
+  mutable bool failed = false;  ///< a call failed (the writer then leaves its file unclosed)
 
   [[noreturn]] void fail(const std::string& what) const {
+    failed = true;
     std::string msg = what;
     const std::string detail = hdf5_error_detail();
     if (!detail.empty()) msg += " (HDF5: " + detail + ")";
     if (input) throw InputError(msg, file);
-    throw std::runtime_error(file + ": " + msg);
+    throw IoError(msg, file);
   }
   Hid own(hid_t id, Hid::Closer close, const std::string& what) const {
     if (id < 0) fail(what);
@@ -111,6 +127,11 @@ struct Hdf5Context {
 };
 
 void silence_hdf5_errors() {
+  // No clean-up at exit: every identifier we open is closed by its Hid, except the file of a writer
+  // whose write failed, which HDF5 can neither flush nor close (see the file comment). Must come
+  // before the library initialises itself, i.e. before any other HDF5 call.
+  static const bool no_atexit = [] { return H5dont_atexit() >= 0; }();
+  (void)no_atexit;
   // The default handler prints the whole stack to stderr; we report through exceptions instead.
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
 }
@@ -345,6 +366,11 @@ struct SnapshotWriter::Impl {
   std::set<std::size_t> vertex_indices;  ///< particle counts whose /xdmf/vertices_<n> exists
 
   void flush() { ctx.call(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "cannot flush"); }
+  /// IoError unless the file system and the file size limit leave room for `bytes` more.
+  void check_room(double bytes, const std::string& what) const;
+  ~Impl() {
+    if (ctx.failed) file.release();  // see the file comment: closing it would crash HDF5 at exit
+  }
   void ensure_vertex_index(std::size_t n);
   void write_fields(hid_t group, const std::string& gpath, std::span<const FieldView> fields,
                     std::span<const std::uint32_t> lines);
@@ -368,6 +394,8 @@ SnapshotWriter::SnapshotWriter(const std::filesystem::path& h5_path, std::string
   m.ctx.input = false;
   silence_hdf5_errors();
 
+  // Room for the root attributes and HDF5's superblock, heaps and B-trees.
+  m.check_room(static_cast<double>(resolved_config.size()) + 32.0 * 1024.0, "a new snapshot file");
   Hid fapl = file_access_plist(m.ctx);
   m.file = m.ctx.own(H5Fcreate(h5_path.string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose,
                      "cannot create the snapshot file");
@@ -386,6 +414,30 @@ SnapshotWriter::SnapshotWriter(const std::filesystem::path& h5_path, std::string
 }
 
 SnapshotWriter::~SnapshotWriter() = default;
+
+void SnapshotWriter::Impl::check_room(double bytes, const std::string& what) const {
+  const std::filesystem::path dir = h5_path.has_parent_path() ? h5_path.parent_path() : ".";
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(h5_path, ec);
+  const double current = ec ? 0.0 : static_cast<double>(size);
+  struct statvfs fs {};
+  if (statvfs(dir.c_str(), &fs) == 0) {
+    const double free = static_cast<double>(fs.f_bavail) * static_cast<double>(fs.f_frsize);
+    if (bytes > free)
+      throw IoError("no space left for " + what + ": it needs about " + format_bytes(bytes) + ", the file system has " +
+                        format_bytes(free) + " free (the snapshots written so far are kept)",
+                    h5_path.string());
+  }
+  rlimit lim{};
+  if (getrlimit(RLIMIT_FSIZE, &lim) == 0 && lim.rlim_cur != RLIM_INFINITY) {
+    const double room = static_cast<double>(lim.rlim_cur) - current;
+    if (bytes > room)
+      throw IoError("no room for " + what + " under the file size limit (ulimit -f): it needs about " +
+                        format_bytes(bytes) + ", " + format_bytes(std::max(room, 0.0)) +
+                        " left (the snapshots written so far are kept)",
+                    h5_path.string());
+  }
+}
 
 void SnapshotWriter::set_attribute(const std::string& name, const std::string& value) {
   write_string_attribute(impl_->ctx, impl_->file.get(), name, value);
@@ -491,8 +543,26 @@ void SnapshotWriter::write(double time, std::int64_t step, std::span<const Field
       throw std::invalid_argument("SnapshotWriter::write: line index " + std::to_string(i) + " >= particle count " +
                                   std::to_string(n));
 
+  if (m.ctx.failed)
+    throw IoError("an earlier write to this file failed; no further snapshot is written", m.h5_path.string());
+  // The same step and time as the previous snapshot is the same state: writing it again would
+  // list every particle twice at that time in ParaView (a run ending on a snapshot time).
+  if (!m.entries.empty() && m.entries.back().step == step && m.entries.back().time == time) return;
+
   const std::string name = snapshot_name(m.entries.size());
   const std::string gpath = std::string(kSnapshotsGroup) + "/" + name;
+  {
+    // Checked before the file is touched, so a full disk leaves the snapshots so far readable.
+    double bytes = 16.0 * 1024.0;  // group, attributes, B-tree and heap growth
+    for (const FieldView& f : fields) {
+      const std::size_t elem = f.type == ScalarType::Float64 || f.type == ScalarType::Int64 ? 8
+                               : f.type == ScalarType::Int32                              ? 4
+                                                                                         : 1;
+      bytes += static_cast<double>(f.count) * f.rows * f.cols * static_cast<double>(elem) + 1024.0;
+    }
+    bytes += 4.0 * static_cast<double>(lines.size() + (m.vertex_indices.count(n) ? 0 : n));
+    m.check_room(1.1 * bytes, "snapshot " + name);
+  }
   try {
     // Track creation order so the reader lists fields in the order the store declares them.
     Hid gcpl = m.ctx.own(H5Pcreate(H5P_GROUP_CREATE), H5Pclose, "cannot create group " + gpath);

@@ -1,8 +1,8 @@
 #pragma once
 /// \file app.hpp
 /// What every geohaz command-line app shares: the common options (Boost.Program_options), the
-/// exception → exit-code mapping (InputError → 2, anything else → 1), thread setup and the
-/// `--help-config` key reference.
+/// exception → exit-code mapping (0 done, 1 simulation failed, 2 bad input, 3 I/O or system
+/// failure; see errors.hpp), thread setup and the `--help-config` key reference.
 
 #include <boost/program_options.hpp>
 #include <functional>
@@ -28,8 +28,9 @@ struct CommonOptions {
 void add_common_options(boost::program_options::options_description& desc, CommonOptions& opts,
                         const std::string& default_out);
 
-/// Parse argv. Returns false (after printing) when --help or --version was asked for.
-/// Unknown options or bad values → InputError.
+/// Parse argv. Returns false (after printing) when --help or --version was asked for; --help ends
+/// with the exit codes. Unknown options, bad values, or a positional argument the app does not
+/// take (`positional` null) → InputError.
 bool parse_command_line(int argc, const char* const* argv, const std::string& app, const std::string& summary,
                         boost::program_options::options_description& desc,
                         boost::program_options::positional_options_description* positional = nullptr);
@@ -37,12 +38,14 @@ bool parse_command_line(int argc, const char* const* argv, const std::string& ap
 /// Read the config file (or an empty one) and apply the --set overrides.
 ConfigReader load_config(const CommonOptions& opts);
 
-/// Set the OpenMP thread count (0 = all cores); InputError when negative. Returns the count used.
+/// Set the OpenMP thread count (0 = all cores); InputError when negative; more than the hardware
+/// threads are capped to them with a note on stderr. Returns the count used.
 int setup_threads(int threads);
 
 /// Run an app body, mapping exceptions to messages on stderr and exit codes:
 /// InputError → 2 ("app: input error: ..."), SimulationError → 1 ("app: simulation stopped: ..."),
-/// any other exception → 1 ("app: error: ...").
+/// IoError → 3 ("app: I/O error: ..."), std::bad_alloc and std::system_error (file system calls)
+/// → 3 ("app: system error: ..."), any other exception → 1 ("app: error: ...").
 int run_main(const std::string& app, const std::function<int()>& body);
 
 /// What a config-driven app (`APP --config case.toml [--set ...] [--out DIR] ...`) tells main().

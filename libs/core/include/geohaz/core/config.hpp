@@ -22,7 +22,8 @@
 
 namespace geohaz {
 
-/// Allowed interval of a numeric key. Infinite bounds mean "no bound".
+/// Allowed interval of a numeric key. Infinite bounds mean "no bound"; an infinite or NaN value is
+/// never contained.
 struct Range {
   double min = -std::numeric_limits<double>::infinity();
   double max = std::numeric_limits<double>::infinity();
@@ -61,8 +62,11 @@ public:
   static ConfigReader describe();
 
   /// Apply `key=value` (value in TOML syntax; a bare word is taken as a string). Creates tables as
-  /// needed; "layers[1].c=5e3" addresses an element of an array of tables.
-  void apply_override(std::string_view assignment);
+  /// needed; "layers[1].c=5e3" addresses an element of an array of tables (which must exist).
+  /// InputError (naming `origin`, the key and the value) for a malformed key or index, for a value
+  /// that would replace a table ("run=5") or a table that would replace a value. Later errors about
+  /// the key (range, type, unknown key) name `origin` instead of the config file.
+  void apply_override(std::string_view assignment, const std::string& origin = "command line (--set)");
 
   /// Optional keys with a default.
   double get(std::string_view key, double def, Range range, KeyDoc doc);
@@ -72,7 +76,8 @@ public:
   /// A string that must be one of `choices`.
   std::string get_choice(std::string_view key, std::string_view def, const std::vector<std::string>& choices,
                          KeyDoc doc);
-  /// An array of numbers, each in range; expected_size 0 means any non-empty length.
+  /// An array of numbers, each in range; expected_size 0 means any length (empty only when the
+  /// default is empty).
   std::vector<double> get_array(std::string_view key, const std::vector<double>& def, Range range, KeyDoc doc,
                                 std::size_t expected_size = 0);
 
@@ -87,8 +92,8 @@ public:
   /// A sub-reader for a table: keys read relative to `key.`.
   ConfigReader section(std::string_view key) const;
 
-  /// Throws InputError for the first key present in the file that was never read, listing the
-  /// keys that exist at that level.
+  /// Throws InputError for the first key present in the file (or set with --set) that was never
+  /// read, listing the keys that exist at that level.
   void finish() const;
   /// The resolved configuration (every key read, with the value used) as TOML text.
   std::string resolved() const;

@@ -1,10 +1,13 @@
 #pragma once
 /// \file errors.hpp
-/// The two failure kinds every geohaz app distinguishes.
-///  - InputError: the user gave something wrong (file, key, value). Exit code 2.
+/// The failure kinds every geohaz app distinguishes, each with its exit code:
+///  - InputError: the user gave something wrong (file, key, value), found before anything is
+///    written. Exit code 2.
 ///  - SimulationError: a run that went unstable (NaN, escape, time-step collapse),
 ///    with a diagnosis of which particle, where and at which step. Exit code 1.
-/// Anything else (std::exception) is a bug or an environment failure: exit code 1.
+///  - IoError: writing an output failed (disk full, file size limit, permission lost mid-run).
+///    The outputs written so far stay readable and no "*.partial" file is left. Exit code 3.
+/// Anything else (std::exception) is a bug: exit code 1.
 /// Throw early with context; catch only in main (see run_main in app.hpp).
 
 #include <stdexcept>
@@ -37,9 +40,30 @@ public:
   using std::runtime_error::runtime_error;
 };
 
-/// Exit codes shared by all apps.
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitFailure = 1;
-inline constexpr int kExitInputError = 2;
+/// An output could not be written: names the file and the system's reason (e.g. "No space left
+/// on device"). Thrown by the output writers (AtomicTextFile, write_geotiff, the PNG writers,
+/// SnapshotWriter); a writer throwing it has removed its temporary file.
+class IoError : public std::runtime_error {
+public:
+  /// \param what what failed and why (the system's reason when known).
+  /// \param file the output file.
+  IoError(const std::string& what, std::string file);
+  const std::string& file() const noexcept { return file_; }
+
+private:
+  std::string file_;
+};
+
+/// Exit codes shared by all apps (README, docs/reliability.md, every app's --help).
+inline constexpr int kExitOk = 0;           ///< done
+inline constexpr int kExitFailure = 1;      ///< the simulation failed (blow-up, diagnosis), or a bug
+inline constexpr int kExitInputError = 2;   ///< bad input; nothing written
+inline constexpr int kExitIoError = 3;      ///< an I/O or system failure; outputs so far kept readable
+
+/// The exit-code paragraph of every app's --help.
+inline constexpr const char* kExitCodesHelp =
+    "Exit codes: 0 done; 1 the simulation failed (blow-up, with a diagnosis); 2 bad input, nothing "
+    "written; 3 an I/O or system failure (disk full, permission lost), the outputs written so far kept "
+    "readable.";
 
 }  // namespace geohaz

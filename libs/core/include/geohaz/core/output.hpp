@@ -11,7 +11,8 @@
 namespace geohaz {
 
 /// A text file that appears under its final name only when commit() is called; destroyed without
-/// commit (an exception), it removes its temporary file.
+/// commit (an exception), it removes its temporary file. IoError when the temporary file cannot
+/// be created.
 class AtomicTextFile {
 public:
   explicit AtomicTextFile(std::filesystem::path final_path);
@@ -25,7 +26,8 @@ public:
     out_ << v;
     return *this;
   }
-  /// Flush, close and rename into place. Throws std::runtime_error when the write failed.
+  /// Flush, close and rename into place. Throws IoError (naming the file and the system's reason)
+  /// when the write failed; the temporary file is removed then.
   void commit();
   const std::filesystem::path& path() const noexcept { return final_; }
 

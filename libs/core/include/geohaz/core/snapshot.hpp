@@ -49,7 +49,7 @@ struct FieldView {
 
 class SnapshotWriter {
 public:
-  /// Create (truncate) `h5_path` and its XDMF companion (same name, .xmf).
+  /// Create (truncate) `h5_path` and its XDMF companion (same name, .xmf). IoError when it cannot.
   /// \param model     "sph-slope", "debris-runout", "dem-avalanche".
   /// \param dimension 2 or 3 (geometry of the "position" field).
   /// \param resolved_config TOML text stored as an attribute.
@@ -65,6 +65,9 @@ public:
   void set_attribute(const std::string& name, double value);
 
   /// Write one snapshot of raw field views. `lines` (optional) are particle index pairs.
+  /// A call with the same step and time as the previous snapshot writes nothing (it is the same
+  /// state). IoError when the file system or the file size limit has no room for the snapshot
+  /// (checked first: the file keeps the snapshots so far) or when HDF5 fails to write.
   void write(double time, std::int64_t step, std::span<const FieldView> fields,
              std::span<const std::uint32_t> lines = {});
 
