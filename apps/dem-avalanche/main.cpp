@@ -16,6 +16,7 @@
 #include "geohaz/core/output.hpp"
 #include "geohaz/core/progress.hpp"
 #include "geohaz/core/raster.hpp"
+#include "geohaz/core/resources.hpp"
 #include "geohaz/core/snapshot.hpp"
 #include "geohaz/dem/experiments.hpp"
 #include "geohaz/dem/output.hpp"
@@ -65,6 +66,22 @@ std::vector<Vec2> points(ConfigReader& r, const char* kx, const char* kz, const 
   std::vector<Vec2> p;
   for (std::size_t k = 0; k < x.size(); ++k) p.emplace_back(x[k], z[k]);
   return p;
+}
+
+/// The discs a packing of `area` (m², unit thickness) asks for, checked against the memory available
+/// before anything is packed (sample.r_min = 1e-9 m would otherwise end in std::bad_alloc).
+void check_disc_memory(double area, const PackingSpec& p, const std::string& source, const std::string& what) {
+  const double r = 0.5 * (p.r_min + p.r_max);
+  const double discs = (1.0 - p.porosity) * area / (3.141592653589793 * r * r);
+  // A lower bound per disc: its fields, a few contacts and bonds, the neighbour cells and the
+  // triangulation used to place the bonds.
+  const double per_disc = 1000.0;
+  std::ostringstream est;
+  est << std::setprecision(3) << discs << " discs × " << per_disc << " B for the " << what << " with radii "
+      << p.r_min << "–" << p.r_max << " m";
+  std::ostringstream value;
+  value << p.r_min;
+  check_memory(discs * per_disc, est.str(), source, "sample.r_min", value.str());
 }
 
 RunConfig read_config(ConfigReader& r, bool describe) {
@@ -196,6 +213,7 @@ RunConfig read_config(ConfigReader& r, bool describe) {
     if (!describe && p.height < 8 * p.r_max)
       throw InputError("the sample must be at least 8 R_max high", r.source(), "sample.height",
                        std::to_string(p.height));
+    if (!describe) check_disc_memory(p.width * p.height, p, r.source(), "sample.width × sample.height");
   }
   if (c.kind == TestKind::Avalanche || describe) {
     AvalancheSpec& a = c.avalanche;
@@ -216,8 +234,21 @@ RunConfig read_config(ConfigReader& r, bool describe) {
         const auto path = std::filesystem::path(dsm).is_absolute() ? std::filesystem::path(dsm) : r.base_dir() / dsm;
         Terrain terrain(read_raster(path));
         std::vector<Vec2> pl;
-        for (std::size_t k = 0; k < sx.size(); ++k) pl.emplace_back(sx[k], sy[k]);
-        for (const auto& q : extract_profile(terrain, pl, spacing))
+        double length = 0.0;
+        for (std::size_t k = 0; k < sx.size(); ++k) {
+          pl.emplace_back(sx[k], sy[k]);
+          if (k > 0) length += (pl.back() - pl[k - 1]).norm();
+        }
+        check_memory(length / spacing * sizeof(ProfilePoint),
+                     "a profile of " + std::to_string(length) + " m sampled every avalanche.section_spacing",
+                     r.source(), "avalanche.section_spacing", std::to_string(spacing));
+        std::vector<ProfilePoint> profile;
+        try {
+          profile = extract_profile(terrain, pl, spacing);
+        } catch (const InputError& e) {  // name the DSM and the key the profile comes from
+          throw InputError(e.reason() + " (" + path.string() + ")", r.source(), "avalanche.section_x");
+        }
+        for (const auto& q : profile)
           if (a.terrain.empty() || q.s > a.terrain.back().x() + 1e-9) a.terrain.emplace_back(q.s, q.z);  // no repeats
       }
     }
@@ -275,6 +306,14 @@ RunConfig read_config(ConfigReader& r, bool describe) {
                                        {"Pa", "isotropic stress of the packing box before the mass is cut out"});
     a.material = m;
     if (!describe) {
+      double x0 = 1e300, x1 = -1e300, z0 = 1e300, z1 = -1e300;
+      for (const auto& q : a.source) {
+        x0 = std::min(x0, q.x());
+        x1 = std::max(x1, q.x());
+        z0 = std::min(z0, q.y());
+        z1 = std::max(z1, q.y());
+      }
+      check_disc_memory((x1 - x0) * (z1 - z0), p, r.source(), "source polygon's bounding box");
       try {
         check_avalanche_spec(a);
       } catch (const InputError& e) {  // add the file name

@@ -9,6 +9,7 @@
 #include "geohaz/core/config.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
+#include "geohaz/core/resources.hpp"
 #include "geohaz/sph/run.hpp"
 
 using namespace geohaz;
@@ -245,9 +246,21 @@ RunConfig read_config(ConfigReader& r, bool describe) {
       const auto path = std::filesystem::path(dsm).is_absolute() ? std::filesystem::path(dsm) : r.base_dir() / dsm;
       auto raster = std::make_shared<Raster>(read_raster(path));
       std::vector<Vec2> line;
-      for (std::size_t k = 0; k < poly.size(); k += 2) line.emplace_back(poly[k], poly[k + 1]);
+      double length = 0.0;
+      for (std::size_t k = 0; k < poly.size(); k += 2) {
+        line.emplace_back(poly[k], poly[k + 1]);
+        if (k > 0) length += (line.back() - line[line.size() - 2]).norm();
+      }
+      // The profile has one point per spacing: checked before it is sampled (spacing 1e-6 m).
+      check_memory(length / n.spacing * sizeof(ProfilePoint),
+                   "a profile of " + std::to_string(length) + " m sampled every numerics.spacing", r.source(),
+                   "numerics.spacing", std::to_string(n.spacing));
       Terrain terrain(*raster);
-      c.section.profile = extract_profile(terrain, line, n.spacing);
+      try {
+        c.section.profile = extract_profile(terrain, line, n.spacing);
+      } catch (const InputError& e) {  // name the DSM and the key the profile comes from
+        throw InputError(e.reason() + " (" + path.string() + ")", r.source(), "section.polyline");
+      }
       c.section.crs_wkt = raster->crs_wkt;
       c.section.dsm = raster;
       c.section.terrain = std::make_shared<const Terrain>(*raster);

@@ -13,6 +13,8 @@
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
 #include "geohaz/core/raster_extra.hpp"
+#include "child_process.hpp"
+#include "tiff_header.hpp"
 
 namespace fs = std::filesystem;
 using namespace geohaz;
@@ -110,7 +112,8 @@ TEST_F(RasterTest, GeoTiffFloat64KeepsDoublesExactly) {
 
 TEST_F(RasterTest, WriteToMissingDirectoryThrowsAndLeavesNothing) {
   const Raster r = make_grid(2, 2, 1.0, 1.0);
-  EXPECT_THROW(write_geotiff(dir_ / "no" / "such" / "dir.tif", r), InputError);
+  // An output that cannot be created is an I/O failure (exit code 3), not bad input.
+  EXPECT_THROW(write_geotiff(dir_ / "no" / "such" / "dir.tif", r), IoError);
   EXPECT_FALSE(fs::exists(dir_ / "no"));
 }
 
@@ -572,5 +575,63 @@ TEST(RasterRealTerrain, AlplehnerDtmAndReleasePolygon) {
   for (const auto& p : rel) {
     EXPECT_DOUBLE_EQ(p.attribute, 1.0);
     for (const auto& v : p.outer) EXPECT_TRUE(terrain.valid(v.x(), v.y()));  // release on the DTM
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Issue #12: full disk while writing a GeoTIFF or PNG, and a header declaring an absurd size.
+
+// A full disk (a 2 kB file size limit in a child process) used to be reported as "input error",
+// exit code 2: it is an IoError naming the file, and no ".partial" file is left.
+TEST_F(RasterTest, FullDiskWhileWritingGeoTiffOrPngIsAnIoError) {
+  Raster r = make_grid(200, 200, 1.0, 1.0);
+  fill(r, [](double x, double y) { return std::sin(x) * std::cos(y); });  // does not compress away
+  geohaz::testing::ChildLimits lim;
+  lim.file_size = 2000;
+  const auto tif = geohaz::testing::run_in_child(
+      [&] {
+        try {
+          write_geotiff(dir_ / "big.tif", r);
+        } catch (const IoError&) {
+          return 3;
+        } catch (const InputError&) {
+          return 2;
+        }
+        return 0;
+      },
+      lim);
+  ASSERT_TRUE(tif.exited) << tif.describe();
+  EXPECT_EQ(tif.code, 3);
+  const auto png = geohaz::testing::run_in_child(
+      [&] {
+        try {
+          write_quicklook_png(dir_ / "big.png", r, nullptr, ColourRamp::Terrain, "elevation (m)");
+        } catch (const IoError&) {
+          return 3;
+        } catch (const InputError&) {
+          return 2;
+        }
+        return 0;
+      },
+      lim);
+  ASSERT_TRUE(png.exited) << png.describe();
+  EXPECT_EQ(png.code, 3);
+  for (const auto& e : fs::directory_iterator(dir_)) ADD_FAILURE() << "left behind: " << e.path();
+}
+
+// A 100000 × 100000 GeoTIFF header on a few kB of data ended in std::bad_alloc naming nothing:
+// now an InputError naming the file and the memory it would need, before anything is allocated.
+TEST_F(RasterTest, HeaderDeclaringTooManyCellsIsAnInputErrorNamingTheFile) {
+  const fs::path tif = dir_ / "huge.tif";
+  Raster r = make_grid(8, 8, 1.0, 1.0);
+  write_geotiff(tif, r);
+  ASSERT_TRUE(geohaz::testing::set_tiff_size(tif, 100000, 100000));
+  try {
+    read_raster(tif);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), tif.string());
+    EXPECT_TRUE(contains_text(e.what(), "100000 × 100000 cells")) << e.what();
+    EXPECT_TRUE(contains_text(e.what(), "of memory")) << e.what();
   }
 }
