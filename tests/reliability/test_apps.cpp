@@ -232,6 +232,16 @@ TEST_F(Reliability, ProfileLeavingTheTerrainNamesTheFileAndTheKey) {
   EXPECT_TRUE(has(r.err, "avaAlr.tif")) << r.err;
 }
 
+// Item 8: checks inside the libraries (here the 3D scenario builder's minimum width) named no file.
+TEST_F(Reliability, ScenarioErrorsNameTheConfigFile) {
+  const auto r = expect_exit(sph_column(dir_ / "o") + std::vector<std::string>{"--set", "run.dimension=3", "--set",
+                                                                                 "geometry.periodic=false", "--set",
+                                                                                 "geometry.width=0.001"},
+                             2);
+  EXPECT_TRUE(has(r.err, "column_collapse.toml")) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
+}
+
 // Item 8: "--set run=5" complained about column.floor_length; a stray positional argument was
 // ignored by sph-slope and dem-avalanche.
 TEST_F(Reliability, SetOfATableAndStrayArgumentsAreBadInput) {

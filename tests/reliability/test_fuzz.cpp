@@ -406,6 +406,13 @@ TEST(Fuzz, EveryMutatedRunEndsWithACodeAndAMessage) {
     for (const auto& [o, n] : outcomes) std::cout << "  " << o << " ×" << n;
     std::cout << "\n";
   }
+  if (const char* log = std::getenv("GEOHAZ_FUZZ_LOG")) {  // every outcome, for reading the messages
+    std::ofstream out(log);
+    for (std::size_t k = 0; k < cases.size(); ++k)
+      out << cases[k].id << '\t' << app_name(cases[k].app) << '\t' << results[k].describe() << '\t'
+          << results[k].seconds << '\t' << cases[k].what << '\t' << results[k].err.substr(0, results[k].err.find('\n'))
+          << '\n';
+  }
   if (failures == 0) fs::remove_all(scratch);  // else kept for reproduction
 }
 

@@ -113,7 +113,14 @@ int run_config_app(int argc, const char* const* argv, const ConfigApp& app) {
       throw InputError("--config FILE is required (see " + app.name + " --help)", "command line", "--config");
     setup_threads(opts.threads);
     auto reader = load_config(opts);
-    return app.run(reader, opts);
+    try {
+      return app.run(reader, opts);
+    } catch (const InputError& e) {
+      // A check deep in a library (a scenario builder, a terrain) knows what is wrong but not which
+      // file it came from: everything app.run reads comes from the config, so name it.
+      if (!e.file().empty()) throw;
+      throw InputError(e.reason(), opts.config, e.key(), e.value());
+    }
   });
 }
 
