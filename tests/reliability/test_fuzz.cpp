@@ -222,7 +222,16 @@ void mutate_command_line(Case& c, Rng& rng) {
   const auto k = rng.below(extra.size() + 2);
   if (k < extra.size()) {
     const auto& e = extra[k];
-    c.argv.insert(c.argv.end(), e.begin(), e.end());
+    // An option the base command line has already (--threads 1, --config FILE) is replaced, so the
+    // mutated value is what the app sees (not "cannot be specified more than once").
+    const auto same = std::find(c.argv.begin(), c.argv.end(), e.front());
+    if (same != c.argv.end() && e.size() == 2 && same + 1 != c.argv.end())
+      *(same + 1) = e[1];
+    else if (same != c.argv.end() && e.size() == 1 && e.front() == "--config")
+      c.argv.erase(same, same + 2);  // "--config" without its file
+    else
+      c.argv.insert(c.argv.end(), e.begin(), e.end());
+    if (e.size() == 1 && e.front() == "--config") c.argv.push_back("--config");
     c.what += " argv[" + e.front() + (e.size() > 1 ? " " + e[1] : "") + "]";
   } else if (k == extra.size()) {  // --out onto an existing file
     c.argv.push_back("--out");

@@ -56,9 +56,9 @@ void write_text_file(const std::filesystem::path& path, std::string_view text) {
 void make_output_dir(const std::filesystem::path& dir) {
   std::error_code ec;
   if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
-    throw InputError("output path exists and is not a directory", "", "--out", dir.string());
+    throw InputError("output path exists and is not a directory", "command line", "--out", dir.string());
   std::filesystem::create_directories(dir, ec);
-  if (ec) throw InputError("cannot create output directory: " + ec.message(), "", "--out", dir.string());
+  if (ec) throw InputError("cannot create output directory: " + ec.message(), "command line", "--out", dir.string());
 }
 
 void remove_partial_files(const std::filesystem::path& dir) {
