@@ -27,16 +27,34 @@ const fs::path kData = fs::path(GEOHAZ_SOURCE_DIR) / "data";
 
 /// Tiny runs of the three apps (each a second or less), to which a test adds its own arguments.
 std::vector<std::string> sph_column(const fs::path& out) {
-  return {SPH_SLOPE_EXE, "--config", (kData / "sph/column_collapse.toml").string(), "--set", "run.end_time=0.002",
-          "--set", "numerics.spacing=0.01", "--set", "run.velocity_png_times=[]", "--quiet", "--out", out.string()};
+  return {SPH_SLOPE_EXE,
+          "--config",
+          (kData / "sph/column_collapse.toml").string(),
+          "--set",
+          "run.end_time=0.002",
+          "--set",
+          "numerics.spacing=0.01",
+          "--set",
+          "run.velocity_png_times=[]",
+          "--quiet",
+          "--out",
+          out.string()};
 }
 std::vector<std::string> dem_avalanche(const fs::path& out) {
-  return {DEM_AVALANCHE_EXE, "--config", (kData / "dem/avalanche.toml").string(), "--set", "avalanche.runout_time=0.2",
-          "--set", "avalanche.settle_time=0.05", "--quiet", "--out", out.string()};
+  return {DEM_AVALANCHE_EXE,
+          "--config",
+          (kData / "dem/avalanche.toml").string(),
+          "--set",
+          "avalanche.runout_time=0.2",
+          "--set",
+          "avalanche.settle_time=0.05",
+          "--quiet",
+          "--out",
+          out.string()};
 }
 std::vector<std::string> runout_valley(const fs::path& out) {
-  return {DEBRIS_RUNOUT_EXE, "--config", (kData / "runout/valley_small.toml").string(), "--duration", "2", "--quiet",
-          "--out", out.string()};
+  return {DEBRIS_RUNOUT_EXE, "--config",  (kData / "runout/valley_small.toml").string(), "--duration", "2", "--quiet",
+          "--out",           out.string()};
 }
 
 std::vector<std::string> operator+(std::vector<std::string> a, const std::vector<std::string>& b) {
@@ -44,14 +62,16 @@ std::vector<std::string> operator+(std::vector<std::string> a, const std::vector
   return a;
 }
 
-bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+bool has(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
 
 class Reliability : public ::testing::Test {
  protected:
   void SetUp() override {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("geohaz_reliability_" + std::string(info->name()) + "_" +
-                                        std::to_string(getpid()));
+    dir_ = fs::temp_directory_path() /
+           ("geohaz_reliability_" + std::string(info->name()) + "_" + std::to_string(getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -94,9 +114,10 @@ TEST_F(Reliability, FullDiskEndsWithExitThreeAndReadableOutputs) {
   ChildLimits lim;
   // dem-avalanche: a snapshot every 0.01 s writes 0.73 MB; 300 kB holds the first few.
   lim.file_size = 300 * 1000;
-  auto r = expect_exit(dem_avalanche(dir_ / "dem") + std::vector<std::string>{"--set", "output.snapshot_every=1",
-                                                                               "--set", "avalanche.record_interval=0.01"},
-                       3, lim);
+  auto r =
+      expect_exit(dem_avalanche(dir_ / "dem") + std::vector<std::string>{"--set", "output.snapshot_every=1", "--set",
+                                                                         "avalanche.record_interval=0.01"},
+                  3, lim);
   EXPECT_TRUE(has(r.err, "I/O error")) << r.err;
   {
     geohaz::SnapshotReader rd(dir_ / "dem/snapshots.h5");
@@ -147,8 +168,8 @@ TEST_F(Reliability, InfiniteValuesAreBadInput) {
 
 // Item 5: a malformed index in --set ended with "error: stol", exit 1, in every app.
 TEST_F(Reliability, MalformedSetIndexIsBadInputNamingTheCommandLine) {
-  for (const char* set : {"material[abc].density=1", "material[].density=1",
-                          "material[12345678901234567890].density=1"}) {
+  for (const char* set :
+       {"material[abc].density=1", "material[].density=1", "material[12345678901234567890].density=1"}) {
     for (auto argv : {sph_column(dir_ / "o"), dem_avalanche(dir_ / "o"), runout_valley(dir_ / "o")}) {
       const auto r = expect_exit(argv + std::vector<std::string>{"--set", set}, 2);
       EXPECT_TRUE(has(r.err, "malformed array index")) << r.err;
@@ -161,10 +182,10 @@ TEST_F(Reliability, MalformedSetIndexIsBadInputNamingTheCommandLine) {
 // Item 6: spacing 0.04 and width 0.2 passed the 3D periodic width check but the neighbour list
 // rejected them mid-run ("a periodic axis must be at least twice the cut-off", exit 1, files left).
 TEST_F(Reliability, PeriodicWidthTheNeighbourListWouldRejectIsBadInput) {
-  const auto r = expect_exit({SPH_SLOPE_EXE, "--config", (kData / "sph/slope_3d_periodic.toml").string(), "--set",
-                              "numerics.spacing=0.04", "--set", "geometry.width=0.2", "--set", "run.end_time=0.001",
-                              "--quiet", "--out", (dir_ / "o").string()},
-                             2);
+  const auto r = expect_exit(
+      {SPH_SLOPE_EXE, "--config", (kData / "sph/slope_3d_periodic.toml").string(), "--set", "numerics.spacing=0.04",
+       "--set", "geometry.width=0.2", "--set", "run.end_time=0.001", "--quiet", "--out", (dir_ / "o").string()},
+      2);
   EXPECT_TRUE(has(r.err, "'geometry.width'")) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "o"));
 }
@@ -200,16 +221,16 @@ TEST_F(Reliability, InputsNeedingTooMuchMemoryAreBadInputNamingKeyAndEstimate) {
 // Item 8: a profile leaving the terrain named neither file nor key.
 TEST_F(Reliability, ProfileLeavingTheTerrainNamesTheFileAndTheKey) {
   const fs::path sph = kData / "sph/section_dsm.toml";
-  auto r = expect_exit({SPH_SLOPE_EXE, "--config", sph.string(), "--set",
-                        "section.polyline=[500010.0, 4000040.0, 900110.0, 4000040.0]", "--quiet", "--out",
-                        (dir_ / "o").string()},
-                       2);
+  auto r = expect_exit(
+      {SPH_SLOPE_EXE, "--config", sph.string(), "--set", "section.polyline=[500010.0, 4000040.0, 900110.0, 4000040.0]",
+       "--quiet", "--out", (dir_ / "o").string()},
+      2);
   EXPECT_TRUE(has(r.err, "section.polyline")) << r.err;
   EXPECT_TRUE(has(r.err, "hillside_dsm.asc")) << r.err;
-  r = expect_exit(dem_avalanche(dir_ / "o") + std::vector<std::string>{"--config",
-                                                                         (kData / "dem/avalanche_alr.toml").string(),
-                                                                         "--set", "avalanche.section_x[0]=1"},
-                  2);
+  r = expect_exit(
+      dem_avalanche(dir_ / "o") + std::vector<std::string>{"--config", (kData / "dem/avalanche_alr.toml").string(),
+                                                           "--set", "avalanche.section_x[0]=1"},
+      2);
   // (--set of one array element is no TOML: this asserts the message names the command line.)
   EXPECT_TRUE(has(r.err, "command line")) << r.err;
   std::ifstream in(kData / "dem/avalanche_alr.toml");
@@ -234,10 +255,10 @@ TEST_F(Reliability, ProfileLeavingTheTerrainNamesTheFileAndTheKey) {
 
 // Item 8: checks inside the libraries (here the 3D scenario builder's minimum width) named no file.
 TEST_F(Reliability, ScenarioErrorsNameTheConfigFile) {
-  const auto r = expect_exit(sph_column(dir_ / "o") + std::vector<std::string>{"--set", "run.dimension=3", "--set",
-                                                                                 "geometry.periodic=false", "--set",
-                                                                                 "geometry.width=0.001"},
-                             2);
+  const auto r = expect_exit(
+      sph_column(dir_ / "o") + std::vector<std::string>{"--set", "run.dimension=3", "--set", "geometry.periodic=false",
+                                                        "--set", "geometry.width=0.001"},
+      2);
   EXPECT_TRUE(has(r.err, "column_collapse.toml")) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "o"));
 }

@@ -57,7 +57,9 @@ std::string read_file(const fs::path& p) {
   s << in.rdbuf();
   return s.str();
 }
-void write_file(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+void write_file(const fs::path& p, const std::string& text) {
+  std::ofstream(p, std::ios::binary) << text;
+}
 
 std::vector<std::string> lines_of(const std::string& text) {
   std::vector<std::string> out;
@@ -73,8 +75,12 @@ std::string join(const std::vector<std::string>& lines) {
 
 enum class App { Sph, Dem, Runout };
 
-const char* exe(App a) { return a == App::Sph ? SPH_SLOPE_EXE : a == App::Dem ? DEM_AVALANCHE_EXE : DEBRIS_RUNOUT_EXE; }
-const char* app_name(App a) { return a == App::Sph ? "sph-slope" : a == App::Dem ? "dem-avalanche" : "debris-runout"; }
+const char* exe(App a) {
+  return a == App::Sph ? SPH_SLOPE_EXE : a == App::Dem ? DEM_AVALANCHE_EXE : DEBRIS_RUNOUT_EXE;
+}
+const char* app_name(App a) {
+  return a == App::Sph ? "sph-slope" : a == App::Dem ? "dem-avalanche" : "debris-runout";
+}
 
 /// Settings appended after the (mutated) config so every run is short: tiny end times and a
 /// shortened preparation phase. They are --set overrides, so the config's own values are still
@@ -85,8 +91,8 @@ std::vector<std::string> tiny(App a, const std::string& config_name) {
   if (a == App::Dem) {
     if (config_name.find("avalanche") != std::string::npos)
       return {"--set", "avalanche.settle_time=0.02", "--set", "avalanche.runout_time=0.05"};
-    return {"--set", "sample.expansion_steps=50", "--set", "sample.relax_steps=200", "--set",
-            "biaxial.max_axial_strain=0.0005"};
+    return {"--set", "sample.expansion_steps=50",      "--set", "sample.relax_steps=200",
+            "--set", "biaxial.max_axial_strain=0.0005"};
   }
   return {"--duration", "1"};
 }
@@ -107,10 +113,32 @@ std::string mutate_toml(const std::string& text, Rng& rng, std::string& what) {
   std::vector<std::size_t> values;  // lines "key = value"
   for (std::size_t k = 0; k < lines.size(); ++k)
     if (lines[k].find('=') != std::string::npos && !lines[k].empty() && lines[k][0] != '#') values.push_back(k);
-  const std::vector<std::string> replacements = {
-      "0",     "-1",   "1e-300", "1e300", "inf", "-inf",     "nan",     "2147483648", "-9223372036854775808",
-      "0.5",   "3.5",  "1e-9",   "1e9",   "\"\"", "\"abc\"", "true",    "[]",         "[1, 2, 3]",
-      "[inf]", "{}",   "-0.0",   "1e-6",  "1e6", "\"/dev/null\"", "\"/nonexistent/file.tif\"", "[[1]]"};
+  const std::vector<std::string> replacements = {"0",
+                                                 "-1",
+                                                 "1e-300",
+                                                 "1e300",
+                                                 "inf",
+                                                 "-inf",
+                                                 "nan",
+                                                 "2147483648",
+                                                 "-9223372036854775808",
+                                                 "0.5",
+                                                 "3.5",
+                                                 "1e-9",
+                                                 "1e9",
+                                                 "\"\"",
+                                                 "\"abc\"",
+                                                 "true",
+                                                 "[]",
+                                                 "[1, 2, 3]",
+                                                 "[inf]",
+                                                 "{}",
+                                                 "-0.0",
+                                                 "1e-6",
+                                                 "1e6",
+                                                 "\"/dev/null\"",
+                                                 "\"/nonexistent/file.tif\"",
+                                                 "[[1]]"};
   const int n = 1 + static_cast<int>(rng.below(3));
   for (int m = 0; m < n; ++m) {
     const auto kind = rng.below(10);
@@ -263,8 +291,8 @@ App app_of(const fs::path& config) {
 }
 
 TEST(Fuzz, EveryMutatedRunEndsWithACodeAndAMessage) {
-  const std::uint64_t seed = std::getenv("GEOHAZ_FUZZ_SEED") ? std::strtoull(std::getenv("GEOHAZ_FUZZ_SEED"), nullptr, 10)
-                                                             : 20261201u;
+  const std::uint64_t seed =
+      std::getenv("GEOHAZ_FUZZ_SEED") ? std::strtoull(std::getenv("GEOHAZ_FUZZ_SEED"), nullptr, 10) : 20261201u;
   const int runs = std::getenv("GEOHAZ_FUZZ_RUNS") ? std::atoi(std::getenv("GEOHAZ_FUZZ_RUNS")) : 300;
   const fs::path scratch = fs::temp_directory_path() / ("geohaz_fuzz_" + std::to_string(getpid()));
   fs::remove_all(scratch);
@@ -320,7 +348,7 @@ TEST(Fuzz, EveryMutatedRunEndsWithACodeAndAMessage) {
         } else {
           const fs::path src = name == std::string("avaAlr.tif")         ? kData / "terrain/alr/avaAlr.tif"
                                : name == std::string("hillside_dsm.asc") ? kData / "sph/hillside_dsm.asc"
-                                                                        : kData / "runout" / name;
+                                                                         : kData / "runout" / name;
           copy = dir / name;
           fs::copy_file(src, copy);
           if (src.extension() == ".asc") fs::copy_file(kData / "sph/hillside_dsm.prj", dir / "hillside_dsm.prj");
