@@ -1,11 +1,11 @@
 #include "geohaz/sph/solver.hpp"
 
+#include <omp.h>
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
-
-#include <omp.h>
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/kernels.hpp"
@@ -50,6 +50,65 @@ Mat<Dim> artificial_stress(const Mat<Dim>& s, double eps, double rho) {
     const Mat3& Q = es.eigenvectors();
     return Q * r.asDiagonal() * Q.transpose();
   }
+}
+
+constexpr std::uint8_t kSoil = static_cast<std::uint8_t>(Kind::Soil);
+constexpr std::uint8_t kRoller = static_cast<std::uint8_t>(Kind::RollerWall);
+
+/// Minimum-image displacement a − b without std::round: positions are wrapped into the box after
+/// every move, so a difference along a periodic axis lies in (−L, L) and one conditional shift suffices.
+template <int Dim>
+struct MinimumImage {
+  bool any = false;
+  Vec<Dim> period = Vec<Dim>::Zero();
+  explicit MinimumImage(const Periodicity<Dim>& per) : any(per.any()) {
+    for (int k = 0; k < Dim; ++k)
+      if (per.axis[k]) period[k] = per.hi[k] - per.lo[k];
+  }
+  Vec<Dim> operator()(const Vec<Dim>& a, const Vec<Dim>& b) const noexcept {
+    Vec<Dim> d = a - b;
+    if (any) {
+      for (int k = 0; k < Dim; ++k) {
+        const double L = period[k];
+        if (L > 0.0) d[k] -= d[k] > 0.5 * L ? L : (d[k] < -0.5 * L ? -L : 0.0);
+      }
+    }
+    return d;
+  }
+};
+
+/// Kernel constants of the pair loops: W = σ w(q), ∇W = x_ij σ/h w'(q)/r with q = r/h.
+template <class Kernel>
+struct PairKernel {
+  double inv_h, sigma, sigma_h, cutoff2, w_self;
+  explicit PairKernel(double h)
+      : inv_h(1.0 / h),
+        sigma(Kernel::sigma(h)),
+        sigma_h(sigma * inv_h),
+        cutoff2((Kernel::support * h) * (Kernel::support * h)),
+        w_self(Kernel::value(0.0, h)) {}
+};
+
+/// Velocity of boundary particle b in its pair with soil particle i (step 1): the mirror image of
+/// v_i, all components (fixed wall, pile) or only the normal one (roller).
+template <int Dim>
+inline Vec<Dim> mirror_velocity(const Vec<Dim>& vi, const Vec<Dim>& vb, const Vec<Dim>& nb, bool roller) noexcept {
+  if (roller) return vi - 2.0 * (vi - vb).dot(nb) * nb;
+  return 2.0 * vb - vi;
+}
+
+/// Stress of boundary particle b in its pair with soil particle i (step 1): σ_i extrapolated along
+/// the layering normal ν_b with the matrix G_b of prepare_boundary_pairs, d = (x_b − x_i)·ν = −x_ib·ν;
+/// shear mirrored through the wall for a roller.
+template <int Dim>
+inline Mat<Dim> mirror_stress(const Mat<Dim>& si, double rhoi, const Vec<Dim>& xib, const Vec<Dim>& nu_b,
+                              const Mat<Dim>& G_b, const Vec<Dim>& nb, bool roller) noexcept {
+  Mat<Dim> sb = si + (rhoi * xib.dot(nu_b)) * G_b;
+  if (roller) {
+    const Mat<Dim> M = Mat<Dim>::Identity() - 2.0 * nb * nb.transpose();
+    sb = M * sb * M;
+  }
+  return sb;
 }
 
 }  // namespace
@@ -107,60 +166,45 @@ void SphSolver<Dim>::step() {
       model_);
 }
 
+// ---- One step: the passes of the numbered list in solver.hpp -------------------------------------
+
 template <int Dim>
 template <class Kernel, class Model>
-void SphSolver<Dim>::step_impl(const Model& /*model*/) {
+void SphSolver<Dim>::step_impl(const Model& model) {
+  update_neighbours(Kernel::support * h_);    // 0. neighbour list (and cell reordering)
+  const Vec<Dim> gbar = body_acceleration();  //    ḡ = g + a_earthquake of this step
+  prepare_boundary_pairs(gbar);               // 1. volumes; the walls' stress extrapolation
+  velocity_gradient<Kernel>();                // 2. L, dρ/dt, ρ̃, XSPH
+  update_stress(model);                       // 3. density, constitutive model, artificial stress
+  momentum<Kernel>();                         // 4. pair forces → acceleration
+  integrate(gbar);                            // 5. body force, damping, leap-frog
+  time_ += dt_;                               // 6. clock, state check, next Δt
+  ++step_;
+  check_state();
+  update_dt();
+}
+
+template <int Dim>
+void SphSolver<Dim>::update_neighbours(double cutoff) {
+  // Cell reordering keeps neighbours close in memory; an optional Verlet skin lets the list be
+  // reused while no particle has moved more than half the skin (max_drift_, from step 5).
   auto& S = store_;
-  const double h = h_;
-  const double cutoff = Kernel::support * h;
-  const auto& per = settings_.periodic;
-
-  // 0. Neighbours (cell reordering keeps neighbours close in memory; an optional Verlet skin lets
-  //    the list be reused while no particle has moved more than half the skin).
-  const double skin = settings_.neighbour_skin * h;
+  const double skin = settings_.neighbour_skin * h_;
   const bool rebuild = skin <= 0.0 || list_.size() != S.size() || max_drift_ > 0.5 * skin;
-  if (rebuild) {
-    if (settings_.reorder_every > 0 && step_ - last_reorder_ >= settings_.reorder_every) {
-      list_.build(S.template get<Position<Dim>>(), cutoff + skin, per);
-      S.reorder(list_.cell_order());
-      last_reorder_ = step_;
-    }
-    list_.build(S.template get<Position<Dim>>(), cutoff + skin, per);
-    ++builds_;
-    S.template get<PositionAtBuild<Dim>>() = S.template get<Position<Dim>>();
-    max_drift_ = 0.0;
+  if (!rebuild) return;
+  if (settings_.reorder_every > 0 && step_ - last_reorder_ >= settings_.reorder_every) {
+    list_.build(S.template get<Position<Dim>>(), cutoff + skin, settings_.periodic);
+    S.reorder(list_.cell_order());
+    last_reorder_ = step_;
   }
-  const double cutoff2 = cutoff * cutoff;
-  // Kernel constants for the pair loops: W = σ w(q), ∇W = x_ij σ/h w'(q)/r with q = r/h.
-  const double inv_h = 1.0 / h, sigma = Kernel::sigma(h), sigma_h = sigma * inv_h;
+  list_.build(S.template get<Position<Dim>>(), cutoff + skin, settings_.periodic);
+  ++builds_;
+  S.template get<PositionAtBuild<Dim>>() = S.template get<Position<Dim>>();
+  max_drift_ = 0.0;
+}
 
-  const std::int64_t n = static_cast<std::int64_t>(S.size());
-  Vec<Dim>* x = S.template get<Position<Dim>>().data();
-  Vec<Dim>* v = S.template get<Velocity<Dim>>().data();
-  Vec<Dim>* acc = S.template get<Acceleration<Dim>>().data();
-  Vec<Dim>* disp = S.template get<Displacement<Dim>>().data();
-  Mat3* sig = S.template get<Stress>().data();
-  Mat<Dim>* L = S.template get<VelocityGradient<Dim>>().data();
-  double* rho = S.template get<Density>().data();
-  double* drho = S.template get<DensityRate>().data();
-  const double* m = S.template get<Mass>().data();
-  const std::int32_t* mat = S.template get<MaterialId>().data();
-  const std::uint8_t* kind = S.template get<ParticleKind>().data();
-  const Vec<Dim>* nrm = S.template get<WallNormal<Dim>>().data();
-  const Vec<Dim>* lnrm = S.template get<LayerNormal<Dim>>().data();
-  double* eps_p = S.template get<PlasticStrain>().data();
-  std::uint8_t* sfree = S.template get<StressFree>().data();
-  double* rsum = S.template get<SummationDensity>().data();
-  Vec<Dim>* xs = S.template get<XsphCorrection<Dim>>().data();
-  Mat<Dim>* R = S.template get<ArtificialStress<Dim>>().data();
-  Mat<Dim>* ps = S.template get<PairStress<Dim>>().data();
-  double* vol = S.template get<Volume>().data();
-  const Vec<Dim>* xb = S.template get<PositionAtBuild<Dim>>().data();
-  const std::uint32_t* off = list_.offsets().data();
-  const std::uint32_t* idx = list_.indices().data();
-  const MaterialParams* mats = materials_.data();
-  const double dt = dt_;
-
+template <int Dim>
+Vec<Dim> SphSolver<Dim>::body_acceleration() const {
   // Effective body acceleration ḡ = g + a_eq (seed 002 eq. 26); gravity along −axis Dim−1.
   Vec<Dim> gbar = Vec<Dim>::Zero();
   gbar[Dim - 1] = -settings_.gravity * gravity_factor_;
@@ -168,47 +212,41 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
     gbar[0] += settings_.earthquake.horizontal(time_);
     gbar[Dim - 1] += settings_.earthquake.vertical(time_);
   }
-  const bool periodic_any = per.any();
-  // Minimum image without std::round: positions are wrapped into the box after every move, so a
-  // difference along a periodic axis lies in (−L, L) and one conditional shift suffices.
-  Vec<Dim> period = Vec<Dim>::Zero();
-  for (int k = 0; k < Dim; ++k)
-    if (per.axis[k]) period[k] = per.hi[k] - per.lo[k];
-  auto displacement = [periodic_any, period](const Vec<Dim>& a, const Vec<Dim>& b) -> Vec<Dim> {
-    Vec<Dim> d = a - b;
-    if (periodic_any) {
-      for (int k = 0; k < Dim; ++k) {
-        const double L = period[k];
-        if (L > 0.0) d[k] -= d[k] > 0.5 * L ? L : (d[k] < -0.5 * L ? -L : 0.0);
-      }
-    }
-    return d;
-  };
-  constexpr std::uint8_t kSoil = static_cast<std::uint8_t>(Kind::Soil);
-  constexpr std::uint8_t kRoller = static_cast<std::uint8_t>(Kind::RollerWall);
+  return gbar;
+}
 
-  // 1. Particle volumes for the pair sums; boundary particles: the extrapolation matrix of their
-  //    stress (below) in the pair-stress slot.
-  //
-  // Boundary particles (Bui et al. 2008) act on each soil particle i as its mirror image: in the
-  // pair (i, b) the wall particle b takes
-  //   velocity  2 v_b − v_i (no slip: zero relative velocity halfway between i and b), or
-  //             v_i − 2 ((v_i − v_b)·n) n (free slip: only the normal component mirrored);
-  //   stress    σ_b = σ_i − ρ_i d [ḡ_n I + ḡ_t ⊗ ν + ν ⊗ ḡ_t], d = (x_b − x_i)·ν,
-  //             shear mirrored through the wall (M σ_b M, M = I − 2nn) for free slip.
-  // The stress extrapolation lets the wall carry the stress gradient equilibrium demands,
-  // ∂σ_ik/∂x_k = −ρ ḡ_i, assuming the stress varies only along the layering normal ν (flat
-  // ground, an infinite slope): its traction on the layering plane changes by −ρ_i ḡ d (normal and
-  // shear), the in-plane normal components take the isotropic part. On flat ground under gravity
-  // this is the hydrostatic term of Adami et al. (2012); on a slope or under horizontal shaking it
-  // also supplies the shear the base must carry.
-  // Why per pair and not a Shepard average over the wall particle's soil neighbours (Adami's
-  // form, used before 2026-11-22): the average couples a soil particle to every soil particle
-  // within 2h of the wall, one-way (no reaction), and with a stiffness or density contrast within
-  // that distance — a thin stiff base under a soft cover, or any layering near an inclined wall —
-  // the coupling made an oscillation grow until the soil failed, at any Δt. The mirror pair is
-  // local and, with the pair forms of steps 2 and 4, conserves energy (docs/sph.md, "Boundary
-  // particles and material interfaces").
+// 1. Particle volumes for the pair sums; boundary particles: the extrapolation matrix of their
+//    stress (below) in the pair-stress slot.
+//
+// Boundary particles (Bui et al. 2008) act on each soil particle i as its mirror image: in the
+// pair (i, b) the wall particle b takes
+//   velocity  2 v_b − v_i (no slip: zero relative velocity halfway between i and b), or
+//             v_i − 2 ((v_i − v_b)·n) n (free slip: only the normal component mirrored);
+//   stress    σ_b = σ_i − ρ_i d [ḡ_n I + ḡ_t ⊗ ν + ν ⊗ ḡ_t], d = (x_b − x_i)·ν,
+//             shear mirrored through the wall (M σ_b M, M = I − 2nn) for free slip.
+// (mirror_velocity and mirror_stress above; the pair passes 2 and 4 call them.)
+// The stress extrapolation lets the wall carry the stress gradient equilibrium demands,
+// ∂σ_ik/∂x_k = −ρ ḡ_i, assuming the stress varies only along the layering normal ν (flat
+// ground, an infinite slope): its traction on the layering plane changes by −ρ_i ḡ d (normal and
+// shear), the in-plane normal components take the isotropic part. On flat ground under gravity
+// this is the hydrostatic term of Adami et al. (2012); on a slope or under horizontal shaking it
+// also supplies the shear the base must carry.
+// Why per pair and not a Shepard average over the wall particle's soil neighbours (Adami's
+// form, used before 2026-11-22): the average couples a soil particle to every soil particle
+// within 2h of the wall, one-way (no reaction), and with a stiffness or density contrast within
+// that distance — a thin stiff base under a soft cover, or any layering near an inclined wall —
+// the coupling made an oscillation grow until the soil failed, at any Δt. The mirror pair is
+// local and, with the pair forms of steps 2 and 4, conserves energy (docs/sph.md, "Boundary
+// particles and material interfaces").
+template <int Dim>
+void SphSolver<Dim>::prepare_boundary_pairs(const Vec<Dim>& gbar) {
+  const std::int64_t n = static_cast<std::int64_t>(store_.size());
+  const double* rho = field<Density>();
+  const double* m = field<Mass>();
+  const std::uint8_t* kind = field<ParticleKind>();
+  const Vec<Dim>* lnrm = field<LayerNormal<Dim>>();
+  Mat<Dim>* ps = field<PairStress<Dim>>();
+  double* vol = field<Volume>();
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
@@ -222,28 +260,34 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
     G.diagonal().array() += g_n;
     ps[i] = G;
   }
-  // The boundary partner of soil particle i in a pair: velocity and stress as above.
-  auto wall_velocity = [&](std::size_t i, std::size_t b) -> Vec<Dim> {
-    if (kind[b] == kRoller) return v[i] - 2.0 * (v[i] - v[b]).dot(nrm[b]) * nrm[b];
-    return 2.0 * v[b] - v[i];
-  };
-  auto wall_stress = [&](const Mat<Dim>& si, double rhoi, std::size_t b, const Vec<Dim>& xib) -> Mat<Dim> {
-    Mat<Dim> sb = si + (rhoi * xib.dot(lnrm[b])) * ps[b];  // d = (x_b − x_i)·ν = −x_ib·ν
-    if (kind[b] == kRoller) {
-      const Mat<Dim> M = Mat<Dim>::Identity() - 2.0 * nrm[b] * nrm[b].transpose();
-      sb = M * sb * M;
-    }
-    return sb;
-  };
+}
 
-  // (The pair loops of steps 2 and 4 repeat the same ten-line neighbour header on purpose: folded
-  //  into a shared lambda it cost 20 % of the 2D speed, the captures defeating register reuse.)
-  // 2. Velocity gradient, continuity, summation density, XSPH (soil particles):
-  //    L_i = Σ_j V_j (v_j − v_i) ⊗ ∇W_ij, dρ_i/dt = −Σ_j m_j (v_j − v_i)·∇W_ij,
-  //    ρ̃_i = Σ_j m_j W_ij, ξ_i = Σ_j V_j W_ij (v_j − v_i), v_j the mirror velocity of a boundary j.
-  //    As in step 4, each soil–soil pair is evaluated once; j's share (V_i dv ⊗ ∇W_ij,
-  //    −m_i dv·∇W_ij, m_i W_ij, −V_i W_ij dv with dv = v_j − v_i) goes to a per-thread buffer.
-  const double w_self = Kernel::value(0.0, h);
+// (The pair loops of steps 2 and 4 repeat the same ten-line neighbour header on purpose: folded
+//  into a shared lambda it cost 20 % of the 2D speed, the captures defeating register reuse.)
+
+// 2. Velocity gradient, continuity, summation density, XSPH (soil particles):
+//    L_i = Σ_j V_j (v_j − v_i) ⊗ ∇W_ij, dρ_i/dt = −Σ_j m_j (v_j − v_i)·∇W_ij,
+//    ρ̃_i = Σ_j m_j W_ij, ξ_i = Σ_j V_j W_ij (v_j − v_i), v_j the mirror velocity of a boundary j.
+//    As in step 4, each soil–soil pair is evaluated once; j's share (V_i dv ⊗ ∇W_ij,
+//    −m_i dv·∇W_ij, m_i W_ij, −V_i W_ij dv with dv = v_j − v_i) goes to a per-thread buffer.
+template <int Dim>
+template <class Kernel>
+void SphSolver<Dim>::velocity_gradient() {
+  const PairKernel<Kernel> K(h_);
+  const MinimumImage<Dim> image(settings_.periodic);
+  const std::int64_t n = static_cast<std::int64_t>(store_.size());
+  const Vec<Dim>* x = field<Position<Dim>>();
+  const Vec<Dim>* v = field<Velocity<Dim>>();
+  const double* m = field<Mass>();
+  const double* vol = field<Volume>();
+  const std::uint8_t* kind = field<ParticleKind>();
+  const Vec<Dim>* nrm = field<WallNormal<Dim>>();
+  Mat<Dim>* L = field<VelocityGradient<Dim>>();
+  double* drho = field<DensityRate>();
+  double* rsum = field<SummationDensity>();
+  Vec<Dim>* xs = field<XsphCorrection<Dim>>();
+  const std::uint32_t* off = list_.offsets().data();
+  const std::uint32_t* idx = list_.indices().data();
   const std::size_t nn = static_cast<std::size_t>(n);
   pair_grad_.resize(static_cast<std::size_t>(omp_get_max_threads()) * nn);
 #pragma omp parallel
@@ -257,21 +301,21 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
       if (kind[i] != kSoil) continue;
       Mat<Dim> Li = Mat<Dim>::Zero();
       Vec<Dim> xi_sum = Vec<Dim>::Zero();
-      double dr = 0.0, rs = m[i] * w_self;
+      double dr = 0.0, rs = m[i] * K.w_self;
       const Vec<Dim> vi = v[i];
       const double Vi = vol[i], mi = m[i];
       for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
         const std::uint32_t j = idx[k];
         const bool soil_j = kind[j] == kSoil;
         if (soil_j && j < i) continue;  // evaluated from j's side
-        const Vec<Dim> xij = displacement(x[i], x[j]);
+        const Vec<Dim> xij = image(x[i], x[j]);
         const double r2 = xij.squaredNorm();
-        if (r2 >= cutoff2) continue;
+        if (r2 >= K.cutoff2) continue;
         const double r = std::sqrt(r2);
-        const double q = r * inv_h;
-        const Vec<Dim> gw = xij * (r > 0.0 ? sigma_h * Kernel::shape_derivative(q) / r : 0.0);
-        const double w = sigma * Kernel::shape(q);
-        const Vec<Dim> dv = (soil_j ? v[j] : wall_velocity(i, j)) - vi;
+        const double q = r * K.inv_h;
+        const Vec<Dim> gw = xij * (r > 0.0 ? K.sigma_h * Kernel::shape_derivative(q) / r : 0.0);
+        const double w = K.sigma * Kernel::shape(q);
+        const Vec<Dim> dv = (soil_j ? v[j] : mirror_velocity<Dim>(v[i], v[j], nrm[j], kind[j] == kRoller)) - vi;
         const Mat<Dim> dvg = dv * gw.transpose();
         const double dvgw = dv.dot(gw);
         const double Vj = vol[j];
@@ -305,10 +349,30 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
       }
     }
   }
+}
 
-  // 3. Density, stress (constitutive model), stress vanishing, artificial stress.
+// 3. Density, stress (constitutive model), stress vanishing, artificial stress.
+template <int Dim>
+template <class Model>
+void SphSolver<Dim>::update_stress(const Model& /*model*/) {
+  const std::int64_t n = static_cast<std::int64_t>(store_.size());
+  const double dt = dt_;
   const double eps_as = settings_.artificial_stress;
   const double sf_frac = settings_.stress_free_fraction;
+  const double* m = field<Mass>();
+  const std::int32_t* mat = field<MaterialId>();
+  const std::uint8_t* kind = field<ParticleKind>();
+  const double* drho = field<DensityRate>();
+  const double* rsum = field<SummationDensity>();
+  const Mat<Dim>* L = field<VelocityGradient<Dim>>();
+  double* rho = field<Density>();
+  double* vol = field<Volume>();
+  Mat3* sig = field<Stress>();
+  double* eps_p = field<PlasticStrain>();
+  std::uint8_t* sfree = field<StressFree>();
+  Mat<Dim>* R = field<ArtificialStress<Dim>>();
+  Mat<Dim>* ps = field<PairStress<Dim>>();
+  const MaterialParams* mats = materials_.data();
   double plastic_sum = 0.0;
   has_as_.resize(static_cast<std::size_t>(n));
   std::uint8_t* has_as = has_as_.data();
@@ -343,23 +407,46 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
     ps[i] = sig[i].template topLeftCorner<Dim, Dim>();
   }
   stats_.plastic_increment = plastic_sum;
+}
 
-  // 4. Momentum: a_i = Σ_j m_j [(σ_i + σ_j)/(ρ_i ρ_j) − Π_ij I + f_ij^n (R_i + R_j)] ∇W_ij + ḡ
-  //    (seed 002 eq. 12 with the stress pair in the form that pairs with the velocity gradient of
-  //    step 2, L_i = Σ_j V_j (v_j − v_i) ⊗ ∇W_ij: together they conserve energy also where the
-  //    density jumps between materials; the seed's σ_i/ρ_i² + σ_j/ρ_j² does not, and a layered
-  //    slope then oscillates at its interfaces, docs/sph.md). Summed as a force density
-  //    f_i = Σ_j V_j [σ_i + σ_j + ρ_i ρ_j (f^n (R_i + R_j) − Π_ij I)] ∇W_ij, a_i = f_i/ρ_i.
-  const double w_dx = Kernel::value(settings_.spacing, h);
-  const double n_as = settings_.artificial_stress_n > 0.0 ? settings_.artificial_stress_n : w_self / w_dx;
+// 4. Momentum: a_i = Σ_j m_j [(σ_i + σ_j)/(ρ_i ρ_j) − Π_ij I + f_ij^n (R_i + R_j)] ∇W_ij + ḡ
+//    (seed 002 eq. 12 with the stress pair in the form that pairs with the velocity gradient of
+//    step 2, L_i = Σ_j V_j (v_j − v_i) ⊗ ∇W_ij: together they conserve energy also where the
+//    density jumps between materials; the seed's σ_i/ρ_i² + σ_j/ρ_j² does not, and a layered
+//    slope then oscillates at its interfaces, docs/sph.md). Summed as a force density
+//    f_i = Σ_j V_j [σ_i + σ_j + ρ_i ρ_j (f^n (R_i + R_j) − Π_ij I)] ∇W_ij, a_i = f_i/ρ_i (ḡ: step 5).
+//    Each soil–soil pair is evaluated once, by the particle of lower index: the pair term is
+//    symmetric (T_ij = T_ji, ∇W_ji = −∇W_ij), so j receives −V_i T ∇W_ij. Those reactions go to a
+//    per-thread buffer (no two threads write the same slot) summed after the pass; soil–boundary
+//    pairs act on the soil particle only.
+template <int Dim>
+template <class Kernel>
+void SphSolver<Dim>::momentum() {
+  const PairKernel<Kernel> K(h_);
+  const MinimumImage<Dim> image(settings_.periodic);
+  const double w_dx = Kernel::value(settings_.spacing, h_);
+  const double n_as = settings_.artificial_stress_n > 0.0 ? settings_.artificial_stress_n : K.w_self / w_dx;
   const double alpha = settings_.viscosity_alpha, beta = settings_.viscosity_beta;
-  const double eta2 = 0.01 * h * h;
+  const double h = h_, eta2 = 0.01 * h * h;
   const double r_rep = settings_.wall_repulsion * settings_.spacing;
   const bool fluid = fluid_;
-  // Each soil–soil pair is evaluated once, by the particle of lower index: the pair term is
-  // symmetric (T_ij = T_ji, ∇W_ji = −∇W_ij), so j receives −V_i T ∇W_ij. Those reactions go to a
-  // per-thread buffer (no two threads write the same slot) summed after the pass; soil–boundary
-  // pairs act on the soil particle only.
+  const std::int64_t n = static_cast<std::int64_t>(store_.size());
+  const Vec<Dim>* x = field<Position<Dim>>();
+  const Vec<Dim>* v = field<Velocity<Dim>>();
+  const double* rho = field<Density>();
+  const double* vol = field<Volume>();
+  const std::int32_t* mat = field<MaterialId>();
+  const std::uint8_t* kind = field<ParticleKind>();
+  const Vec<Dim>* nrm = field<WallNormal<Dim>>();
+  const Vec<Dim>* lnrm = field<LayerNormal<Dim>>();
+  const Mat<Dim>* ps = field<PairStress<Dim>>();
+  const Mat<Dim>* R = field<ArtificialStress<Dim>>();
+  const std::uint8_t* has_as = has_as_.data();
+  Vec<Dim>* acc = field<Acceleration<Dim>>();
+  const std::uint32_t* off = list_.offsets().data();
+  const std::uint32_t* idx = list_.indices().data();
+  const MaterialParams* mats = materials_.data();
+  const std::size_t nn = static_cast<std::size_t>(n);
   pair_acc_.resize(static_cast<std::size_t>(omp_get_max_threads()) * nn);
 #pragma omp parallel
   {
@@ -381,25 +468,27 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
         const std::uint32_t j = idx[k];
         const bool soil_j = kind[j] == kSoil;
         if (soil_j && j < i) continue;  // evaluated from j's side
-        const Vec<Dim> xij = displacement(x[i], x[j]);
+        const Vec<Dim> xij = image(x[i], x[j]);
         const double r2 = xij.squaredNorm();
-        if (r2 >= cutoff2) continue;
+        if (r2 >= K.cutoff2) continue;
         const double r = std::sqrt(r2);
-        const double q = r * inv_h;
-        const Vec<Dim> gw = xij * (r > 0.0 ? sigma_h * Kernel::shape_derivative(q) / r : 0.0);
-        Mat<Dim> T = si + (soil_j ? ps[j] : wall_stress(si, rhoi, j, xij));
-        const Vec<Dim> vij = v[i] - (soil_j ? v[j] : wall_velocity(i, j));
+        const double q = r * K.inv_h;
+        const Vec<Dim> gw = xij * (r > 0.0 ? K.sigma_h * Kernel::shape_derivative(q) / r : 0.0);
+        Mat<Dim> T =
+            si + (soil_j ? ps[j] : mirror_stress<Dim>(si, rhoi, xij, lnrm[j], ps[j], nrm[j], kind[j] == kRoller));
+        const Vec<Dim> vij = v[i] - (soil_j ? v[j] : mirror_velocity<Dim>(v[i], v[j], nrm[j], kind[j] == kRoller));
         const double vr = vij.dot(xij);
         if (vr < 0.0 && alpha + beta > 0.0) {
           const MaterialParams& pj = mats[mat[j]];
           const double cj = fluid ? std::sqrt(pj.bulk / pj.density) : pj.p_wave_speed;
           const double mu = h * vr / (r * r + eta2);
           // ρ_i ρ_j Π_ij with Π_ij = (−α c̄ μ + β μ²)/ρ̄.
-          const double Pi = (-alpha * 0.5 * (ci + cj) * mu + beta * mu * mu) * (rhoi * rho[j]) / (0.5 * (rhoi + rho[j]));
+          const double Pi =
+              (-alpha * 0.5 * (ci + cj) * mu + beta * mu * mu) * (rhoi * rho[j]) / (0.5 * (rhoi + rho[j]));
           T.diagonal().array() -= Pi;
         }
         if (has_Ri || has_as[j]) {
-          const double f = sigma * Kernel::shape(q) / w_dx;
+          const double f = K.sigma * Kernel::shape(q) / w_dx;
           T += (std::pow(f, n_as) * rhoi * rho[j]) * (Ri + R[j]);
         }
         const Vec<Dim> Tg = T * gw;
@@ -426,10 +515,28 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
       acc[i] = a / rho[i];
     }
   }
+}
 
-  // 5. Body force, local damping, leap-frog update.
+// 5. Body force ḡ, Cundall local damping (seed 002 eq. 14), leap-frog update (kick–drift, with
+//    the XSPH correction in the drift); boundary particles move with their prescribed velocity.
+//    The step statistics (max speed, max acceleration) and the drift since the last neighbour
+//    build (Verlet skin) are gathered here.
+template <int Dim>
+void SphSolver<Dim>::integrate(const Vec<Dim>& gbar) {
+  const std::int64_t n = static_cast<std::int64_t>(store_.size());
+  const double dt = dt_;
   const double zeta = damping_;
   const double eps_x = settings_.xsph;
+  const auto& per = settings_.periodic;
+  const bool periodic_any = per.any();
+  const MinimumImage<Dim> image(per);
+  const std::uint8_t* kind = field<ParticleKind>();
+  const Vec<Dim>* xs = field<XsphCorrection<Dim>>();
+  const Vec<Dim>* xb = field<PositionAtBuild<Dim>>();
+  Vec<Dim>* x = field<Position<Dim>>();
+  Vec<Dim>* v = field<Velocity<Dim>>();
+  Vec<Dim>* acc = field<Acceleration<Dim>>();
+  Vec<Dim>* disp = field<Displacement<Dim>>();
   double vmax = 0.0, amax = 0.0, drift = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : vmax, amax, drift)
   for (std::int64_t ii = 0; ii < n; ++ii) {
@@ -439,7 +546,7 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
       x[i] += dx;
       disp[i] += dx;
       if (periodic_any) x[i] = per.wrap(x[i]);
-      drift = std::max(drift, displacement(x[i], xb[i]).squaredNorm());
+      drift = std::max(drift, image(x[i], xb[i]).squaredNorm());
       continue;
     }
     Vec<Dim> a = acc[i] + gbar;
@@ -457,15 +564,11 @@ void SphSolver<Dim>::step_impl(const Model& /*model*/) {
     if (periodic_any) x[i] = per.wrap(x[i]);
     vmax = std::max(vmax, v[i].norm());
     amax = std::max(amax, a.norm());
-    drift = std::max(drift, displacement(x[i], xb[i]).squaredNorm());
+    drift = std::max(drift, image(x[i], xb[i]).squaredNorm());
   }
   max_drift_ = std::sqrt(drift);
   stats_.max_speed = vmax;
   stats_.max_acceleration = amax;
-  time_ += dt;
-  ++step_;
-  check_state();
-  update_dt();
 }
 
 template <int Dim>

@@ -129,10 +129,26 @@ class SphSolver {
   double bytes_per_particle() const;
 
  private:
+  // One step (solver.cpp), the numbered passes of the file comment:
   template <class Kernel, class Model>
   void step_impl(const Model& model);
-  void check_state() const;
-  void update_dt();
+  void update_neighbours(double cutoff);              // 0
+  Vec<Dim> body_acceleration() const;                 //   ḡ = g + a_earthquake
+  void prepare_boundary_pairs(const Vec<Dim>& gbar);  // 1
+  template <class Kernel>
+  void velocity_gradient();  // 2
+  template <class Model>
+  void update_stress(const Model& model);  // 3
+  template <class Kernel>
+  void momentum();                       // 4
+  void integrate(const Vec<Dim>& gbar);  // 5
+  void check_state() const;              // 6
+  void update_dt();                      // 6
+  /// The raw array of a field of the store (the pair loops index it directly).
+  template <class Tag>
+  typename Tag::type* field() noexcept {
+    return store_.template get<Tag>().data();
+  }
 
   SphStore<Dim> store_;
   std::vector<MaterialParams> materials_;
@@ -156,10 +172,10 @@ class SphSolver {
   std::vector<Vec<Dim>> pair_acc_;
   // Scratch of the velocity-gradient pass: per-thread reactions of the soil–soil pairs (threads × n).
   struct GradientReaction {
-    Mat<Dim> L;    // Σ V_i (v_i − v_j) ⊗ ∇W_ji
-    Vec<Dim> xs;   // XSPH sum
-    double drho;   // continuity
-    double rsum;   // summation density
+    Mat<Dim> L;   // Σ V_i (v_i − v_j) ⊗ ∇W_ji
+    Vec<Dim> xs;  // XSPH sum
+    double drho;  // continuity
+    double rsum;  // summation density
   };
   std::vector<GradientReaction> pair_grad_;
   std::int64_t last_reorder_ = -1000000;
