@@ -60,10 +60,17 @@ RunConfig read_config(ConfigReader& r, bool describe) {
     c.restart = std::filesystem::path(restart).is_absolute() ? std::filesystem::path(restart) : r.base_dir() / restart;
 
   // [model]
-  const auto model = r.get_choice("model.constitutive", "drucker_prager",
-                                  {"drucker_prager", "von_mises", "linear_elastic", "newtonian_fluid"},
-                                  {"", "constitutive model of all soil materials"});
-  constitutive_model_from_name(model, c.model);
+  {  // the choices and their sentences come from the one name table (constitutive.hpp)
+    std::vector<std::string> names;
+    std::string help = "constitutive model of all soil materials:";
+    for (std::size_t k = 0; k < constitutive_model_names.size(); ++k) {
+      names.emplace_back(constitutive_model_names[k]);
+      help += (k ? "; " : " ") + names.back() + " = " + std::string(constitutive_model_summaries[k]);
+    }
+    const auto model =
+        r.get_choice("model.constitutive", std::string(constitutive_model_name(c.model)), names, {"", help});
+    c.model = *constitutive_model_from_name(model);  // get_choice has checked the name
+  }
   const auto fit = r.get_choice("model.dp_fit", "auto", {"auto", "plane_strain", "compression_3d"},
                                 {"",
                                  "Drucker-Prager constants: auto = plane_strain in 2D (seed 002 eqs. 18-19), "
@@ -95,36 +102,46 @@ RunConfig read_config(ConfigReader& r, bool describe) {
 
   // [numerics]
   auto& n = c.numerics;
-  n.spacing = r.get("numerics.spacing", 0.01, Range::positive(), {"m", "initial particle spacing dx"});
-  n.h_factor = r.get("numerics.h_factor", 1.2, Range::closed(1.0, 2.0), {"1", "smoothing length h = h_factor dx"});
-  n.kernel = r.get_choice("numerics.kernel", "cubic_spline", {"cubic_spline", "wendland_c2"}, {"", "SPH kernel"}) ==
-                     "cubic_spline"
-                 ? KernelChoice::CubicSpline
-                 : KernelChoice::WendlandC2;
-  n.gravity = r.get("numerics.gravity", 9.81, Range::non_negative(), {"m/s^2", "gravitational acceleration"});
-  n.cfl = r.get("numerics.cfl", 0.2, Range::open_closed(0.0, 1.0), {"1", "CFL number on (c_p + |v|max)"});
-  n.force_factor = r.get("numerics.force_factor", 0.25, Range::open_closed(0.0, 1.0), {"1", "dt <= f sqrt(h/|a|max)"});
-  n.dt_max = r.get("numerics.dt_max", 1e-3, Range::positive(), {"s", "largest time step"});
-  n.dt_min = r.get("numerics.dt_min", 1e-10, Range::positive(), {"s", "a smaller step stops the run (collapse)"});
-  n.viscosity_alpha =
-      r.get("numerics.viscosity_alpha", 0.1, Range::non_negative(), {"1", "Monaghan artificial viscosity alpha"});
-  n.viscosity_beta =
-      r.get("numerics.viscosity_beta", 0.0, Range::non_negative(), {"1", "Monaghan artificial viscosity beta"});
-  n.artificial_stress = r.get("numerics.artificial_stress", 0.3, Range::closed(0.0, 1.0),
+  const NumericalSettings d;  // the defaults (solver.hpp)
+  n.spacing = r.get("numerics.spacing", d.spacing, Range::positive(), {"m", "initial particle spacing dx"});
+  n.h_factor =
+      r.get("numerics.h_factor", d.h_factor, Range::closed(1.0, 2.0), {"1", "smoothing length h = h_factor dx"});
+  {  // from the kernels' name table (solver.hpp)
+    std::vector<std::string> names;
+    std::string def;
+    for (const auto& [name, k] : kernel_names) {
+      names.emplace_back(name);
+      if (k == d.kernel) def = name;
+    }
+    const auto kernel = r.get_choice("numerics.kernel", def, names, {"", "SPH kernel"});
+    for (const auto& [name, k] : kernel_names)
+      if (name == kernel) n.kernel = k;
+  }
+  n.gravity = r.get("numerics.gravity", d.gravity, Range::non_negative(), {"m/s^2", "gravitational acceleration"});
+  n.cfl = r.get("numerics.cfl", d.cfl, Range::open_closed(0.0, 1.0), {"1", "CFL number on (c_p + |v|max)"});
+  n.force_factor =
+      r.get("numerics.force_factor", d.force_factor, Range::open_closed(0.0, 1.0), {"1", "dt <= f sqrt(h/|a|max)"});
+  n.dt_max = r.get("numerics.dt_max", d.dt_max, Range::positive(), {"s", "largest time step"});
+  n.dt_min = r.get("numerics.dt_min", d.dt_min, Range::positive(), {"s", "a smaller step stops the run (collapse)"});
+  n.viscosity_alpha = r.get("numerics.viscosity_alpha", d.viscosity_alpha, Range::non_negative(),
+                            {"1", "Monaghan artificial viscosity alpha"});
+  n.viscosity_beta = r.get("numerics.viscosity_beta", d.viscosity_beta, Range::non_negative(),
+                           {"1", "Monaghan artificial viscosity beta"});
+  n.artificial_stress = r.get("numerics.artificial_stress", d.artificial_stress, Range::closed(0.0, 1.0),
                               {"1", "Gray-Monaghan artificial stress epsilon (0: off)"});
-  n.artificial_stress_n = r.get("numerics.artificial_stress_n", 0.0, Range::non_negative(),
+  n.artificial_stress_n = r.get("numerics.artificial_stress_n", d.artificial_stress_n, Range::non_negative(),
                                 {"1", "artificial-stress exponent n (0: W(0)/W(dx))"});
-  n.xsph =
-      r.get("numerics.xsph", 0.0, Range::closed(0.0, 1.0), {"1", "XSPH velocity-correction factor epsilon (seed 000)"});
-  n.damping = r.get("numerics.damping", 0.0, Range::closed_open(0.0, 1.0),
+  n.xsph = r.get("numerics.xsph", d.xsph, Range::closed(0.0, 1.0),
+                 {"1", "XSPH velocity-correction factor epsilon (seed 000)"});
+  n.damping = r.get("numerics.damping", d.damping, Range::closed_open(0.0, 1.0),
                     {"1", "Cundall local damping zeta in the main phase (seed 002 uses 0.2 under shaking)"});
-  n.stress_free_fraction = r.get("numerics.stress_free_fraction", 0.0, Range::closed_open(0.0, 1.0),
+  n.stress_free_fraction = r.get("numerics.stress_free_fraction", d.stress_free_fraction, Range::closed_open(0.0, 1.0),
                                  {"1", "stress vanishes where the kernel-sum density < fraction rho0 (0: off)"});
-  n.reorder_every = static_cast<int>(r.get_int("numerics.reorder_every", 20, Range::closed(0, 1e6),
+  n.reorder_every = static_cast<int>(r.get_int("numerics.reorder_every", d.reorder_every, Range::closed(0, 1e6),
                                                {"1", "steps between cell reorderings (0: never)"}));
-  n.wall_repulsion = r.get("numerics.wall_repulsion", 0.5, Range::closed(0.0, 1.0),
+  n.wall_repulsion = r.get("numerics.wall_repulsion", d.wall_repulsion, Range::closed(0.0, 1.0),
                            {"1", "soil closer than this x dx to a wall particle is pushed back (0: off)"});
-  n.neighbour_skin = r.get("numerics.neighbour_skin", 0.3, Range::closed(0.0, 1.0),
+  n.neighbour_skin = r.get("numerics.neighbour_skin", d.neighbour_skin, Range::closed(0.0, 1.0),
                            {"1", "Verlet skin in units of h (0: rebuild the neighbour list every step)"});
 
   // [geostatic]
@@ -211,7 +228,8 @@ RunConfig read_config(ConfigReader& r, bool describe) {
       throw InputError("must be non-zero", r.source(), "biaxial.strain_rate", "0");
   }
   if (is3d || describe) {
-    c.width = r.get("geometry.width", 0.1, Range::positive(), {"m", "3D width (axis y); a 3D DSM section: the strip width, centred on the polyline"});
+    c.width = r.get("geometry.width", 0.1, Range::positive(),
+                    {"m", "3D width (axis y); a 3D DSM section: the strip width, centred on the polyline"});
     c.periodic_width =
         r.get_bool("geometry.periodic", c.scenario != ScenarioType::Section,
                    {"", "3D: periodic across the width (seed 001), else roller walls (default for a DSM section)"});
@@ -227,11 +245,13 @@ RunConfig read_config(ConfigReader& r, bool describe) {
     c.section.soil_thickness =
         r.get("section.soil_thickness", 2.0, Range::positive(), {"m", "soil layer thickness below the surface"});
     c.section.bedrock = r.get_choice("section.base", "bedrock", {"bedrock", "fill"},
-                                     {"", "bedrock: soil and base layers follow the surface on fixed bedrock "
-                                          "particles; fill: the base fills down to a flat bottom"}) == "bedrock";
+                                     {"",
+                                      "bedrock: soil and base layers follow the surface on fixed bedrock "
+                                      "particles; fill: the base fills down to a flat bottom"}) == "bedrock";
     c.section.base_thickness = r.get("section.base_thickness", 2.0, Range::positive(),
-                                     {"m", "base layer under the soil (bedrock: parallel to the surface; fill: "
-                                           "below the lowest soil)"});
+                                     {"m",
+                                      "base layer under the soil (bedrock: parallel to the surface; fill: "
+                                      "below the lowest soil)"});
     c.section.soil_material = static_cast<int>(
         r.get_int("section.soil_material", 1, Range::closed(0, 1000), {"1", "material index of the soil layer"}));
     c.section.base_material = static_cast<int>(

@@ -4,8 +4,10 @@
 
 #include <Eigen/LU>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
+#include <type_traits>
 
 #include "geohaz/sph/constitutive.hpp"
 
@@ -125,7 +127,8 @@ TEST(VonMises, RadialReturn) {
   Mat3 s = Mat3::Zero();
   Mat3 L = Mat3::Zero();
   L(0, 1) = 1.0;  // simple shear rate 1/s
-  for (int i = 0; i < 2000; ++i) VonMises::update(s, L, 1e-5, p.density, p);
+  double eps_p = 0.0;
+  for (int i = 0; i < 2000; ++i) VonMises::update(s, L, 1e-5, p.density, p, eps_p);
   EXPECT_NEAR(std::sqrt(J2(s)), 30e3 / std::sqrt(3.0), 1e-6 * 30e3);
 }
 
@@ -188,12 +191,48 @@ TEST(NewtonianFluid, StressFromRate) {
 }
 
 TEST(ConstitutiveModel, NamesRoundTrip) {
-  ConstitutiveModel m;
+  EXPECT_EQ(constitutive_model_names.size(), std::variant_size_v<ConstitutiveModel>);
   for (const char* n : {"linear_elastic", "von_mises", "drucker_prager", "newtonian_fluid"}) {
-    ASSERT_TRUE(constitutive_model_from_name(n, m));
-    EXPECT_EQ(std::visit([](auto& x) { return std::string(std::decay_t<decltype(x)>::name); }, m), n);
+    const auto m = constitutive_model_from_name(n);
+    ASSERT_TRUE(m.has_value()) << n;
+    EXPECT_EQ(std::visit([](auto& x) { return std::string(std::decay_t<decltype(x)>::name); }, *m), n);
+    EXPECT_EQ(constitutive_model_name(*m), n);
   }
-  EXPECT_FALSE(constitutive_model_from_name("mohr", m));
+  EXPECT_FALSE(constitutive_model_from_name("mohr").has_value());
+}
+
+// What the models declare instead of special cases in the solver: a fluid's wave speed is the
+// sound speed √(K/ρ0) and it bounds Δt by viscous diffusion, 0.125 h²ρ0/μ (Morris et al. 1997);
+// a solid's is the P-wave speed and it sets no bound of its own; only the solids may be loaded
+// elastically in the geostatic phase; the plastic models accumulate Δλ in their internal variable.
+TEST(ConstitutiveModel, ModelsDeclareWaveSpeedTimeStepLimitAndInternalVariables) {
+  MaterialParams p;
+  p.density = 1000.0;
+  p.young = 3e4;
+  p.poisson = 0.0;
+  p.viscosity = 2.0;
+  p.finalise();
+  EXPECT_DOUBLE_EQ(NewtonianFluid::wave_speed(p), std::sqrt(1e4 / 1000.0));
+  EXPECT_DOUBLE_EQ(NewtonianFluid::time_step_limit(p, 0.01), 0.125 * 1e-4 / 2e-3);
+  p.viscosity = 0.0;
+  EXPECT_EQ(NewtonianFluid::time_step_limit(p, 0.01), std::numeric_limits<double>::infinity());
+  EXPECT_DOUBLE_EQ(DruckerPrager::wave_speed(p), p.p_wave_speed);
+  EXPECT_EQ(DruckerPrager::time_step_limit(p, 0.01), std::numeric_limits<double>::infinity());
+  EXPECT_FALSE(NewtonianFluid::elastic_loading);
+  EXPECT_TRUE(DruckerPrager::elastic_loading && VonMises::elastic_loading && LinearElastic::elastic_loading);
+  static_assert(std::is_same_v<DruckerPrager::InternalVariables, FieldList<PlasticStrain>>);
+  static_assert(std::is_same_v<NewtonianFluid::InternalVariables, FieldList<>>);
+  // Δλ returned and accumulated: a shear beyond the cone.
+  p.young = 1e6;
+  p.poisson = 0.3;
+  p.friction = 0.5;
+  p.finalise();
+  Mat3 s = -1000.0 * Mat3::Identity(), L = Mat3::Zero();
+  L(0, 1) = 10.0;
+  double eps_p = 0.25;
+  const double dl = DruckerPrager::update(s, L, 1e-3, p.density, p, eps_p);
+  EXPECT_GT(dl, 0.0);
+  EXPECT_DOUBLE_EQ(eps_p, 0.25 + dl);
 }
 
 }  // namespace

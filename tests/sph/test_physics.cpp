@@ -76,6 +76,7 @@ TEST(ElasticWave, CompressionArrivalMatchesPWaveSpeed) {
   s.periodic.axis[0] = true;
   s.periodic.lo[0] = 0.0;
   s.periodic.hi[0] = W;
+  s.neighbour_skin = 0.0;  // the 5-particle period must be ≥ 2 × the list's cut-off, (2 + skin) h
   auto& v = sc.store.get<Velocity<2>>();
   const auto& kind = sc.store.get<ParticleKind>();
   for (std::size_t i = 0; i < v.size(); ++i)

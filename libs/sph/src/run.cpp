@@ -37,6 +37,36 @@ const char* scenario_name(ScenarioType t) {
   return "?";
 }
 
+template <class... F>
+struct Overloaded : F... {
+  using F::operator()...;
+};
+
+/// What a material means under the model of the run, for summary.json and the log. One case per
+/// model and no generic fallback: a model added to ConstitutiveModel without its case here fails to
+/// compile.
+nlohmann::json model_parameters(const ConstitutiveModel& model, const MaterialParams& m) {
+  using nlohmann::json;
+  return std::visit(Overloaded{[&](const LinearElastic&) {
+                                 return json{{"K_Pa", m.bulk}, {"G_Pa", m.shear}};
+                               },
+                               [&](const VonMises&) {
+                                 return json{{"K_Pa", m.bulk}, {"G_Pa", m.shear}, {"yield_stress_Pa", m.yield_stress}};
+                               },
+                               [&](const DruckerPrager&) {
+                                 return json{{"K_Pa", m.bulk},
+                                             {"G_Pa", m.shear},
+                                             {"alpha_phi", m.dp.alpha_phi},
+                                             {"k_c_Pa", m.dp.kc},
+                                             {"alpha_psi", m.dp.alpha_psi},
+                                             {"min_density_kg_per_m3", DruckerPrager::min_density(m)}};
+                               },
+                               [&](const NewtonianFluid&) {
+                                 return json{{"K_Pa", m.bulk}, {"viscosity_Pa_s", m.viscosity}};
+                               }},
+                    model);
+}
+
 template <int Dim>
 struct Built {
   Scenario<Dim> sc;
@@ -167,30 +197,12 @@ Built<Dim> build(const RunConfig& c) {
 
 template <int Dim>
 SolverSettings<Dim> settings_for(const RunConfig& c, const Scenario<Dim>& sc) {
-  const auto& n = c.numerics;
   SolverSettings<Dim> s;
-  s.spacing = n.spacing;
-  s.h_factor = n.h_factor;
-  s.kernel = n.kernel;
-  s.gravity = c.scenario == ScenarioType::Biaxial ? 0.0 : n.gravity;
-  s.cfl = n.cfl;
-  s.force_factor = n.force_factor;
-  s.dt_max = n.dt_max;
-  s.dt_min = n.dt_min;
-  s.viscosity_alpha = n.viscosity_alpha;
-  s.viscosity_beta = n.viscosity_beta;
-  s.artificial_stress = n.artificial_stress;
-  s.artificial_stress_n = n.artificial_stress_n;
-  s.xsph = n.xsph;
-  s.damping = n.damping;
-  s.stress_free_fraction = n.stress_free_fraction;
-  s.reorder_every = n.reorder_every;
-  s.neighbour_skin = n.neighbour_skin;
-  s.wall_repulsion = n.wall_repulsion;
+  static_cast<NumericalSettings&>(s) = c.numerics;
+  if (c.scenario == ScenarioType::Biaxial) s.gravity = 0.0;
   s.periodic = sc.periodic;
   s.domain_lo = sc.domain_lo;
   s.domain_hi = sc.domain_hi;
-  s.earthquake = n.earthquake;
   return s;
 }
 
@@ -199,6 +211,23 @@ void add_view(std::vector<FieldView>& v, const Store& s) {
   using Tr = FieldTraits<typename Tag::type>;
   const auto& a = s.template get<Tag>();
   v.push_back({Tag::label, Tag::unit, scalar_type_of<typename Tr::scalar>(), a.data(), a.size(), Tr::rows, Tr::cols});
+}
+
+/// The internal variables of every constitutive model (constitutive.hpp), each once.
+template <int Dim, class... Tags>
+void add_fields_once(std::vector<FieldView>& v, const SphStore<Dim>& s, FieldList<Tags...>) {
+  [[maybe_unused]] auto once = [&](auto tag) {
+    using Tag = decltype(tag);
+    for (const auto& f : v)
+      if (f.label == Tag::label) return;
+    add_view<Tag>(v, s);
+  };
+  (once(Tags{}), ...);
+}
+template <int Dim, class... Models>
+void add_internal_variables(std::vector<FieldView>& v, const SphStore<Dim>& s,
+                            std::type_identity<std::variant<Models...>>) {
+  (add_fields_once(v, s, typename Models::InternalVariables{}), ...);
 }
 
 /// The fields written to snapshots: the state a restart needs plus what the issue asks to see.
@@ -218,6 +247,7 @@ void write_snapshot(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::in
   add_view<WallNormal<Dim>>(v, s);
   add_view<LayerNormal<Dim>>(v, s);
   add_view<ParticleId>(v, s);
+  add_internal_variables(v, s, std::type_identity<ConstitutiveModel>{});
   w.write(t, step, v);
 }
 
@@ -306,23 +336,17 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
   SphSolver<Dim> solver(std::move(b.sc.store), c.materials, c.model, settings);
   const auto& mats = solver.materials();
   std::vector<double> rho0;
-  double cmax = 0.0;
-  for (const auto& m : mats) {
-    rho0.push_back(m.density);
-    cmax = std::max(cmax, m.p_wave_speed);
-  }
+  for (const auto& m : mats) rho0.push_back(m.density);
+  const double cmax = solver.max_wave_speed();
   if (!quiet) {
     std::fprintf(stderr, "sph-slope: %dD %s, %zu soil + %zu boundary particles, h = %.4g m, model %s\n", Dim,
                  scenario_name(c.scenario), soil_count, boundary_count, solver.smoothing_length(),
                  solver.model_name().c_str());
     for (std::size_t k = 0; k < mats.size(); ++k)
-      std::fprintf(stderr,
-                   "  material %zu (%s): K = %.4g Pa, G = %.4g Pa, c_p = %.4g m/s, DP fit %s: alpha_phi = %.6g, "
-                   "k_c = %.6g Pa, alpha_psi = %.6g\n",
-                   k, k < c.material_names.size() ? c.material_names[k].c_str() : "", mats[k].bulk, mats[k].shear,
-                   mats[k].p_wave_speed,
+      std::fprintf(stderr, "  material %zu (%s): c_p = %.4g m/s, DP fit %s, %s %s\n", k,
+                   k < c.material_names.size() ? c.material_names[k].c_str() : "", mats[k].p_wave_speed,
                    mats[k].fit == DruckerPragerFit::PlaneStrain ? "plane_strain" : "compression_3d",
-                   mats[k].dp.alpha_phi, mats[k].dp.kc, mats[k].dp.alpha_psi);
+                   solver.model_name().c_str(), model_parameters(c.model, mats[k]).dump().c_str());
   }
 
   make_output_dir(out);
@@ -342,14 +366,13 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
   summary["boundary_particles"] = boundary_count;
   summary["spacing_m"] = c.numerics.spacing;
   summary["smoothing_length_m"] = solver.smoothing_length();
-  for (std::size_t k = 0; k < mats.size(); ++k)
-    summary["materials"].push_back(
-        {{"name", k < c.material_names.size() ? c.material_names[k] : ""},
-         {"p_wave_speed_m_per_s", mats[k].p_wave_speed},
-         {"dp_fit", mats[k].fit == DruckerPragerFit::PlaneStrain ? "plane_strain" : "compression_3d"},
-         {"alpha_phi", mats[k].dp.alpha_phi},
-         {"k_c_Pa", mats[k].dp.kc},
-         {"alpha_psi", mats[k].dp.alpha_psi}});
+  for (std::size_t k = 0; k < mats.size(); ++k) {
+    nlohmann::json e = {{"name", k < c.material_names.size() ? c.material_names[k] : ""},
+                        {"p_wave_speed_m_per_s", mats[k].p_wave_speed},
+                        {"dp_fit", mats[k].fit == DruckerPragerFit::PlaneStrain ? "plane_strain" : "compression_3d"}};
+    e.update(model_parameters(c.model, mats[k]));
+    summary["materials"].push_back(e);
+  }
 
   // Geostatic phase or restart.
   std::int64_t step_offset = 0;

@@ -5,7 +5,11 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
+#include <tuple>
+#include <type_traits>
+#include <variant>
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/kernels.hpp"
@@ -89,6 +93,29 @@ struct PairKernel {
         w_self(Kernel::value(0.0, h)) {}
 };
 
+/// Whether a store has every field of a list (compile time).
+template <class Store, class... Tags>
+constexpr bool has_fields(FieldList<Tags...>) {
+  return (Store::template has<Tags>() && ...);
+}
+
+/// Zero every internal variable of every model (fields.hpp FieldList, constitutive.hpp).
+template <class Store, class... Tags>
+void zero_fields(Store& s, FieldList<Tags...>) {
+  [[maybe_unused]] auto zero = [&](auto& v) {
+    using T = typename std::decay_t<decltype(v)>::value_type;
+    if constexpr (std::is_arithmetic_v<T>)
+      std::fill(v.begin(), v.end(), T{});
+    else
+      std::fill(v.begin(), v.end(), T::Zero());
+  };
+  (zero(s.template get<Tags>()), ...);
+}
+template <class Store, class... Models>
+void reset_internal_variables(Store& s, std::type_identity<std::variant<Models...>>) {
+  (zero_fields(s, typename Models::InternalVariables{}), ...);
+}
+
 /// Velocity of boundary particle b in its pair with soil particle i (step 1): the mirror image of
 /// v_i, all components (fixed wall, pile) or only the normal one (roller).
 template <int Dim>
@@ -121,13 +148,7 @@ SphSolver<Dim>::SphSolver(SphStore<Dim> store, std::vector<MaterialParams> mater
   if (!(settings_.spacing > 0.0)) throw InputError("particle spacing must be > 0", "", "spacing");
   if (!(settings_.h_factor >= 1.0 && settings_.h_factor <= 2.0))
     throw InputError("h_factor must be in [1, 2]", "", "h_factor");
-  fluid_ = std::holds_alternative<NewtonianFluid>(model_);
-  for (auto& m : materials_) {
-    m.finalise();
-    const double c = fluid_ ? std::sqrt(m.bulk / m.density) : m.p_wave_speed;
-    max_wave_speed_ = std::max(max_wave_speed_, c);
-    if (fluid_) max_kinematic_viscosity_ = std::max(max_kinematic_viscosity_, m.viscosity / m.density);
-  }
+  for (auto& m : materials_) m.finalise();
   const auto& mat = store_.template get<MaterialId>();
   for (std::size_t i = 0; i < store_.size(); ++i)
     if (mat[i] < 0 || static_cast<std::size_t>(mat[i]) >= materials_.size())
@@ -136,8 +157,29 @@ SphSolver<Dim>::SphSolver(SphStore<Dim> store, std::vector<MaterialParams> mater
   fill_missing_layer_normals(store_);
   h_ = settings_.h_factor * settings_.spacing;
   damping_ = settings_.damping;
+  set_model(model_);
   dt_ = std::min(settings_.dt_max, settings_.cfl * h_ / max_wave_speed_);
-  if (fluid_ && max_kinematic_viscosity_ > 0.0) dt_ = std::min(dt_, 0.125 * h_ * h_ / max_kinematic_viscosity_);
+  dt_ = std::min(dt_, model_dt_limit_);
+}
+
+template <int Dim>
+void SphSolver<Dim>::set_model(const ConstitutiveModel& model) {
+  model_ = model;
+  std::visit(
+      [&](const auto& m) {
+        using Model = std::decay_t<decltype(m)>;
+        static_assert(has_fields<SphStore<Dim>>(typename Model::InternalVariables{}),
+                      "a model's internal variables must be fields of SphStore (fields.hpp)");
+        wave_speed_.clear();
+        max_wave_speed_ = 0.0;
+        model_dt_limit_ = std::numeric_limits<double>::infinity();
+        for (const auto& p : materials_) {
+          wave_speed_.push_back(Model::wave_speed(p));
+          max_wave_speed_ = std::max(max_wave_speed_, wave_speed_.back());
+          model_dt_limit_ = std::min(model_dt_limit_, Model::time_step_limit(p, h_));
+        }
+      },
+      model_);
 }
 
 template <int Dim>
@@ -158,10 +200,12 @@ template <int Dim>
 void SphSolver<Dim>::step() {
   std::visit(
       [&](const auto& model) {
-        if (settings_.kernel == KernelChoice::CubicSpline)
-          step_impl<CubicSpline<Dim>>(model);
-        else
-          step_impl<WendlandC2<Dim>>(model);
+        switch (settings_.kernel) {  // no default: a kernel added to KernelChoice must be handled (-Wswitch)
+          case KernelChoice::CubicSpline:
+            return step_impl<CubicSpline<Dim>>(model);
+          case KernelChoice::WendlandC2:
+            return step_impl<WendlandC2<Dim>>(model);
+        }
       },
       model_);
 }
@@ -368,11 +412,12 @@ void SphSolver<Dim>::update_stress(const Model& /*model*/) {
   double* rho = field<Density>();
   double* vol = field<Volume>();
   Mat3* sig = field<Stress>();
-  double* eps_p = field<PlasticStrain>();
   std::uint8_t* sfree = field<StressFree>();
   Mat<Dim>* R = field<ArtificialStress<Dim>>();
   Mat<Dim>* ps = field<PairStress<Dim>>();
   const MaterialParams* mats = materials_.data();
+  // The model's internal variables (fields of the store), passed per particle to its update.
+  const auto iv = field_arrays(typename Model::InternalVariables{});
   double plastic_sum = 0.0;
   has_as_.resize(static_cast<std::size_t>(n));
   std::uint8_t* has_as = has_as_.data();
@@ -396,8 +441,8 @@ void SphSolver<Dim>::update_stress(const Model& /*model*/) {
       continue;
     }
     sfree[i] = 0;
-    const double dl = Model::update(sig[i], embed3<Dim>(L[i]), dt, rho[i], p);
-    eps_p[i] += dl;
+    const double dl =
+        std::apply([&](auto*... a) { return Model::update(sig[i], embed3<Dim>(L[i]), dt, rho[i], p, a[i]...); }, iv);
     plastic_sum += dl;
     if (eps_as > 0.0) {
       const Mat<Dim> s2 = sig[i].template topLeftCorner<Dim, Dim>();
@@ -429,7 +474,7 @@ void SphSolver<Dim>::momentum() {
   const double alpha = settings_.viscosity_alpha, beta = settings_.viscosity_beta;
   const double h = h_, eta2 = 0.01 * h * h;
   const double r_rep = settings_.wall_repulsion * settings_.spacing;
-  const bool fluid = fluid_;
+  const double* wave = wave_speed_.data();
   const std::int64_t n = static_cast<std::int64_t>(store_.size());
   const Vec<Dim>* x = field<Position<Dim>>();
   const Vec<Dim>* v = field<Velocity<Dim>>();
@@ -445,7 +490,6 @@ void SphSolver<Dim>::momentum() {
   Vec<Dim>* acc = field<Acceleration<Dim>>();
   const std::uint32_t* off = list_.offsets().data();
   const std::uint32_t* idx = list_.indices().data();
-  const MaterialParams* mats = materials_.data();
   const std::size_t nn = static_cast<std::size_t>(n);
   pair_acc_.resize(static_cast<std::size_t>(omp_get_max_threads()) * nn);
 #pragma omp parallel
@@ -460,8 +504,7 @@ void SphSolver<Dim>::momentum() {
       const Mat<Dim> si = ps[i];
       const Mat<Dim> Ri = R[i];
       const bool has_Ri = has_as[i];
-      const MaterialParams& pi = mats[mat[i]];
-      const double ci = fluid ? std::sqrt(pi.bulk / pi.density) : pi.p_wave_speed;
+      const double ci = wave[mat[i]];
       const double Vi = vol[i], rhoi = rho[i];
       Vec<Dim> ai = Vec<Dim>::Zero();
       for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
@@ -479,8 +522,7 @@ void SphSolver<Dim>::momentum() {
         const Vec<Dim> vij = v[i] - (soil_j ? v[j] : mirror_velocity<Dim>(v[i], v[j], nrm[j], kind[j] == kRoller));
         const double vr = vij.dot(xij);
         if (vr < 0.0 && alpha + beta > 0.0) {
-          const MaterialParams& pj = mats[mat[j]];
-          const double cj = fluid ? std::sqrt(pj.bulk / pj.density) : pj.p_wave_speed;
+          const double cj = wave[mat[j]];
           const double mu = h * vr / (r * r + eta2);
           // ρ_i ρ_j Π_ij with Π_ij = (−α c̄ μ + β μ²)/ρ̄.
           const double Pi =
@@ -616,7 +658,7 @@ void SphSolver<Dim>::update_dt() {
   double dt = settings_.cfl * h_ / (max_wave_speed_ + stats_.max_speed);
   if (stats_.max_acceleration > 0.0)
     dt = std::min(dt, settings_.force_factor * std::sqrt(h_ / stats_.max_acceleration));
-  if (fluid_ && max_kinematic_viscosity_ > 0.0) dt = std::min(dt, 0.125 * h_ * h_ / max_kinematic_viscosity_);
+  dt = std::min(dt, model_dt_limit_);
   dt = std::min(dt, settings_.dt_max);
   if (!(dt >= settings_.dt_min)) {
     std::ostringstream os;
@@ -635,7 +677,9 @@ GeostaticReport SphSolver<Dim>::apply_gravity_gradually(double duration, double 
   rep.duration = duration;
   const ConstitutiveModel saved = model_;
   const double saved_damping = damping_;
-  if (elastic && !fluid_) model_ = LinearElastic{};
+  // A solid is loaded as linear elastic if asked; a model without an elastic range (a fluid) keeps its law.
+  if (elastic && std::visit([](const auto& m) { return std::decay_t<decltype(m)>::elastic_loading; }, model_))
+    set_model(LinearElastic{});
   damping_ = damping;
   earthquake_on_ = false;
   const double t0 = time_;
@@ -646,7 +690,7 @@ GeostaticReport SphSolver<Dim>::apply_gravity_gradually(double duration, double 
     step();
     if (on_step) on_step();
   }
-  model_ = saved;
+  set_model(saved);
   damping_ = saved_damping;
   gravity_factor_ = 1.0;
   earthquake_on_ = true;
@@ -655,7 +699,7 @@ GeostaticReport SphSolver<Dim>::apply_gravity_gradually(double duration, double 
   for (auto& v : store_.template get<Velocity<Dim>>()) v.setZero();
   // Boundary particles keep their prescribed wall velocity only in the main phase: none here.
   for (auto& d : store_.template get<Displacement<Dim>>()) d.setZero();
-  for (auto& e : store_.template get<PlasticStrain>()) e = 0.0;
+  reset_internal_variables(store_, std::type_identity<ConstitutiveModel>{});  // Σ Δλ of the loading is not failure
   time_ = 0.0;
   return rep;
 }

@@ -22,14 +22,42 @@
 /// parting (seed 000 "meeting and parting"), not dilating: the gap between them is not material
 /// volume. Without the floor m/ρ of separating particles grows without bound (ρ → 0), their
 /// neighbours' velocity gradients and σ/ρ² blow up (column collapses at Δx = L0/30–L0/40).
-/// The models are plain types with a static `update`; the solver picks one per run through a
-/// std::variant visited once per step, so the particle loop has no dispatch.
+///
+/// The model interface (checked by the concept `ConstitutiveLaw`). A model is a plain struct with
+/// static members only — the solver picks one per run through the std::variant ConstitutiveModel,
+/// visited once per step, so the particle loop has no dispatch — that declares everything the
+/// solver needs to know about it (the solver has no special case for any model):
+///   name, summary              config name (`model.constitutive`) and a sentence for --help-config;
+///   InternalVariables          FieldList of the per-particle fields the model evolves, e.g.
+///                              FieldList<PlasticStrain>; each is a field of the store (fields.hpp),
+///                              so it is reordered, written to snapshots and restored on restart
+///                              with the rest; the geostatic phase resets them to zero;
+///   wave_speed(p)              signal speed of the material (m/s): Δt (CFL), artificial viscosity,
+///                              wall repulsion;
+///   time_step_limit(p, h)      a bound on Δt of the model's own (s), +∞ if none;
+///   min_density(p)             the density floor (below);
+///   elastic_loading            whether the geostatic phase may load the material as linear elastic
+///                              (a solid), or must keep the model's own law (a fluid has no elastic
+///                              state to load into);
+///   update(σ, L, Δt, ρ, p, iv...)  the stress update of one particle, with a reference to each of
+///                              its internal variables in the order of InternalVariables; returns
+///                              the plastic multiplier Δλ of the step (0 if elastic) for the step
+///                              statistics.
+/// A new model (say Drucker–Prager with c and φ softening over a plastic-strain range) is a struct
+/// like DruckerPrager below, with update reading its PlasticStrain argument, plus its entry in
+/// ConstitutiveModel (the name table); parameters it adds go into MaterialParams and the app's
+/// [[material]] table. docs/sph.md, "Adding a constitutive model".
 
+#include <array>
 #include <cmath>
-#include <string>
+#include <concepts>
+#include <limits>
+#include <optional>
+#include <string_view>
 #include <variant>
 
 #include "geohaz/core/vec.hpp"
+#include "geohaz/sph/fields.hpp"
 
 namespace geohaz::sph {
 
@@ -160,32 +188,61 @@ inline double drucker_prager_yield(const Mat3& sigma, double alpha_phi, double k
 /// Linear elasticity with the Jaumann rate (Hooke's law, K and G from E and ν).
 struct LinearElastic {
   static constexpr const char* name = "linear_elastic";
+  static constexpr const char* summary = "linear elasticity (E, nu), Jaumann rate";
+  using InternalVariables = FieldList<>;
   static double update(Mat3& sigma, const Mat3& L, double dt, double /*rho*/, const MaterialParams& p) noexcept {
     sigma = elastic_trial(sigma, L, dt, p.bulk, p.shear);
     return 0.0;
   }
+  /// The P-wave speed √((K + 4G/3)/ρ0).
+  static double wave_speed(const MaterialParams& p) noexcept { return p.p_wave_speed; }
+  static double time_step_limit(const MaterialParams& /*p*/, double /*h*/) noexcept {
+    return std::numeric_limits<double>::infinity();
+  }
   /// No floor: an elastic solid carries any tension.
   static double min_density(const MaterialParams& /*p*/) noexcept { return 0.0; }
+  static constexpr bool elastic_loading = true;
 };
 
 /// Elastic–perfectly plastic von Mises: f = √J2 − σ_y/√3, associated flow, radial return.
 struct VonMises {
   static constexpr const char* name = "von_mises";
-  static double update(Mat3& sigma, const Mat3& L, double dt, double /*rho*/, const MaterialParams& p) noexcept {
+  static constexpr const char* summary = "elastic-perfectly plastic von Mises (E, nu, yield_stress)";
+  using InternalVariables = FieldList<PlasticStrain>;
+  static double update(Mat3& sigma, const Mat3& L, double dt, double /*rho*/, const MaterialParams& p,
+                       double& plastic_strain) noexcept {
     sigma = elastic_trial(sigma, L, dt, p.bulk, p.shear);
-    return drucker_prager_return(sigma, 0.0, 0.0, p.yield_stress / std::sqrt(3.0), p.bulk, p.shear);
+    const double dl = drucker_prager_return(sigma, 0.0, 0.0, p.yield_stress / std::sqrt(3.0), p.bulk, p.shear);
+    plastic_strain += dl;
+    return dl;
+  }
+  static double wave_speed(const MaterialParams& p) noexcept { return p.p_wave_speed; }
+  static double time_step_limit(const MaterialParams& /*p*/, double /*h*/) noexcept {
+    return std::numeric_limits<double>::infinity();
   }
   /// No floor: von Mises has no tension cut-off.
   static double min_density(const MaterialParams& /*p*/) noexcept { return 0.0; }
+  static constexpr bool elastic_loading = true;
 };
 
 /// Elastic–perfectly plastic Drucker–Prager, non-associated (dilatancy ψ), Jaumann rate,
 /// seed 002 eqs. 17–22 / seed 001 eqs. 18–23, return mapping after Bui et al. (2008).
+/// Internal variable: the accumulated plastic multiplier Σ Δλ (PlasticStrain).
 struct DruckerPrager {
   static constexpr const char* name = "drucker_prager";
-  static double update(Mat3& sigma, const Mat3& L, double dt, double /*rho*/, const MaterialParams& p) noexcept {
+  static constexpr const char* summary =
+      "elastic-perfectly plastic Drucker-Prager (E, nu, cohesion, friction, dilatancy), Bui et al. 2008";
+  using InternalVariables = FieldList<PlasticStrain>;
+  static double update(Mat3& sigma, const Mat3& L, double dt, double /*rho*/, const MaterialParams& p,
+                       double& plastic_strain) noexcept {
     sigma = elastic_trial(sigma, L, dt, p.bulk, p.shear);
-    return drucker_prager_return(sigma, p.dp.alpha_phi, p.dp.alpha_psi, p.dp.kc, p.bulk, p.shear);
+    const double dl = drucker_prager_return(sigma, p.dp.alpha_phi, p.dp.alpha_psi, p.dp.kc, p.bulk, p.shear);
+    plastic_strain += dl;
+    return dl;
+  }
+  static double wave_speed(const MaterialParams& p) noexcept { return p.p_wave_speed; }
+  static double time_step_limit(const MaterialParams& /*p*/, double /*h*/) noexcept {
+    return std::numeric_limits<double>::infinity();
   }
   /// ρ0/(1 + p_t/K) with the apex tension p_t = k_c/(3α_φ): elastic dilation up to the tension
   /// cut-off, parting beyond it (see the file comment). α_φ = 0 (φ = 0): no cut-off, no floor.
@@ -193,12 +250,15 @@ struct DruckerPrager {
     if (!(p.dp.alpha_phi > 0.0)) return 0.0;
     return p.density / (1.0 + p.dp.kc / (3.0 * p.dp.alpha_phi * p.bulk));
   }
+  static constexpr bool elastic_loading = true;
 };
 
 /// Weakly compressible Newtonian fluid: σ = −p I + 2μ ė, p = K (ρ/ρ0 − 1) (linear equation of
 /// state with bulk modulus K = E/(3(1−2ν))). Used for the viscous simple-shear check of seed 000.
 struct NewtonianFluid {
   static constexpr const char* name = "newtonian_fluid";
+  static constexpr const char* summary = "weakly compressible Newtonian fluid (viscosity; bulk modulus from E, nu)";
+  using InternalVariables = FieldList<>;
   static double update(Mat3& sigma, const Mat3& L, double /*dt*/, double rho, const MaterialParams& p) noexcept {
     const Mat3 D = 0.5 * (L + L.transpose());
     Mat3 dev = D;
@@ -207,27 +267,64 @@ struct NewtonianFluid {
     sigma.diagonal().array() -= p.bulk * (rho / p.density - 1.0);
     return 0.0;
   }
+  /// The sound speed of the equation of state, √(K/ρ0) (no shear wave in a fluid).
+  static double wave_speed(const MaterialParams& p) noexcept { return std::sqrt(p.bulk / p.density); }
+  /// Viscous diffusion: Δt ≤ 0.125 h²/ν with ν = μ/ρ0 (Morris et al. 1997).
+  static double time_step_limit(const MaterialParams& p, double h) noexcept {
+    if (!(p.viscosity > 0.0)) return std::numeric_limits<double>::infinity();
+    return 0.125 * h * h / (p.viscosity / p.density);
+  }
   /// No floor: the equation of state reacts to ρ < ρ0 itself.
   static double min_density(const MaterialParams& /*p*/) noexcept { return 0.0; }
+  static constexpr bool elastic_loading = false;
 };
 
-/// The run-time choice of model (one per run; all materials of a run share the model type).
+/// What the solver requires of a constitutive model (see the file comment).
+template <class M>
+concept ConstitutiveLaw = requires(const MaterialParams& p, double h) {
+  { M::name } -> std::convertible_to<const char*>;
+  { M::summary } -> std::convertible_to<const char*>;
+  typename M::InternalVariables;
+  { M::wave_speed(p) } -> std::same_as<double>;
+  { M::time_step_limit(p, h) } -> std::same_as<double>;
+  { M::min_density(p) } -> std::same_as<double>;
+  { M::elastic_loading } -> std::convertible_to<bool>;
+};
+
+/// The run-time choice of model (one per run; all materials of a run share the model type), and
+/// the one name table of the models: its alternatives' `name`s are the values of
+/// `model.constitutive`. A model is added here and nowhere else in the solver or the app.
 using ConstitutiveModel = std::variant<LinearElastic, VonMises, DruckerPrager, NewtonianFluid>;
 
-/// Model from its name ("linear_elastic", "von_mises", "drucker_prager", "newtonian_fluid");
-/// returns false for an unknown name.
-inline bool constitutive_model_from_name(const std::string& name, ConstitutiveModel& out) {
-  if (name == LinearElastic::name)
-    out = LinearElastic{};
-  else if (name == VonMises::name)
-    out = VonMises{};
-  else if (name == DruckerPrager::name)
-    out = DruckerPrager{};
-  else if (name == NewtonianFluid::name)
-    out = NewtonianFluid{};
-  else
-    return false;
-  return true;
+namespace detail {
+template <class V>
+struct ModelTable;
+template <class... M>
+struct ModelTable<std::variant<M...>> {
+  static_assert((ConstitutiveLaw<M> && ...), "every alternative of ConstitutiveModel is a ConstitutiveLaw");
+  static constexpr std::array<std::string_view, sizeof...(M)> names{std::string_view(M::name)...};
+  static constexpr std::array<std::string_view, sizeof...(M)> summaries{std::string_view(M::summary)...};
+  static std::optional<std::variant<M...>> from_name(std::string_view n) {
+    std::optional<std::variant<M...>> out;
+    (void)((n == M::name ? (out = M{}, true) : false) || ...);
+    return out;
+  }
+};
+}  // namespace detail
+
+/// Config names of the models, in the order of ConstitutiveModel.
+inline constexpr auto constitutive_model_names = detail::ModelTable<ConstitutiveModel>::names;
+/// One sentence per model (same order), for --help-config.
+inline constexpr auto constitutive_model_summaries = detail::ModelTable<ConstitutiveModel>::summaries;
+
+/// The model of that config name; std::nullopt for an unknown name.
+inline std::optional<ConstitutiveModel> constitutive_model_from_name(std::string_view name) {
+  return detail::ModelTable<ConstitutiveModel>::from_name(name);
+}
+
+/// Name of a model.
+inline std::string_view constitutive_model_name(const ConstitutiveModel& m) noexcept {
+  return constitutive_model_names[m.index()];
 }
 
 }  // namespace geohaz::sph

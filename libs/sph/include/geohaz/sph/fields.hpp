@@ -140,13 +140,16 @@ struct PositionAtBuild {
   static constexpr const char* unit = "m";
 };
 
+/// A list of field tags: the internal variables a constitutive model evolves (constitutive.hpp).
+template <class... Tags>
+struct FieldList {};
+
 /// The store of the SPH model.
 template <int Dim>
 using SphStore =
     ParticleStore<Position<Dim>, Velocity<Dim>, Acceleration<Dim>, Displacement<Dim>, Stress, VelocityGradient<Dim>,
                   Density, DensityRate, Mass, MaterialId, ParticleKind, WallNormal<Dim>, LayerNormal<Dim>,
-                  PlasticStrain, StressFree,
-                  SummationDensity, XsphCorrection<Dim>, ArtificialStress<Dim>,
+                  PlasticStrain, StressFree, SummationDensity, XsphCorrection<Dim>, ArtificialStress<Dim>,
                   PairStress<Dim>, Volume, PositionAtBuild<Dim>, ParticleId>;
 
 /// Boundary particles without a layering normal (stores built by hand, snapshots written before the

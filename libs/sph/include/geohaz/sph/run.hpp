@@ -37,13 +37,13 @@ struct PileRows {
 struct SectionInput {
   std::vector<ProfilePoint> profile;  ///< s (m along the polyline), x, y (map), z (m)
   std::string crs_wkt;
-  std::shared_ptr<const Raster> dsm;  ///< for release_thickness.tif (may be null)
+  std::shared_ptr<const Raster> dsm;       ///< for release_thickness.tif (may be null)
   std::shared_ptr<const Terrain> terrain;  ///< the DSM surface (3D sections; may be null in 2D)
-  double soil_thickness = 2.0;        ///< m: soil layer (material `soil_material`) below the surface
+  double soil_thickness = 2.0;             ///< m: soil layer (material `soil_material`) below the surface
   /// true: soil + base layers rest on fixed bedrock following the surface; false: the base fills
   /// down to a flat bottom base_thickness below the lowest point of the soil.
   bool bedrock = true;
-  double base_thickness = 2.0;        ///< m: base material below the lowest point of the soil layer
+  double base_thickness = 2.0;  ///< m: base material below the lowest point of the soil layer
   int soil_material = 1, base_material = 0;
   double release_width = 10.0;  ///< W (m): plane-strain particles are spread over this width
 };
@@ -69,8 +69,7 @@ struct RunConfig {
   double biaxial_strain_rate = 0.5;  ///< 1/s, > 0 compression, < 0 tension
   SectionInput section;
 
-  // Numerics (copied into SolverSettings).
-  SolverSettings<3> numerics;  ///< Dim-independent scalars only are used
+  NumericalSettings numerics;  ///< the solver's settings (the domain geometry comes from the scenario)
   // Geostatic phase.
   bool geostatic = true;
   double geostatic_duration = 0.0;  ///< s; 0 → 20 H / c_p

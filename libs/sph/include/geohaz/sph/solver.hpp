@@ -19,12 +19,18 @@
 ///      with Monaghan's viscosity Π_ij (sound speed = P-wave speed √((K+4G/3)/ρ0)), f_ij = W(r)/W(Δx),
 ///      ḡ = g + a_earthquake (seed 002 eqs. 25–26), Cundall local damping −ζ|a_α| sign(v_α) (seed 002 eq. 14);
 ///   5. leap-frog (kick–drift: v^{n+½} = v^{n−½} + Δt a^n, x^{n+1} = x^n + Δt (v^{n+½} + ε ΔvXSPH));
-///   6. Δt = min(C_cfl h/(c_p + |v|max), C_f √(h/|a|max), 0.125 ρ h²/μ (fluid), Δt_max).
+///   6. Δt = min(C_cfl h/(c + |v|max), C_f √(h/|a|max), the model's own limit, Δt_max), c the
+///      model's wave speed (constitutive.hpp: P-wave speed of a solid; a fluid's sound speed and its
+///      viscous limit 0.125 h²ρ/μ).
 /// Units: SI throughout (m, s, kg, Pa).
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <string_view>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "geohaz/core/neighbours.hpp"
@@ -37,9 +43,13 @@ namespace geohaz::sph {
 /// Smoothing kernel choice (resolved once per step to a template parameter).
 enum class KernelChoice { CubicSpline, WendlandC2 };
 
-/// Numerical settings of a run (all SI).
-template <int Dim>
-struct SolverSettings {
+/// The name table of the kernels (`numerics.kernel`).
+inline constexpr std::array<std::pair<std::string_view, KernelChoice>, 2> kernel_names{
+    {{"cubic_spline", KernelChoice::CubicSpline}, {"wendland_c2", KernelChoice::WendlandC2}}};
+
+/// Numerical settings of a run that do not depend on the dimension (all SI). The defaults here are
+/// the only ones: sph-slope reads every `numerics.*` key into this struct with these defaults.
+struct NumericalSettings {
   double spacing = 0.01;  ///< initial particle spacing Δx (m)
   double h_factor = 1.2;  ///< h = h_factor·Δx (1.2–1.5)
   KernelChoice kernel = KernelChoice::CubicSpline;
@@ -58,14 +68,19 @@ struct SolverSettings {
   int reorder_every = 20;             ///< steps between cell reorderings of the store
   /// Verlet skin in units of h: the list is built with cutoff 2h + skin·h and rebuilt when a particle
   /// has moved more than skin·h/2 (or at a reordering). 0 rebuilds the list every step.
-  double neighbour_skin = 0.0;
+  double neighbour_skin = 0.3;
   /// Soil particles closer than this many Δx to a boundary particle are pushed back with
   /// a = c_p² ((r0/r)⁴ − (r0/r)²) x/r² (Monaghan 1994 form); 0 switches it off.
   double wall_repulsion = 0.5;
+  EarthquakeLoading earthquake;  ///< applied in the main phase (time from 0 after the geostatic phase)
+};
+
+/// All settings of a solver: the numerical ones and the geometry of the domain.
+template <int Dim>
+struct SolverSettings : NumericalSettings {
   Periodicity<Dim> periodic;                       ///< periodic axes (3D: the width axis 1)
   Vec<Dim> domain_lo = Vec<Dim>::Constant(-1e30);  ///< a particle leaving this box → SimulationError
   Vec<Dim> domain_hi = Vec<Dim>::Constant(1e30);
-  EarthquakeLoading earthquake;  ///< applied in the main phase (time from 0 after the geostatic phase)
 };
 
 /// Outcome of the gravity-loading (geostatic) phase.
@@ -102,6 +117,8 @@ class SphSolver {
   const StepStats& last_stats() const noexcept { return stats_; }
   /// Name of the constitutive model in use.
   std::string model_name() const;
+  /// Largest wave speed of the materials under the model in use (m/s).
+  double max_wave_speed() const noexcept { return max_wave_speed_; }
 
   /// Set the simulated time (restart).
   void set_time(double t) noexcept { time_ = t; }
@@ -149,6 +166,11 @@ class SphSolver {
   typename Tag::type* field() noexcept {
     return store_.template get<Tag>().data();
   }
+  /// The raw arrays of a list of fields (a model's internal variables), as a tuple of pointers.
+  template <class... Tags>
+  std::tuple<typename Tags::type*...> field_arrays(FieldList<Tags...>) noexcept {
+    return {field<Tags>()...};
+  }
 
   SphStore<Dim> store_;
   std::vector<MaterialParams> materials_;
@@ -162,8 +184,11 @@ class SphSolver {
   double gravity_factor_ = 1.0;
   bool earthquake_on_ = true;
   double damping_ = 0.0;
+  // What the model declares per material (set_model): wave speed (m/s) and its own Δt limit (s).
+  void set_model(const ConstitutiveModel& model);
+  std::vector<double> wave_speed_;
   double max_wave_speed_ = 0.0;
-  double max_kinematic_viscosity_ = 0.0;
+  double model_dt_limit_ = 0.0;
   double max_drift_ = 0.0;  // largest displacement since the last neighbour build (m)
   // Scratch, rewritten every step (not particle state): 1 where the artificial stress R_i ≠ 0, so
   // the momentum pass need not read a neighbour's R (as big as its stress) to find it is zero.
@@ -180,7 +205,6 @@ class SphSolver {
   std::vector<GradientReaction> pair_grad_;
   std::int64_t last_reorder_ = -1000000;
   std::int64_t builds_ = 0;
-  bool fluid_ = false;
   StepStats stats_;
 };
 
