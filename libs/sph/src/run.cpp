@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "geohaz/core/errors.hpp"
@@ -231,8 +232,10 @@ void add_internal_variables(std::vector<FieldView>& v, const SphStore<Dim>& s,
 }
 
 /// The fields written to snapshots: the state a restart needs plus what the issue asks to see.
+/// position_at_build (the positions of the last neighbour-list build) is restart state: the list,
+/// hence the Verlet-skin decisions and the order of the pair sums, is rebuilt from it.
 template <int Dim>
-void write_snapshot(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int64_t step) {
+void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int64_t step) {
   std::vector<FieldView> v;
   add_view<Position<Dim>>(v, s);
   add_view<Velocity<Dim>>(v, s);
@@ -248,12 +251,36 @@ void write_snapshot(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::in
   add_view<LayerNormal<Dim>>(v, s);
   add_view<ParticleId>(v, s);
   add_internal_variables(v, s, std::type_identity<ConstitutiveModel>{});
+  add_view<PositionAtBuild<Dim>>(v, s);
   w.write(t, step, v);
 }
 
+/// The solver state of the last snapshot (SolverState), as a root attribute: a snapshot group has
+/// room for its time and step only (core snapshot.hpp). It names the snapshot it belongs to, so a
+/// run killed between the snapshot and the attribute is not restarted with the wrong state; Δt in
+/// hexadecimal, exact.
+constexpr const char* kSolverStateAttribute = "sph_solver_state";
+
+template <int Dim>
+void write_snapshot(SnapshotWriter& w, const SphSolver<Dim>& solver, std::int64_t step) {
+  write_fields<Dim>(w, solver.store(), solver.time(), step);
+  const SolverState st = solver.state();
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "snapshot %zu step %lld dt %a last_reorder %lld", w.snapshot_count() - 1,
+                static_cast<long long>(st.step), st.dt, static_cast<long long>(st.last_reorder));
+  w.set_attribute(kSolverStateAttribute, buf);
+}
+
+/// What a restart file gives besides the particles.
+struct Restart {
+  double time = 0.0;
+  std::int64_t step = 0;             ///< the snapshot's step
+  std::optional<SolverState> state;  ///< absent in files written before it existed
+};
+
 /// Replace the store by the last snapshot of a file written by sph-slope.
 template <int Dim>
-double load_restart(const std::filesystem::path& path, SphStore<Dim>& s, std::int64_t& step) {
+Restart load_restart(const std::filesystem::path& path, SphStore<Dim>& s) {
   SnapshotReader r(path);
   if (r.model() != "sph-slope")
     throw InputError("not an sph-slope snapshot file (model '" + r.model() + "')", path.string());
@@ -280,8 +307,18 @@ double load_restart(const std::filesystem::path& path, SphStore<Dim>& s, std::in
     s.template get<LayerNormal<Dim>>().assign(s.size(), Vec<Dim>::Zero());
     fill_missing_layer_normals(s);
   }
-  step = r.step(k);
-  return r.time(k);
+  Restart out;
+  out.time = r.time(k);
+  out.step = r.step(k);
+  // The solver state, if it belongs to this snapshot and the neighbour-list positions are there.
+  std::istringstream is(r.attribute(kSolverStateAttribute));
+  std::string w1, w2, w3, w4, dt;
+  std::size_t snap = 0;
+  long long step = 0, reorder = 0;
+  if (is >> w1 >> snap >> w2 >> step >> w3 >> dt >> w4 >> reorder && snap == k &&
+      r.has_field(k, PositionAtBuild<Dim>::label))
+    out.state = SolverState{out.time, step, std::strtod(dt.c_str(), nullptr), reorder};
+  return out;
 }
 
 /// Quick-look picture: particles in the x–z plane coloured by `value` (soil) on a ramp, boundary grey.
@@ -377,11 +414,17 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
   // Geostatic phase or restart.
   std::int64_t step_offset = 0;
   if (!c.restart.empty()) {
-    std::int64_t st = 0;
-    const double t = load_restart<Dim>(c.restart, solver.store(), st);
-    solver.set_time(t);
-    summary["restart"] = {{"file", c.restart.string()}, {"time_s", t}, {"step", st}};
-    step_offset = st;
+    const Restart rs = load_restart<Dim>(c.restart, solver.store());
+    // With the solver state the run continues exactly as the one that wrote the file; without it
+    // (files of older versions) from the snapshot's particles, with Δt from the wave speed and a
+    // fresh neighbour list: the same physics, another round-off.
+    if (rs.state)
+      solver.resume(*rs.state);
+    else
+      solver.set_time(rs.time);
+    step_offset = rs.state ? 0 : rs.step;
+    summary["restart"] = {
+        {"file", c.restart.string()}, {"time_s", rs.time}, {"step", rs.step}, {"exact", rs.state.has_value()}};
   } else if (c.geostatic && c.scenario != ScenarioType::Biaxial) {
     const double dur = c.geostatic_duration > 0.0 ? c.geostatic_duration : 20.0 * href / cmax;
     ProgressReporter prog("sph-slope geostatic", dur, quiet);
@@ -415,7 +458,7 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
   }
 
   // Main phase.
-  write_snapshot<Dim>(snaps, solver.store(), solver.time(), step_offset);
+  write_snapshot<Dim>(snaps, solver, step_offset);
   std::ostringstream series;
   series << "time_s,front_m,tip_m,runout_m,normalised_runout,max_speed_m_per_s,mean_speed_m_per_s,kinetic_energy_J,"
             "plastic_fraction,max_displacement_m,earthquake_acceleration_m_per_s2\n";
@@ -485,7 +528,7 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
       if (vmax > c.rest_speed) last_moving = solver.time();
       prog.update(solver.time(), solver.step_count(), solver.store().size());
       if (c.snapshot_interval > 0.0 && solver.time() >= next_snap - 1e-12) {
-        write_snapshot<Dim>(snaps, solver.store(), solver.time(), step_offset + solver.step_count());
+        write_snapshot<Dim>(snaps, solver, step_offset + solver.step_count());
         next_snap += c.snapshot_interval;
       }
       if (c.stop_at_rest && solver.time() - t_start > std::max(0.05, 0.1 * c.end_time) && vmax < c.rest_speed &&
@@ -500,7 +543,7 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
   }
   prog.finish(solver.time(), solver.step_count(), solver.store().size());
   const auto last = record();
-  write_snapshot<Dim>(snaps, solver.store(), solver.time(), step_offset + solver.step_count());
+  write_snapshot<Dim>(snaps, solver, step_offset + solver.step_count());
   write_text_file(out / "series.csv", series.str());
   if (c.scenario == ScenarioType::Biaxial) write_text_file(out / "stress_strain.csv", biax.str());
 

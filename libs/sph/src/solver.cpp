@@ -248,6 +248,32 @@ void SphSolver<Dim>::update_neighbours(double cutoff) {
 }
 
 template <int Dim>
+void SphSolver<Dim>::resume(const SolverState& st) {
+  time_ = st.time;
+  step_ = st.step;
+  dt_ = st.dt;
+  last_reorder_ = st.last_reorder;
+  double support = 0.0;
+  switch (settings_.kernel) {
+    case KernelChoice::CubicSpline:
+      support = CubicSpline<Dim>::support;
+      break;
+    case KernelChoice::WendlandC2:
+      support = WendlandC2<Dim>::support;
+      break;
+  }
+  const auto& xb = store_.template get<PositionAtBuild<Dim>>();
+  list_.build(xb, support * h_ + settings_.neighbour_skin * h_, settings_.periodic);
+  ++builds_;
+  // The drift since that build, as step 5 computes it.
+  const MinimumImage<Dim> image(settings_.periodic);
+  const auto& x = store_.template get<Position<Dim>>();
+  double drift = 0.0;
+  for (std::size_t i = 0; i < store_.size(); ++i) drift = std::max(drift, image(x[i], xb[i]).squaredNorm());
+  max_drift_ = std::sqrt(drift);
+}
+
+template <int Dim>
 Vec<Dim> SphSolver<Dim>::body_acceleration() const {
   // Effective body acceleration ḡ = g + a_eq (seed 002 eq. 26); gravity along −axis Dim−1.
   Vec<Dim> gbar = Vec<Dim>::Zero();

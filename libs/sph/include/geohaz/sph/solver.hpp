@@ -91,6 +91,16 @@ struct GeostaticReport {
   double max_stress_error = 0.0;  ///< unused by the solver (filled by callers that know σ_v)
 };
 
+/// The solver's own state beyond the particle fields. A snapshot holding it and every field that
+/// decides the next step (PositionAtBuild included, for the neighbour list) lets a restarted run
+/// continue bit for bit like the uninterrupted one (run.cpp writes it with every snapshot).
+struct SolverState {
+  double time = 0.0;              ///< s
+  std::int64_t step = 0;          ///< steps so far (geostatic phase included)
+  double dt = 0.0;                ///< Δt of the next step (from the last step's speeds and accelerations), s
+  std::int64_t last_reorder = 0;  ///< step of the last cell reordering of the store
+};
+
 /// Per-step statistics (cheap, gathered in the integration loop).
 struct StepStats {
   double max_speed = 0.0;          ///< m/s (soil)
@@ -120,8 +130,15 @@ class SphSolver {
   /// Largest wave speed of the materials under the model in use (m/s).
   double max_wave_speed() const noexcept { return max_wave_speed_; }
 
-  /// Set the simulated time (restart).
+  /// Set the simulated time (a restart from a snapshot without the solver state).
   void set_time(double t) noexcept { time_ = t; }
+  /// The state to store beside the particle fields for an exact restart.
+  SolverState state() const noexcept { return {time_, step_, dt_, last_reorder_}; }
+  /// Continue from a restored store (all fields of the snapshot, PositionAtBuild included) and the
+  /// state written with it: the neighbour list is rebuilt from the positions of its last build, in
+  /// the store's order, so that the Verlet-skin decisions and the order of every pair sum are those
+  /// of the run that wrote the snapshot.
+  void resume(const SolverState& s);
   /// Scale of gravity (0..1) used by the next steps.
   void set_gravity_factor(double f) noexcept { gravity_factor_ = f; }
   /// Whether earthquake loading is applied (main phase only).
