@@ -116,6 +116,39 @@ void reset_internal_variables(Store& s, std::type_identity<std::variant<Models..
   (zero_fields(s, typename Models::InternalVariables{}), ...);
 }
 
+/// The fixed-order reactions of the pair passes (steps 2 and 4; docs/sph.md, "Determinism").
+/// Each soil–soil pair is evaluated once, by the particle of lower index, which adds the partner's
+/// share (the reaction) to a buffer. The buffers belong to blocks of B = 2^shift consecutive
+/// particles — not to threads — so that every sum is grouped the same way whatever the thread
+/// count: block b adds, in the order of its particles, the reactions to particles [bB, bB + 2B);
+/// particle i then adds to its own sum the buffers of blocks b(i) − 1 and b(i), in that order.
+/// A pair whose partner lies two or more blocks ahead is evaluated by both particles, each for
+/// itself (the two evaluations give the same term with opposite sign, to the bit). B is chosen at
+/// each list build from the largest index distance of a soil–soil pair (after the cell reordering
+/// a few rows or layers of cells), so that few pairs or none are far, and small enough for at least
+/// eight blocks to share among the threads.
+struct PairBlocks {
+  unsigned shift = 6;
+  std::size_t n = 0;
+  std::size_t size() const noexcept { return std::size_t{1} << shift; }
+  std::size_t count() const noexcept { return (n + size() - 1) >> shift; }
+  std::size_t window() const noexcept { return 2 * size(); }  ///< reaction slots per block
+  /// Add the reactions for particle i, in the fixed order (block b(i) − 1, then b(i)).
+  template <class T, class Add>
+  void gather(const T* buf, std::size_t i, Add&& add) const {
+    const std::size_t b = i >> shift;
+    if (b > 0) add(buf[(b - 1) * window() + (i - ((b - 1) << shift))]);
+    add(buf[b * window() + (i - (b << shift))]);
+  }
+};
+
+/// ρ_i ρ_j Π_ij of Monaghan's artificial viscosity, Π_ij = (−α c̄ μ + β μ²)/ρ̄ with c̄ and ρ̄ the pair's
+/// mean sound speed and density, for an approaching pair (μ = h v_ij·x_ij/(r² + 0.01h²) < 0).
+inline double viscous_pressure(double alpha, double beta, double ci, double cj, double mu, double rhoi,
+                               double rhoj) noexcept {
+  return (-alpha * 0.5 * (ci + cj) * mu + beta * mu * mu) * (rhoi * rhoj) / (0.5 * (rhoi + rhoj));
+}
+
 /// Velocity of boundary particle b in its pair with soil particle i (step 1): the mirror image of
 /// v_i, all components (fixed wall, pile) or only the normal one (roller).
 template <int Dim>
@@ -243,8 +276,31 @@ void SphSolver<Dim>::update_neighbours(double cutoff) {
   }
   list_.build(S.template get<Position<Dim>>(), cutoff + skin, settings_.periodic);
   ++builds_;
+  choose_pair_blocks();
   S.template get<PositionAtBuild<Dim>>() = S.template get<Position<Dim>>();
   max_drift_ = 0.0;
+}
+
+template <int Dim>
+void SphSolver<Dim>::choose_pair_blocks() {
+  // The largest index distance of a soil–soil pair in the list (PairBlocks): blocks at least that
+  // long have no far pairs; at least eight blocks (when n > 512) keep two threads busy.
+  const std::int64_t n = static_cast<std::int64_t>(store_.size());
+  const std::uint8_t* kind = field<ParticleKind>();
+  const std::uint32_t* off = list_.offsets().data();
+  const std::uint32_t* idx = list_.indices().data();
+  std::uint32_t band = 0;
+#pragma omp parallel for schedule(static) reduction(max : band)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const auto i = static_cast<std::uint32_t>(ii);
+    if (kind[i] != kSoil) continue;
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k)
+      if (idx[k] > i && kind[idx[k]] == kSoil) band = std::max(band, idx[k] - i);
+  }
+  unsigned shift = 6;
+  while ((std::uint64_t{1} << shift) < band) ++shift;
+  while (shift > 6 && (std::uint64_t{8} << shift) > static_cast<std::uint64_t>(n)) --shift;
+  block_shift_ = shift;
 }
 
 template <int Dim>
@@ -265,6 +321,7 @@ void SphSolver<Dim>::resume(const SolverState& st) {
   const auto& xb = store_.template get<PositionAtBuild<Dim>>();
   list_.build(xb, support * h_ + settings_.neighbour_skin * h_, settings_.periodic);
   ++builds_;
+  choose_pair_blocks();
   // The drift since that build, as step 5 computes it.
   const MinimumImage<Dim> image(settings_.periodic);
   const auto& x = store_.template get<Position<Dim>>();
@@ -332,6 +389,23 @@ void SphSolver<Dim>::prepare_boundary_pairs(const Vec<Dim>& gbar) {
   }
 }
 
+// After a pair pass (steps 2 and 4): every soil particle adds its reactions from the block buffers
+// in the fixed order of PairBlocks::gather, then `finish` completes it.
+template <int Dim>
+template <class T, class Add, class Finish>
+void SphSolver<Dim>::gather_reactions(const std::vector<T>& buffer, Add&& add, Finish&& finish) {
+  const PairBlocks blocks{block_shift_, store_.size()};
+  const std::uint8_t* kind = field<ParticleKind>();
+  const std::int64_t n = static_cast<std::int64_t>(store_.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    if (kind[i] != kSoil) continue;
+    blocks.gather(buffer.data(), i, [&](const T& r) { add(i, r); });
+    finish(i);
+  }
+}
+
 // (The pair loops of steps 2 and 4 repeat the same ten-line neighbour header on purpose: folded
 //  into a shared lambda it cost 20 % of the 2D speed, the captures defeating register reuse.)
 
@@ -339,7 +413,7 @@ void SphSolver<Dim>::prepare_boundary_pairs(const Vec<Dim>& gbar) {
 //    L_i = Σ_j V_j (v_j − v_i) ⊗ ∇W_ij, dρ_i/dt = −Σ_j m_j (v_j − v_i)·∇W_ij,
 //    ρ̃_i = Σ_j m_j W_ij, ξ_i = Σ_j V_j W_ij (v_j − v_i), v_j the mirror velocity of a boundary j.
 //    As in step 4, each soil–soil pair is evaluated once; j's share (V_i dv ⊗ ∇W_ij,
-//    −m_i dv·∇W_ij, m_i W_ij, −V_i W_ij dv with dv = v_j − v_i) goes to a per-thread buffer.
+//    −m_i dv·∇W_ij, m_i W_ij, −V_i W_ij dv with dv = v_j − v_i) goes to a block buffer (PairBlocks).
 template <int Dim>
 template <class Kernel>
 void SphSolver<Dim>::velocity_gradient() {
@@ -358,16 +432,16 @@ void SphSolver<Dim>::velocity_gradient() {
   Vec<Dim>* xs = field<XsphCorrection<Dim>>();
   const std::uint32_t* off = list_.offsets().data();
   const std::uint32_t* idx = list_.indices().data();
-  const std::size_t nn = static_cast<std::size_t>(n);
-  pair_grad_.resize(static_cast<std::size_t>(omp_get_max_threads()) * nn);
-#pragma omp parallel
-  {
-    const int nthreads = omp_get_num_threads();
-    GradientReaction* mine = pair_grad_.data() + static_cast<std::size_t>(omp_get_thread_num()) * nn;
-    std::fill(mine, mine + nn, GradientReaction{Mat<Dim>::Zero(), Vec<Dim>::Zero(), 0.0, 0.0});
-#pragma omp for schedule(static)
-    for (std::int64_t ii = 0; ii < n; ++ii) {
-      const auto i = static_cast<std::size_t>(ii);
+  const PairBlocks blocks{block_shift_, static_cast<std::size_t>(n)};
+  const std::int64_t nblocks = static_cast<std::int64_t>(blocks.count());
+  pair_grad_.resize(blocks.count() * blocks.window());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t bb = 0; bb < nblocks; ++bb) {
+    const auto b = static_cast<std::size_t>(bb);
+    const std::size_t first = b << blocks.shift, last = std::min(blocks.n, first + blocks.size());
+    GradientReaction* mine = pair_grad_.data() + b * blocks.window();  // reactions to first + [0, 2B)
+    std::fill(mine, mine + blocks.window(), GradientReaction{Mat<Dim>::Zero(), Vec<Dim>::Zero(), 0.0, 0.0});
+    for (std::size_t i = first; i < last; ++i) {
       if (kind[i] != kSoil) continue;
       Mat<Dim> Li = Mat<Dim>::Zero();
       Vec<Dim> xi_sum = Vec<Dim>::Zero();
@@ -377,7 +451,9 @@ void SphSolver<Dim>::velocity_gradient() {
       for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
         const std::uint32_t j = idx[k];
         const bool soil_j = kind[j] == kSoil;
-        if (soil_j && j < i) continue;  // evaluated from j's side
+        const std::size_t bj = j >> blocks.shift;
+        if (soil_j && j < i && bj + 1 >= b) continue;  // evaluated from j's side
+        const bool react = soil_j && j > i && bj <= b + 1;
         const Vec<Dim> xij = image(x[i], x[j]);
         const double r2 = xij.squaredNorm();
         if (r2 >= K.cutoff2) continue;
@@ -393,8 +469,8 @@ void SphSolver<Dim>::velocity_gradient() {
         dr -= m[j] * dvgw;
         rs += m[j] * w;
         xi_sum += (Vj * w) * dv;
-        if (soil_j) {
-          GradientReaction& g = mine[j];
+        if (react) {
+          GradientReaction& g = mine[j - first];
           g.L.noalias() += Vi * dvg;
           g.drho -= mi * dvgw;
           g.rsum += mi * w;
@@ -406,19 +482,16 @@ void SphSolver<Dim>::velocity_gradient() {
       rsum[i] = rs;
       xs[i] = xi_sum;
     }
-#pragma omp for schedule(static)
-    for (std::int64_t ii = 0; ii < n; ++ii) {
-      const auto i = static_cast<std::size_t>(ii);
-      if (kind[i] != kSoil) continue;
-      for (int t = 0; t < nthreads; ++t) {
-        const GradientReaction& g = pair_grad_[static_cast<std::size_t>(t) * nn + i];
+  }
+  gather_reactions(
+      pair_grad_,
+      [&](std::size_t i, const GradientReaction& g) {
         L[i] += g.L;
         drho[i] += g.drho;
         rsum[i] += g.rsum;
         xs[i] += g.xs;
-      }
-    }
-  }
+      },
+      [](std::size_t) {});
 }
 
 // 3. Density, stress (constitutive model), stress vanishing, artificial stress.
@@ -444,40 +517,46 @@ void SphSolver<Dim>::update_stress(const Model& /*model*/) {
   const MaterialParams* mats = materials_.data();
   // The model's internal variables (fields of the store), passed per particle to its update.
   const auto iv = field_arrays(typename Model::InternalVariables{});
-  double plastic_sum = 0.0;
   has_as_.resize(static_cast<std::size_t>(n));
   std::uint8_t* has_as = has_as_.data();
-#pragma omp parallel for schedule(static) reduction(+ : plastic_sum)
-  for (std::int64_t ii = 0; ii < n; ++ii) {
-    const auto i = static_cast<std::size_t>(ii);
-    has_as[i] = 0;
-    if (kind[i] != kSoil) {
-      R[i].setZero();
-      continue;
+  // Σ Δλ by blocks of particles, then over the blocks in order: the same sum on any thread count.
+  const PairBlocks blocks{block_shift_, static_cast<std::size_t>(n)};
+  block_sums_.assign(blocks.count(), 0.0);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t bb = 0; bb < static_cast<std::int64_t>(blocks.count()); ++bb) {
+    const auto b = static_cast<std::size_t>(bb);
+    double plastic = 0.0;
+    for (std::size_t i = b << blocks.shift; i < std::min(blocks.n, (b + 1) << blocks.shift); ++i) {
+      has_as[i] = 0;
+      if (kind[i] != kSoil) {
+        R[i].setZero();
+        continue;
+      }
+      const MaterialParams& p = mats[mat[i]];
+      // Continuity, floored at the model's parting density (constitutive.hpp, `min_density`).
+      rho[i] = std::max(rho[i] + dt * drho[i], Model::min_density(p));
+      vol[i] = m[i] / rho[i];
+      if (sf_frac > 0.0 && rsum[i] < sf_frac * p.density) {
+        sfree[i] = 1;
+        sig[i].setZero();
+        R[i].setZero();
+        ps[i].setZero();
+        continue;
+      }
+      sfree[i] = 0;
+      plastic +=
+          std::apply([&](auto*... a) { return Model::update(sig[i], embed3<Dim>(L[i]), dt, rho[i], p, a[i]...); }, iv);
+      if (eps_as > 0.0) {
+        const Mat<Dim> s2 = sig[i].template topLeftCorner<Dim, Dim>();
+        R[i] = artificial_stress<Dim>(s2, eps_as, rho[i]);
+        has_as[i] = R[i].squaredNorm() > 0.0;
+      }
+      ps[i] = sig[i].template topLeftCorner<Dim, Dim>();
     }
-    const MaterialParams& p = mats[mat[i]];
-    // Continuity, floored at the model's parting density (constitutive.hpp, `min_density`).
-    rho[i] = std::max(rho[i] + dt * drho[i], Model::min_density(p));
-    vol[i] = m[i] / rho[i];
-    if (sf_frac > 0.0 && rsum[i] < sf_frac * p.density) {
-      sfree[i] = 1;
-      sig[i].setZero();
-      R[i].setZero();
-      ps[i].setZero();
-      continue;
-    }
-    sfree[i] = 0;
-    const double dl =
-        std::apply([&](auto*... a) { return Model::update(sig[i], embed3<Dim>(L[i]), dt, rho[i], p, a[i]...); }, iv);
-    plastic_sum += dl;
-    if (eps_as > 0.0) {
-      const Mat<Dim> s2 = sig[i].template topLeftCorner<Dim, Dim>();
-      R[i] = artificial_stress<Dim>(s2, eps_as, rho[i]);
-      has_as[i] = R[i].squaredNorm() > 0.0;
-    }
-    ps[i] = sig[i].template topLeftCorner<Dim, Dim>();
+    block_sums_[b] = plastic;
   }
-  stats_.plastic_increment = plastic_sum;
+  stats_.plastic_increment = 0.0;
+  for (const double p : block_sums_) stats_.plastic_increment += p;
 }
 
 // 4. Momentum: a_i = Σ_j m_j [(σ_i + σ_j)/(ρ_i ρ_j) − Π_ij I + f_ij^n (R_i + R_j)] ∇W_ij + ḡ
@@ -488,8 +567,12 @@ void SphSolver<Dim>::update_stress(const Model& /*model*/) {
 //    f_i = Σ_j V_j [σ_i + σ_j + ρ_i ρ_j (f^n (R_i + R_j) − Π_ij I)] ∇W_ij, a_i = f_i/ρ_i (ḡ: step 5).
 //    Each soil–soil pair is evaluated once, by the particle of lower index: the pair term is
 //    symmetric (T_ij = T_ji, ∇W_ji = −∇W_ij), so j receives −V_i T ∇W_ij. Those reactions go to a
-//    per-thread buffer (no two threads write the same slot) summed after the pass; soil–boundary
-//    pairs act on the soil particle only.
+//    block buffer (PairBlocks: no two threads write the same slot, and the sums are grouped alike
+//    on any number of threads) gathered after the pass; soil–boundary pairs act on the soil
+//    particle only.
+//    Last-resort wall repulsion (Monaghan 1994 form, exponents 4 and 2): only a soil particle closer
+//    than r0 = wall_repulsion·Δx to a boundary particle feels it — nothing in a normal configuration
+//    (spacing ≈ Δx) — and it stops particles from being squeezed through walls.
 template <int Dim>
 template <class Kernel>
 void SphSolver<Dim>::momentum() {
@@ -516,16 +599,16 @@ void SphSolver<Dim>::momentum() {
   Vec<Dim>* acc = field<Acceleration<Dim>>();
   const std::uint32_t* off = list_.offsets().data();
   const std::uint32_t* idx = list_.indices().data();
-  const std::size_t nn = static_cast<std::size_t>(n);
-  pair_acc_.resize(static_cast<std::size_t>(omp_get_max_threads()) * nn);
-#pragma omp parallel
-  {
-    const int nthreads = omp_get_num_threads();
-    Vec<Dim>* mine = pair_acc_.data() + static_cast<std::size_t>(omp_get_thread_num()) * nn;
-    std::fill(mine, mine + nn, Vec<Dim>::Zero());
-#pragma omp for schedule(static)
-    for (std::int64_t ii = 0; ii < n; ++ii) {
-      const auto i = static_cast<std::size_t>(ii);
+  const PairBlocks blocks{block_shift_, static_cast<std::size_t>(n)};
+  const std::int64_t nblocks = static_cast<std::int64_t>(blocks.count());
+  pair_acc_.resize(blocks.count() * blocks.window());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t bb = 0; bb < nblocks; ++bb) {
+    const auto b = static_cast<std::size_t>(bb);
+    const std::size_t first = b << blocks.shift, last = std::min(blocks.n, first + blocks.size());
+    Vec<Dim>* mine = pair_acc_.data() + b * blocks.window();  // reactions to first + [0, 2B)
+    std::fill(mine, mine + blocks.window(), Vec<Dim>::Zero());
+    for (std::size_t i = first; i < last; ++i) {
       if (kind[i] != kSoil) continue;
       const Mat<Dim> si = ps[i];
       const Mat<Dim> Ri = R[i];
@@ -536,7 +619,9 @@ void SphSolver<Dim>::momentum() {
       for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
         const std::uint32_t j = idx[k];
         const bool soil_j = kind[j] == kSoil;
-        if (soil_j && j < i) continue;  // evaluated from j's side
+        const std::size_t bj = j >> blocks.shift;
+        if (soil_j && j < i && bj + 1 >= b) continue;  // evaluated from j's side
+        const bool react = soil_j && j > i && bj <= b + 1;
         const Vec<Dim> xij = image(x[i], x[j]);
         const double r2 = xij.squaredNorm();
         if (r2 >= K.cutoff2) continue;
@@ -547,42 +632,27 @@ void SphSolver<Dim>::momentum() {
             si + (soil_j ? ps[j] : mirror_stress<Dim>(si, rhoi, xij, lnrm[j], ps[j], nrm[j], kind[j] == kRoller));
         const Vec<Dim> vij = v[i] - (soil_j ? v[j] : mirror_velocity<Dim>(v[i], v[j], nrm[j], kind[j] == kRoller));
         const double vr = vij.dot(xij);
-        if (vr < 0.0 && alpha + beta > 0.0) {
-          const double cj = wave[mat[j]];
-          const double mu = h * vr / (r * r + eta2);
-          // ρ_i ρ_j Π_ij with Π_ij = (−α c̄ μ + β μ²)/ρ̄.
-          const double Pi =
-              (-alpha * 0.5 * (ci + cj) * mu + beta * mu * mu) * (rhoi * rho[j]) / (0.5 * (rhoi + rho[j]));
-          T.diagonal().array() -= Pi;
-        }
+        if (vr < 0.0 && alpha + beta > 0.0)
+          T.diagonal().array() -=
+              viscous_pressure(alpha, beta, ci, wave[mat[j]], h * vr / (r * r + eta2), rhoi, rho[j]);
         if (has_Ri || has_as[j]) {
           const double f = K.sigma * Kernel::shape(q) / w_dx;
           T += (std::pow(f, n_as) * rhoi * rho[j]) * (Ri + R[j]);
         }
         const Vec<Dim> Tg = T * gw;
         ai.noalias() += vol[j] * Tg;
-        if (soil_j) {
-          mine[j].noalias() -= Vi * Tg;
-        } else if (r < r_rep) {
-          // Last-resort wall repulsion (Monaghan 1994 form, exponents 4 and 2): only a soil
-          // particle closer than r0 = wall_repulsion·Δx to a boundary particle feels it — nothing
-          // in a normal configuration (spacing ≈ Δx) — and it stops particles from being squeezed
-          // through walls.
+        if (react) {
+          mine[j - first].noalias() -= Vi * Tg;
+        } else if (!soil_j && r < r_rep) {  // wall repulsion
           const double q2 = (r_rep * r_rep) / r2;
           ai.noalias() += (rhoi * ci * ci * (q2 * q2 - q2) / r2) * xij;
         }
       }
       acc[i] = ai;
     }
-#pragma omp for schedule(static)
-    for (std::int64_t ii = 0; ii < n; ++ii) {
-      const auto i = static_cast<std::size_t>(ii);
-      if (kind[i] != kSoil) continue;
-      Vec<Dim> a = acc[i];
-      for (int t = 0; t < nthreads; ++t) a += pair_acc_[static_cast<std::size_t>(t) * nn + i];
-      acc[i] = a / rho[i];
-    }
   }
+  gather_reactions(
+      pair_acc_, [&](std::size_t i, const Vec<Dim>& r) { acc[i] += r; }, [&](std::size_t i) { acc[i] /= rho[i]; });
 }
 
 // 5. Body force ḡ, Cundall local damping (seed 002 eq. 14), leap-frog update (kick–drift, with

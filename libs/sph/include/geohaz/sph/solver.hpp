@@ -167,12 +167,15 @@ class SphSolver {
   template <class Kernel, class Model>
   void step_impl(const Model& model);
   void update_neighbours(double cutoff);              // 0
+  void choose_pair_blocks();                          //   block size of the pair reactions (PairBlocks)
   Vec<Dim> body_acceleration() const;                 //   ḡ = g + a_earthquake
   void prepare_boundary_pairs(const Vec<Dim>& gbar);  // 1
   template <class Kernel>
   void velocity_gradient();  // 2
   template <class Model>
   void update_stress(const Model& model);  // 3
+  template <class T, class Add, class Finish>
+  void gather_reactions(const std::vector<T>& buffer, Add&& add, Finish&& finish);  // 2, 4
   template <class Kernel>
   void momentum();                       // 4
   void integrate(const Vec<Dim>& gbar);  // 5
@@ -210,9 +213,14 @@ class SphSolver {
   // Scratch, rewritten every step (not particle state): 1 where the artificial stress R_i ≠ 0, so
   // the momentum pass need not read a neighbour's R (as big as its stress) to find it is zero.
   std::vector<std::uint8_t> has_as_;
-  // Scratch of the momentum pass: per-thread reactions V_i T ∇W of the soil–soil pairs (threads × n).
+  // The pair passes' reactions are summed per block of 2^block_shift_ particles (solver.cpp,
+  // PairBlocks), chosen at each list build: the same grouping of every sum on any thread count.
+  unsigned block_shift_ = 6;
+  std::vector<double> block_sums_;  // Σ Δλ per block (step 3)
+  // Scratch of the momentum pass: reactions V_i T ∇W of the soil–soil pairs, 2 × 2^block_shift_
+  // slots per block (≈ 2n).
   std::vector<Vec<Dim>> pair_acc_;
-  // Scratch of the velocity-gradient pass: per-thread reactions of the soil–soil pairs (threads × n).
+  // Scratch of the velocity-gradient pass: reactions of the soil–soil pairs, as pair_acc_.
   struct GradientReaction {
     Mat<Dim> L;   // Σ V_i (v_i − v_j) ⊗ ∇W_ji
     Vec<Dim> xs;  // XSPH sum
