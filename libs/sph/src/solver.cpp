@@ -118,27 +118,30 @@ void reset_internal_variables(Store& s, std::type_identity<std::variant<Models..
 
 /// The fixed-order reactions of the pair passes (steps 2 and 4; docs/sph.md, "Determinism").
 /// Each soil–soil pair is evaluated once, by the particle of lower index, which adds the partner's
-/// share (the reaction) to a buffer. The buffers belong to blocks of B = 2^shift consecutive
-/// particles — not to threads — so that every sum is grouped the same way whatever the thread
-/// count: block b adds, in the order of its particles, the reactions to particles [bB, bB + 2B);
-/// particle i then adds to its own sum the buffers of blocks b(i) − 1 and b(i), in that order.
-/// A pair whose partner lies two or more blocks ahead is evaluated by both particles, each for
-/// itself (the two evaluations give the same term with opposite sign, to the bit). B is chosen at
-/// each list build from the largest index distance of a soil–soil pair (after the cell reordering
-/// a few rows or layers of cells), so that few pairs or none are far, and small enough for at least
-/// eight blocks to share among the threads.
+/// share (the reaction) to a buffer. The buffers belong to blocks of B consecutive particles — not
+/// to threads — so that every sum is grouped the same way whatever the thread count: block b adds,
+/// in the order of its particles, the reactions to particles [bB, bB + B + W), W the reach of the
+/// list (the largest index distance of a soil–soil pair, after the cell reordering a few rows or
+/// layers of cells); particle i then adds to its own sum the buffers of the blocks that reach it,
+/// in ascending order. Block b's slots are addressed as buffer[b·W + j], so the pair loop indexes
+/// its buffer by the partner's index, exactly as a per-thread buffer of size n would be.
 struct PairBlocks {
-  unsigned shift = 6;
-  std::size_t n = 0;
-  std::size_t size() const noexcept { return std::size_t{1} << shift; }
-  std::size_t count() const noexcept { return (n + size() - 1) >> shift; }
-  std::size_t window() const noexcept { return 2 * size(); }  ///< reaction slots per block
-  /// Add the reactions for particle i, in the fixed order (block b(i) − 1, then b(i)).
+  std::size_t size = 64;  ///< B, particles per block
+  std::size_t reach = 0;  ///< W, largest j − i of a soil–soil pair in the list
+  std::size_t n = 0;      ///< particles
+  std::size_t count() const noexcept { return (n + size - 1) / size; }
+  std::size_t window() const noexcept { return size + reach; }  ///< reaction slots per block
+  std::size_t slots() const noexcept { return count() * window(); }
+  /// Block b's buffer, to be indexed by particle index j ∈ [bB, bB + B + W).
+  template <class T>
+  T* buffer(T* all, std::size_t b) const noexcept {
+    return all + b * reach;
+  }
+  /// Add the reactions for particle i, in the fixed order of the blocks.
   template <class T, class Add>
-  void gather(const T* buf, std::size_t i, Add&& add) const {
-    const std::size_t b = i >> shift;
-    if (b > 0) add(buf[(b - 1) * window() + (i - ((b - 1) << shift))]);
-    add(buf[b * window() + (i - (b << shift))]);
+  void gather(const T* all, std::size_t i, Add&& add) const {
+    const std::size_t first = i + 1 > window() ? (i + 1 - window() + size - 1) / size : 0;
+    for (std::size_t b = first; b <= i / size; ++b) add(all[b * reach + i]);
   }
 };
 
@@ -283,8 +286,7 @@ void SphSolver<Dim>::update_neighbours(double cutoff) {
 
 template <int Dim>
 void SphSolver<Dim>::choose_pair_blocks() {
-  // The largest index distance of a soil–soil pair in the list (PairBlocks): blocks at least that
-  // long have no far pairs; at least eight blocks (when n > 512) keep two threads busy.
+  // The reach W of the list: the largest index distance of a soil–soil pair (PairBlocks).
   const std::int64_t n = static_cast<std::int64_t>(store_.size());
   const std::uint8_t* kind = field<ParticleKind>();
   const std::uint32_t* off = list_.offsets().data();
@@ -297,10 +299,11 @@ void SphSolver<Dim>::choose_pair_blocks() {
     for (std::uint32_t k = off[i]; k < off[i + 1]; ++k)
       if (idx[k] > i && kind[idx[k]] == kSoil) band = std::max(band, idx[k] - i);
   }
-  unsigned shift = 6;
-  while ((std::uint64_t{1} << shift) < band) ++shift;
-  while (shift > 6 && (std::uint64_t{8} << shift) > static_cast<std::uint64_t>(n)) --shift;
-  block_shift_ = shift;
+  // B = W when that leaves at least eight blocks for the threads, else n/8, but at least W/3 (the
+  // buffers hold n (1 + W/B) slots: at most 4n) and 64.
+  const std::size_t nn = static_cast<std::size_t>(n), reach = band;
+  block_size_ = std::max<std::size_t>({64, std::min(reach, std::max(nn / 8, reach / 3))});
+  block_reach_ = reach;
 }
 
 template <int Dim>
@@ -394,7 +397,7 @@ void SphSolver<Dim>::prepare_boundary_pairs(const Vec<Dim>& gbar) {
 template <int Dim>
 template <class T, class Add, class Finish>
 void SphSolver<Dim>::gather_reactions(const std::vector<T>& buffer, Add&& add, Finish&& finish) {
-  const PairBlocks blocks{block_shift_, store_.size()};
+  const PairBlocks blocks{block_size_, block_reach_, store_.size()};
   const std::uint8_t* kind = field<ParticleKind>();
   const std::int64_t n = static_cast<std::int64_t>(store_.size());
 #pragma omp parallel for schedule(static)
@@ -432,15 +435,16 @@ void SphSolver<Dim>::velocity_gradient() {
   Vec<Dim>* xs = field<XsphCorrection<Dim>>();
   const std::uint32_t* off = list_.offsets().data();
   const std::uint32_t* idx = list_.indices().data();
-  const PairBlocks blocks{block_shift_, static_cast<std::size_t>(n)};
+  const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
   const std::int64_t nblocks = static_cast<std::int64_t>(blocks.count());
-  pair_grad_.resize(blocks.count() * blocks.window());
+  pair_grad_.resize(blocks.slots());
 #pragma omp parallel for schedule(static)
   for (std::int64_t bb = 0; bb < nblocks; ++bb) {
     const auto b = static_cast<std::size_t>(bb);
-    const std::size_t first = b << blocks.shift, last = std::min(blocks.n, first + blocks.size());
-    GradientReaction* mine = pair_grad_.data() + b * blocks.window();  // reactions to first + [0, 2B)
-    std::fill(mine, mine + blocks.window(), GradientReaction{Mat<Dim>::Zero(), Vec<Dim>::Zero(), 0.0, 0.0});
+    const std::size_t first = b * blocks.size, last = std::min(blocks.n, first + blocks.size);
+    GradientReaction* mine = blocks.buffer(pair_grad_.data(), b);  // mine[j]: the reaction to j
+    std::fill(mine + first, mine + first + blocks.window(),
+              GradientReaction{Mat<Dim>::Zero(), Vec<Dim>::Zero(), 0.0, 0.0});
     for (std::size_t i = first; i < last; ++i) {
       if (kind[i] != kSoil) continue;
       Mat<Dim> Li = Mat<Dim>::Zero();
@@ -451,9 +455,7 @@ void SphSolver<Dim>::velocity_gradient() {
       for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
         const std::uint32_t j = idx[k];
         const bool soil_j = kind[j] == kSoil;
-        const std::size_t bj = j >> blocks.shift;
-        if (soil_j && j < i && bj + 1 >= b) continue;  // evaluated from j's side
-        const bool react = soil_j && j > i && bj <= b + 1;
+        if (soil_j && j < i) continue;  // evaluated from j's side
         const Vec<Dim> xij = image(x[i], x[j]);
         const double r2 = xij.squaredNorm();
         if (r2 >= K.cutoff2) continue;
@@ -469,8 +471,8 @@ void SphSolver<Dim>::velocity_gradient() {
         dr -= m[j] * dvgw;
         rs += m[j] * w;
         xi_sum += (Vj * w) * dv;
-        if (react) {
-          GradientReaction& g = mine[j - first];
+        if (soil_j) {
+          GradientReaction& g = mine[j];
           g.L.noalias() += Vi * dvg;
           g.drho -= mi * dvgw;
           g.rsum += mi * w;
@@ -520,13 +522,13 @@ void SphSolver<Dim>::update_stress(const Model& /*model*/) {
   has_as_.resize(static_cast<std::size_t>(n));
   std::uint8_t* has_as = has_as_.data();
   // Σ Δλ by blocks of particles, then over the blocks in order: the same sum on any thread count.
-  const PairBlocks blocks{block_shift_, static_cast<std::size_t>(n)};
+  const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
   block_sums_.assign(blocks.count(), 0.0);
 #pragma omp parallel for schedule(static)
   for (std::int64_t bb = 0; bb < static_cast<std::int64_t>(blocks.count()); ++bb) {
     const auto b = static_cast<std::size_t>(bb);
     double plastic = 0.0;
-    for (std::size_t i = b << blocks.shift; i < std::min(blocks.n, (b + 1) << blocks.shift); ++i) {
+    for (std::size_t i = b * blocks.size; i < std::min(blocks.n, (b + 1) * blocks.size); ++i) {
       has_as[i] = 0;
       if (kind[i] != kSoil) {
         R[i].setZero();
@@ -599,15 +601,15 @@ void SphSolver<Dim>::momentum() {
   Vec<Dim>* acc = field<Acceleration<Dim>>();
   const std::uint32_t* off = list_.offsets().data();
   const std::uint32_t* idx = list_.indices().data();
-  const PairBlocks blocks{block_shift_, static_cast<std::size_t>(n)};
+  const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
   const std::int64_t nblocks = static_cast<std::int64_t>(blocks.count());
-  pair_acc_.resize(blocks.count() * blocks.window());
+  pair_acc_.resize(blocks.slots());
 #pragma omp parallel for schedule(static)
   for (std::int64_t bb = 0; bb < nblocks; ++bb) {
     const auto b = static_cast<std::size_t>(bb);
-    const std::size_t first = b << blocks.shift, last = std::min(blocks.n, first + blocks.size());
-    Vec<Dim>* mine = pair_acc_.data() + b * blocks.window();  // reactions to first + [0, 2B)
-    std::fill(mine, mine + blocks.window(), Vec<Dim>::Zero());
+    const std::size_t first = b * blocks.size, last = std::min(blocks.n, first + blocks.size);
+    Vec<Dim>* mine = blocks.buffer(pair_acc_.data(), b);  // mine[j]: the reaction to j
+    std::fill(mine + first, mine + first + blocks.window(), Vec<Dim>::Zero());
     for (std::size_t i = first; i < last; ++i) {
       if (kind[i] != kSoil) continue;
       const Mat<Dim> si = ps[i];
@@ -619,9 +621,7 @@ void SphSolver<Dim>::momentum() {
       for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
         const std::uint32_t j = idx[k];
         const bool soil_j = kind[j] == kSoil;
-        const std::size_t bj = j >> blocks.shift;
-        if (soil_j && j < i && bj + 1 >= b) continue;  // evaluated from j's side
-        const bool react = soil_j && j > i && bj <= b + 1;
+        if (soil_j && j < i) continue;  // evaluated from j's side
         const Vec<Dim> xij = image(x[i], x[j]);
         const double r2 = xij.squaredNorm();
         if (r2 >= K.cutoff2) continue;
@@ -641,9 +641,9 @@ void SphSolver<Dim>::momentum() {
         }
         const Vec<Dim> Tg = T * gw;
         ai.noalias() += vol[j] * Tg;
-        if (react) {
-          mine[j - first].noalias() -= Vi * Tg;
-        } else if (!soil_j && r < r_rep) {  // wall repulsion
+        if (soil_j) {
+          mine[j].noalias() -= Vi * Tg;
+        } else if (r < r_rep) {  // wall repulsion
           const double q2 = (r_rep * r_rep) / r2;
           ai.noalias() += (rhoi * ci * ci * (q2 * q2 - q2) / r2) * xij;
         }

@@ -213,12 +213,13 @@ class SphSolver {
   // Scratch, rewritten every step (not particle state): 1 where the artificial stress R_i ≠ 0, so
   // the momentum pass need not read a neighbour's R (as big as its stress) to find it is zero.
   std::vector<std::uint8_t> has_as_;
-  // The pair passes' reactions are summed per block of 2^block_shift_ particles (solver.cpp,
-  // PairBlocks), chosen at each list build: the same grouping of every sum on any thread count.
-  unsigned block_shift_ = 6;
+  // The pair passes' reactions are summed per block of block_size_ particles reaching block_reach_
+  // particles beyond (solver.cpp, PairBlocks), chosen at each list build: the same grouping of
+  // every sum on any thread count.
+  std::size_t block_size_ = 64, block_reach_ = 0;
   std::vector<double> block_sums_;  // Σ Δλ per block (step 3)
-  // Scratch of the momentum pass: reactions V_i T ∇W of the soil–soil pairs, 2 × 2^block_shift_
-  // slots per block (≈ 2n).
+  // Scratch of the momentum pass: reactions V_i T ∇W of the soil–soil pairs, block_size_ +
+  // block_reach_ slots per block (2n–4n).
   std::vector<Vec<Dim>> pair_acc_;
   // Scratch of the velocity-gradient pass: reactions of the soil–soil pairs, as pair_acc_.
   struct GradientReaction {
