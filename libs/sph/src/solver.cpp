@@ -229,7 +229,7 @@ double SphSolver<Dim>::bytes_per_particle() const {
   return static_cast<double>(SphStore<Dim>::bytes_per_particle()) + 4.0 * static_cast<double>(list_.pair_count()) / n +
          4.0 + 3.0 * 4.0 + 1.0 +  // CSR indices + offsets + cell data + artificial-stress flag
          static_cast<double>(pair_acc_.size() * sizeof(Vec<Dim>) + pair_grad_.size() * sizeof(GradientReaction)) /
-             n;  // block buffers of the pair reactions (≈ 2n each)
+             n;  // block buffers of the pair reactions (n (1 + W/B) slots each)
 }
 
 template <int Dim>
