@@ -2,7 +2,8 @@
 // collapse (~1e5 particles) and a 3D slope (~4e4 particles, seed 001's size), on 1 and 2 threads,
 // and the memory per particle. Prints figures; never asserts (docs/performance.md). The state hash
 // after the steps is the same on 1 and 2 threads (results independent of the thread count).
-//   bench_sph [steps] [scale]   (scale < 1 shrinks the problems for a quick look)
+//   bench_sph [steps] [scale] [2d|3d|all] [threads] [skin]   (scale < 1 shrinks the problems for a
+//   quick look; the others select runs, e.g. `bench_sph 50 1 2d 2 0.3` for one figure)
 #include <omp.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <numbers>
+#include <string>
 
 #include "geohaz/sph/scenario.hpp"
 #include "geohaz/sph/solver.hpp"
@@ -32,10 +34,21 @@ unsigned long long state_hash(const SphStore<Dim>& S) {
   return h;
 }
 
+/// Which runs (all by default): `bench_sph [steps] [scale] [2d|3d|all] [threads] [skin]`.
+struct Selection {
+  int dim = 0;       ///< 0: both
+  int threads = 0;   ///< 0: 1 and 2
+  double skin = -1;  ///< < 0: 0 and 0.3
+};
+Selection selection;
+
 template <int Dim>
 void run(const char* name, Scenario<Dim> sc, const MaterialParams& m, int steps) {
   for (double skin : {0.0, 0.3})
     for (int threads : {1, 2}) {
+      if ((selection.threads > 0 && threads != selection.threads) ||
+          (selection.skin >= 0.0 && std::abs(skin - selection.skin) > 1e-9))
+        continue;
       omp_set_num_threads(threads);
       SolverSettings<Dim> s;
       s.spacing = sc.spacing;
@@ -61,12 +74,15 @@ void run(const char* name, Scenario<Dim> sc, const MaterialParams& m, int steps)
 int main(int argc, char** argv) {
   const int steps = argc > 1 ? std::atoi(argv[1]) : 50;
   const double scale = argc > 2 ? std::atof(argv[2]) : 1.0;
+  if (argc > 3) selection.dim = std::string(argv[3]) == "2d" ? 2 : (std::string(argv[3]) == "3d" ? 3 : 0);
+  if (argc > 4) selection.threads = std::atoi(argv[4]);
+  if (argc > 5) selection.skin = std::atof(argv[5]);
   MaterialParams m;
   m.density = 1800;
   m.young = 1e6;
   m.poisson = 0.3;
   m.friction = 30 * std::numbers::pi / 180;
-  {
+  if (selection.dim != 3) {
     // 2D column: 1e5 particles ≈ 316 × 316 at Δx = 1 mm... use a 2:1 column of 0.45 m × 0.225 m at 1 mm.
     const double dx = 0.001 / std::sqrt(scale);
     ProfileDomain d;
@@ -76,7 +92,7 @@ int main(int argc, char** argv) {
     d.right = WallType::None;
     run<2>("2D DP column collapse", build_profile<2>(d, dx, {m.density}, 1.2), m, steps);
   }
-  {
+  if (selection.dim != 2) {
     m.fit = DruckerPragerFit::Compression3D;
     SlopeGeometry g;  // seed 001 Fig. 3: 0.25 m high, 1.5H:1V, crest 0.3 m, front 0.6 m
     g.height = 0.25;
