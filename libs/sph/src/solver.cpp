@@ -297,7 +297,7 @@ void SphSolver<Dim>::choose_pair_blocks() {
   // particles the threads had before), and few slots beyond n, n (1 + W/B) in all (1.08n in the 2D
   // benchmark, 2.6n in 3D); but at least W/3 (at most 4n slots) and 64.
   const std::size_t nn = static_cast<std::size_t>(n), reach = band;
-  block_size_ = std::max<std::size_t>({64, nn / 8, reach / 3});
+  block_size_ = std::max<std::size_t>({64, (nn + 7) / 8, (reach + 2) / 3});  // ceil: eight blocks, not nine
   block_reach_ = reach;
 }
 
