@@ -116,10 +116,11 @@ TEST(ElasticWave, CompressionArrivalMatchesPWaveSpeed) {
     stress_behind = sum / cnt;
   }
   const double t_theory = z_probe[1] / cp, dt_theory = (z_probe[1] - z_probe[0]) / cp;
-  std::printf("P-wave: c_p = %.2f m/s, arrival at %.1f / %.1f m: %.5f / %.5f s (theory %.5f / %.5f s), travel time "
-              "%.5f s (theory %.5f s), stress %.1f Pa (theory %.1f Pa)\n",
-              cp, z_probe[0], z_probe[1], t_arrival[0], t_arrival[1], z_probe[0] / cp, t_theory,
-              t_arrival[1] - t_arrival[0], dt_theory, stress_behind, -rho * cp * v0);
+  std::printf(
+      "P-wave: c_p = %.2f m/s, arrival at %.1f / %.1f m: %.5f / %.5f s (theory %.5f / %.5f s), travel time "
+      "%.5f s (theory %.5f s), stress %.1f Pa (theory %.1f Pa)\n",
+      cp, z_probe[0], z_probe[1], t_arrival[0], t_arrival[1], z_probe[0] / cp, t_theory, t_arrival[1] - t_arrival[0],
+      dt_theory, stress_behind, -rho * cp * v0);
   ASSERT_GT(t_arrival[0], 0.0);
   ASSERT_GT(t_arrival[1], 0.0);
   EXPECT_NEAR((t_arrival[1] - t_arrival[0]) / dt_theory, 1.0, 0.05);
@@ -367,13 +368,12 @@ TEST(Geostatic, ElasticColumnAtRest) {
   EXPECT_GT(min_soil_distance(S), 0.7 * dx) << "tensile-instability clumping";
 }
 
-
 // A cover on inclined bedrock (the DSM-section layout of the demo): 3 m of Drucker–Prager soil,
-// three particles deep, on a 50° slope; infinite-slope factor of safety ≈ 1.5. After the geostatic phase it must stay where it is. The
-// boundary particles carry the stress extrapolated along the layering normal (solver step 1); with
-// the extrapolation along the vertical instead — the flat-ground (Adami) form, which drops the
-// shear-stress gradient ρ g sin θ at the wall — the same cover creeps down the bedrock, the defect
-// that made the real-terrain section of the demo move without shaking.
+// three particles deep, on a 50° slope; infinite-slope factor of safety ≈ 1.5. After the geostatic phase it must stay
+// where it is. The boundary particles carry the stress extrapolated along the layering normal (solver step 1); with the
+// extrapolation along the vertical instead — the flat-ground (Adami) form, which drops the shear-stress gradient ρ g
+// sin θ at the wall — the same cover creeps down the bedrock, the defect that made the real-terrain section of the demo
+// move without shaking.
 double cover_creep(bool vertical_layering) {
   const double dx = 1.0, depth = 3.0, L = 30.0, slope = std::tan(50.0 * kDeg), rho = 1900.0;
   ProfileDomain d;
@@ -410,9 +410,10 @@ double cover_creep(bool vertical_layering) {
 
 TEST(Geostatic, CoverOnInclinedBedrockStaysPut) {
   const double u_layered = cover_creep(false), u_vertical = cover_creep(true);
-  std::printf("cover on 50 deg bedrock, 2 s after the geostatic phase: max displacement %.2e m (layer-normal "
-              "extrapolation), %.2e m (vertical extrapolation)\n",
-              u_layered, u_vertical);
+  std::printf(
+      "cover on 50 deg bedrock, 2 s after the geostatic phase: max displacement %.2e m (layer-normal "
+      "extrapolation), %.2e m (vertical extrapolation)\n",
+      u_layered, u_vertical);
   EXPECT_LT(u_layered, 0.01);  // 1 cm: elastic adjustment only
   EXPECT_GT(u_vertical, 10.0 * u_layered) << "the test no longer distinguishes the two extrapolations";
 }

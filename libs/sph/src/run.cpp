@@ -628,7 +628,8 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
     std::ostringstream src;
     src << c.config_source << "; " << Dim << "D section; displacement > " << c.failed_threshold << " m; width " << W
         << " m";
-    const Handoff handoff{pts, vols, c.section.crs_wkt, src.str(), c.bulking_factor, solver.time(), solver.step_count()};
+    const Handoff handoff{
+        pts, vols, c.section.crs_wkt, src.str(), c.bulking_factor, solver.time(), solver.step_count()};
     write_handoff(out / "release.h5", handoff, c.resolved_config);
     summary["release"] = {{"file", "release.h5"}, {"points", pts.size()}, {"total_volume_m3", total}, {"width_m", W}};
     if (c.section.dsm) {
@@ -699,8 +700,8 @@ void check_resources(const RunConfig& c) {
   // entries in 2D) and the solver's scratch arrays; solver.bytes_per_particle() reports ~0.6 kB (2D).
   const double per_particle = c.dimension == 3 ? 1500.0 : 500.0;
   std::ostringstream est;
-  est << std::setprecision(3) << particles << " particles × " << per_particle << " B for the " << what << " at "
-      << dx << " m spacing";
+  est << std::setprecision(3) << particles << " particles × " << per_particle << " B for the " << what << " at " << dx
+      << " m spacing";
   check_memory(particles * per_particle, est.str(), c.config_source, "numerics.spacing", csv_number(dx));
 
   // The neighbour list needs a periodic axis of at least twice its cut-off, 2h plus the Verlet skin
