@@ -14,8 +14,10 @@
 /// Value types must be trivially copyable: arithmetic types or fixed-size Eigen matrices.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <new>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -141,7 +143,8 @@ public:
   }
 
   /// Reorder every field so that new[i] = old[perm[i]]. perm must be a permutation of 0..size-1.
-  /// Uses one scratch buffer per call (not per particle); cheap enough to do every few steps.
+  /// Uses a scratch buffer kept by the store (no allocation once it has grown); cheap enough to do
+  /// every few steps.
   void reorder(std::span<const std::uint32_t> perm) {
     if (perm.size() != size_) throw std::invalid_argument("ParticleStore::reorder: permutation size mismatch");
     (permute_one<Tags>(perm), ...);
@@ -176,13 +179,28 @@ private:
     auto& v = get<Tag>();
     v[to] = v[from];
   }
+  // The gathered copy goes to one scratch buffer kept across calls and is copied back, so a
+  // reordering allocates (and page-faults) nothing once the store has reached its size. The
+  // gather is parallel over i (each element written once: the result does not depend on threads).
   template <class Tag>
   void permute_one(std::span<const std::uint32_t> perm) {
+    using T = typename Tag::type;
     auto& v = get<Tag>();
-    std::vector<typename Tag::type> tmp(v.size());
-    for (std::size_t i = 0; i < perm.size(); ++i) tmp[i] = v[perm[i]];
-    v.swap(tmp);
+    const std::size_t bytes = v.size() * sizeof(T);
+    if (scratch_.size() * sizeof(Scratch) < bytes) scratch_.resize((bytes + sizeof(Scratch) - 1) / sizeof(Scratch));
+    T* tmp = reinterpret_cast<T*>(scratch_.data());
+    const T* src = v.data();
+    const std::int64_t n = static_cast<std::int64_t>(perm.size());
+#pragma omp parallel for schedule(static) if (n >= 65536)
+    for (std::int64_t i = 0; i < n; ++i) new (tmp + i) T(src[perm[static_cast<std::size_t>(i)]]);
+    std::copy(tmp, tmp + n, v.data());
   }
+
+  // Scratch storage for reorder(), aligned for every field type (Eigen fixed-size types included).
+  struct alignas(64) Scratch {
+    std::byte b[64];
+  };
+  std::vector<Scratch> scratch_;
 
   std::tuple<std::vector<typename Tags::type>...> fields_;
   std::size_t size_ = 0;

@@ -273,7 +273,10 @@ class RunoutSolver {
     const double eps = p_.smoothing;
     double signal = 0.0;
     if (eps == 0.0) {
-      // One pass: depth, mean velocity and head pressure (none needs the neighbours' depths).
+      // One pass: depth, mean velocity and head pressure (none needs the neighbours' depths). The
+      // periodic test of the pair height is hoisted out of the pair loop (two instantiations).
+      const auto one_pass = [&](auto periodic_tag) {
+        constexpr bool kPeriodic = decltype(periodic_tag)::value;
 #pragma omp parallel for reduction(max : signal) schedule(static) if (n >= kParallelMin)
       for (std::int64_t ii = 0; ii < n; ++ii) {
         const auto i = static_cast<std::size_t>(ii);
@@ -285,8 +288,10 @@ class RunoutSolver {
         const double ci = cb[i];
         // W/σ (kernels.hpp) and f (head_pressure.hpp) written out per branch of q; the
         // arithmetic is exactly that of CubicSpline and HeadPressureForce::shape.
+        const double zi = z[i];
         neighbours(i, [&](std::size_t j, const Vec2& xij, double r2) {
-          const double zij = dz(i, j, xij);
+          double zij = zi - z[j];
+          if constexpr (kPeriodic) zij += grad[i].dot(xij - (x[i] - x[j]));
           const double r3 = r2 + zij * zij;
           if (r3 >= support2) return;  // beyond the support on the bed (or in the list's skin)
           const double r = std::sqrt(r3);
@@ -315,6 +320,11 @@ class RunoutSolver {
         dv[i] = Vec2::Zero();
         signal = std::max(signal, signal_speed(i));
       }
+      };
+      if (periodic)
+        one_pass(std::true_type{});
+      else
+        one_pass(std::false_type{});
       return signal;
     }
     // Pass 1: depths and mean velocities.
