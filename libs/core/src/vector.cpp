@@ -134,6 +134,17 @@ void add_line(const OGRLineString* line, double attribute, std::vector<Polyline>
 
 }  // namespace
 
+std::vector<std::string> vector_field_names(const std::filesystem::path& path) {
+  detail::ensure_gdal_registered();
+  const std::string file = path.string();
+  detail::QuietGdalErrors quiet;
+  VectorLayer v(file, "", "", "features");
+  std::vector<std::string> names;
+  const OGRFeatureDefn* defn = v.layer->GetLayerDefn();
+  for (int i = 0; i < defn->GetFieldCount(); ++i) names.emplace_back(defn->GetFieldDefn(i)->GetNameRef());
+  return names;
+}
+
 std::vector<Polygon> read_polygons(const std::filesystem::path& path, const std::string& attribute,
                                    const std::string& target_wkt) {
   detail::ensure_gdal_registered();

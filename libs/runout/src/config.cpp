@@ -61,6 +61,72 @@ std::string resolve(const ConfigReader& cfg, std::string p) {
   return p;
 }
 
+/// Entrainment, friction zones, forest and the inflow hydrograph (docs/runout.md, "Processes").
+void read_processes(ConfigReader& cfg, RunoutCase& c) {
+  auto& e = c.params.entrainment;
+  auto& s = c.processes;
+  const std::string law = cfg.get_choice("entrainment.law", to_string(e.law), {"none", "growth", "shear"},
+                                         {"",
+                                          "bed erosion: none, growth (dV/ds = E_s V, McDougall & Hungr 2005) or "
+                                          "shear (rate k_e (τ_b − τ_c) where τ_b > τ_c)"});
+  e.law = law == "growth" ? EntrainmentLaw::GrowthRate
+          : law == "shear" ? EntrainmentLaw::ShearStress
+                           : EntrainmentLaw::None;
+  e.growth_rate = cfg.get("entrainment.growth_rate", e.growth_rate, Range::closed(0.0, 1.0),
+                          {"1/m", "E_s of the growth law: volume growth per metre of path inside the erodible area"});
+  e.critical_shear = cfg.get("entrainment.critical_shear", e.critical_shear, Range::closed(0.0, 1e7),
+                             {"Pa", "τ_c of the shear law: no erosion below this basal shear stress"});
+  e.erosion_coefficient =
+      cfg.get("entrainment.coefficient", e.erosion_coefficient, Range::closed(0.0, 1.0),
+              {"m/(s*Pa)", "k_e of the shear law: erosion rate (m/s of bed depth) per Pa of excess shear"});
+  s.erodible = resolve(cfg, cfg.get_string("entrainment.file", "",
+                                           {"", "erodible layer: depth raster (m, vertical) or polygons"}));
+  s.erodible_attribute = cfg.get_string("entrainment.attribute", s.erodible_attribute,
+                                        {"", "polygon attribute holding the erodible depth (m)"});
+  s.erodible_depth = cfg.get("entrainment.depth", s.erodible_depth, Range::closed(0.0, 100.0),
+                             {"m", "uniform erodible depth of the polygons; 0: use the attribute"});
+  if (e.law == EntrainmentLaw::GrowthRate && !(e.growth_rate > 0.0))
+    throw InputError("entrainment.law = growth needs entrainment.growth_rate > 0 (1/m)", cfg.source(),
+                     "entrainment.growth_rate", "0");
+  if (e.law == EntrainmentLaw::ShearStress && !(e.erosion_coefficient > 0.0))
+    throw InputError("entrainment.law = shear needs entrainment.coefficient > 0 (m/(s*Pa))", cfg.source(),
+                     "entrainment.coefficient", "0");
+
+  s.zones = resolve(cfg, cfg.get_string("zones.file", "",
+                                        {"",
+                                         "friction zones: polygons whose attributes n, icr, m, mu, xi override the "
+                                         "global coefficients inside them"}));
+  for (int k = 0; k < kFrictionParameters; ++k) {
+    const std::string name = kFrictionParameterNames[static_cast<std::size_t>(k)];
+    s.zone_rasters[static_cast<std::size_t>(k)] = resolve(
+        cfg, cfg.get_string("zones." + name, "",
+                            {"", "raster of the friction coefficient " + name + " (nodata: the global value)"}));
+  }
+
+  s.forest = resolve(cfg, cfg.get_string("forest.file", "",
+                                         {"",
+                                          "forest: polygons (attributes stem_density, stem_diameter) or a "
+                                          "stem-density raster (1/m^2)"}));
+  s.stem_density = cfg.get("forest.stem_density", s.stem_density, Range::closed(0.0, 10.0),
+                           {"1/m^2", "stems per square metre where the polygons carry none"});
+  s.stem_diameter = cfg.get("forest.stem_diameter", s.stem_diameter, Range::open_closed(0.0, 5.0),
+                            {"m", "stem diameter at breast height where the polygons carry none"});
+  s.drag_coefficient = cfg.get("forest.drag_coefficient", s.drag_coefficient, Range::open_closed(0.0, 10.0),
+                               {"1", "drag coefficient C_D of a stem (k_f = ½ C_D n d)"});
+
+  s.hydrograph = resolve(cfg, cfg.get_string("inflow.hydrograph", "",
+                                             {"", "inflow hydrograph table: CSV time_s,discharge_m3_s"}));
+  s.inflow_points = cfg.get_array("inflow.points", s.inflow_points, Range::closed(-1e8, 1e8),
+                                  {"m", "inflow point [x, y] or short line [x1, y1, x2, y2] in the DSM's CRS"});
+  s.inflow_azimuth = cfg.get("inflow.azimuth", s.inflow_azimuth, Range::closed_open(-1.0, 360.0),
+                             {"deg", "inflow direction clockwise from north; -1: down the steepest slope"});
+  s.inflow_speed = cfg.get("inflow.speed", s.inflow_speed, Range::open_closed(0.0, 100.0),
+                           {"m/s", "surface speed of the inflowing material"});
+  if (!s.hydrograph.empty() && s.inflow_points.empty())
+    throw InputError("inflow.hydrograph needs inflow.points ([x, y] or [x1, y1, x2, y2], m)", cfg.source(),
+                     "inflow.points");
+}
+
 }  // namespace
 
 RunoutCase read_case(ConfigReader& cfg) {
@@ -113,6 +179,8 @@ RunoutCase read_case(ConfigReader& cfg) {
   const std::string norm = cfg.get_choice("numerics.pressure_normalisation", "consistent", {"consistent", "seed"},
                                           {"", "head-pressure constant: consistent (continuum −g∇h) or seed (1)"});
   p.pressure_scale = norm == "seed" ? 1.0 : HeadPressureForce::consistent_normalisation();
+
+  read_processes(cfg, c);
 
   auto& o = c.output;
   o.series_interval = cfg.get("output.series_interval", o.series_interval, Range::open_closed(0.0, 1e6),

@@ -287,6 +287,15 @@ RunoutInputs load_inputs(const RunoutCase& c) {
   for (double& v : z)
     if (in.dsm.is_nodata(v) || !std::isfinite(v)) v = std::numeric_limits<double>::quiet_NaN();
   in.surface = GridSurface(grid, std::move(z), c.params.d0);
+  in.processes = load_processes(c.processes, c.params, in.dsm, in.surface);
+  if (c.release.file.empty() && c.release.handoff.empty() && !in.processes.inflows.empty()) {
+    // An inflow hydrograph alone: no release.
+    in.thickness.assign(grid.cells(), 0.0);
+    in.volume = 0.0;
+    in.source = c.processes.hydrograph;
+    in.description = "inflow hydrograph " + c.processes.hydrograph;
+    return in;
+  }
   read_release(c.release, in.dsm, in);
   return in;
 }
@@ -314,13 +323,21 @@ RunoutSimulation::RunoutSimulation(const RunoutInputs& in, RunoutParameters para
                            ") lies on DSM nodata or in the outermost half cell",
                        in.source);
   }
+  solver_.set_processes(in.processes);
   solver_.initialise();
-  const double rel_err = std::abs(seeded_.volume_seeded - in.volume) / in.volume;
+  const double rel_err = in.volume > 0.0 ? std::abs(seeded_.volume_seeded - in.volume) / in.volume : 0.0;
   if (rel_err > 1e-9)
     throw std::logic_error("seeded volume " + fmt(seeded_.volume_seeded, 15) + " differs from the release " +
                            fmt(in.volume, 15));
   maps_.record(store, 0.0);
   top_ = release_top(store);
+  for (const Hydrograph& q : in.processes.inflows) {
+    // The top of an inflow line counts as the top of the release for H/L.
+    for (const Vec2& e : {q.a, q.b}) {
+      SurfaceSample smp;
+      if (in.surface.sample(e, smp) && smp.z > top_.elevation) top_ = {e, smp.z};
+    }
+  }
   series_.push_back(series_row(store, solver_.budget(), 0.0, 0));
   next_series_ = output_.series_interval;
 }
@@ -403,6 +420,13 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
   write_geotiff(out / "deposit.tif", r_dep);
   write_geotiff(out / "mobile_at_end.tif", r_mob);
   write_geotiff(out / "arrival_time.tif", r_arr);
+  const auto& solver = sim.solver();
+  if (!solver.eroded_depth().empty()) {
+    const Raster r_ero = map_raster(solver.eroded_depth(), 0.0);
+    write_geotiff(out / "erosion_depth.tif", r_ero);
+    if (c.output.pngs)
+      write_quicklook_png(out / "erosion_depth.png", dsm, &r_ero, ColourRamp::Magma, "eroded depth (m)", 0.0, 0.0, 0.001);
+  }
   if (c.output.pngs) {
     write_quicklook_png(out / "max_depth.png", dsm, &r_depth, ColourRamp::Viridis, "peak flow thickness (m)", 0.0, 0.0,
                         0.01);
@@ -413,13 +437,13 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
   {
     AtomicTextFile csv(out / "series.csv");
     csv << "time_s,step,particles,front_x_m,front_y_m,front_travel_m,front_drop_m,mean_speed_m_s,max_speed_m_s,"
-           "mobile_volume_m3,deposited_volume_m3,lost_volume_m3,balance_error_m3\n";
+           "mobile_volume_m3,deposited_volume_m3,lost_volume_m3,balance_error_m3,entrained_volume_m3,injected_volume_m3\n";
     csv.stream() << std::setprecision(10);
     for (const auto& r : sim.series())
       csv << r.time << ',' << r.step << ',' << r.particles << ',' << r.front.x() << ',' << r.front.y() << ','
           << r.front_travel << ',' << r.front_drop << ',' << r.mean_speed << ',' << r.max_speed << ','
           << r.volumes.mobile << ',' << r.volumes.deposited << ',' << r.volumes.lost << ',' << r.volumes.balance_error()
-          << '\n';
+          << ',' << r.volumes.entrained << ',' << r.volumes.injected << '\n';
     csv.commit();
   }
 
@@ -462,10 +486,57 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
                      {"deposited", b.deposited},
                      {"mobile", b.mobile},
                      {"lost", b.lost},
+                     {"entrained", b.entrained},
+                     {"injected", b.injected},
                      {"deposit_raster", res.deposit_raster_volume},
                      {"mobile_raster", res.mobile_raster_volume}};
   j["lost_particles"] = b.lost_particles;
-  j["mass_balance_error_relative"] = b.balance_error() / b.initial;
+  j["mass_balance_error_relative"] = b.total_in() > 0.0 ? b.balance_error() / b.total_in() : 0.0;
+  // The processes in force (docs/runout.md, "Processes").
+  const EntrainmentParameters& ent = sim.parameters().entrainment;
+  const SpatialProcesses& proc = solver.processes();
+  nlohmann::json jp;
+  jp["entrainment"] = {{"law", to_string(ent.law)}};
+  if (ent.law == EntrainmentLaw::GrowthRate) jp["entrainment"]["growth_rate_per_m"] = ent.growth_rate;
+  if (ent.law == EntrainmentLaw::ShearStress) {
+    jp["entrainment"]["critical_shear_pa"] = ent.critical_shear;
+    jp["entrainment"]["coefficient_m_per_s_pa"] = ent.erosion_coefficient;
+  }
+  if (ent.law != EntrainmentLaw::None) {
+    double eroded_max = 0.0;
+    for (double e : solver.eroded_depth()) eroded_max = std::max(eroded_max, e);
+    jp["entrainment"]["file"] = c.processes.erodible;
+    jp["entrainment"]["entrained_volume_m3"] = b.entrained;
+    jp["entrainment"]["growth_factor"] = b.initial + b.injected > 0.0 ? b.total_in() / (b.initial + b.injected) : 0.0;
+    jp["entrainment"]["max_eroded_depth_m"] = eroded_max;
+    jp["entrainment"]["terrain"] = "fixed (the DSM is not lowered by the eroded depth)";
+  }
+  nlohmann::json zones = nlohmann::json::array();
+  for (int k = 0; k < kFrictionParameters; ++k)
+    if (!proc.friction[static_cast<std::size_t>(k)].empty()) zones.push_back(kFrictionParameterNames[static_cast<std::size_t>(k)]);
+  jp["friction_zones"] = {{"file", c.processes.zones}, {"coefficients", zones}};
+  if (!proc.forest_drag.empty()) {
+    double area = 0.0, kmax = 0.0;
+    for (double k : proc.forest_drag)
+      if (k > 0.0) {
+        area += sim.inputs().grid().cell_area();
+        kmax = std::max(kmax, k);
+      }
+    jp["forest"] = {{"file", c.processes.forest},
+                    {"area_m2", area},
+                    {"max_drag_per_m", kmax},
+                    {"drag_coefficient", c.processes.drag_coefficient}};
+  }
+  if (!proc.inflows.empty()) {
+    const Hydrograph& q = proc.inflows.front();
+    jp["inflow"] = {{"hydrograph", q.source},
+                    {"volume_of_table_m3", q.volume()},
+                    {"injected_m3", b.injected},
+                    {"end_time_s", q.end_time()},
+                    {"speed_m_s", q.speed},
+                    {"direction_xy", {q.direction.x(), q.direction.y()}}};
+  }
+  j["processes"] = jp;
   write_text_file(out / "summary.json", j.dump(2) + "\n");
 }
 

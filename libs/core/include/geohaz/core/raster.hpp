@@ -106,6 +106,10 @@ struct Polygon {
 std::vector<Polygon> read_polygons(const std::filesystem::path& path, const std::string& attribute,
                                    const std::string& target_wkt);
 
+/// Names of the attribute fields of the first layer of an OGR data source (InputError when it
+/// cannot be read).
+std::vector<std::string> vector_field_names(const std::filesystem::path& path);
+
 /// A polyline and the value of a requested attribute (NaN if not requested/absent).
 struct Polyline {
   std::vector<Vec2> vertices;

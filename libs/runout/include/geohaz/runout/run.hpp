@@ -15,6 +15,7 @@
 /// `run_case(case, out, quiet)` chains them the way `debris-runout` does (outputs created only
 /// after every input is valid; snapshots during the run; progress on stderr).
 
+#include <array>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -22,6 +23,7 @@
 
 #include "geohaz/core/raster.hpp"
 #include "geohaz/runout/hazard_maps.hpp"
+#include "geohaz/runout/processes.hpp"
 #include "geohaz/runout/release.hpp"
 #include "geohaz/runout/solver.hpp"
 #include "geohaz/runout/surface.hpp"
@@ -49,6 +51,27 @@ struct ReleaseSpec {
   ThicknessDirection direction = ThicknessDirection::Normal;
 };
 
+/// Where the spatial processes come from (docs/runout.md, "Processes"); empty: not used.
+struct ProcessSpec {
+  std::string zones;  ///< friction zones: polygons with attributes named n, icr, m, mu, xi
+  std::array<std::string, kFrictionParameters> zone_rasters;  ///< a raster per coefficient (by FrictionParameter)
+  std::string forest;            ///< forest polygons (attributes stem_density, stem_diameter) or stem-density raster
+  double stem_density = 0.0;     ///< stems per m² where the polygons carry none (1/m²)
+  double stem_diameter = 0.3;    ///< stem diameter where the polygons carry none (m)
+  double drag_coefficient = 1.0;  ///< C_D of a stem (1)
+  std::string erodible;          ///< erodible depth raster (m) or polygons
+  std::string erodible_attribute = "depth";  ///< polygon attribute of the erodible depth (m)
+  double erodible_depth = 0.0;               ///< uniform polygon depth (m); 0: use the attribute
+  std::string hydrograph;                    ///< inflow table (CSV time_s, discharge_m3_s)
+  std::vector<double> inflow_points;         ///< [x, y] or [x1, y1, x2, y2] (m, DSM CRS)
+  double inflow_azimuth = -1.0;              ///< degrees clockwise from north; < 0: down the slope
+  double inflow_speed = 5.0;                 ///< surface speed of the inflowing particles (m/s)
+};
+
+/// Read the fields and the inflow of `s` onto the DSM grid (InputError naming file, key, value).
+SpatialProcesses load_processes(const ProcessSpec& s, const RunoutParameters& p, const Raster& dsm,
+                                const GridSurface& surface);
+
 /// What to write besides the maps and the summary.
 struct OutputSettings {
   double series_interval = 1.0;     ///< s between rows of series.csv
@@ -61,6 +84,7 @@ struct OutputSettings {
 struct RunoutCase {
   std::string dsm;  ///< terrain raster (projected CRS, metres)
   ReleaseSpec release;
+  ProcessSpec processes;
   RunoutParameters params;
   OutputSettings output;
   std::string resolved_config;  ///< TOML text of the resolved configuration (written beside the outputs)
@@ -82,6 +106,7 @@ struct RunoutInputs {
   std::string description;        ///< "polygons relAlr.shp", "points from release.h5 (…)"
   std::string source;             ///< the release file (for messages)
   bool from_handoff = false;      ///< the release came as points with volumes
+  SpatialProcesses processes;     ///< friction zones, forest, erodible layer, inflows
 
   const GridGeometry& grid() const noexcept { return surface.geometry(); }
 };

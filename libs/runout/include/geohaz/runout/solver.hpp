@@ -54,6 +54,7 @@
 #include "geohaz/runout/basal_friction.hpp"
 #include "geohaz/runout/fields.hpp"
 #include "geohaz/runout/head_pressure.hpp"
+#include "geohaz/runout/processes.hpp"
 #include "geohaz/runout/surface.hpp"
 
 namespace geohaz::runout {
@@ -82,17 +83,24 @@ struct RunoutParameters {
   int reorder_interval = 25;  ///< steps between cell reorderings of the store
   double skin = 0.0;          ///< neighbour-list skin in units of d0 (list cutoff (2 + skin)·d0)
   BasalFriction friction = ModifiedManningFriction{};
+  /// Bed erosion law and coefficients (the erodible layer is a field: SpatialProcesses).
+  EntrainmentParameters entrainment;
 
   double nominal_volume() const noexcept { return h0 * d0 * d0; }
 };
 
-/// Volumes (m³) at a moment of the run; initial = mobile + deposited + lost up to round-off.
+/// Volumes (m³) at a moment of the run; initial + injected + entrained = mobile + deposited + lost
+/// up to round-off.
 struct VolumeBudget {
   double initial = 0.0, mobile = 0.0, deposited = 0.0, lost = 0.0;
+  double injected = 0.0;   ///< brought in by inflow hydrographs
+  double entrained = 0.0;  ///< eroded from the bed
   std::size_t lost_particles = 0;
   double kinetic_energy = 0.0;       ///< Σ ½ ρ V S² now (J)
   double peak_kinetic_energy = 0.0;  ///< its maximum so far (J)
-  double balance_error() const noexcept { return mobile + deposited + lost - initial; }
+  /// Everything that has entered the flow.
+  double total_in() const noexcept { return initial + injected + entrained; }
+  double balance_error() const noexcept { return mobile + deposited + lost - total_in(); }
 };
 
 /// Below this many particles the per-particle loops run on one thread: the work of a step is then
@@ -112,6 +120,27 @@ class RunoutSolver {
   double time() const noexcept { return time_; }
   std::int64_t step_count() const noexcept { return step_; }
   double last_dt() const noexcept { return dt_; }
+
+  /// Spatial fields (friction zones, forest, erodible layer) and inflow hydrographs (docs/runout.md,
+  /// "Processes"). Set before initialise(). The erodible depth is consumed as the bed is eroded.
+  void set_processes(SpatialProcesses proc) {
+    proc_ = std::move(proc);
+    eroded_.assign(proc_.erodible_depth.empty() ? 0 : proc_.grid.cells(), 0.0);
+    emitted_.assign(proc_.inflows.size(), 0.0);
+    slot_.assign(proc_.inflows.size(), 0);
+  }
+  const SpatialProcesses& processes() const noexcept { return proc_; }
+  /// Depth eroded from the bed per cell of the processes' grid (m, vertical; empty without an
+  /// erodible layer).
+  const std::vector<double>& eroded_depth() const noexcept { return eroded_; }
+  /// Volume each inflow has delivered so far (m³).
+  const std::vector<double>& inflow_volumes() const noexcept { return emitted_; }
+  /// True while an inflow hydrograph still has volume to deliver.
+  bool inflow_pending() const noexcept {
+    for (std::size_t m = 0; m < emitted_.size(); ++m)
+      if (emitted_[m] < proc_.inflows[m].volume() - 1e-9 * p_.nominal_volume()) return true;
+    return false;
+  }
 
   /// Call once the particles (position, velocity, volume, id) are in the store: samples the
   /// terrain, records start elevations and the initial volume, computes depths. Throws
@@ -137,6 +166,8 @@ class RunoutSolver {
     }
     budget_ = {};
     for (double v : vol) budget_.initial += v;
+    next_id_ = 0;
+    for (auto id : store_.get<ParticleId>()) next_id_ = std::max(next_id_, id + 1);
     energy_stop_ = false;
     compute_pair_terms();
     update_budget();
@@ -163,10 +194,12 @@ class RunoutSolver {
     // 4-5. Integrate with the friction law resolved once for the whole loop.
     const IntegrateFlags flags = std::visit([&](const auto& law) { return integrate(law, dt); }, p_.friction);
     if (flags.non_finite) throw_non_finite();
+    if (flags.entraining) entrain();
     if (flags.leaving) remove_leaving();
     dt_ = dt;
     time_ += dt;
     ++step_;
+    if (!proc_.inflows.empty()) inject(time_);
     update_budget();
     return dt;
   }
@@ -180,8 +213,9 @@ class RunoutSolver {
   /// Whether the run is over: duration reached, all stopped, no particle left, or the kinetic
   /// energy below stop_energy_fraction of its peak.
   bool finished() const noexcept {
-    return time_ >= p_.duration - 1e-12 * std::max(1.0, p_.duration) || store_.empty() ||
-           (step_ > 0 && all_stopped()) || energy_stop_;
+    if (time_ >= p_.duration - 1e-12 * std::max(1.0, p_.duration)) return true;
+    if (inflow_pending()) return false;
+    return store_.empty() || (step_ > 0 && all_stopped()) || energy_stop_;
   }
   /// True when the run ended (or would end) by the kinetic-energy criterion.
   bool stopped_by_energy() const noexcept { return energy_stop_; }
@@ -406,6 +440,7 @@ class RunoutSolver {
   struct IntegrateFlags {
     bool leaving = false;     ///< a particle left the terrain
     bool non_finite = false;  ///< a position or velocity is not finite
+    bool entraining = false;  ///< a particle asks to erode the bed (demand_)
   };
 
   template <class Law>
@@ -430,10 +465,21 @@ class RunoutSolver {
     const bool curvature = p_.curvature;
     const bool periodic = periodic_.any();
     const std::int64_t n = static_cast<std::int64_t>(store_.size());
-    int any_leaving = 0, any_non_finite = 0;
-#pragma omp parallel for reduction(max : any_leaving, any_non_finite) schedule(static) if (n >= kParallelMin)
+    // Spatial processes: one cell look-up per particle, at its position during the step.
+    const bool cells = proc_.has_cell_fields(), zones = proc_.has_friction_fields();
+    const bool forest = !proc_.forest_drag.empty();
+    const EntrainmentParameters& ent = p_.entrainment;
+    const bool erode = ent.law != EntrainmentLaw::None && !proc_.erodible_depth.empty();
+    if (erode) {
+      demand_.assign(store_.size(), 0.0);
+      demand_cell_.resize(store_.size());
+    }
+    int any_leaving = 0, any_non_finite = 0, any_entraining = 0;
+#pragma omp parallel for reduction(max : any_leaving, any_non_finite, any_entraining) schedule(static) \
+    if (n >= kParallelMin)
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
+      const std::size_t cell = cells ? proc_.cell(x[i]) : SpatialProcesses::npos;
       const Vec2 gz = grad[i];
       const double cos_theta = cb[i];
       const double h_n = std::max(h[i], p_.min_depth);
@@ -456,8 +502,29 @@ class RunoutSolver {
       const double kv = curvature ? H[0] * vi.x() * vi.x() + 2.0 * H[1] * vi.x() * vi.y() + H[2] * vi.y() * vi.y() : 0.0;
       const double vz = gz.dot(v_star);
       const double s_star = std::sqrt(v_star.squaredNorm() + vz * vz);
-      const FrictionTerms t = law.terms(g, std::max(g + kv, 0.0) * cos_theta, h_n, s_star);
+      //    The law's coefficients of the particle's friction zone; forest drag k_f |v|² on top.
+      Law local = law;
+      if (zones) local = proc_.law_at(law, cell);
+      FrictionTerms t = local.terms(g, std::max(g + kv, 0.0) * cos_theta, h_n, s_star);
+      const double basal_drag = t.drag;
+      if (forest && cell != SpatialProcesses::npos && proc_.forest_drag[cell] > 0.0) t.drag += proc_.forest_drag[cell];
       const double s = speed_after_friction(s_star, dt, t);
+      //    Erosion the particle asks for over the step (granted in entrain(), capped by the layer).
+      if (erode && s > 0.0 && cell != SpatialProcesses::npos && proc_.erodible_depth[cell] > 0.0) {
+        double want = 0.0;
+        if (ent.law == EntrainmentLaw::GrowthRate) {
+          want = vol[i] * std::expm1(ent.growth_rate * s * dt);  // V (exp(E_s Δs) − 1), Δs = S Δt
+        } else {
+          const double tau_b = p_.density * h_n * (t.rest + basal_drag * s * s);  // basal shear (Pa)
+          const double rate = ent.erosion_coefficient * std::max(tau_b - ent.critical_shear, 0.0);
+          want = rate * dt * vol[i] / h_n;  // ė Δt × bed area V/h_n
+        }
+        if (want > 0.0) {
+          demand_[i] = want;
+          demand_cell_[i] = cell;
+          any_entraining = 1;
+        }
+      }
       Vec2 v_new = s > 0.0 ? Vec2(v_star * (s / s_star)) : Vec2::Zero();
       const double moved = dt * v_new.norm();
       Vec2 x_new = x[i] + dt * v_new;
@@ -494,7 +561,89 @@ class RunoutSolver {
       moving[i] = s > 0.0 ? 1 : 0;
       if (!(x_new.allFinite() && v_new.allFinite())) any_non_finite = 1;
     }
-    return {any_leaving != 0, any_non_finite != 0};
+    return {any_leaving != 0, any_non_finite != 0, any_entraining != 0};
+  }
+
+  /// Grant the erosion asked for in integrate(), in store order (deterministic), capped by the depth
+  /// left in each cell. The eroded mass joins its particle at rest: V v is conserved, so the
+  /// particle slows by V/(V + ΔV).
+  void entrain() {
+    auto& vol = store_.get<Volume>();
+    auto& v = store_.get<Velocity<2>>();
+    auto& speed = store_.get<Speed>();
+    auto& vz = store_.get<VerticalVelocity>();
+    auto& layer = proc_.erodible_depth;
+    const double area = proc_.grid.cell_area();
+    for (std::size_t i = 0; i < store_.size(); ++i) {
+      if (!(demand_[i] > 0.0)) continue;
+      const std::size_t k = demand_cell_[i];
+      const double dV = std::min(demand_[i], layer[k] * area);
+      if (!(dV > 0.0)) continue;
+      layer[k] = std::max(layer[k] - dV / area, 0.0);
+      eroded_[k] += dV / area;
+      const double f = vol[i] / (vol[i] + dV);
+      v[i] *= f;
+      speed[i] *= f;
+      vz[i] *= f;
+      vol[i] += dV;
+      budget_.entrained += dV;
+    }
+  }
+
+  /// Particles of the inflow hydrographs due by time t: one of volume V0 each time ∫Q has grown by
+  /// V0, and the remainder when the hydrograph ends, so the injected volume is ∫Q dt exactly. Each
+  /// enters at the next slot across the inflow line (slots d0 apart) and is placed where it would
+  /// be at t had it entered when the middle of its volume did.
+  void inject(double t) {
+    const double v0 = p_.nominal_volume();
+    for (std::size_t m = 0; m < proc_.inflows.size(); ++m) {
+      const Hydrograph& q = proc_.inflows[m];
+      const bool ended = t >= q.end_time();
+      double due = (ended ? q.volume() : q.volume_until(t)) - emitted_[m];
+      while (due >= v0 || (ended && due > 1e-9 * v0)) {
+        const double dv = std::min(v0, due);
+        const double entered = q.time_of_volume(emitted_[m] + 0.5 * dv);
+        emitted_[m] += dv;
+        due -= dv;
+        add_inflow_particle(q, slot_[m]++, dv, std::max(t - entered, 0.0));
+        budget_.injected += dv;
+      }
+    }
+  }
+  void add_inflow_particle(const Hydrograph& q, std::int64_t slot, double volume, double age) {
+    const int slots = std::max(1, static_cast<int>(std::lround((q.b - q.a).norm() / p_.d0)));
+    const Vec2 base = q.a + (q.b - q.a) * ((static_cast<double>(slot % slots) + 0.5) / slots);
+    SurfaceSample s0, s;
+    if (!surface_.sample(base, s0))
+      throw SimulationError("the inflow of " + q.source + " is off the terrain at (" + std::to_string(base.x()) + ", " +
+                            std::to_string(base.y()) + ")");
+    // Map velocity of surface speed q.speed along the map direction of the inflow.
+    const auto map_velocity = [&](const Vec2& grad) {
+      const double pz = grad.dot(q.direction);
+      return Vec2(q.direction * (q.speed / std::sqrt(1.0 + pz * pz)));
+    };
+    Vec2 xp = base + age * map_velocity(s0.grad);
+    if (!surface_.sample(xp, s)) {
+      xp = base;
+      s = s0;
+    }
+    const Vec2 vp = map_velocity(s.grad);
+    const std::size_t i = store_.append(1);
+    store_.get<Position<2>>()[i] = xp;
+    store_.get<Velocity<2>>()[i] = vp;
+    store_.get<Volume>()[i] = volume;
+    store_.get<ParticleId>()[i] = next_id_++;
+    store_.get<Elevation>()[i] = s.z;
+    store_.get<StartElevation>()[i] = s0.z;
+    store_.get<StartPosition>()[i] = base;
+    store_.get<PathLength>()[i] = (xp - base).norm();
+    store_.get<SurfaceGradient>()[i] = s.grad;
+    store_.get<SurfaceCurvature>()[i] = s.hess;
+    store_.get<BedCos>()[i] = 1.0 / std::sqrt(1.0 + s.grad.squaredNorm());
+    store_.get<Speed>()[i] = q.speed;
+    store_.get<VerticalVelocity>()[i] = s.grad.dot(vp);
+    store_.get<Moving>()[i] = 1;
+    list_valid_ = false;
   }
 
   /// Name the first particle with a non-finite state (integrate() found one).
@@ -551,6 +700,13 @@ class RunoutSolver {
   NeighbourList<2> list_;  // with a skin (numerics.skin > 0)
   CellPairScan<2> scan_;   // without (the default)
   VolumeBudget budget_;
+  SpatialProcesses proc_;
+  std::vector<double> eroded_;               // per cell of proc_.grid (m)
+  std::vector<double> demand_;               // per particle, this step (m³)
+  std::vector<std::size_t> demand_cell_;     // the cell it erodes
+  std::vector<double> emitted_;              // per inflow (m³)
+  std::vector<std::int64_t> slot_;           // per inflow: particles emitted
+  std::int64_t next_id_ = 0;
   bool list_valid_ = false;
   bool energy_stop_ = false;
   double time_ = 0.0, dt_ = 0.0;
