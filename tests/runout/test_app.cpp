@@ -3,11 +3,13 @@
 // the input, no output written).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -345,4 +347,127 @@ TEST(DebrisRunoutApp, ThicknessNormalToTheSlopeHoldsMoreVolume) {
   };
   EXPECT_NEAR(volume("vertical"), 1600.0, 1e-9);
   EXPECT_NEAR(volume("normal"), 1600.0 * std::sqrt(1.25), 1e-9);
+}
+
+namespace {
+
+/// A GeoJSON polygon layer (EPSG:32654, the tiny valley's CRS) of axis-aligned boxes
+/// [xmin, xmax] × [ymin, ymax] with one set of properties each (a JSON object body).
+void write_boxes(const fs::path& path, const std::vector<std::pair<std::array<double, 4>, std::string>>& boxes) {
+  std::ofstream f(path);
+  f << R"({"type":"FeatureCollection","crs":{"type":"name","properties":{"name":"urn:ogc:def:crs:EPSG::32654"}},)"
+    << R"("features":[)";
+  for (std::size_t k = 0; k < boxes.size(); ++k) {
+    const auto& [b, props] = boxes[k];
+    f << (k ? "," : "") << R"({"type":"Feature","properties":{)" << props
+      << R"(},"geometry":{"type":"Polygon","coordinates":[[)" << std::setprecision(12) << "[" << b[0] << "," << b[2]
+      << "],[" << b[1] << "," << b[2] << "],[" << b[1] << "," << b[3] << "],[" << b[0] << "," << b[3] << "],[" << b[0]
+      << "," << b[2] << "]]]}}";
+  }
+  f << "]}";
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream f(path);
+  f << text;
+}
+
+}  // namespace
+
+// The tiny valley with every process of docs/runout.md "Processes": an erodible channel reach
+// (growth law), a rougher fan (Manning n zone) and a forest on it. Outputs and the volume budget
+// release + entrained = deposited + mobile + lost.
+TEST(DebrisRunoutApp, ProcessesRunEndToEndAndBalanceVolume) {
+  const fs::path dsm = tiny_dsm(), d = work_dir();
+  write_boxes(d / "erodible.geojson", {{{480080, 480300, 4309835, 4309915}, R"("depth":0.5)"}});
+  write_boxes(d / "zones.geojson", {{{480300, 480500, 4309750, 4310000}, R"("n":0.1)"}});
+  write_boxes(d / "forest.geojson", {{{480350, 480450, 4309750, 4310000}, R"("stem_density":0.1,"stem_diameter":0.3)"}});
+  const fs::path out = d / "processes_out";
+  fs::remove_all(out);
+  const auto r = run(dsm.string() + " --release " + (d / "tiny_release.tif").string() +
+                     " --d0 2.5 --h0 0.75 --duration 60 --out " + out.string() + " --quiet --threads 1" +
+                     " --set entrainment.law=growth --set entrainment.growth_rate=0.005" +
+                     " --set entrainment.file=" + (d / "erodible.geojson").string() +
+                     " --set zones.file=" + (d / "zones.geojson").string() +
+                     " --set forest.file=" + (d / "forest.geojson").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* f : {"erosion_depth.tif", "erosion_depth.png"}) EXPECT_TRUE(fs::exists(out / f)) << f;
+  std::ifstream in(out / "summary.json");
+  const auto j = nlohmann::json::parse(in);
+  const auto& v = j["volumes_m3"];
+  const double read = v["release_read"], entrained = v["entrained"];
+  EXPECT_GT(entrained, 0.05 * read);  // 220 m of erodible channel at E_s = 0.005/m: ≈ × 3 if all of it ran through
+  EXPECT_NEAR(v["deposited"].get<double>() + v["mobile"].get<double>() + v["lost"].get<double>(), read + entrained,
+              1e-9 * (read + entrained));
+  const auto& p = j["processes"];
+  EXPECT_EQ(p["entrainment"]["law"], "growth");
+  EXPECT_NEAR(p["entrainment"]["entrained_volume_m3"].get<double>(), entrained, 1e-9 * entrained);
+  EXPECT_LE(p["entrainment"]["max_eroded_depth_m"].get<double>(), 0.5 + 1e-12);
+  EXPECT_EQ(p["friction_zones"]["coefficients"], nlohmann::json::array({"n"}));
+  // Forest: 100 m × 250 m of cells with k_f = ½ · 1 · 0.1 · 0.3 = 0.015 1/m.
+  EXPECT_NEAR(p["forest"]["area_m2"].get<double>(), 100.0 * 250.0, 0.03 * 100.0 * 250.0);
+  EXPECT_NEAR(p["forest"]["max_drag_per_m"].get<double>(), 0.015, 1e-12);
+  // The eroded depth raster integrates to the entrained volume.
+  const geohaz::Raster e = geohaz::read_raster(out / "erosion_depth.tif");
+  double sum = 0.0;
+  for (double x : e.data)
+    if (!e.is_nodata(x)) sum += x * e.cell_size_x() * e.cell_size_y();
+  EXPECT_NEAR(sum, entrained, 1e-5 * entrained);  // float32 raster
+}
+
+// An inflow hydrograph alone (no release): the injected volume is ∫Q dt and the budget closes.
+TEST(DebrisRunoutApp, HydrographInflowDeliversItsVolume) {
+  const fs::path dsm = tiny_dsm(), d = work_dir();
+  write_text(d / "hydrograph.csv", "time_s,discharge_m3_s\n0,0\n5,10\n20,0\n");  // 100 m³
+  const fs::path out = d / "hydrograph_out";
+  fs::remove_all(out);
+  const auto r = run(dsm.string() + " --d0 2.5 --h0 0.75 --duration 60 --out " + out.string() + " --quiet --threads 1" +
+                     " --set inflow.hydrograph=" + (d / "hydrograph.csv").string() +
+                     " --set inflow.points=[480040,4309880,480040,4309890] --set inflow.speed=3");
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::ifstream in(out / "summary.json");
+  const auto j = nlohmann::json::parse(in);
+  const auto& v = j["volumes_m3"];
+  EXPECT_NEAR(v["injected"].get<double>(), 100.0, 1e-9 * 100.0);
+  EXPECT_NEAR(j["processes"]["inflow"]["volume_of_table_m3"].get<double>(), 100.0, 1e-12);
+  EXPECT_NEAR(v["deposited"].get<double>() + v["mobile"].get<double>() + v["lost"].get<double>(), 100.0, 1e-9 * 100.0);
+  EXPECT_GT(j["runout_length_along_path_m"].get<double>(), 50.0);  // it flowed down the valley
+}
+
+TEST(DebrisRunoutApp, BadProcessInputsExitTwoAndWriteNothing) {
+  const fs::path dsm = tiny_dsm(), d = work_dir();
+  const std::string rel = " --release " + (d / "tiny_release.tif").string();
+  write_boxes(d / "erodible_negative.geojson", {{{480080, 480300, 4309835, 4309915}, R"("depth":-1)"}});
+  write_boxes(d / "erodible_ok.geojson", {{{480080, 480300, 4309835, 4309915}, R"("depth":1)"}});
+  write_text(d / "q_not_increasing.csv", "time_s,discharge_m3_s\n0,0\n10,5\n10,3\n");
+  write_text(d / "q_negative.csv", "0,0\n10,-5\n20,0\n");
+  write_text(d / "q_ok.csv", "0,0\n10,5\n20,0\n");
+  const std::string inflow = " --set inflow.points=[480040,4309880]";
+  struct Case {
+    std::string args, expect;
+  };
+  const std::vector<Case> cases = {
+      {rel + " --set entrainment.law=growth --set entrainment.growth_rate=0.01 --set entrainment.file=" +
+           (d / "erodible_negative.geojson").string(),
+       "depth"},
+      {rel + " --set entrainment.law=growth --set entrainment.growth_rate=-0.01", "entrainment.growth_rate"},
+      {rel + " --set entrainment.law=growth --set entrainment.growth_rate=0.01", "entrainment.file"},
+      {rel + " --set entrainment.file=" + (d / "erodible_ok.geojson").string(), "entrainment.law"},
+      {rel + " --set entrainment.law=shear --set entrainment.file=" + (d / "erodible_ok.geojson").string(),
+       "entrainment.coefficient"},
+      {" --set inflow.hydrograph=" + (d / "q_not_increasing.csv").string() + inflow, "line 4"},
+      {" --set inflow.hydrograph=" + (d / "q_negative.csv").string() + inflow, "negative discharge"},
+      {" --set inflow.hydrograph=" + (d / "q_ok.csv").string() + " --set inflow.points=[100,100]", "inflow.points"},
+      {" --set inflow.hydrograph=" + (d / "q_ok.csv").string(), "inflow.points"},
+      {rel + " --set forest.drag_coefficient=-1", "forest.drag_coefficient"},
+      {rel + " --set zones.mu=" + (d / "tiny_release.tif").string(), "zones.mu"},
+  };
+  const fs::path out = d / "bad_process_out";
+  for (const auto& c : cases) {
+    fs::remove_all(out);
+    const auto r = run(dsm.string() + c.args + " --out " + out.string() + " --quiet");
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.output;
+    EXPECT_NE(r.output.find(c.expect), std::string::npos) << c.args << "\n" << r.output;
+    EXPECT_FALSE(dir_has_files(out)) << c.args;
+  }
 }
