@@ -4,7 +4,7 @@
 //  2. wall time of the seed's case at the seed's scale: 10 simulated minutes of a ~5000-particle
 //     release (d0 = 5 m, h0 = 1 m, 2 m thick over 300 m × 200 m) on the synthetic 5 km valley DSM of 2000 × 1000 cells
 //     at 2.5 m, n = 0.06, i_cr = 0.15 (target < 10 s), with the hazard maps recorded every step as the app does.
-// Prints rates; never asserts. Usage: bench_runout [particles=100000] [steps=40] [all|plane|seed] [threads] [skin]
+// Prints rates; never asserts. Usage: bench_runout [particles=100000] [steps=40] [all|plane|seed|processes] [threads] [skin]
 // (the third argument runs one case only, the fourth one thread count only, the fifth sets
 // numerics.skin in units of d0: for profiling and for comparing list strategies).
 #include <omp.h>
@@ -38,7 +38,9 @@ struct Rate {
   double wall, cpu;
 };
 
-Rate plane_rate(std::size_t target, int steps, int threads, double skin) {
+/// `processes`: an erodible layer under the whole plane (growth law), a friction-zone field and a
+/// forest field, so every particle looks up three cells per step and erodes.
+Rate plane_rate(std::size_t target, int steps, int threads, double skin, bool processes = false) {
   omp_set_num_threads(threads);
   RunoutParameters p;
   p.d0 = 5.0;
@@ -48,9 +50,19 @@ Rate plane_rate(std::size_t target, int steps, int threads, double skin) {
   p.friction = ModifiedManningFriction{0.06, 0.15, 0.0};
   InclinedPlane plane;
   plane.slope = Vec2(-0.3, 0.0);
-  RunoutSolver<InclinedPlane> s(plane, p);
   const int n = static_cast<int>(std::sqrt(static_cast<double>(target)));
   const double d = p.d0 / std::sqrt(2.0);  // 2 m thick layer
+  if (processes) p.entrainment = {EntrainmentLaw::GrowthRate, 1e-4, 0.0, 0.0};
+  RunoutSolver<InclinedPlane> s(plane, p);
+  if (processes) {
+    SpatialProcesses proc;
+    const int cells = static_cast<int>(std::ceil((n * d + 400.0) / 5.0));
+    proc.grid = {cells, cells, -200.0, n * d + 200.0, 5.0, 5.0};
+    proc.erodible_depth.assign(proc.grid.cells(), 10.0);
+    proc.forest_drag.assign(proc.grid.cells(), 1e-3);
+    proc.friction[kManningN].assign(proc.grid.cells(), 0.07);
+    s.set_processes(std::move(proc));
+  }
   auto& st = s.particles();
   st.append(static_cast<std::size_t>(n) * n);
   for (int j = 0; j < n; ++j)
@@ -76,6 +88,18 @@ int main(int argc, char** argv) {
   const std::string which = argc > 3 ? argv[3] : "all";
   const int only_threads = argc > 4 ? std::atoi(argv[4]) : 0;
   const double skin = argc > 5 ? std::atof(argv[5]) : RunoutParameters{}.skin;
+  if (which == "processes") {
+    // The plane with entrainment, a friction zone and a forest everywhere, back to back with the plain plane.
+    std::printf("bench_runout: %zu particles on a plane, %d steps, plain vs with processes\n", n, steps);
+    for (int t : {1, 2}) {
+      if (only_threads > 0 && t != only_threads) continue;
+      const Rate a = plane_rate(n, steps, t, skin), b = plane_rate(n, steps, t, skin, true);
+      std::printf("  %d thread(s): plain %.3g, with processes %.3g particle-steps/s (wall); ratio %.3f (CPU %.3f)\n", t,
+                  a.wall, b.wall, b.wall / a.wall, b.cpu / a.cpu);
+      std::fflush(stdout);
+    }
+    return 0;
+  }
   if (which == "all" || which == "plane") {
     std::printf("bench_runout: %zu particles on a plane, %d steps\n", n, steps);
     std::fflush(stdout);
