@@ -335,7 +335,8 @@ TEST(Fuzz, EveryMutatedRunEndsWithACodeAndAMessage) {
       std::string text = read_file(config);
       std::vector<std::pair<std::string, fs::path>> files;  // key text in the config → file
       for (const auto& name :
-           {"valley_small.tif", "valley_small_release.tif", "hillside_dsm.asc", "avaAlr.tif", "relAlr.shp"}) {
+           {"valley_small.tif", "valley_small_release.tif", "hillside_dsm.asc", "avaAlr.tif", "relAlr.shp",
+            "erodible_channel.geojson", "forest_fan.geojson", "hydrograph_alr.csv"}) {
         const auto at = text.find(name);
         if (at != std::string::npos) files.emplace_back(name, fs::path(name));
       }
@@ -355,9 +356,10 @@ TEST(Fuzz, EveryMutatedRunEndsWithACodeAndAMessage) {
           mutate_binary(dir / ("relAlr" + rng.pick(parts)), rng, c.what);
           copy = dir / "relAlr.shp";
         } else {
-          const fs::path src = name == std::string("avaAlr.tif")         ? kData / "terrain/alr/avaAlr.tif"
-                               : name == std::string("hillside_dsm.asc") ? kData / "sph/hillside_dsm.asc"
-                                                                         : kData / "runout" / name;
+          const std::string n = name;
+          const fs::path src = n == "avaAlr.tif" || ext == ".geojson" ? kData / "terrain/alr" / n
+                               : n == "hillside_dsm.asc"              ? kData / "sph/hillside_dsm.asc"
+                                                                      : kData / "runout" / n;
           copy = dir / name;
           fs::copy_file(src, copy);
           if (src.extension() == ".asc") fs::copy_file(kData / "sph/hillside_dsm.prj", dir / "hillside_dsm.prj");

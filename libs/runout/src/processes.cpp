@@ -122,10 +122,13 @@ void read_hydrograph_table(const std::string& file, Hydrograph& q) {
   if (!in) throw InputError("cannot open the hydrograph table", file, "inflow.hydrograph");
   std::string line;
   int lineno = 0;
+  bool first = true;  // the first non-comment line may be a header
   while (std::getline(in, line)) {
     ++lineno;
     if (const auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const bool header_allowed = first;
+    first = false;
     std::replace(line.begin(), line.end(), ';', ',');
     std::istringstream row(line);
     std::string a, b;
@@ -133,11 +136,10 @@ void read_hydrograph_table(const std::string& file, Hydrograph& q) {
       throw InputError("line " + std::to_string(lineno) + ": expected 'time_s,discharge_m3_s'", file);
     double t, d;
     try {
-      std::size_t ua, ub;
-      t = std::stod(a, &ua);
-      d = std::stod(b, &ub);
+      t = std::stod(a);
+      d = std::stod(b);
     } catch (const std::exception&) {
-      if (q.time.empty() && lineno == 1) continue;  // a header
+      if (header_allowed) continue;  // a header
       throw InputError("line " + std::to_string(lineno) + ": not two numbers: '" + line + "'", file);
     }
     const std::string where = "line " + std::to_string(lineno) + ": ";
