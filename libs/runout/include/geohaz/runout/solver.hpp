@@ -30,13 +30,19 @@
 ///     d. the bed constraint: the velocity is turned into the tangent plane at the new position
 ///        keeping its magnitude S (the normal reaction does no work), as AvaFrame com1DFA
 ///        reprojects it;
-///  5. particles whose new position is off the terrain (raster edge, nodata) are removed and their
-///     volume is added to the lost volume;
+///     With spatial processes (processes.hpp, set_processes) the friction coefficients are those of
+///     the particle's cell, forest drag k_f S² joins the law's drag, and a particle in an erodible
+///     cell records the volume it asks to entrain;
+///  5. entrainment granted in store order, capped by the layer, the mass joining at rest;
+///     particles whose new position is off the terrain (raster edge, nodata) are removed and their
+///     volume is added to the lost volume; inflow hydrographs inject the particles now due;
 ///  6. the volume budget and the kinetic energy Σ ½ ρ V S²; the run ends at the duration, when
 ///     every particle is at rest, or when the kinetic energy has fallen below
-///     stop_energy_fraction of its peak (AvaFrame com1DFA / RAMMS practice).
+///     stop_energy_fraction of its peak (AvaFrame com1DFA / RAMMS practice) — not before the
+///     inflows have delivered their volume.
 /// All per-particle loops are parallel over i with no order-dependent reduction (only maxima and
-/// "any" flags), so 1 and N threads give bit-identical results.
+/// "any" flags); entrainment and injection are serial in store order; so 1 and N threads give
+/// bit-identical results.
 
 #include <omp.h>
 
