@@ -13,7 +13,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 #include "geohaz/runout/solver.hpp"
@@ -347,4 +349,49 @@ TEST(Hydrograph, InjectedVolumeIsTheIntegralOfDischarge) {
   EXPECT_LT(worst, 1e-10 * q.volume());
   // Particles entered moving down the slope: all of them are below the line now.
   for (const Vec2& x : s.particles().get<Position<2>>()) EXPECT_GT(x.x(), 0.0);
+}
+
+// Entrainment, zones and forest on a sheet large enough for the parallel loops (≥ kParallelMin
+// particles): 1 and 2 threads give bit-identical states (erosion is granted serially in store order).
+TEST(Processes, OneAndTwoThreadsGiveIdenticalResults) {
+  const auto run = [](int threads) {
+    omp_set_num_threads(threads);
+    const double th = 25.0 * kDeg;
+    RunoutParameters p;
+    p.d0 = 1.0;
+    p.h0 = 1.0 / 64.0;
+    p.duration = 0.5;
+    p.stop_energy_fraction = 0.0;
+    p.friction = VoellmyFriction{0.2, 1000.0};
+    p.entrainment = {EntrainmentLaw::ShearStress, 0.0, 500.0, 1e-6};
+    const double lx = 6.0 * std::cos(th), ly = 6.0;
+    InclinedPlane plane;
+    plane.slope = Vec2(-std::tan(th), 0.0);
+    RunoutSolver<InclinedPlane> s(plane, p, box(lx, ly));
+    SpatialProcesses proc;
+    proc.grid = square_grid(0.0, 0.0, 6, 1.0);
+    proc.erodible_depth.assign(proc.grid.cells(), 0.02);
+    proc.forest_drag.assign(proc.grid.cells(), 0.0);
+    proc.friction[kCoulombMu].assign(proc.grid.cells(), std::numeric_limits<double>::quiet_NaN());
+    for (int r = 0; r < 6; ++r) {
+      proc.forest_drag[proc.grid.index(2, r)] = 0.02;
+      proc.friction[kCoulombMu][proc.grid.index(4, r)] = 0.35;
+    }
+    s.set_processes(proc);
+    fill_sheet(s, lx, ly, 1.0, std::cos(th), Vec2(2.0, 0.5));
+    EXPECT_GE(s.particles().size(), static_cast<std::size_t>(kParallelMin));
+    s.initialise();
+    while (!s.finished()) s.step();
+    omp_set_num_threads(1);
+    return std::make_pair(s.particles(), s.budget().entrained);
+  };
+  const auto [a, ea] = run(1);
+  const auto [b, eb] = run(2);
+  EXPECT_GT(ea, 0.0);
+  EXPECT_EQ(ea, eb);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a.get<Position<2>>()[i], b.get<Position<2>>()[i]) << i;
+    ASSERT_EQ(a.get<Volume>()[i], b.get<Volume>()[i]) << i;
+  }
 }
