@@ -79,7 +79,8 @@ TEST(DebrisRunoutApp, TinyValleyRunsAndBalancesVolume) {
   ASSERT_EQ(r.code, 0) << r.output;
   for (const char* f : {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "mobile_at_end.tif",
                         "arrival_time.tif", "snapshots.h5", "snapshots.xmf", "series.csv", "summary.json",
-                        "config.resolved.toml", "deposit.png", "max_speed.png", "max_depth.png"})
+                        "config.resolved.toml", "deposit.png", "max_speed.png", "max_depth.png", "intensity.tif",
+                        "intensity.png", "intensity.qml", "max_momentum.tif", "max_depth.qml", "deposit.qml"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
@@ -102,6 +103,18 @@ TEST(DebrisRunoutApp, TinyValleyRunsAndBalancesVolume) {
   EXPECT_GT(j["fahrboeschung"]["angle_deg"].get<double>(), 8.5);
   EXPECT_LT(j["fahrboeschung"]["angle_deg"].get<double>(), 24.0);
   EXPECT_GT(j["max_speed_m_s"].get<double>(), 1.0);
+  // Intensity areas add up to the affected area (every reached cell is medium or strong).
+  const auto& it = j["intensity"];
+  EXPECT_EQ(it["scheme"], "depth_speed");
+  EXPECT_EQ(it["area_low_m2"].get<double>(), 0.0);
+  EXPECT_NEAR(it["area_medium_m2"].get<double>() + it["area_strong_m2"].get<double>(),
+              j["area_affected_m2"].get<double>(), 1e-9 * j["area_affected_m2"].get<double>());
+  EXPECT_GT(it["area_strong_m2"].get<double>(), 0.0);
+  // GIS conventions: description and unit on the band, nodata set.
+  const geohaz::Raster speed = geohaz::read_raster(out / "max_speed.tif");
+  EXPECT_EQ(speed.unit, "m/s");
+  EXPECT_EQ(speed.description, "peak surface speed");
+  EXPECT_TRUE(speed.nodata.has_value());
 }
 
 TEST(DebrisRunoutApp, BadInputsExitTwoAndWriteNothing) {
@@ -461,6 +474,10 @@ TEST(DebrisRunoutApp, BadProcessInputsExitTwoAndWriteNothing) {
       {" --set inflow.hydrograph=" + (d / "q_ok.csv").string(), "inflow.points"},
       {rel + " --set forest.drag_coefficient=-1", "forest.drag_coefficient"},
       {rel + " --set zones.mu=" + (d / "tiny_release.tif").string(), "zones.mu"},
+      {rel + " --set intensity.pressure_classes=[30000,3000]", "intensity.pressure_classes"},
+      {rel + " --set intensity.pressure_classes=[-1,3000]", "intensity.pressure_classes"},
+      {rel + " --set intensity.strong_depth=-1", "intensity.strong_depth"},
+      {rel + " --set intensity.scheme=colour", "intensity.scheme"},
   };
   const fs::path out = d / "bad_process_out";
   for (const auto& c : cases) {

@@ -67,6 +67,8 @@ std::array<std::uint8_t, 3> ramp_colour(ColourRamp ramp, double t) noexcept {
       return interpolate(kTerrain, t);
     case ColourRamp::BlueRed:
       return interpolate(kBlueRed, t);
+    case ColourRamp::Intensity:  // three steps: low, medium, strong
+      return t < 1.0 / 3.0 ? Rgb{255, 221, 51} : t < 2.0 / 3.0 ? Rgb{245, 130, 32} : Rgb{200, 30, 45};
   }
   return interpolate(kViridis, t);
 }

@@ -206,6 +206,8 @@ Raster read_raster(const std::filesystem::path& path, CrsPolicy policy) {
   int has_nodata = 0;
   const double nd = band->GetNoDataValue(&has_nodata);
   if (has_nodata) r.nodata = nd;
+  if (const char* d = band->GetDescription()) r.description = d;
+  if (const char* u = band->GetUnitType()) r.unit = u;
 
   // The header alone may declare any size (a 1.8 MB sparse GeoTIFF can declare 10^10 cells): check
   // before allocating. Two copies of 8-byte values: the Raster and the model's own grid or Terrain.
@@ -240,34 +242,40 @@ void write_geotiff(const std::filesystem::path& path, const Raster& r, bool floa
   if (!r.crs_wkt.empty() && !detail::parse_srs(r.crs_wkt, srs))
     throw InputError("the raster's CRS cannot be interpreted", file, "", r.crs_wkt);
 
-  // The GTiff driver does not depend on the extension, so "<name>.partial" (the project-wide
+  // The COG driver does not depend on the extension, so "<name>.partial" (the project-wide
   // temporary name that remove_partial_files() knows) works.
   const std::string tmp = file + ".partial";
   QuietGdalErrors quiet;
-  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
-  if (!driver) throw std::runtime_error("GDAL has no GTiff driver");
+  GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+  GDALDriver* cog = GetGDALDriverManager()->GetDriverByName("COG");
+  if (!mem || !cog) throw std::runtime_error("GDAL has no MEM or COG driver");
+  // The raster is assembled in memory, then copied by the COG driver (tiles, overviews, layout).
+  std::unique_ptr<GDALDataset> src(mem->Create("", r.nx, r.ny, 1, float64 ? GDT_Float64 : GDT_Float32, nullptr));
+  if (!src) throw std::runtime_error("GDAL cannot create an in-memory raster" + gdal_last_error());
+  std::array<double, 6> gt = r.geotransform;
+  src->SetGeoTransform(gt.data());
+  if (!r.crs_wkt.empty()) src->SetSpatialRef(&srs);
+  GDALRasterBand* band = src->GetRasterBand(1);
+  if (r.nodata) band->SetNoDataValue(*r.nodata);
+  if (!r.description.empty()) band->SetDescription(r.description.c_str());
+  if (!r.unit.empty()) band->SetUnitType(r.unit.c_str());
+  if (band->RasterIO(GF_Write, 0, 0, r.nx, r.ny, const_cast<double*>(r.data.data()), r.nx, r.ny, GDT_Float64, 0, 0,
+                     nullptr) != CE_None)
+    throw std::runtime_error("GDAL cannot fill an in-memory raster" + gdal_last_error());
   // From here on a failure is the file system's (full disk, size limit, permission): IoError.
-  const char* options[] = {"COMPRESS=DEFLATE", "PREDICTOR=1", "TILED=NO", nullptr};
+  const char* options[] = {"COMPRESS=DEFLATE", "BLOCKSIZE=256", "RESAMPLING=NEAREST", "OVERVIEWS=AUTO", nullptr};
+  CPLErrorReset();
   bool ok = true;
   {
     std::unique_ptr<GDALDataset> ds(
-        driver->Create(tmp.c_str(), r.nx, r.ny, 1, float64 ? GDT_Float64 : GDT_Float32, const_cast<char**>(options)));
+        cog->CreateCopy(tmp.c_str(), src.get(), FALSE, const_cast<char**>(options), nullptr, nullptr));
     if (!ds) {
       const std::string msg = gdal_last_error();
       std::error_code ec;
       std::filesystem::remove(tmp, ec);
-      throw IoError("cannot create the GeoTIFF" + msg, file);
+      throw IoError("cannot write the GeoTIFF" + msg, file);
     }
-    std::array<double, 6> gt = r.geotransform;
-    ok = ds->SetGeoTransform(gt.data()) == CE_None;
-    if (ok && !r.crs_wkt.empty()) ok = ds->SetSpatialRef(&srs) == CE_None;
-    GDALRasterBand* band = ds->GetRasterBand(1);
-    if (ok && r.nodata) ok = band->SetNoDataValue(*r.nodata) == CE_None;
-    if (ok)
-      ok = band->RasterIO(GF_Write, 0, 0, r.nx, r.ny, const_cast<double*>(r.data.data()), r.nx, r.ny, GDT_Float64, 0, 0,
-                          nullptr) == CE_None;
-    if (ok) ds->FlushCache(true);  // returns void in GDAL 3.6: failures show in the error state
-    ok = ok && CPLGetLastErrorType() != CE_Failure && CPLGetLastErrorType() != CE_Fatal;
+    ok = CPLGetLastErrorType() != CE_Failure && CPLGetLastErrorType() != CE_Fatal;
   }  // closes the dataset (writes the rest)
   ok = ok && CPLGetLastErrorType() != CE_Failure && CPLGetLastErrorType() != CE_Fatal;
   std::error_code ec;

@@ -189,6 +189,28 @@ RunoutCase read_case(ConfigReader& cfg) {
                                 {"s", "time between particle snapshots"});
   o.snapshots = cfg.get_bool("output.snapshots", o.snapshots, {"", "write snapshots.h5 + .xmf"});
   o.pngs = cfg.get_bool("output.png", o.pngs, {"", "write the quick-look PNGs"});
+  auto& it = o.intensity;
+  const std::string scheme =
+      cfg.get_choice("intensity.scheme", to_string(it.scheme), {"depth_speed", "pressure"},
+                     {"",
+                      "intensity classes: depth_speed (Swiss debris-flow guideline: strong where peak depth > "
+                      "strong_depth and peak speed > strong_speed, medium elsewhere reached) or pressure"});
+  it.scheme = scheme == "pressure" ? IntensityScheme::Pressure : IntensityScheme::DepthSpeed;
+  it.min_depth = cfg.get("intensity.min_depth", it.min_depth, Range::closed(0.0, 100.0),
+                         {"m", "a cell counts as reached when its peak depth exceeds this"});
+  it.strong_depth = cfg.get("intensity.strong_depth", it.strong_depth, Range::open_closed(0.0, 100.0),
+                            {"m", "depth_speed: peak depth above which (with the speed) a cell is strong"});
+  it.strong_speed = cfg.get("intensity.strong_speed", it.strong_speed, Range::open_closed(0.0, 200.0),
+                            {"m/s", "depth_speed: peak speed above which (with the depth) a cell is strong"});
+  const std::vector<double> classes =
+      cfg.get_array("intensity.pressure_classes", {it.medium_pressure, it.strong_pressure}, Range::open_closed(0.0, 1e9),
+                    {"Pa", "pressure: [medium, strong] lower bounds of peak ρv², increasing"}, 2);
+  if (!(classes[0] < classes[1]))
+    throw InputError("intensity.pressure_classes must increase: [medium, strong] = [" + std::to_string(classes[0]) +
+                         ", " + std::to_string(classes[1]) + "] Pa",
+                     cfg.source().empty() ? "command line" : cfg.source(), "intensity.pressure_classes");
+  it.medium_pressure = classes[0];
+  it.strong_pressure = classes[1];
   return c;
 }
 

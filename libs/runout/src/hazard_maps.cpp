@@ -17,6 +17,7 @@ HazardMaps::HazardMaps(GridGeometry grid, double d0, double density)
       radius_(std::max({0.5 * d0, grid.dx, grid.dy})),
       max_depth_(grid.cells(), 0.0),
       max_speed_(grid.cells(), 0.0),
+      max_momentum_(grid.cells(), 0.0),
       arrival_(grid.cells(), std::numeric_limits<double>::quiet_NaN()) {}
 
 void HazardMaps::record(const RunoutStore& store, double t) {
@@ -65,6 +66,7 @@ void HazardMaps::record(const RunoutStore& store, double t) {
           const std::size_t k = g_.index(c, r);
           max_depth_[k] = std::max(max_depth_[k], hi);
           max_speed_[k] = std::max(max_speed_[k], si);
+          max_momentum_[k] = std::max(max_momentum_[k], hi * si);
           if (arrives && std::isnan(arrival_[k])) arrival_[k] = t;
         }
     }
@@ -182,6 +184,29 @@ RunoutSummary summarise(const RunoutStore& store, const ReleaseTop& top) {
   s.com_travel = pc / v;
   if (s.com_travel > 0.0) s.com_angle_deg = std::atan2(s.com_drop, s.com_travel) * 180.0 / std::numbers::pi;
   return s;
+}
+
+const char* to_string(IntensityScheme s) noexcept {
+  return s == IntensityScheme::Pressure ? "pressure" : "depth_speed";
+}
+
+std::vector<double> intensity_classes(const std::vector<double>& depth, const std::vector<double>& speed, double density,
+                                      const IntensityTable& t) {
+  std::vector<double> c(depth.size(), 0.0);
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    if (!(depth[k] > t.min_depth)) continue;  // not reached
+    if (t.scheme == IntensityScheme::DepthSpeed) {
+      c[k] = (depth[k] > t.strong_depth && speed[k] > t.strong_speed) ? 3.0 : 2.0;
+    } else {
+      const double p = density * speed[k] * speed[k];
+      c[k] = p >= t.strong_pressure ? 3.0 : p >= t.medium_pressure ? 2.0 : 1.0;
+    }
+  }
+  return c;
+}
+
+std::vector<double> intensity_classes(const HazardMaps& maps, const IntensityTable& t) {
+  return intensity_classes(maps.max_depth(), maps.max_speed(), maps.density(), t);
 }
 
 }  // namespace geohaz::runout

@@ -411,19 +411,59 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
     return r;
   };
   const HazardMaps& maps = sim.maps();
-  const Raster r_depth = map_raster(maps.max_depth(), 0.0), r_speed = map_raster(maps.max_speed(), 0.0),
-               r_press = map_raster(maps.max_pressure(), 0.0), r_dep = map_raster(sim.deposit(), 0.0),
-               r_mob = map_raster(sim.mobile_at_end(), 0.0), r_arr = map_raster(maps.arrival_time(), -9999.0);
-  write_geotiff(out / "max_depth.tif", r_depth);
-  write_geotiff(out / "max_speed.tif", r_speed);
-  write_geotiff(out / "max_pressure.tif", r_press);
-  write_geotiff(out / "deposit.tif", r_dep);
-  write_geotiff(out / "mobile_at_end.tif", r_mob);
-  write_geotiff(out / "arrival_time.tif", r_arr);
+  // Every raster with its band description, unit and a QGIS style beside it (docs/runout.md,
+  // "Outputs"); continuous maps transparent where zero.
+  const auto put = [&](const char* name, const std::vector<double>& v, double fill_unreached, const char* description,
+                       const char* unit, ColourRamp ramp) {
+    Raster r = map_raster(v, fill_unreached);
+    r.description = description;
+    r.unit = unit;
+    write_geotiff(out / (std::string(name) + ".tif"), r);
+    double vmax = 0.0;
+    for (std::size_t k = 0; k < r.data.size(); ++k)
+      if (r.data[k] != -9999.0) vmax = std::max(vmax, r.data[k]);
+    write_qgis_ramp_style(out / (std::string(name) + ".qml"), ramp, 0.0, vmax > 0.0 ? vmax : 1.0, unit, 0.0);
+    return r;
+  };
+  const Raster r_depth = put("max_depth", maps.max_depth(), 0.0, "peak flow depth, normal to the bed", "m",
+                             ColourRamp::Viridis);
+  const Raster r_speed = put("max_speed", maps.max_speed(), 0.0, "peak surface speed", "m/s", ColourRamp::Magma);
+  put("max_pressure", maps.max_pressure(), 0.0, "peak dynamic pressure rho v^2", "Pa", ColourRamp::Magma);
+  put("max_momentum", maps.max_momentum(), 0.0, "peak momentum per unit area over density, h v", "m2/s",
+      ColourRamp::Magma);
+  const Raster r_dep = put("deposit", sim.deposit(), 0.0, "final deposit thickness, vertical", "m", ColourRamp::Viridis);
+  put("mobile_at_end", sim.mobile_at_end(), 0.0, "thickness still moving when the run ended at its duration, vertical",
+      "m", ColourRamp::Viridis);
+  put("arrival_time", maps.arrival_time(), -9999.0, "first arrival of the flow (-9999: never)", "s",
+      ColourRamp::Viridis);
+  // Intensity classes (0 not reached, 1 low, 2 medium, 3 strong) with their labelled palette.
+  const IntensityTable& itab = c.output.intensity;
+  Raster r_int = map_raster(intensity_classes(maps, itab), 0.0);
+  r_int.description = itab.scheme == IntensityScheme::DepthSpeed
+                          ? "intensity class (depth_speed: 2 medium, 3 strong; 0 not reached)"
+                          : "intensity class (pressure: 1 low, 2 medium, 3 strong; 0 not reached)";
+  r_int.unit = "1";
+  write_geotiff(out / "intensity.tif", r_int);
+  {
+    std::vector<StyleClass> cls;
+    const auto col = [](double t) { return ramp_colour(ColourRamp::Intensity, t); };
+    std::ostringstream strong, medium, low;
+    if (itab.scheme == IntensityScheme::DepthSpeed) {
+      strong << "strong: h > " << itab.strong_depth << " m and v > " << itab.strong_speed << " m/s";
+      medium << "medium: reached, not strong";
+      cls = {{2.0, medium.str(), col(0.5)}, {3.0, strong.str(), col(0.9)}};
+    } else {
+      strong << "strong: p >= " << itab.strong_pressure / 1e3 << " kPa";
+      medium << "medium: " << itab.medium_pressure / 1e3 << "-" << itab.strong_pressure / 1e3 << " kPa";
+      low << "low: p < " << itab.medium_pressure / 1e3 << " kPa";
+      cls = {{1.0, low.str(), col(0.1)}, {2.0, medium.str(), col(0.5)}, {3.0, strong.str(), col(0.9)}};
+    }
+    write_qgis_class_style(out / "intensity.qml", cls);
+  }
   const auto& solver = sim.solver();
   if (!solver.eroded_depth().empty()) {
-    const Raster r_ero = map_raster(solver.eroded_depth(), 0.0);
-    write_geotiff(out / "erosion_depth.tif", r_ero);
+    const Raster r_ero = put("erosion_depth", solver.eroded_depth(), 0.0, "depth eroded from the bed, vertical", "m",
+                             ColourRamp::Magma);
     if (c.output.pngs)
       write_quicklook_png(out / "erosion_depth.png", dsm, &r_ero, ColourRamp::Magma, "eroded depth (m)", 0.0, 0.0, 0.001);
   }
@@ -432,6 +472,10 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
                         0.01);
     write_quicklook_png(out / "deposit.png", dsm, &r_dep, ColourRamp::Viridis, "deposit thickness (m)", 0.0, 0.0, 0.01);
     write_quicklook_png(out / "max_speed.png", dsm, &r_speed, ColourRamp::Magma, "maximum speed (m/s)", 0.0, 0.0, 0.01);
+    write_quicklook_png(out / "intensity.png", dsm, &r_int, ColourRamp::Intensity,
+                        itab.scheme == IntensityScheme::DepthSpeed ? "intensity: 2 medium, 3 strong"
+                                                                   : "intensity: 1 low, 2 medium, 3 strong",
+                        0.5, 3.5, 0.5);
   }
 
   {
@@ -448,6 +492,7 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
   }
 
   const RunoutResult res = sim.result();
+  const double in_grid_area = sim.inputs().grid().cell_area();
   const auto& sum = res.path;
   const VolumeBudget& b = res.volumes;
   nlohmann::json j;
@@ -491,6 +536,19 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
                      {"deposit_raster", res.deposit_raster_volume},
                      {"mobile_raster", res.mobile_raster_volume}};
   j["lost_particles"] = b.lost_particles;
+  {
+    double a[4] = {0.0, 0.0, 0.0, 0.0};
+    for (std::size_t k = 0; k < r_int.data.size(); ++k)
+      if (r_int.data[k] >= 1.0 && r_int.data[k] <= 3.0) a[static_cast<int>(r_int.data[k])] += in_grid_area;
+    j["intensity"] = {{"scheme", to_string(itab.scheme)},
+                      {"area_low_m2", a[1]},
+                      {"area_medium_m2", a[2]},
+                      {"area_strong_m2", a[3]}};
+    if (itab.scheme == IntensityScheme::DepthSpeed)
+      j["intensity"].update({{"strong_depth_m", itab.strong_depth}, {"strong_speed_m_s", itab.strong_speed}});
+    else
+      j["intensity"].update({{"medium_pressure_pa", itab.medium_pressure}, {"strong_pressure_pa", itab.strong_pressure}});
+  }
   j["mass_balance_error_relative"] = b.total_in() > 0.0 ? b.balance_error() / b.total_in() : 0.0;
   // The processes in force (docs/runout.md, "Processes").
   const EntrainmentParameters& ent = sim.parameters().entrainment;

@@ -26,6 +26,8 @@ struct Raster {
   std::string crs_wkt;                       ///< WKT of the CRS ("" if none)
   std::optional<double> nodata;              ///< nodata value, if any
   std::vector<double> data;                  ///< nx·ny values, row-major, row 0 north
+  std::string description;                   ///< band description (what the values are), "" if none
+  std::string unit;                          ///< unit of the values ("m", "m/s", "Pa", "1"), "" if none
 
   /// An empty raster on the same grid and CRS, filled with `fill`.
   Raster like(double fill, std::optional<double> nodata_value = std::nullopt) const;
@@ -53,8 +55,10 @@ enum class CrsPolicy {
 /// RequireProjected prints a warning to stderr and the units are taken as metres.
 Raster read_raster(const std::filesystem::path& path, CrsPolicy policy = CrsPolicy::RequireProjected);
 
-/// Write a GeoTIFF (Float32 unless `float64`), deflate-compressed, same grid, CRS and nodata.
-/// Written to a temporary name and renamed, so no half-written file is left on failure.
+/// Write a GeoTIFF (Float32 unless `float64`) in the Cloud-Optimized layout GDAL's COG driver
+/// writes: deflate-compressed 256 × 256 tiles with internal overviews (nearest-neighbour, so class
+/// and peak values are never averaged), same grid, CRS and nodata, and the band's description and
+/// unit. Written to a temporary name and renamed, so no half-written file is left on failure.
 void write_geotiff(const std::filesystem::path& path, const Raster& r, bool float64 = false);
 
 /// Whether the WKT describes a geographic (degrees) CRS.
@@ -124,7 +128,21 @@ std::vector<Polyline> read_lines(const std::filesystem::path& path, const std::s
                                  const std::string& target_wkt);
 
 /// Colour ramps for quick-look pictures.
-enum class ColourRamp { Viridis, Magma, Terrain, BlueRed };
+/// Intensity: three steps (yellow, orange, red) for class rasters 1–3 drawn with vmin 0.5, vmax 3.5.
+enum class ColourRamp { Viridis, Magma, Terrain, BlueRed, Intensity };
+
+/// A QGIS layer style (.qml) for a single-band raster: a continuous colour ramp between vmin and
+/// vmax, the legend labelled with `unit`, values at or below `transparent_below` not drawn.
+void write_qgis_ramp_style(const std::filesystem::path& path, ColourRamp ramp, double vmin, double vmax,
+                           const std::string& unit, double transparent_below);
+/// One class of a categorical raster: its value, legend label and colour.
+struct StyleClass {
+  double value;
+  std::string label;
+  std::array<std::uint8_t, 3> colour;
+};
+/// A QGIS layer style (.qml) for a categorical raster (paletted renderer).
+void write_qgis_class_style(const std::filesystem::path& path, const std::vector<StyleClass>& classes);
 
 /// Write a quick-look PNG: a hillshade of `elevation`, overlaid where `overlay` is present, finite,
 /// not nodata and above `overlay_min` by the colour ramp between vmin and vmax (auto when vmin ≥ vmax).

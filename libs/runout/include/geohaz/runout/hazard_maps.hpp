@@ -32,10 +32,13 @@ class HazardMaps {
   void record(const RunoutStore& store, double t);
 
   const GridGeometry& grid() const noexcept { return g_; }
+  double density() const noexcept { return density_; }  ///< kg/m³, of the pressure map
   const std::vector<double>& max_depth() const noexcept { return max_depth_; }  ///< m, normal to the bed
   const std::vector<double>& max_speed() const noexcept { return max_speed_; }  ///< m/s
   std::vector<double> max_pressure() const;  ///< Pa (ρ S²), from max_speed (exact: ρS² is monotone in S)
   const std::vector<double>& arrival_time() const noexcept { return arrival_; }  ///< s, NaN: never
+  /// Maximum over time of h·S, the momentum per unit area over ρ (m²/s).
+  const std::vector<double>& max_momentum() const noexcept { return max_momentum_; }
   /// Area (m²) of the cells reached by the flow (max depth > 0).
   double affected_area() const;
 
@@ -46,10 +49,40 @@ class HazardMaps {
  private:
   GridGeometry g_;
   double d0_, density_, radius_;
-  std::vector<double> max_depth_, max_speed_, arrival_;
+  std::vector<double> max_depth_, max_speed_, max_momentum_, arrival_;
   std::vector<int> band_start_;          // first grid row of each thread's band (scratch)
   std::vector<std::int64_t> row_count_;  // particles per grid row (scratch)
 };
+
+/// How intensity classes are drawn from the peak maps (docs/runout.md, "Intensity").
+enum class IntensityScheme {
+  /// Swiss federal guidelines for debris flows (BWG 1997; ARE/BWG/BUWAL 2005): strong where the
+  /// peak depth exceeds strong_depth and the peak speed strong_speed, medium elsewhere the flow
+  /// passes (no "low" class for debris flows).
+  DepthSpeed,
+  /// Peak dynamic pressure ρS²: strong ≥ strong_pressure, medium ≥ medium_pressure, low below (the
+  /// avalanche classes, e.g. 30 and 3 kPa).
+  Pressure
+};
+const char* to_string(IntensityScheme s) noexcept;
+
+/// Class thresholds (SI).
+struct IntensityTable {
+  IntensityScheme scheme = IntensityScheme::DepthSpeed;
+  double min_depth = 0.0;             ///< a cell is reached when its peak depth exceeds this (m)
+  double strong_depth = 1.0;          ///< m
+  double strong_speed = 1.0;          ///< m/s
+  double medium_pressure = 3.0e3;     ///< Pa
+  double strong_pressure = 30.0e3;    ///< Pa
+};
+
+/// Intensity class per cell from peak depth (m) and peak speed (m/s) maps (the pressure is
+/// ρ·speed²): 0 not reached, 1 low, 2 medium, 3 strong. The peaks of a cell may come from
+/// different times (the practice of RAMMS and AvaFrame's peak-field maps).
+std::vector<double> intensity_classes(const std::vector<double>& depth, const std::vector<double>& speed, double density,
+                                      const IntensityTable& t);
+/// The same from a run's maps.
+std::vector<double> intensity_classes(const HazardMaps& maps, const IntensityTable& t);
 
 /// One row of the time series.
 struct SeriesRow {

@@ -78,6 +78,7 @@ struct OutputSettings {
   double snapshot_interval = 30.0;  ///< s between particle snapshots
   bool snapshots = true;            ///< snapshots.h5 + .xmf
   bool pngs = true;                 ///< quick-look PNGs
+  IntensityTable intensity;         ///< classes of intensity.tif
 };
 
 /// Everything a run needs, in SI units. Defaults are those of the structs it holds.
