@@ -259,11 +259,12 @@ TEST(DemApp, BiaxialCompressionTinyConfig) {
   const double p0 = j["tests"][0]["peak_stress_Pa"], p1 = j["tests"][1]["peak_stress_Pa"];
   EXPECT_GT(p1, p0);
   EXPECT_TRUE(j["mohr_coulomb"]["valid"].get<bool>());
-  // Stored values (this build, 22 Nov 2026). The sample is fixed by the seed (184 discs, 355
-  // bonds); the peaks may move with compiler / library rounding, amplified near the peak by bond
-  // breaking, so they are compared within 10 %.
+  // Stored values (this build, 22 Nov 2026). The sample is fixed by the seed (184 discs, 362
+  // bonds since the disc–wall dashpot reproduces its restitution, 1 Dec 2026: the packing's servo
+  // walls shape the sample; 355 before); the peaks may move with compiler / library rounding,
+  // amplified near the peak by bond breaking, so they are compared within 10 %.
   EXPECT_EQ(j["sample"]["discs"].get<int>(), 184);
-  EXPECT_EQ(j["sample"]["bonds"].get<int>(), 355);
+  EXPECT_EQ(j["sample"]["bonds"].get<int>(), 362);
   EXPECT_NEAR(p0, 47.2e6, 4.7e6);
   EXPECT_NEAR(p1, 76.5e6, 7.6e6);
   // Snapshots: several time levels, the documented fields, intact bonds as line cells.
@@ -293,7 +294,9 @@ TEST(DemApp, BiaxialTensionTinyConfig) {
   ASSERT_EQ(run_app("--config " + (kData / "biaxial_tension.toml").string() + kTinyLab + " --out " + out.string()), 0);
   const auto j = read_json(out / "summary.json");
   const double st = j["tests"][0]["peak_stress_Pa"];
-  EXPECT_NEAR(st, 17.0e6, 1.7e6);  // stored value (this build), 10 % as for the compression peaks
+  // Stored value (this build; 17.0 MPa on the 355-bond sample before the disc–wall dashpot
+  // change, 18.8 MPa on today's 362-bond sample), 10 % as for the compression peaks.
+  EXPECT_NEAR(st, 18.8e6, 1.9e6);
   // Macro tensile strength of a BPM is a fraction of the mean bond strength (50 MPa here).
   EXPECT_GT(st, 2e6);
   EXPECT_LT(st, 50e6);
