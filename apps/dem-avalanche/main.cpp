@@ -77,8 +77,8 @@ void check_disc_memory(double area, const PackingSpec& p, const std::string& sou
   // triangulation used to place the bonds.
   const double per_disc = 1000.0;
   std::ostringstream est;
-  est << std::setprecision(3) << discs << " discs × " << per_disc << " B for the " << what << " with radii "
-      << p.r_min << "–" << p.r_max << " m";
+  est << std::setprecision(3) << discs << " discs × " << per_disc << " B for the " << what << " with radii " << p.r_min
+      << "–" << p.r_max << " m";
   std::ostringstream value;
   value << p.r_min;
   check_memory(discs * per_disc, est.str(), source, "sample.r_min", value.str());
@@ -295,7 +295,17 @@ RunConfig read_config(ConfigReader& r, bool describe) {
     a.trigger_acceleration = Vec2(trig[0], trig[1]);
     a.trigger_duration =
         r.get("avalanche.trigger_duration", 0.0, Range::non_negative(), {"s", "duration of the trigger acceleration"});
-    a.runout_time = r.get("avalanche.runout_time", 30.0, Range::positive(), {"s", "simulated time after release"});
+    a.runout_time = r.get("avalanche.runout_time", AvalancheSpec{}.runout_time, Range::positive(),
+                          {"s",
+                           "longest simulated time after release; the run ends earlier once the mass is at rest "
+                           "(stop_kinetic_fraction, stop_speed), and warns if it is still moving at this time"});
+    a.stop_kinetic_fraction =
+        r.get("avalanche.stop_kinetic_fraction", AvalancheSpec{}.stop_kinetic_fraction, Range{0.0, 1.0, true, true},
+              {"1",
+               "at rest when the kinetic energy is below this fraction of its peak after release (and no disc "
+               "is faster than stop_speed)"});
+    a.stop_speed = r.get("avalanche.stop_speed", AvalancheSpec{}.stop_speed, Range::non_negative(),
+                         {"m/s", "at rest when no disc is faster than this (0: kinetic-energy criterion alone)"});
     a.runout_damping =
         r.get("avalanche.runout_damping", 0.0, Range::closed_open(0.0, 1.0), {"1", "local damping during the run-out"});
     a.record_interval = r.get("avalanche.record_interval", 0.1, Range::positive(), {"s", "time-series interval"});
@@ -499,7 +509,22 @@ int run_avalanche_case(const RunConfig& c, const std::filesystem::path& out, boo
                   {"fragments_with_2_or_more_discs", multi},
                   {"largest_fragment_discs", r.fragment_sizes.empty() ? 0 : r.fragment_sizes.front()},
                   {"simulated_time_s", s.time()},
+                  {"runout_duration_s", r.duration},
+                  {"at_rest", r.at_rest},
+                  {"max_speed_at_end_m_s", r.max_speed_at_end},
+                  {"moving_mass_fraction_at_end", r.moving_fraction_at_end},
+                  {"peak_kinetic_energy_J_per_m", r.peak_kinetic_energy},
                   {"steps", s.step_count()}};
+  json warnings = json::array();
+  if (!r.at_rest) {
+    std::ostringstream w;
+    w << "the run reached avalanche.runout_time (" << c.avalanche.runout_time << " s) with "
+      << 100.0 * r.moving_fraction_at_end << " % of the mass still moving (fastest disc " << r.max_speed_at_end
+      << " m/s): run-out, H/L and the deposit are not final; raise avalanche.runout_time";
+    warnings.push_back(w.str());
+    std::cerr << "dem-avalanche: warning: " << w.str() << "\n";
+  }
+  summary["warnings"] = warnings;
   write_text_file(out / "summary.json", summary.dump(2) + "\n");
   if (!quiet)
     std::cerr << "dem-avalanche: run-out L = " << r.runout << " m, H = " << r.fall_height << " m, H/L = " << r.h_over_l

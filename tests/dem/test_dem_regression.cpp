@@ -12,12 +12,12 @@
 #include <numbers>
 #include <sstream>
 
-#include "geohaz/core/raster.hpp"
-#include "geohaz/core/snapshot.hpp"
 #include "bonded_lab_spec.hpp"
 #include "column_collapse.hpp"
-#include "run_command.hpp"
+#include "geohaz/core/raster.hpp"
+#include "geohaz/core/snapshot.hpp"
 #include "geohaz/dem/experiments.hpp"
+#include "run_command.hpp"
 
 using namespace geohaz;
 using namespace geohaz::dem;
@@ -226,7 +226,9 @@ namespace {
 const fs::path kApp = fs::path(GEOHAZ_BINARY_DIR) / "apps" / "dem-avalanche" / "dem-avalanche";
 const fs::path kData = fs::path(GEOHAZ_SOURCE_DIR) / "data" / "dem";
 
-int run_app(const std::string& args) { return geohaz::testing::run_command(kApp.string() + " " + args).code; }
+int run_app(const std::string& args) {
+  return geohaz::testing::run_command(kApp.string() + " " + args).code;
+}
 
 fs::path fresh_dir(const std::string& name) {
   const fs::path d = fs::path(GEOHAZ_BINARY_DIR) / "tests" / "dem" / name;
@@ -320,6 +322,28 @@ TEST(DemApp, AvalancheTinyConfig) {
   EXPECT_GT(j["fall_height_H_m"].get<double>(), 0.0);
   EXPECT_GT(j["runout_L_m"].get<double>(), 0.0);
   EXPECT_GT(j["discontinuities"]["bonds_cut"].get<int>(), 0);
+  // Cut off at 4 s with the mass still moving: the summary says so.
+  EXPECT_FALSE(j["at_rest"].get<bool>());
+  ASSERT_EQ(j["warnings"].size(), 1u);
+  EXPECT_NE(j["warnings"][0].get<std::string>().find("avalanche.runout_time"), std::string::npos);
+  EXPECT_GT(j["moving_mass_fraction_at_end"].get<double>(), 0.5);
+}
+
+TEST(DemApp, AvalancheRunsToRest) {
+  // The same tiny mass with the default time limit stops on the stop criterion (kinetic energy
+  // below 10⁻³ of its peak and no disc faster than 0.1 m/s), about 40 s after release.
+  const fs::path out = fresh_dir("app_avalanche_rest");
+  ASSERT_EQ(run_app("--config " + (kData / "avalanche.toml").string() +
+                    " --set sample.r_min=1.2 --set sample.r_max=2.0 --set avalanche.settle_time=0.5"
+                    " --set output.snapshot_every=0 --threads 1 --quiet --out " +
+                    out.string()),
+            0);
+  const auto j = read_json(out / "summary.json");
+  EXPECT_TRUE(j["at_rest"].get<bool>());
+  EXPECT_TRUE(j["warnings"].empty());
+  EXPECT_LE(j["max_speed_at_end_m_s"].get<double>(), 0.1);
+  EXPECT_EQ(j["moving_mass_fraction_at_end"].get<double>(), 0.0);
+  EXPECT_LT(j["runout_duration_s"].get<double>(), 300.0);
 }
 
 TEST(DemApp, AvalancheOnAProfileCutFromADsm) {
@@ -422,6 +446,17 @@ TEST(DemApp, BadInputExitsWithCode2AndWritesNothing) {
                     " --set 'avalanche.source_z=[100.0, 80.0, 90.0, 110.0]' --out " + out.string()),
             2);
   EXPECT_FALSE(fs::exists(out));
+  // Stop fraction, restitution and rolling resistance out of range: the message names the key.
+  for (const char* set :
+       {"avalanche.stop_kinetic_fraction=1.0", "avalanche.stop_kinetic_fraction=0", "avalanche.terrain_restitution=1.5",
+        "avalanche.terrain_restitution=0", "material.restitution=0", "material.rolling_friction=-0.1"}) {
+    const auto r = geohaz::testing::run_command(kApp.string() + " --config " + (kData / "avalanche.toml").string() +
+                                                " --set " + set + " --out " + out.string());
+    EXPECT_EQ(r.code, 2) << set;
+    const std::string key(set, std::string(set).find('='));
+    EXPECT_NE(r.output.find(key), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out));
+  }
   // Missing config file and help/version.
   EXPECT_EQ(run_app("--config /nonexistent.toml --out " + out.string()), 2);
   EXPECT_EQ(run_app("--help"), 0);

@@ -382,6 +382,14 @@ std::vector<std::size_t> label_fragments(DemSolver& s) {
 }
 
 void check_avalanche_spec(const AvalancheSpec& spec) {
+  if (!(spec.stop_kinetic_fraction > 0.0 && spec.stop_kinetic_fraction < 1.0))
+    throw InputError("must lie in (0, 1)", "", "avalanche.stop_kinetic_fraction",
+                     std::to_string(spec.stop_kinetic_fraction));
+  if (!(spec.stop_speed >= 0.0))
+    throw InputError("must be ≥ 0 m/s", "", "avalanche.stop_speed", std::to_string(spec.stop_speed));
+  if (!(spec.terrain_restitution > 0.0 && spec.terrain_restitution <= 1.0))
+    throw InputError("must lie in (0, 1]", "", "avalanche.terrain_restitution",
+                     std::to_string(spec.terrain_restitution));
   if (spec.source.size() < 3)
     throw InputError("the source polygon needs at least 3 vertices", "", "avalanche.source_x");
   if (spec.terrain.size() < 2)
@@ -502,6 +510,20 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
   std::size_t last_events = s.events.size();
   double next_record = t_release;
   double prev_front = mass_quantile_x(s, 0.99), prev_t = t_release;
+  // Fastest disc and the mass fraction faster than the stop speed.
+  auto motion = [&](double& vmax, double& moving) {
+    const auto& v = s.discs.get<Velocity<2>>();
+    const auto& m = s.discs.get<Mass>();
+    double v2 = 0, mm = 0, mt = 0;
+    for (std::size_t i = 0; i < s.discs.size(); ++i) {
+      const double q = v[i].squaredNorm();
+      v2 = std::max(v2, q);
+      mt += m[i];
+      if (q > spec.stop_speed * spec.stop_speed) mm += m[i];
+    }
+    vmax = std::sqrt(v2);
+    moving = mt > 0 ? mm / mt : 0.0;
+  };
   while (true) {
     const double tr = s.time() - t_release;
     s.settings.gravity = tr < spec.trigger_duration ? Vec2(g0 + spec.trigger_acceleration) : g0;
@@ -513,6 +535,8 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
       prev_front = p.front;
       prev_t = s.time();
       p.kinetic_energy = s.kinetic_energy();
+      motion(p.max_speed, p.moving_fraction);
+      res.peak_kinetic_energy = std::max(res.peak_kinetic_energy, p.kinetic_energy);
       const auto sizes = label_fragments(s);
       p.fragments = sizes.size();
       p.largest_fragment = sizes.empty() ? 0 : sizes.front();
@@ -523,11 +547,19 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
       res.series.push_back(p);
       if (observe) observe(s, "runout");
       next_record += spec.record_interval;
+      // At rest: the energy has fallen to a small fraction of its peak and no disc still moves.
+      if (tr > 0 && p.kinetic_energy <= spec.stop_kinetic_fraction * res.peak_kinetic_energy &&
+          p.max_speed <= spec.stop_speed) {
+        res.at_rest = true;
+        break;
+      }
     }
     if (tr >= spec.runout_time) break;
     s.step();
   }
   s.settings.gravity = g0;
+  res.duration = s.time() - t_release;
+  motion(res.max_speed_at_end, res.moving_fraction_at_end);
   // Run-out measures: toe = 99 % mass quantile of x at the end, on the terrain.
   res.toe_x = mass_quantile_x(s, 0.99);
   res.toe_z = s.terrain.elevation(res.toe_x);

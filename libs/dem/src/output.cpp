@@ -58,10 +58,11 @@ void write_avalanche_csv(const std::filesystem::path& path, const std::vector<Av
   std::ostringstream o;
   o << std::setprecision(9);
   o << "time_s,front_m,front_velocity_m_per_s,kinetic_energy_J_per_m,fragments,largest_fragment_discs,ae_count,"
-       "ae_energy_J_per_m\n";
+       "ae_energy_J_per_m,max_speed_m_per_s,moving_mass_fraction\n";
   for (const auto& p : series)
     o << p.time << ',' << p.front << ',' << p.front_velocity << ',' << p.kinetic_energy << ',' << p.fragments << ','
-      << p.largest_fragment << ',' << p.ae_count << ',' << p.ae_energy << '\n';
+      << p.largest_fragment << ',' << p.ae_count << ',' << p.ae_energy << ',' << p.max_speed << ',' << p.moving_fraction
+      << '\n';
   write_text_file(path, o.str());
 }
 

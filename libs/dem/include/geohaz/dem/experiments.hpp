@@ -114,14 +114,20 @@ struct AvalancheSpec {
   double strength_factor = 1.0;              ///< bond strengths × this at release (weakening trigger)
   Vec2 trigger_acceleration = Vec2::Zero();  ///< extra acceleration during the trigger (m/s²)
   double trigger_duration = 0.0;             ///< s
-  double runout_time = 30.0;                 ///< s after release
-  double runout_damping = 0.0;               ///< Cundall α during the run-out
-  double record_interval = 0.1;              ///< s between time-series points
-  double volume_width = 0.0;  ///< out-of-plane width to turn the 2D area into a volume (m); 0: source length
+  double runout_time = 300.0;                ///< s after release: the longest run (it ends earlier at rest)
+  /// The run ends at the first record where the kinetic energy is below this fraction of its peak
+  /// after release and no disc is faster than stop_speed, ∈ (0, 1).
+  double stop_kinetic_fraction = 1e-3;
+  double stop_speed = 0.1;       ///< m/s, ≥ 0 (0: the kinetic-energy criterion alone)
+  double runout_damping = 0.0;   ///< Cundall α during the run-out
+  double record_interval = 0.1;  ///< s between time-series points
+  double volume_width = 0.0;     ///< out-of-plane width to turn the 2D area into a volume (m); 0: source length
 };
 
 struct AvalanchePoint {
   double time, front, front_velocity, kinetic_energy;
+  double max_speed;        ///< fastest disc (m/s)
+  double moving_fraction;  ///< mass fraction of the discs faster than stop_speed
   std::size_t fragments, largest_fragment, ae_count;
   double ae_energy;
 };
@@ -138,6 +144,11 @@ struct AvalancheResult {
   DiscontinuityReport discontinuities;
   std::vector<AcousticEvent> events;  ///< all bond breaks, settling included
   double release_time = 0;            ///< s (simulated time at release)
+  bool at_rest = false;               ///< the stop criterion ended the run (false: runout_time was reached)
+  double duration = 0;                ///< s of run-out simulated after release
+  double peak_kinetic_energy = 0;     ///< J/m
+  double max_speed_at_end = 0;        ///< m/s
+  double moving_fraction_at_end = 0;  ///< mass fraction faster than stop_speed at the end
   std::size_t events_before_release = 0;
 };
 
