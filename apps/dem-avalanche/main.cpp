@@ -477,10 +477,16 @@ int run_avalanche_case(const RunConfig& c, const std::filesystem::path& out, boo
   write_avalanche_csv(out / "runout.csv", r.series);
   write_ae_csv(out / "ae.csv", r.events);
   write_deposit_csv(out / "deposit.csv", r.deposit);
+  write_deposit_png(out / "deposit_thickness.png", r.deposit);
   {
+    // Fragments, largest first: size, mass, equivalent-area diameter, centre of mass, travel.
     std::ostringstream o;
-    o << "fragment,discs\n";
-    for (std::size_t k = 0; k < r.fragment_sizes.size(); ++k) o << k << ',' << r.fragment_sizes[k] << '\n';
+    o << std::setprecision(9) << "fragment,discs,mass_kg_per_m,equivalent_diameter_m,x_m,z_m,travel_m\n";
+    for (std::size_t k = 0; k < r.fragments.size(); ++k) {
+      const auto& f = r.fragments[k];
+      const double d = 2.0 * std::sqrt(f.mass / c.avalanche.packing.density / std::numbers::pi);
+      o << k << ',' << f.discs << ',' << f.mass << ',' << d << ',' << f.x << ',' << f.z << ',' << f.travel << '\n';
+    }
     write_text_file(out / "fragments.csv", o.str());
   }
   write_avalanche_png(out / "deposit.png", s, c.avalanche.terrain, c.avalanche.source);
@@ -488,6 +494,16 @@ int run_avalanche_case(const RunConfig& c, const std::filesystem::path& out, boo
   for (const auto& e : r.events) (e.mode == FailureMode::Tensile ? tens : shear) += 1;
   std::size_t multi = 0;
   for (auto n : r.fragment_sizes) multi += n >= 2;
+  json quantiles = json::array();
+  for (const auto& q : r.quantiles)
+    quantiles.push_back({{"mass_fraction", q.fraction},
+                         {"toe", {q.x, q.z}},
+                         {"runout_L_m", q.runout},
+                         {"fall_height_H_m", q.fall_height},
+                         {"H_over_L", q.h_over_l}});
+  double mass_total = 0;
+  for (const auto& f : r.fragments) mass_total += f.mass;
+  const double largest_fraction = r.fragments.empty() ? 0.0 : r.fragments.front().mass / mass_total;
   json summary = {{"model", "dem-avalanche"},
                   {"version", GEOHAZ_VERSION},
                   {"test", "avalanche"},
@@ -504,6 +520,13 @@ int run_avalanche_case(const RunConfig& c, const std::filesystem::path& out, boo
                   {"runout_L_m", r.runout},
                   {"fall_height_H_m", r.fall_height},
                   {"H_over_L", r.h_over_l},
+                  {"toe_definition", "x below which 99 % of the mass lies"},
+                  {"runout_by_mass_quantile", quantiles},
+                  {"centre_of_mass",
+                   {{"start", {r.com_start.x(), r.com_start.y()}},
+                    {"end", {r.com_end.x(), r.com_end.y()}},
+                    {"H_over_L", r.com_h_over_l}}},
+                  {"fragment_mass_fraction_of_largest", largest_fraction},
                   {"scheidegger_1973_H_over_L", r.scheidegger_h_over_l},
                   {"fragments_final", r.fragment_sizes.size()},
                   {"fragments_with_2_or_more_discs", multi},

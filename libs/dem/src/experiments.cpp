@@ -497,6 +497,22 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
         res.crown_x = x[i].x();
       }
   }
+  // Centre of mass and each disc's start position (by id) at release.
+  auto centre_of_mass = [&]() {
+    const auto& x = s.discs.get<Position<2>>();
+    const auto& m = s.discs.get<Mass>();
+    Vec2 c = Vec2::Zero();
+    double mt = 0;
+    for (std::size_t i = 0; i < s.discs.size(); ++i) {
+      c += m[i] * x[i];
+      mt += m[i];
+    }
+    return Vec2(c / mt);
+  };
+  res.com_start = centre_of_mass();
+  std::vector<double> start_x(s.discs.size());
+  for (std::size_t i = 0; i < s.discs.size(); ++i)
+    start_x[static_cast<std::size_t>(s.discs.get<ParticleId>()[i])] = s.discs.get<Position<2>>()[i].x();
   // Release.
   for (auto& w : s.walls) w.active = false;
   for (std::size_t b = 0; b < s.bonds.size(); ++b) {
@@ -593,6 +609,43 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
     }
   }
   res.fragment_sizes = label_fragments(s);
+  {
+    const auto& x = s.discs.get<Position<2>>();
+    const auto& m = s.discs.get<Mass>();
+    const auto& fr = s.discs.get<Fragment>();
+    const auto& id = s.discs.get<ParticleId>();
+    res.fragments.assign(res.fragment_sizes.size(), FragmentSummary{});
+    std::vector<double> x0(res.fragments.size(), 0.0);
+    for (std::size_t i = 0; i < s.discs.size(); ++i) {
+      FragmentSummary& f = res.fragments[static_cast<std::size_t>(fr[i])];
+      ++f.discs;
+      f.mass += m[i];
+      f.x += m[i] * x[i].x();
+      f.z += m[i] * x[i].y();
+      x0[static_cast<std::size_t>(fr[i])] += m[i] * start_x[static_cast<std::size_t>(id[i])];
+    }
+    for (std::size_t k = 0; k < res.fragments.size(); ++k) {
+      FragmentSummary& f = res.fragments[k];
+      f.x /= f.mass;
+      f.z /= f.mass;
+      f.travel = f.x - x0[k] / f.mass;
+    }
+  }
+  res.com_end = centre_of_mass();
+  {
+    const double dl = res.com_end.x() - res.com_start.x();
+    res.com_h_over_l = dl > 0 ? (res.com_start.y() - res.com_end.y()) / dl : 0.0;
+  }
+  for (double f : {0.5, 0.9, 0.95, 0.99, 1.0}) {
+    RunoutQuantile q;
+    q.fraction = f;
+    q.x = mass_quantile_x(s, f);
+    q.z = s.terrain.elevation(q.x);
+    q.runout = q.x - res.crown_x;
+    q.fall_height = res.crown_z - q.z;
+    q.h_over_l = q.runout > 0 ? q.fall_height / q.runout : 0.0;
+    res.quantiles.push_back(q);
+  }
   res.events = s.events;  // settling breaks included (time < release time)
   res.release_time = t_release;
   res.events_before_release = events_before;

@@ -743,6 +743,7 @@ void DemSolver::finish_step(const Law& law) {
   const auto& kin = discs.get<Kinematic>();
   const Vec2 g = settings.gravity;
   const double alpha = settings.local_damping;
+  const double step_factor = wall_step_factor_;  // a local, so the loop does not reload it
   const double dt = dt_;
   const double vmax2 = settings.max_speed * settings.max_speed;
   const std::int64_t n = static_cast<std::int64_t>(discs.size());
@@ -764,7 +765,7 @@ void DemSolver::finish_step(const Law& law) {
       w[i] += 0.5 * dt / I[i] * tq;
     }
     if (!x[i].allFinite() || !v[i].allFinite() || v[i].squaredNorm() > vmax2) bad = std::max(bad, ii);
-    const double kn0 = law.reference_kn(R[i]) * wall_step_factor_, kt0 = law.reference_kt(R[i]);
+    const double kn0 = law.reference_kn(R[i]) * step_factor, kt0 = law.reference_kt(R[i]);
     const double ktr = std::max(K[i][0], std::max(kn0, kt0));
     const double krot = std::max(K[i][1], kt0 * R[i] * R[i]);
     inv2 = std::max(inv2, std::max(ktr / m[i], krot / I[i]));

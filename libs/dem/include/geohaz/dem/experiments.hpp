@@ -132,6 +132,20 @@ struct AvalanchePoint {
   double ae_energy;
 };
 
+/// Run-out measured to the x below which a fraction of the mass lies (a mass quantile of the
+/// deposit), with the fall height from the crown and H/L.
+struct RunoutQuantile {
+  double fraction = 0, x = 0, z = 0, runout = 0, fall_height = 0, h_over_l = 0;
+};
+
+/// One fragment at the end of the run.
+struct FragmentSummary {
+  std::size_t discs = 0;
+  double mass = 0;      ///< kg per m of thickness
+  double x = 0, z = 0;  ///< centre of mass (m)
+  double travel = 0;    ///< horizontal travel of its centre of mass from where its discs started (m)
+};
+
 struct AvalancheResult {
   std::vector<AvalanchePoint> series;
   double crown_x = 0, crown_z = 0, toe_x = 0, toe_z = 0;
@@ -140,6 +154,13 @@ struct AvalancheResult {
   double scheidegger_h_over_l = 0;                 ///< log10(H/L) = −0.15666 log10(V) + 0.62419 (Scheidegger 1973)
   std::vector<std::pair<double, double>> deposit;  ///< (x, thickness) profile (m)
   std::vector<std::size_t> fragment_sizes;         ///< discs per fragment at the end, descending
+  std::vector<FragmentSummary> fragments;          ///< same order as fragment_sizes
+  /// Toe at the mass quantiles 0.5, 0.9, 0.95, 0.99 and 1 (farthest disc) of x; the headline
+  /// toe/runout/h_over_l above is the 0.99 one.
+  std::vector<RunoutQuantile> quantiles;
+  /// Centre of mass after settling and at the end (m), and its travel angle tan = ΔH/ΔL.
+  Vec2 com_start = Vec2::Zero(), com_end = Vec2::Zero();
+  double com_h_over_l = 0;
   std::size_t discs = 0, bonds = 0, joints_cut = 0;
   DiscontinuityReport discontinuities;
   std::vector<AcousticEvent> events;  ///< all bond breaks, settling included
