@@ -282,6 +282,9 @@ RunConfig read_config(ConfigReader& r, bool describe) {
                                {"1", "friction coefficient of disc-terrain contacts"});
     a.terrain_restitution = r.get("avalanche.terrain_restitution", 0.3, Range::open_closed(0.0, 1.0),
                                   {"1", "restitution of disc-terrain contacts"});
+    a.terrain_rolling_friction = r.get(
+        "avalanche.terrain_rolling_friction", m.contact.rolling_friction, Range::non_negative(),
+        {"1", "rolling-resistance coefficient mu_r of disc-terrain contacts (default: material.rolling_friction)"});
     a.settle_time =
         r.get("avalanche.settle_time", 1.0, Range::non_negative(), {"s", "settling under gravity before release"});
     a.settle_damping =

@@ -384,3 +384,23 @@ TEST(DemContact, JointContactConservesMomentumAndAngularMomentum) {
   EXPECT_NEAR((s.momentum() - p0).norm(), 0.0, 1e-10 * p0.norm());
   EXPECT_NEAR(angular(), l0, 1e-9 * scale);
 }
+
+TEST(DemContact, DiscRollingOnTerrainDeceleratesWithTheTerrainRollingResistance) {
+  // A disc rolling without slip on flat terrain with rolling-resistance moment μ_r R N decelerates
+  // at a = μ_r g / (1 + I/(m R²)) = ⅔ μ_r g: it loses μ_r m g per metre, an energy line of atan μ_r.
+  // The terrain's μ_r (0.2) applies, not the discs' (0).
+  const double R = 0.5, g = 9.81, mu_r = 0.2, kn = 1e9;
+  DemSolver s;
+  s.law = LinearSpringCoulomb{kn, 0.4 * kn};
+  s.contact.rolling_friction = 0.0;
+  add_disc(s.discs, Vec2(0, R - 2650 * kPi * R * R * g / kn), R, 2650);
+  s.discs.get<Velocity<2>>()[0] = Vec2(5, 0);
+  s.discs.get<AngularVelocity>()[0] = -5 / R;
+  s.terrain.add_polyline({Vec2(-10, 0), Vec2(100, 0)}, 0.5, 0.3, mu_r);
+  s.initialise();
+  s.run_until(0.2);
+  const double t1 = s.time(), v1 = s.discs.get<Velocity<2>>()[0].x();
+  s.run_until(1.2);
+  const double a = (v1 - s.discs.get<Velocity<2>>()[0].x()) / (s.time() - t1);
+  EXPECT_NEAR(a, 2.0 / 3.0 * mu_r * g, 0.02 * 2.0 / 3.0 * mu_r * g);
+}

@@ -449,7 +449,8 @@ TEST(DemApp, BadInputExitsWithCode2AndWritesNothing) {
   // Stop fraction, restitution and rolling resistance out of range: the message names the key.
   for (const char* set :
        {"avalanche.stop_kinetic_fraction=1.0", "avalanche.stop_kinetic_fraction=0", "avalanche.terrain_restitution=1.5",
-        "avalanche.terrain_restitution=0", "material.restitution=0", "material.rolling_friction=-0.1"}) {
+        "avalanche.terrain_restitution=0", "material.restitution=0", "material.rolling_friction=-0.1",
+        "avalanche.terrain_rolling_friction=-0.2"}) {
     const auto r = geohaz::testing::run_command(kApp.string() + " --config " + (kData / "avalanche.toml").string() +
                                                 " --set " + set + " --out " + out.string());
     EXPECT_EQ(r.code, 2) << set;

@@ -468,7 +468,7 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
   ter.insert(ter.begin(), ter.front() + Vec2(0, tall));
   ter.push_back(ter.back() + Vec2(0, tall));
   s.terrain = TerrainSegments{};
-  s.terrain.add_polyline(ter, spec.terrain_friction, spec.terrain_restitution);
+  s.terrain.add_polyline(ter, spec.terrain_friction, spec.terrain_restitution, spec.terrain_rolling_friction);
   s.walls.clear();
   if (spec.support.size() == 2) {
     WallSegment w;
@@ -476,6 +476,7 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
     w.b = spec.support[1];
     w.friction = spec.terrain_friction;
     w.restitution = spec.terrain_restitution;
+    w.rolling_friction = spec.terrain_rolling_friction;
     s.walls.push_back(w);
   }
   s.initialise();

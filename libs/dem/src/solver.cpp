@@ -577,10 +577,11 @@ void DemSolver::wall_forces(const Law& law) {
         const double limit = s.friction * std::max(fn, 0.0);
         if (std::abs(fs) > limit) fs = sgn(fs) * limit;
         double md = 0.0, kr = 0.0;
-        if (mu_r > 0) {
-          kr = rolling_stiffness(mu_r, c.kn, Ri);
+        const double mu_rw = s.rolling_friction >= 0.0 ? s.rolling_friction : mu_r;  // the wall's own, if set
+        if (mu_rw > 0) {
+          kr = rolling_stiffness(mu_rw, c.kn, Ri);
           mr -= kr * w[i] * dt;
-          const double mmax = mu_r * Ri * std::max(fn, 0.0);
+          const double mmax = mu_rw * Ri * std::max(fn, 0.0);
           if (std::abs(mr) >= mmax)
             mr = sgn(mr) * mmax;
           else
@@ -908,13 +909,15 @@ Vec2 DemSolver::kinematic_group_force(std::uint8_t group) const {
 // ---------------------------------------------------------------------------------------------
 // Terrain
 
-void TerrainSegments::add_polyline(const std::vector<Vec2>& pts, double friction, double restitution) {
+void TerrainSegments::add_polyline(const std::vector<Vec2>& pts, double friction, double restitution,
+                                   double rolling_friction) {
   for (std::size_t k = 0; k + 1 < pts.size(); ++k) {
     WallSegment s;
     s.a = pts[k];
     s.b = pts[k + 1];
     s.friction = friction;
     s.restitution = restitution;
+    s.rolling_friction = rolling_friction;
     s.joined_prev = k > 0;
     s.joined_next = k + 2 < pts.size();
     segs_.push_back(s);

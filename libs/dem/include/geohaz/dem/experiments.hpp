@@ -105,8 +105,9 @@ MohrCoulombFit fit_mohr_coulomb(const std::vector<double>& sigma3, const std::ve
 struct AvalancheSpec {
   std::vector<Vec2> terrain;  ///< profile (distance along the section, elevation) (m), downhill in +x
   double terrain_friction = 0.6, terrain_restitution = 0.3;
-  std::vector<Vec2> source;  ///< rock-mass polygon (m)
-  PackingSpec packing;       ///< radii, porosity, seed (width/height are taken from the polygon)
+  double terrain_rolling_friction = -1.0;  ///< μ_r of disc–terrain contacts (< 0: material.contact's)
+  std::vector<Vec2> source;                ///< rock-mass polygon (m)
+  PackingSpec packing;                     ///< radii, porosity, seed (width/height are taken from the polygon)
   MaterialSpec material;
   double settle_time = 1.0;  ///< s, gravity settling with damping and the support in place
   double settle_damping = 0.7;
