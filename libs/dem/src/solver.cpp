@@ -286,9 +286,7 @@ void DemSolver::pair_forces(const Law& law) {
       const double r = std::sqrt(r2);
       const double delta = Rs - r;
       Vec2 nrm = d / r;
-      const Vec2 tc = perp(nrm);  // tangent of the centre line: the contact point moves along it
       double mu_c = mu, mu_rc = mu_r;
-      bool jointed = false;
       if (any_joints) {
         for (std::uint32_t q = joint_offsets_[id[i]]; q < joint_offsets_[id[i] + 1]; ++q) {
           const JointPair& jp = joints_[joint_entries_[q]];
@@ -296,7 +294,6 @@ void DemSolver::pair_forces(const Law& law) {
             nrm = jp.normal.dot(nrm) >= 0 ? jp.normal : Vec2(-jp.normal);
             mu_c = mu_joint;
             mu_rc = 0.0;
-            jointed = true;
             break;
           }
         }
@@ -308,7 +305,7 @@ void DemSolver::pair_forces(const Law& law) {
       // Levers to the common contact point (mid-overlap), so the pair of shear forces is a zero
       // net couple and angular momentum is conserved exactly.
       const double li = Ri - 0.5 * delta, lj = R[j] - 0.5 * delta;
-      const Vec2 vrel = v[i] - v[j] - (w[i] * li + w[j] * lj) * tc;
+      const Vec2 vrel = v[i] - v[j] - (w[i] * li + w[j] * lj) * t;
       const double vn = vrel.dot(nrm);
       const double vt = vrel.dot(t);
       const double fn = c.fn_elastic - c.cn * vn;
@@ -345,17 +342,7 @@ void DemSolver::pair_forces(const Law& law) {
         mr = 0.0;
       }
       f += fn * nrm + fs * t;
-      if (jointed) {
-        // Across a joint the force fn n + fs t is not along the centre line n_c; it acts at the
-        // contact point x_i − l_i n_c, so its moment is −l_i n_c × (fn n + fs t). The moment of
-        // the shear force alone (below) left the pair with a net couple: an oblique collision
-        // across a joint created angular momentum of order m v R (1.3 in a unit test).
-        const Vec2 nc = d / r;
-        const auto cross = [](const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); };
-        tq += -li * (fn * cross(nc, nrm) + fs * cross(nc, t)) + mr + mdamp;
-      } else {
-        tq += -li * fs + mr + mdamp;
-      }
+      tq += -li * fs + mr + mdamp;
       ktr += std::max(c.kn, c.kt);
       krot += c.kt * Ri * Ri + kr;
       hist_next_.partner[k] = pj;
