@@ -77,8 +77,8 @@ void check_disc_memory(double area, const PackingSpec& p, const std::string& sou
   // triangulation used to place the bonds.
   const double per_disc = 1000.0;
   std::ostringstream est;
-  est << std::setprecision(3) << discs << " discs × " << per_disc << " B for the " << what << " with radii "
-      << p.r_min << "–" << p.r_max << " m";
+  est << std::setprecision(3) << discs << " discs × " << per_disc << " B for the " << what << " with radii " << p.r_min
+      << "–" << p.r_max << " m";
   std::ostringstream value;
   value << p.r_min;
   check_memory(discs * per_disc, est.str(), source, "sample.r_min", value.str());
@@ -282,6 +282,9 @@ RunConfig read_config(ConfigReader& r, bool describe) {
                                {"1", "friction coefficient of disc-terrain contacts"});
     a.terrain_restitution = r.get("avalanche.terrain_restitution", 0.3, Range::open_closed(0.0, 1.0),
                                   {"1", "restitution of disc-terrain contacts"});
+    a.terrain_rolling_friction = r.get(
+        "avalanche.terrain_rolling_friction", m.contact.rolling_friction, Range::non_negative(),
+        {"1", "rolling-resistance coefficient mu_r of disc-terrain contacts (default: material.rolling_friction)"});
     a.settle_time =
         r.get("avalanche.settle_time", 1.0, Range::non_negative(), {"s", "settling under gravity before release"});
     a.settle_damping =
@@ -295,7 +298,17 @@ RunConfig read_config(ConfigReader& r, bool describe) {
     a.trigger_acceleration = Vec2(trig[0], trig[1]);
     a.trigger_duration =
         r.get("avalanche.trigger_duration", 0.0, Range::non_negative(), {"s", "duration of the trigger acceleration"});
-    a.runout_time = r.get("avalanche.runout_time", 30.0, Range::positive(), {"s", "simulated time after release"});
+    a.runout_time = r.get("avalanche.runout_time", AvalancheSpec{}.runout_time, Range::positive(),
+                          {"s",
+                           "longest simulated time after release; the run ends earlier once the mass is at rest "
+                           "(stop_kinetic_fraction, stop_speed), and warns if it is still moving at this time"});
+    a.stop_kinetic_fraction =
+        r.get("avalanche.stop_kinetic_fraction", AvalancheSpec{}.stop_kinetic_fraction, Range{0.0, 1.0, true, true},
+              {"1",
+               "at rest when the kinetic energy is below this fraction of its peak after release (and no disc "
+               "is faster than stop_speed)"});
+    a.stop_speed = r.get("avalanche.stop_speed", AvalancheSpec{}.stop_speed, Range::non_negative(),
+                         {"m/s", "at rest when no disc is faster than this (0: kinetic-energy criterion alone)"});
     a.runout_damping =
         r.get("avalanche.runout_damping", 0.0, Range::closed_open(0.0, 1.0), {"1", "local damping during the run-out"});
     a.record_interval = r.get("avalanche.record_interval", 0.1, Range::positive(), {"s", "time-series interval"});
@@ -467,10 +480,16 @@ int run_avalanche_case(const RunConfig& c, const std::filesystem::path& out, boo
   write_avalanche_csv(out / "runout.csv", r.series);
   write_ae_csv(out / "ae.csv", r.events);
   write_deposit_csv(out / "deposit.csv", r.deposit);
+  write_deposit_png(out / "deposit_thickness.png", r.deposit);
   {
+    // Fragments, largest first: size, mass, equivalent-area diameter, centre of mass, travel.
     std::ostringstream o;
-    o << "fragment,discs\n";
-    for (std::size_t k = 0; k < r.fragment_sizes.size(); ++k) o << k << ',' << r.fragment_sizes[k] << '\n';
+    o << std::setprecision(9) << "fragment,discs,mass_kg_per_m,equivalent_diameter_m,x_m,z_m,travel_m\n";
+    for (std::size_t k = 0; k < r.fragments.size(); ++k) {
+      const auto& f = r.fragments[k];
+      const double d = 2.0 * std::sqrt(f.mass / c.avalanche.packing.density / std::numbers::pi);
+      o << k << ',' << f.discs << ',' << f.mass << ',' << d << ',' << f.x << ',' << f.z << ',' << f.travel << '\n';
+    }
     write_text_file(out / "fragments.csv", o.str());
   }
   write_avalanche_png(out / "deposit.png", s, c.avalanche.terrain, c.avalanche.source);
@@ -478,6 +497,16 @@ int run_avalanche_case(const RunConfig& c, const std::filesystem::path& out, boo
   for (const auto& e : r.events) (e.mode == FailureMode::Tensile ? tens : shear) += 1;
   std::size_t multi = 0;
   for (auto n : r.fragment_sizes) multi += n >= 2;
+  json quantiles = json::array();
+  for (const auto& q : r.quantiles)
+    quantiles.push_back({{"mass_fraction", q.fraction},
+                         {"toe", {q.x, q.z}},
+                         {"runout_L_m", q.runout},
+                         {"fall_height_H_m", q.fall_height},
+                         {"H_over_L", q.h_over_l}});
+  double mass_total = 0;
+  for (const auto& f : r.fragments) mass_total += f.mass;
+  const double largest_fraction = r.fragments.empty() ? 0.0 : r.fragments.front().mass / mass_total;
   json summary = {{"model", "dem-avalanche"},
                   {"version", GEOHAZ_VERSION},
                   {"test", "avalanche"},
@@ -494,12 +523,34 @@ int run_avalanche_case(const RunConfig& c, const std::filesystem::path& out, boo
                   {"runout_L_m", r.runout},
                   {"fall_height_H_m", r.fall_height},
                   {"H_over_L", r.h_over_l},
+                  {"toe_definition", "x below which 99 % of the mass lies"},
+                  {"runout_by_mass_quantile", quantiles},
+                  {"centre_of_mass",
+                   {{"start", {r.com_start.x(), r.com_start.y()}},
+                    {"end", {r.com_end.x(), r.com_end.y()}},
+                    {"H_over_L", r.com_h_over_l}}},
+                  {"fragment_mass_fraction_of_largest", largest_fraction},
                   {"scheidegger_1973_H_over_L", r.scheidegger_h_over_l},
                   {"fragments_final", r.fragment_sizes.size()},
                   {"fragments_with_2_or_more_discs", multi},
                   {"largest_fragment_discs", r.fragment_sizes.empty() ? 0 : r.fragment_sizes.front()},
                   {"simulated_time_s", s.time()},
+                  {"runout_duration_s", r.duration},
+                  {"at_rest", r.at_rest},
+                  {"max_speed_at_end_m_s", r.max_speed_at_end},
+                  {"moving_mass_fraction_at_end", r.moving_fraction_at_end},
+                  {"peak_kinetic_energy_J_per_m", r.peak_kinetic_energy},
                   {"steps", s.step_count()}};
+  json warnings = json::array();
+  if (!r.at_rest) {
+    std::ostringstream w;
+    w << "the run reached avalanche.runout_time (" << c.avalanche.runout_time << " s) with "
+      << 100.0 * r.moving_fraction_at_end << " % of the mass still moving (fastest disc " << r.max_speed_at_end
+      << " m/s): run-out, H/L and the deposit are not final; raise avalanche.runout_time";
+    warnings.push_back(w.str());
+    std::cerr << "dem-avalanche: warning: " << w.str() << "\n";
+  }
+  summary["warnings"] = warnings;
   write_text_file(out / "summary.json", summary.dump(2) + "\n");
   if (!quiet)
     std::cerr << "dem-avalanche: run-out L = " << r.runout << " m, H = " << r.fall_height << " m, H/L = " << r.h_over_l

@@ -382,6 +382,14 @@ std::vector<std::size_t> label_fragments(DemSolver& s) {
 }
 
 void check_avalanche_spec(const AvalancheSpec& spec) {
+  if (!(spec.stop_kinetic_fraction > 0.0 && spec.stop_kinetic_fraction < 1.0))
+    throw InputError("must lie in (0, 1)", "", "avalanche.stop_kinetic_fraction",
+                     std::to_string(spec.stop_kinetic_fraction));
+  if (!(spec.stop_speed >= 0.0))
+    throw InputError("must be ≥ 0 m/s", "", "avalanche.stop_speed", std::to_string(spec.stop_speed));
+  if (!(spec.terrain_restitution > 0.0 && spec.terrain_restitution <= 1.0))
+    throw InputError("must lie in (0, 1]", "", "avalanche.terrain_restitution",
+                     std::to_string(spec.terrain_restitution));
   if (spec.source.size() < 3)
     throw InputError("the source polygon needs at least 3 vertices", "", "avalanche.source_x");
   if (spec.terrain.size() < 2)
@@ -460,7 +468,7 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
   ter.insert(ter.begin(), ter.front() + Vec2(0, tall));
   ter.push_back(ter.back() + Vec2(0, tall));
   s.terrain = TerrainSegments{};
-  s.terrain.add_polyline(ter, spec.terrain_friction, spec.terrain_restitution);
+  s.terrain.add_polyline(ter, spec.terrain_friction, spec.terrain_restitution, spec.terrain_rolling_friction);
   s.walls.clear();
   if (spec.support.size() == 2) {
     WallSegment w;
@@ -468,6 +476,7 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
     w.b = spec.support[1];
     w.friction = spec.terrain_friction;
     w.restitution = spec.terrain_restitution;
+    w.rolling_friction = spec.terrain_rolling_friction;
     s.walls.push_back(w);
   }
   s.initialise();
@@ -489,6 +498,22 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
         res.crown_x = x[i].x();
       }
   }
+  // Centre of mass and each disc's start position (by id) at release.
+  auto centre_of_mass = [&]() {
+    const auto& x = s.discs.get<Position<2>>();
+    const auto& m = s.discs.get<Mass>();
+    Vec2 c = Vec2::Zero();
+    double mt = 0;
+    for (std::size_t i = 0; i < s.discs.size(); ++i) {
+      c += m[i] * x[i];
+      mt += m[i];
+    }
+    return Vec2(c / mt);
+  };
+  res.com_start = centre_of_mass();
+  std::vector<double> start_x(s.discs.size());
+  for (std::size_t i = 0; i < s.discs.size(); ++i)
+    start_x[static_cast<std::size_t>(s.discs.get<ParticleId>()[i])] = s.discs.get<Position<2>>()[i].x();
   // Release.
   for (auto& w : s.walls) w.active = false;
   for (std::size_t b = 0; b < s.bonds.size(); ++b) {
@@ -502,6 +527,20 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
   std::size_t last_events = s.events.size();
   double next_record = t_release;
   double prev_front = mass_quantile_x(s, 0.99), prev_t = t_release;
+  // Fastest disc and the mass fraction faster than the stop speed.
+  auto motion = [&](double& vmax, double& moving) {
+    const auto& v = s.discs.get<Velocity<2>>();
+    const auto& m = s.discs.get<Mass>();
+    double v2 = 0, mm = 0, mt = 0;
+    for (std::size_t i = 0; i < s.discs.size(); ++i) {
+      const double q = v[i].squaredNorm();
+      v2 = std::max(v2, q);
+      mt += m[i];
+      if (q > spec.stop_speed * spec.stop_speed) mm += m[i];
+    }
+    vmax = std::sqrt(v2);
+    moving = mt > 0 ? mm / mt : 0.0;
+  };
   while (true) {
     const double tr = s.time() - t_release;
     s.settings.gravity = tr < spec.trigger_duration ? Vec2(g0 + spec.trigger_acceleration) : g0;
@@ -513,6 +552,8 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
       prev_front = p.front;
       prev_t = s.time();
       p.kinetic_energy = s.kinetic_energy();
+      motion(p.max_speed, p.moving_fraction);
+      res.peak_kinetic_energy = std::max(res.peak_kinetic_energy, p.kinetic_energy);
       const auto sizes = label_fragments(s);
       p.fragments = sizes.size();
       p.largest_fragment = sizes.empty() ? 0 : sizes.front();
@@ -523,11 +564,19 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
       res.series.push_back(p);
       if (observe) observe(s, "runout");
       next_record += spec.record_interval;
+      // At rest: the energy has fallen to a small fraction of its peak and no disc still moves.
+      if (tr > 0 && p.kinetic_energy <= spec.stop_kinetic_fraction * res.peak_kinetic_energy &&
+          p.max_speed <= spec.stop_speed) {
+        res.at_rest = true;
+        break;
+      }
     }
     if (tr >= spec.runout_time) break;
     s.step();
   }
   s.settings.gravity = g0;
+  res.duration = s.time() - t_release;
+  motion(res.max_speed_at_end, res.moving_fraction_at_end);
   // Run-out measures: toe = 99 % mass quantile of x at the end, on the terrain.
   res.toe_x = mass_quantile_x(s, 0.99);
   res.toe_z = s.terrain.elevation(res.toe_x);
@@ -561,6 +610,43 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
     }
   }
   res.fragment_sizes = label_fragments(s);
+  {
+    const auto& x = s.discs.get<Position<2>>();
+    const auto& m = s.discs.get<Mass>();
+    const auto& fr = s.discs.get<Fragment>();
+    const auto& id = s.discs.get<ParticleId>();
+    res.fragments.assign(res.fragment_sizes.size(), FragmentSummary{});
+    std::vector<double> x0(res.fragments.size(), 0.0);
+    for (std::size_t i = 0; i < s.discs.size(); ++i) {
+      FragmentSummary& f = res.fragments[static_cast<std::size_t>(fr[i])];
+      ++f.discs;
+      f.mass += m[i];
+      f.x += m[i] * x[i].x();
+      f.z += m[i] * x[i].y();
+      x0[static_cast<std::size_t>(fr[i])] += m[i] * start_x[static_cast<std::size_t>(id[i])];
+    }
+    for (std::size_t k = 0; k < res.fragments.size(); ++k) {
+      FragmentSummary& f = res.fragments[k];
+      f.x /= f.mass;
+      f.z /= f.mass;
+      f.travel = f.x - x0[k] / f.mass;
+    }
+  }
+  res.com_end = centre_of_mass();
+  {
+    const double dl = res.com_end.x() - res.com_start.x();
+    res.com_h_over_l = dl > 0 ? (res.com_start.y() - res.com_end.y()) / dl : 0.0;
+  }
+  for (double f : {0.5, 0.9, 0.95, 0.99, 1.0}) {
+    RunoutQuantile q;
+    q.fraction = f;
+    q.x = mass_quantile_x(s, f);
+    q.z = s.terrain.elevation(q.x);
+    q.runout = q.x - res.crown_x;
+    q.fall_height = res.crown_z - q.z;
+    q.h_over_l = q.runout > 0 ? q.fall_height / q.runout : 0.0;
+    res.quantiles.push_back(q);
+  }
   res.events = s.events;  // settling breaks included (time < release time)
   res.release_time = t_release;
   res.events_before_release = events_before;

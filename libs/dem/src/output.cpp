@@ -1,9 +1,11 @@
 #include "geohaz/dem/output.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+#include <string>
 
 #include "geohaz/core/output.hpp"
 #include "geohaz/core/raster.hpp"
@@ -58,10 +60,11 @@ void write_avalanche_csv(const std::filesystem::path& path, const std::vector<Av
   std::ostringstream o;
   o << std::setprecision(9);
   o << "time_s,front_m,front_velocity_m_per_s,kinetic_energy_J_per_m,fragments,largest_fragment_discs,ae_count,"
-       "ae_energy_J_per_m\n";
+       "ae_energy_J_per_m,max_speed_m_per_s,moving_mass_fraction\n";
   for (const auto& p : series)
     o << p.time << ',' << p.front << ',' << p.front_velocity << ',' << p.kinetic_energy << ',' << p.fragments << ','
-      << p.largest_fragment << ',' << p.ae_count << ',' << p.ae_energy << '\n';
+      << p.largest_fragment << ',' << p.ae_count << ',' << p.ae_energy << ',' << p.max_speed << ',' << p.moving_fraction
+      << '\n';
   write_text_file(path, o.str());
 }
 
@@ -169,6 +172,89 @@ void write_avalanche_png(const std::filesystem::path& path, const DemSolver& s, 
     const double t = frag[i] <= 0 ? 0.0 : 0.15 + 0.85 * std::fmod(0.618034 * frag[i], 1.0);
     img.fill_circle(f.px(x[i].x()), f.py(x[i].y()), std::max(0.8, R[i] * f.scale), ramp_colour(ColourRamp::Viridis, t));
   }
+  write_png(path, img);
+}
+
+namespace {
+
+/// 3×5 pixel glyphs for tick labels: digits, '.', '-' (rows top to bottom, 3 bits each).
+const std::array<std::uint16_t, 12> kGlyphs{{
+    0b111101101101111,  // 0
+    0b010110010010111,  // 1
+    0b111001111100111,  // 2
+    0b111001111001111,  // 3
+    0b101101111001001,  // 4
+    0b111100111001111,  // 5
+    0b111100111101111,  // 6
+    0b111001001001001,  // 7
+    0b111101111101111,  // 8
+    0b111101111001111,  // 9
+    0b000000000000010,  // .
+    0b000000111000000,  // -
+}};
+
+void draw_text(Image& img, int x, int y, const std::string& text, int scale) {
+  for (char ch : text) {
+    int g = ch == '.' ? 10 : ch == '-' ? 11 : (ch >= '0' && ch <= '9' ? ch - '0' : -1);
+    if (g >= 0)
+      for (int r = 0; r < 5; ++r)
+        for (int c = 0; c < 3; ++c)
+          if (kGlyphs[g] >> (14 - (3 * r + c)) & 1)
+            for (int a = 0; a < scale; ++a)
+              for (int b = 0; b < scale; ++b) img.set(x + c * scale + b, y + r * scale + a, {0, 0, 0});
+    x += 4 * scale;
+  }
+}
+
+/// A "nice" tick step (1, 2 or 5 × 10^k) giving about n ticks over span.
+double nice_step(double span, int n) {
+  const double raw = span / n, p = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (m * p >= raw) return m * p;
+  return 10 * p;
+}
+
+std::string tick_label(double v, double step) {
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(step >= 1 ? 0 : static_cast<int>(std::ceil(-std::log10(step)))) << v;
+  return o.str();
+}
+
+}  // namespace
+
+void write_deposit_png(const std::filesystem::path& path, const std::vector<std::pair<double, double>>& deposit) {
+  const int W = 900, H = 360, ml = 60, mr = 20, mt = 20, mb = 40;
+  Image img(W, H);
+  double x0 = 0, x1 = 1, hmax = 0;
+  if (!deposit.empty()) {
+    x0 = deposit.front().first;
+    x1 = deposit.back().first;
+    for (const auto& d : deposit) hmax = std::max(hmax, d.second);
+  }
+  if (!(x1 > x0)) x1 = x0 + 1;
+  const double xs = nice_step(x1 - x0, 8), ys = nice_step(std::max(hmax, 1e-3), 5);
+  x0 = std::floor(x0 / xs) * xs;
+  x1 = std::ceil(x1 / xs) * xs;
+  const double y1 = std::ceil(std::max(hmax, 1e-3) / ys) * ys;
+  auto px = [&](double x) { return ml + (x - x0) / (x1 - x0) * (W - ml - mr); };
+  auto py = [&](double y) { return H - mb - y / y1 * (H - mt - mb); };
+  const std::array<std::uint8_t, 3> grid{225, 225, 225}, black{0, 0, 0}, fill{160, 120, 70};
+  for (const auto& [x, h] : deposit)  // thickness as filled columns
+    if (h > 0) img.line(px(x), py(0), px(x), py(h), fill);
+  for (double x = x0; x <= x1 + 1e-9 * xs; x += xs) {
+    img.line(px(x), py(0), px(x), py(y1), grid);
+    const std::string l = tick_label(x, xs);
+    draw_text(img, static_cast<int>(px(x)) - 4 * static_cast<int>(l.size()), H - mb + 8, l, 2);
+  }
+  for (double y = 0; y <= y1 + 1e-9 * ys; y += ys) {
+    img.line(px(x0), py(y), px(x1), py(y), grid);
+    const std::string l = tick_label(y, ys);
+    draw_text(img, ml - 8 - 8 * static_cast<int>(l.size()), static_cast<int>(py(y)) - 5, l, 2);
+  }
+  for (std::size_t k = 1; k < deposit.size(); ++k)  // deposit surface
+    img.line(px(deposit[k - 1].first), py(deposit[k - 1].second), px(deposit[k].first), py(deposit[k].second), black);
+  img.line(px(x0), py(0), px(x1), py(0), black);
+  img.line(px(x0), py(0), px(x0), py(y1), black);
   write_png(path, img);
 }
 

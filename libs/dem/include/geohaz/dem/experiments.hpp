@@ -105,8 +105,9 @@ MohrCoulombFit fit_mohr_coulomb(const std::vector<double>& sigma3, const std::ve
 struct AvalancheSpec {
   std::vector<Vec2> terrain;  ///< profile (distance along the section, elevation) (m), downhill in +x
   double terrain_friction = 0.6, terrain_restitution = 0.3;
-  std::vector<Vec2> source;  ///< rock-mass polygon (m)
-  PackingSpec packing;       ///< radii, porosity, seed (width/height are taken from the polygon)
+  double terrain_rolling_friction = -1.0;  ///< μ_r of disc–terrain contacts (< 0: material.contact's)
+  std::vector<Vec2> source;                ///< rock-mass polygon (m)
+  PackingSpec packing;                     ///< radii, porosity, seed (width/height are taken from the polygon)
   MaterialSpec material;
   double settle_time = 1.0;  ///< s, gravity settling with damping and the support in place
   double settle_damping = 0.7;
@@ -114,16 +115,36 @@ struct AvalancheSpec {
   double strength_factor = 1.0;              ///< bond strengths × this at release (weakening trigger)
   Vec2 trigger_acceleration = Vec2::Zero();  ///< extra acceleration during the trigger (m/s²)
   double trigger_duration = 0.0;             ///< s
-  double runout_time = 30.0;                 ///< s after release
-  double runout_damping = 0.0;               ///< Cundall α during the run-out
-  double record_interval = 0.1;              ///< s between time-series points
-  double volume_width = 0.0;  ///< out-of-plane width to turn the 2D area into a volume (m); 0: source length
+  double runout_time = 300.0;                ///< s after release: the longest run (it ends earlier at rest)
+  /// The run ends at the first record where the kinetic energy is below this fraction of its peak
+  /// after release and no disc is faster than stop_speed, ∈ (0, 1).
+  double stop_kinetic_fraction = 1e-3;
+  double stop_speed = 0.1;       ///< m/s, ≥ 0 (0: the kinetic-energy criterion alone)
+  double runout_damping = 0.0;   ///< Cundall α during the run-out
+  double record_interval = 0.1;  ///< s between time-series points
+  double volume_width = 0.0;     ///< out-of-plane width to turn the 2D area into a volume (m); 0: source length
 };
 
 struct AvalanchePoint {
   double time, front, front_velocity, kinetic_energy;
+  double max_speed;        ///< fastest disc (m/s)
+  double moving_fraction;  ///< mass fraction of the discs faster than stop_speed
   std::size_t fragments, largest_fragment, ae_count;
   double ae_energy;
+};
+
+/// Run-out measured to the x below which a fraction of the mass lies (a mass quantile of the
+/// deposit), with the fall height from the crown and H/L.
+struct RunoutQuantile {
+  double fraction = 0, x = 0, z = 0, runout = 0, fall_height = 0, h_over_l = 0;
+};
+
+/// One fragment at the end of the run.
+struct FragmentSummary {
+  std::size_t discs = 0;
+  double mass = 0;      ///< kg per m of thickness
+  double x = 0, z = 0;  ///< centre of mass (m)
+  double travel = 0;    ///< horizontal travel of its centre of mass from where its discs started (m)
 };
 
 struct AvalancheResult {
@@ -134,10 +155,22 @@ struct AvalancheResult {
   double scheidegger_h_over_l = 0;                 ///< log10(H/L) = −0.15666 log10(V) + 0.62419 (Scheidegger 1973)
   std::vector<std::pair<double, double>> deposit;  ///< (x, thickness) profile (m)
   std::vector<std::size_t> fragment_sizes;         ///< discs per fragment at the end, descending
+  std::vector<FragmentSummary> fragments;          ///< same order as fragment_sizes
+  /// Toe at the mass quantiles 0.5, 0.9, 0.95, 0.99 and 1 (farthest disc) of x; the headline
+  /// toe/runout/h_over_l above is the 0.99 one.
+  std::vector<RunoutQuantile> quantiles;
+  /// Centre of mass after settling and at the end (m), and its travel angle tan = ΔH/ΔL.
+  Vec2 com_start = Vec2::Zero(), com_end = Vec2::Zero();
+  double com_h_over_l = 0;
   std::size_t discs = 0, bonds = 0, joints_cut = 0;
   DiscontinuityReport discontinuities;
   std::vector<AcousticEvent> events;  ///< all bond breaks, settling included
   double release_time = 0;            ///< s (simulated time at release)
+  bool at_rest = false;               ///< the stop criterion ended the run (false: runout_time was reached)
+  double duration = 0;                ///< s of run-out simulated after release
+  double peak_kinetic_energy = 0;     ///< J/m
+  double max_speed_at_end = 0;        ///< m/s
+  double moving_fraction_at_end = 0;  ///< mass fraction faster than stop_speed at the end
   std::size_t events_before_release = 0;
 };
 

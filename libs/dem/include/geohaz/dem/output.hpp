@@ -25,6 +25,10 @@ void write_avalanche_csv(const std::filesystem::path& path, const std::vector<Av
 /// Deposit profile (x, thickness).
 void write_deposit_csv(const std::filesystem::path& path, const std::vector<std::pair<double, double>>& deposit);
 
+/// Deposit thickness along the profile: x (m, horizontal axis) against thickness above the
+/// terrain (m, vertical axis), numeric tick labels, grid; the axis names are in docs/dem.md.
+void write_deposit_png(const std::filesystem::path& path, const std::vector<std::pair<double, double>>& deposit);
+
 /// Quick look of a sample: discs in grey, bonds coloured by state (intact blue, broken in tension
 /// red, in shear orange, cut by a joint green), walls black.
 void write_sample_png(const std::filesystem::path& path, const DemSolver& s, int width_px = 800);

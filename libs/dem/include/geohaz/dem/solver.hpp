@@ -106,6 +106,8 @@ class DemSolver {
   void wall_forces(const Law& law);
   template <class Law>
   void finish_step(const Law& law);
+  template <class Law>
+  void update_wall_damping(const Law& law);
   void bond_forces();
   void rebuild_neighbours();
   void reorder();
@@ -135,6 +137,14 @@ class DemSolver {
   double time_ = 0, dt_ = 0, dt_crit_ = 0;
   std::int64_t steps_ = 0;
   std::vector<std::uint32_t> perm_scratch_;
+  // Normal damping of disc–wall contacts from each wall's / terrain segment's restitution
+  // (Law::wall_damping), cached: recomputed when a wall's e or the law changes, and on initialise().
+  std::vector<double> wall_damping_, wall_damping_e_, terrain_damping_;
+  std::size_t damping_law_ = SIZE_MAX;  ///< law.index() the caches were computed for
+  /// Largest dashpot time-step factor (ζ + √(1+ζ²))² of the walls and terrain: the reference
+  /// stiffness of a disc without contacts is scaled by it, so the step in which a free disc first
+  /// touches a strongly damped wall is already short enough.
+  double wall_step_factor_ = 1.0;
 };
 
 }  // namespace geohaz::dem

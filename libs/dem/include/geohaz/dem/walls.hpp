@@ -23,6 +23,7 @@ struct WallSegment {
   Vec2 velocity = Vec2::Zero();             ///< prescribed velocity (m/s), or servo output
   double friction = 0.5;                    ///< μ of disc–wall contacts
   double restitution = 0.5;                 ///< e of disc–wall contacts
+  double rolling_friction = -1.0;           ///< μ_r of disc–wall contacts (< 0: the discs' contact μ_r)
   WallControl control = WallControl::Velocity;
   Vec2 servo_normal = Vec2::Zero();  ///< unit normal pointing into the sample (servo only)
   double target_stress = 0.0;        ///< servo target compressive normal stress (Pa)
@@ -62,8 +63,9 @@ inline Vec2 closest_point_on_segment(const Vec2& a, const Vec2& b, const Vec2& p
 /// Static terrain made of polylines, binned along x so a disc looks up only nearby segments.
 class TerrainSegments {
  public:
-  /// Add a polyline (≥ 2 vertices) with its friction and restitution.
-  void add_polyline(const std::vector<Vec2>& pts, double friction, double restitution);
+  /// Add a polyline (≥ 2 vertices) with its friction, restitution and rolling resistance
+  /// (< 0: the discs' contact μ_r).
+  void add_polyline(const std::vector<Vec2>& pts, double friction, double restitution, double rolling_friction = -1.0);
   /// Build the x-bins; max_reach is the largest disc radius (m).
   void build(double max_reach);
   std::size_t size() const noexcept { return segs_.size(); }
