@@ -30,9 +30,12 @@ foreach(lib IN LISTS _geohaz_libs)
   set_property(TARGET ${t} PROPERTY INTERFACE_INCLUDE_DIRECTORIES
                ${_wrapped} "$<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>")
   set_target_properties(${t} PROPERTIES EXPORT_NAME ${lib} OUTPUT_NAME geohaz_${lib})
-  # Position-independent code, so the static libraries can go into the Python module (a shared
-  # object); Debian's compiler builds position-independent executables anyway.
-  set_target_properties(${t} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  # Position-independent code (-fPIC rather than Debian's default -fPIE), so that the static
+  # libraries can go into the Python module, a shared object. Only then: docs/performance.md
+  # ("Python module overhead") compares the apps built both ways.
+  if(GEOHAZ_BUILD_PYTHON OR GEOHAZ_SHARED_LIBS)
+    set_target_properties(${t} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  endif()
   if(GEOHAZ_SHARED_LIBS)
     set_target_properties(${t} PROPERTIES VERSION ${PROJECT_VERSION} SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR})
   endif()
