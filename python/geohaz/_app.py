@@ -6,6 +6,7 @@ so from Python they run as the apps do; debris-runout runs in-process (geohaz.ru
 import csv
 import json
 import os
+import re
 import shutil
 import subprocess
 import tempfile
@@ -35,6 +36,18 @@ def find_app(app):
         return found
     raise FileNotFoundError(f"{app} not found (looked in {', '.join(map(str, candidates))} and PATH); "
                             "set GEOHAZ_BIN_DIR to the folder holding it")
+
+
+# An InputError's message as errors.cpp composes it: "FILE: 'KEY' = 'VALUE': REASON".
+_MESSAGE = re.compile(r"^(?P<file>.+?): '(?P<key>[^']+)'(?: = '(?P<value>.*?)')?: (?P<reason>.+)$", re.S)
+
+
+def _parts(text):
+    """(file, key, value, reason) of an app's error message; None where the message has none."""
+    m = _MESSAGE.match(text)
+    if not m:
+        return None, None, None, text
+    return m.group("file"), m.group("key"), m.group("value"), m.group("reason")
 
 
 def _read_csv(path):
@@ -79,10 +92,10 @@ def run_app(app, config, set_, out, threads, quiet):
                                 ("I/O error: ", IoError), ("system error: ", IoError), ("error: ", RuntimeError)):
                 tag = f"{app}: {prefix}"
                 if message.startswith(tag):
-                    e = exc(message[len(tag):])
+                    text = message[len(tag):]
+                    e = exc(text)
                     e.exit_code = proc.returncode
-                    # The app's message names file, key and value; they are not parsed out of it.
-                    e.reason, e.file, e.key, e.value = message[len(tag):], None, None, None
+                    e.file, e.key, e.value, e.reason = _parts(text)
                     raise e
             raise RuntimeError(message)
         result = {"out": None if tmp else str(out_dir), "stdout": proc.stdout}
