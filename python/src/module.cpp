@@ -1,0 +1,327 @@
+// The compiled part of the Python package `geohaz` (python/geohaz/): the exceptions and an
+// in-process debris-runout run. The Python side (python/geohaz/runout.py) turns keyword arguments
+// into the same config overrides as the app's flags; this file reads the config with the model's
+// own key declarations (runout::read_case), runs through libs/runout/run.hpp, and hands the maps,
+// particles, series and summary back as NumPy arrays and dicts.
+//
+// The GIL is released for the whole run; it is taken back only to call a progress callback (when
+// one is given) and, every few hundred steps, to let Ctrl-C interrupt the run.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "geohaz/core/app.hpp"
+#include "geohaz/core/config.hpp"
+#include "geohaz/core/errors.hpp"
+#include "geohaz/core/output.hpp"
+#include "geohaz/core/progress.hpp"
+#include "geohaz/core/snapshot.hpp"
+#include "geohaz/runout/run.hpp"
+
+namespace py = pybind11;
+namespace fs = std::filesystem;
+using namespace geohaz;
+using namespace geohaz::runout;
+
+namespace {
+
+// The Python exception classes, created in PYBIND11_MODULE.
+PyObject* g_input_error = nullptr;
+PyObject* g_simulation_error = nullptr;
+PyObject* g_io_error = nullptr;
+
+/// Raise `type` with message `what` and attributes (name → value) on the exception object.
+void raise_with(PyObject* type, const char* what, std::initializer_list<std::pair<const char*, std::string>> attrs) {
+  py::object exc = py::reinterpret_steal<py::object>(PyObject_CallFunction(type, "s", what));
+  if (!exc) return;  // the call set a Python error already
+  for (const auto& [name, value] : attrs) exc.attr(name) = value;
+  PyErr_SetObject(type, exc.ptr());
+}
+
+/// A 2D (ny, nx) float64 array of a map on the DSM grid; NaN where the DSM has no data (and where
+/// the map itself holds NaN, e.g. cells the flow never reached in arrival_time).
+py::array_t<double> grid_array(const Raster& dsm, const std::vector<double>& v) {
+  py::array_t<double> a({static_cast<py::ssize_t>(dsm.ny), static_cast<py::ssize_t>(dsm.nx)});
+  double* p = a.mutable_data();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t k = 0; k < v.size(); ++k) p[k] = dsm.is_nodata(dsm.data[k]) ? nan : v[k];
+  return a;
+}
+
+/// Every field of a particle store as NumPy arrays: scalars (n,), vectors (n, dim).
+template <class Store>
+py::dict particle_arrays(const Store& store) {
+  py::dict out;
+  const auto n = static_cast<py::ssize_t>(store.size());
+  store.for_each_field([&](auto tag, const auto& v) {
+    using Tag = decltype(tag);
+    using T = typename Tag::type;
+    if constexpr (std::is_arithmetic_v<T>) {
+      py::array_t<T> a(n);
+      std::copy(v.begin(), v.end(), a.mutable_data());
+      out[Tag::label] = a;
+    } else {  // a fixed-size Eigen vector
+      constexpr py::ssize_t dim = T::SizeAtCompileTime;
+      py::array_t<typename T::Scalar> a({n, dim});
+      auto* p = a.mutable_data();
+      for (py::ssize_t i = 0; i < n; ++i)
+        for (py::ssize_t d = 0; d < dim; ++d) p[i * dim + d] = v[static_cast<std::size_t>(i)](d);
+      out[Tag::label] = a;
+    }
+  });
+  return out;
+}
+
+/// The columns of series.csv as arrays.
+py::dict series_arrays(const std::vector<SeriesRow>& rows) {
+  const auto n = static_cast<py::ssize_t>(rows.size());
+  auto column = [&](auto get) {
+    py::array_t<double> a(n);
+    double* p = a.mutable_data();
+    for (py::ssize_t i = 0; i < n; ++i) p[i] = get(rows[static_cast<std::size_t>(i)]);
+    return a;
+  };
+  py::dict d;
+  d["time_s"] = column([](const SeriesRow& r) { return r.time; });
+  d["step"] = column([](const SeriesRow& r) { return static_cast<double>(r.step); });
+  d["particles"] = column([](const SeriesRow& r) { return static_cast<double>(r.particles); });
+  d["front_x_m"] = column([](const SeriesRow& r) { return r.front.x(); });
+  d["front_y_m"] = column([](const SeriesRow& r) { return r.front.y(); });
+  d["front_travel_m"] = column([](const SeriesRow& r) { return r.front_travel; });
+  d["front_drop_m"] = column([](const SeriesRow& r) { return r.front_drop; });
+  d["mean_speed_m_s"] = column([](const SeriesRow& r) { return r.mean_speed; });
+  d["max_speed_m_s"] = column([](const SeriesRow& r) { return r.max_speed; });
+  d["mobile_volume_m3"] = column([](const SeriesRow& r) { return r.volumes.mobile; });
+  d["deposited_volume_m3"] = column([](const SeriesRow& r) { return r.volumes.deposited; });
+  d["lost_volume_m3"] = column([](const SeriesRow& r) { return r.volumes.lost; });
+  return d;
+}
+
+/// The key figures, with the names of summary.json.
+py::dict summary_dict(const RunoutSimulation& sim, const RunoutCase& c) {
+  const RunoutResult r = sim.result();
+  const VolumeBudget& b = r.volumes;
+  py::dict s;
+  s["model"] = "debris-runout";
+  s["version"] = GEOHAZ_VERSION;
+  s["dsm"] = c.dsm;
+  s["release"] = sim.inputs().description;
+  s["friction"] = friction_name(sim.parameters().friction);
+  s["particles_released"] = r.particles_released;
+  s["particles_left"] = r.particles_left;
+  s["simulated_time_s"] = r.simulated_time;
+  s["steps"] = r.steps;
+  s["wall_time_s"] = r.wall_time;
+  s["ended_by"] = to_string(r.ended);
+  s["unfinished"] = r.unfinished();
+  s["runout_length_along_path_m"] = r.path.runout_length;
+  py::dict fb;
+  fb["drop_height_m"] = r.path.drop_height;
+  fb["reach_m"] = r.path.reach;
+  fb["ratio_H_over_L"] = r.path.fahrboeschung;
+  fb["angle_deg"] = r.path.fahrboeschung_deg;
+  fb["toe_x_m"] = r.path.toe.x();
+  fb["toe_y_m"] = r.path.toe.y();
+  s["fahrboeschung"] = fb;
+  py::dict com;
+  com["drop_m"] = r.path.com_drop;
+  com["travel_m"] = r.path.com_travel;
+  com["angle_deg"] = r.path.com_angle_deg;
+  s["centre_of_mass"] = com;
+  s["max_speed_m_s"] = r.max_speed;
+  s["max_pressure_pa"] = r.max_pressure;
+  s["area_affected_m2"] = r.affected_area;
+  py::dict vol;
+  vol["release_read"] = sim.inputs().volume;
+  vol["seeded"] = sim.seeded().volume_seeded;
+  vol["deposited"] = b.deposited;
+  vol["mobile"] = b.mobile;
+  vol["lost"] = b.lost;
+  vol["deposit_raster"] = r.deposit_raster_volume;
+  vol["mobile_raster"] = r.mobile_raster_volume;
+  s["volumes_m3"] = vol;
+  s["mass_balance_error_relative"] = b.initial > 0.0 ? b.balance_error() / b.initial : 0.0;
+  return s;
+}
+
+/// The observer of a run from Python: the progress callback (every `every` steps, and at start
+/// and end), snapshots and the progress line when writing into a directory, and Ctrl-C.
+class PythonObserver : public RunObserver {
+ public:
+  PythonObserver(py::object callback, int every, double duration) : cb_(std::move(callback)), every_(every) {
+    duration_ = duration;
+  }
+  std::unique_ptr<SnapshotWriter> snapshots;
+  double snapshot_interval = 0.0;
+  std::unique_ptr<ProgressReporter> progress;
+
+  void started(const RunoutSimulation& sim) override {
+    if (snapshots) {
+      write_snapshot(sim);
+      next_snapshot_ = snapshot_interval;
+    }
+    call("started", sim);
+  }
+  void stepped(const RunoutSimulation& sim) override {
+    const auto& s = sim.solver();
+    if (snapshots && (s.time() >= next_snapshot_ - 1e-9 || s.finished())) {
+      write_snapshot(sim);
+      while (next_snapshot_ <= s.time() + 1e-9) next_snapshot_ += snapshot_interval;
+    }
+    if (progress) progress->update(s.time(), s.step_count(), s.particles().size());
+    const std::int64_t k = s.step_count();
+    if (!cb_.is_none() && k % every_ == 0) {
+      call("running", sim);
+    } else if (k % 256 == 0) {  // let Ctrl-C through without a callback
+      py::gil_scoped_acquire gil;
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    }
+  }
+  void finished(const RunoutSimulation& sim) override {
+    const auto& s = sim.solver();
+    if (progress) progress->finish(s.time(), s.step_count(), s.particles().size());
+    call("finished", sim);
+  }
+
+ private:
+  void write_snapshot(const RunoutSimulation& sim) {
+    const auto& s = sim.solver();
+    snapshots->write(s.particles(), s.time(), s.step_count());
+  }
+  void call(const char* phase, const RunoutSimulation& sim) {
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    if (cb_.is_none()) return;
+    const auto& s = sim.solver();
+    py::dict d;
+    d["phase"] = phase;
+    d["time"] = s.time();
+    d["duration"] = duration_;
+    d["step"] = s.step_count();
+    d["particles"] = s.particles().size();
+    d["mobile_volume"] = s.budget().mobile;
+    cb_(d);
+  }
+  py::object cb_;
+  int every_;
+  double duration_ = 0.0, next_snapshot_ = 0.0;
+};
+
+/// geohaz._geohaz.runout_run: see python/geohaz/runout.py for the documented signature.
+py::dict runout_run(const std::string& config, const std::vector<std::string>& overrides, const std::string& out,
+                    py::object progress, int progress_every, bool quiet, int threads, bool particles) {
+  if (progress_every < 1) throw InputError("must be ≥ 1", "python", "progress_every", std::to_string(progress_every));
+  if (!progress.is_none() && !PyCallable_Check(progress.ptr()))
+    throw InputError("must be callable (or None)", "python", "progress");
+  const int nthreads = setup_threads(threads);
+  // Config: the file, then the overrides in the order of the app (--set, direct flags, inputs).
+  ConfigReader cfg =
+      config.empty() ? ConfigReader::from_string("", "<no config file>") : ConfigReader::from_file(config);
+  for (const auto& o : overrides) cfg.apply_override(o);
+  RunoutCase c = read_case(cfg);
+  cfg.finish();
+  c.resolved_config = cfg.resolved();
+
+  auto in = std::make_unique<RunoutInputs>();
+  std::unique_ptr<RunoutSimulation> sim;
+  PythonObserver obs(progress, progress_every, c.params.duration);
+  {
+    py::gil_scoped_release nogil;
+    // 1-2. Inputs and particles, all checked before anything is written (as run_case).
+    *in = load_inputs(c);
+    sim = std::make_unique<RunoutSimulation>(*in, c.params, c.output);
+    // 3. Outputs only now, when asked for.
+    if (!out.empty()) {
+      make_output_dir(out);
+      write_text_file(fs::path(out) / "config.resolved.toml", c.resolved_config);
+      if (c.output.snapshots) {
+        obs.snapshots =
+            std::make_unique<SnapshotWriter>(fs::path(out) / "snapshots.h5", "debris-runout", 2, c.resolved_config);
+        obs.snapshots->set_attribute("crs_wkt", in->dsm.crs_wkt);
+        obs.snapshots->set_attribute("release_volume", in->volume);
+        obs.snapshot_interval = c.output.snapshot_interval;
+      }
+    }
+    if (!quiet) obs.progress = std::make_unique<ProgressReporter>("debris-runout", c.params.duration, quiet);
+    sim->run(&obs);
+    obs.snapshots.reset();  // closes the HDF5 file
+    if (!out.empty()) write_outputs(c, *sim, out, nthreads);
+  }
+
+  const Raster& dsm = in->dsm;
+  const HazardMaps& m = sim->maps();
+  py::dict maps;
+  maps["max_depth"] = grid_array(dsm, m.max_depth());
+  maps["max_speed"] = grid_array(dsm, m.max_speed());
+  maps["max_pressure"] = grid_array(dsm, m.max_pressure());
+  maps["deposit"] = grid_array(dsm, sim->deposit());
+  maps["mobile_at_end"] = grid_array(dsm, sim->mobile_at_end());
+  maps["arrival_time"] = grid_array(dsm, m.arrival_time());
+  std::vector<double> z(dsm.data);
+  for (double& v : z)
+    if (dsm.is_nodata(v)) v = std::numeric_limits<double>::quiet_NaN();
+
+  py::dict r;
+  r["summary"] = summary_dict(*sim, c);
+  r["maps"] = maps;
+  r["dsm"] = grid_array(dsm, z);
+  r["release_thickness"] = grid_array(dsm, in->thickness);
+  r["geotransform"] = py::make_tuple(dsm.geotransform[0], dsm.geotransform[1], dsm.geotransform[2], dsm.geotransform[3],
+                                     dsm.geotransform[4], dsm.geotransform[5]);
+  r["crs_wkt"] = dsm.crs_wkt;
+  r["series"] = series_arrays(sim->series());
+  r["particles"] = particles ? py::object(particle_arrays(sim->solver().particles())) : py::none();
+  r["resolved_config"] = c.resolved_config;
+  r["out"] = out.empty() ? py::none() : py::object(py::str(out));
+  r["threads"] = nthreads;
+  return r;
+}
+
+/// The config keys of debris-runout with unit, default, range and help (as --help-config).
+std::string runout_help_config() {
+  ConfigReader d = ConfigReader::describe();
+  read_case(d);
+  return ConfigReader::format_reference(d.reference());
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_geohaz, m) {
+  m.doc() = "geohaz: compiled core of the Python package (use the geohaz package, not this module)";
+  m.attr("__version__") = GEOHAZ_VERSION;
+
+  // Exceptions: InputError subclasses ValueError (bad input), IoError subclasses OSError,
+  // SimulationError subclasses RuntimeError; all three carry the message the apps print after
+  // "<app>: input error: " etc.
+  static py::exception<InputError> input_error(m, "InputError", PyExc_ValueError);
+  static py::exception<SimulationError> simulation_error(m, "SimulationError", PyExc_RuntimeError);
+  static py::exception<IoError> io_error(m, "IoError", PyExc_OSError);
+  g_input_error = input_error.ptr();
+  g_simulation_error = simulation_error.ptr();
+  g_io_error = io_error.ptr();
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      raise_with(g_input_error, e.what(),
+                 {{"file", e.file()}, {"key", e.key()}, {"value", e.value()}, {"reason", e.reason()}});
+    } catch (const SimulationError& e) {
+      raise_with(g_simulation_error, e.what(), {});
+    } catch (const IoError& e) {
+      raise_with(g_io_error, e.what(), {{"file", e.file()}});
+    }
+  });
+
+  m.def("runout_run", &runout_run, py::arg("config"), py::arg("overrides"), py::arg("out"), py::arg("progress"),
+        py::arg("progress_every"), py::arg("quiet"), py::arg("threads"), py::arg("particles"));
+  m.def("runout_help_config", &runout_help_config);
+}
