@@ -323,3 +323,51 @@ TEST(SphSlopeApp, BlowUpStopsWithDiagnosisAndKeepsSnapshots) {
 }
 
 }  // namespace
+
+namespace {
+
+// Strength reduction on the ACADS 1(a) slope (Giam & Donald 1989, referee F = 1.00) at 1 m spacing
+// (10 particles over the height; the data file's 0.5 m and the validation run's 0.25 m are the
+// coarse and the full versions): a bracketed factor within 5 % of the referee and of Bishop's factor
+// computed on the same section, the trials, the curve and the mechanism written. About 10 s.
+TEST(SphSlopeApp, StrengthReductionBracketsTheAcadsFactor) {
+  const fs::path out = kWork / "srm_acads";
+  fs::remove_all(out);
+  const auto r = run("--config " + (kData / "acads_1a_srm.toml").string() + " --out " + out.string() +
+                         " --set numerics.spacing=1.0 --set strength_reduction.f_min=0.8"
+                         " --set strength_reduction.f_max=1.3 --set strength_reduction.tolerance=0.04 --quiet",
+                     "srm_acads");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto s = summary(out);
+  EXPECT_EQ(s["outcome"], "bracketed");
+  const double F = s["factor_of_safety"].get<double>(), Fb = s["bishop"]["factor"].get<double>();
+  EXPECT_NEAR(F, 1.00, 0.05);
+  EXPECT_NEAR(Fb, 1.00, 0.03);
+  EXPECT_NEAR(F, Fb, 0.05 * Fb);
+  const double lo = s["bracket"][0].get<double>(), hi = s["bracket"][1].get<double>();
+  EXPECT_LE(hi - lo, 0.04 + 1e-12);
+  EXPECT_EQ(csv_rows(out / "srm_trials.csv"), s["trials"].get<std::size_t>());
+  for (const char* f :
+       {"srm_curve.csv", "srm_curve.png", "mechanism.png", "slip_surface.csv", "bishop_circle.csv", "snapshots.h5"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  // The mechanism: the failed trial's slip surface leaves the slope near the toe (x = 45 m), as
+  // Bishop's circle does.
+  EXPECT_NEAR(s["bishop"]["exit_x_m"].get<double>(), 45.0, 2.0);
+}
+
+TEST(SphSlopeApp, StrengthReductionBadRangeExitsTwoNamingTheKey) {
+  const fs::path out = kWork / "srm_bad";
+  fs::remove_all(out);
+  for (const auto& [set, key] : std::vector<std::pair<std::string, std::string>>{
+           {"strength_reduction.tolerance=0", "strength_reduction.tolerance"},
+           {"strength_reduction.f_min=-1", "strength_reduction.f_min"},
+           {"strength_reduction.f_max=0.4", "strength_reduction.f_max"}}) {
+    const auto r = run(
+        "--config " + (kData / "acads_1a_srm.toml").string() + " --out " + out.string() + " --set " + set, "srm_bad");
+    EXPECT_EQ(r.code, 2) << set << ": " << r.err;
+    EXPECT_NE(r.err.find(key), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+}  // namespace
