@@ -122,6 +122,23 @@ RunConfig read_config(ConfigReader& r, bool describe) {
         kDeg * m.get("dilatancy", 0.0, Range::closed_open(0.0, 90.0), {"deg", "dilatancy angle psi (<= phi)"});
     p.yield_stress = m.get("yield_stress", 1e5, Range::positive(), {"Pa", "uniaxial yield stress (von Mises)"});
     p.viscosity = m.get("viscosity", 1e-3, Range::non_negative(), {"Pa s", "dynamic viscosity (Newtonian fluid)"});
+    p.residual_cohesion =
+        m.get("residual_cohesion", p.cohesion, Range::non_negative(),
+              {"Pa", "residual cohesion c_r <= cohesion (drucker_prager_softening; default: cohesion)"});
+    p.residual_friction =
+        kDeg *
+        m.get("residual_friction", p.friction / kDeg, Range::closed_open(0.0, 90.0),
+              {"deg", "residual friction angle phi_r <= friction (drucker_prager_softening; default: friction)"});
+    p.softening_strain =
+        m.get("softening_strain", p.softening_strain, Range::positive(),
+              {"1", "plastic strain (sum of plastic multipliers) over which c and phi fall to residual"});
+    if (p.residual_cohesion > p.cohesion)
+      throw InputError("residual cohesion must not exceed the peak cohesion (" + std::to_string(p.cohesion) + " Pa)",
+                       r.source(), "material.residual_cohesion", std::to_string(p.residual_cohesion));
+    if (p.residual_friction > p.friction + 1e-12)
+      throw InputError(
+          "residual friction must not exceed the peak friction angle (" + std::to_string(p.friction / kDeg) + " deg)",
+          r.source(), "material.residual_friction", std::to_string(p.residual_friction / kDeg));
     p.fit = dpfit;
     if (p.dilatancy > p.friction + 1e-12)
       throw InputError("dilatancy must not exceed the friction angle", r.source(), "material.dilatancy",

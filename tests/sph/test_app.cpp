@@ -4,6 +4,7 @@
 // release file for debris-runout conserves the failed volume (handoff spec).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -364,6 +365,75 @@ TEST(SphSlopeApp, StrengthReductionBadRangeExitsTwoNamingTheKey) {
            {"strength_reduction.f_max=0.4", "strength_reduction.f_max"}}) {
     const auto r = run(
         "--config " + (kData / "acads_1a_srm.toml").string() + " --out " + out.string() + " --set " + set, "srm_bad");
+    EXPECT_EQ(r.code, 2) << set << ": " << r.err;
+    EXPECT_NE(r.err.find(key), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+}  // namespace
+
+namespace {
+
+/// Deviator column (Pa, compression negative) of stress_strain.csv.
+std::vector<double> deviators(const fs::path& p) {
+  std::ifstream in(p);
+  std::string line;
+  std::getline(in, line);
+  std::vector<double> q;
+  while (std::getline(in, line)) q.push_back(std::stod(line.substr(line.rfind(',') + 1)));
+  return q;
+}
+
+/// Plane-strain Drucker–Prager constants (seed 002 eqs. 18–19).
+std::pair<double, double> dp_plane_strain(double c, double phi_deg) {
+  const double t = std::tan(phi_deg * 3.14159265358979323846 / 180.0), d = std::sqrt(9.0 + 12.0 * t * t);
+  return {t / d, 3.0 * c / d};
+}
+
+// Strain softening in the SPH biaxial test (unconfined plane strain, rough platens, 10 × 20
+// particles, ψ = 0): c = 20 kPa, φ = 25° falling to c_r = 2 kPa, φ_r = 20° over κ_r = 0.02. Peak: first
+// yield of the elastic state (σ_lateral = 0, σ_zz = −ν q) on the peak surface, solved for q by
+// bisection; residual: steady plastic flow on the residual surface (s_zz = 0 with ψ = 0 and
+// ε̇_zz = 0), q = k_r/(½ − 3α_r/2). Tolerance 5 % (the issue's). About 3 s.
+TEST(SphSlopeApp, SofteningBiaxialDropsFromPeakToResidual) {
+  const fs::path out = kWork / "softening_biaxial";
+  fs::remove_all(out);
+  const auto r = run("--config " + (kData / "biaxial.toml").string() + " --out " + out.string() +
+                         " --set numerics.spacing=0.005 --set model.constitutive=drucker_prager_softening"
+                         " --set material[0].residual_cohesion=2e3 --set material[0].residual_friction=20"
+                         " --set material[0].softening_strain=0.02 --set run.end_time=0.1"
+                         " --set run.output_interval=0.0002 --quiet",
+                     "softening_biaxial");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto q = deviators(out / "stress_strain.csv");
+  ASSERT_GT(q.size(), 100u);
+  const double peak = -*std::min_element(q.begin(), q.end()), residual = -q.back();
+  const auto [a, k] = dp_plane_strain(20e3, 25.0);
+  const double nu = 0.3;
+  auto f = [&](double qq) {  // yield function at σ = diag(0, −q, −ν q)
+    const double s0 = 0.0, s1 = -qq, s2 = -nu * qq, m = (s0 + s1 + s2) / 3.0;
+    const double j2 = 0.5 * ((s0 - m) * (s0 - m) + (s1 - m) * (s1 - m) + (s2 - m) * (s2 - m));
+    return a * (s0 + s1 + s2) + std::sqrt(j2) - k;
+  };
+  double lo = 0.0, hi = 1e6;
+  for (int it = 0; it < 200; ++it) (f(0.5 * (lo + hi)) > 0.0 ? hi : lo) = 0.5 * (lo + hi);
+  const auto [ar, kr] = dp_plane_strain(2e3, 20.0);
+  const double q_res = kr / (0.5 - 1.5 * ar);
+  EXPECT_NEAR(peak, lo, 0.05 * lo);            // 51.2 kPa against 52.5 kPa
+  EXPECT_NEAR(residual, q_res, 0.05 * q_res);  // 5.58 kPa against 5.55 kPa
+}
+
+TEST(SphSlopeApp, ResidualAbovePeakExitsTwoNamingTheKey) {
+  const fs::path out = kWork / "bad_residual";
+  fs::remove_all(out);
+  for (const auto& [set, key] :
+       std::vector<std::pair<std::string, std::string>>{{"material[0].residual_cohesion=30e3", "residual_cohesion"},
+                                                        {"material[0].residual_friction=30", "residual_friction"},
+                                                        {"material[0].softening_strain=0", "softening_strain"}}) {
+    const auto r = run("--config " + (kData / "biaxial.toml").string() + " --out " + out.string() +
+                           " --set model.constitutive=drucker_prager_softening --set " + set,
+                       "bad_residual");
     EXPECT_EQ(r.code, 2) << set << ": " << r.err;
     EXPECT_NE(r.err.find(key), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out));

@@ -63,6 +63,19 @@ nlohmann::json model_parameters(const ConstitutiveModel& model, const MaterialPa
                                              {"alpha_psi", m.dp.alpha_psi},
                                              {"min_density_kg_per_m3", DruckerPrager::min_density(m)}};
                                },
+                               [&](const DruckerPragerSoftening&) {
+                                 const auto r = drucker_prager_constants(m.residual_cohesion, m.residual_friction,
+                                                                         m.dilatancy, m.fit);
+                                 return json{{"K_Pa", m.bulk},
+                                             {"G_Pa", m.shear},
+                                             {"alpha_phi", m.dp.alpha_phi},
+                                             {"k_c_Pa", m.dp.kc},
+                                             {"alpha_psi", m.dp.alpha_psi},
+                                             {"residual_alpha_phi", r.alpha_phi},
+                                             {"residual_k_c_Pa", r.kc},
+                                             {"softening_strain", m.softening_strain},
+                                             {"min_density_kg_per_m3", DruckerPragerSoftening::min_density(m)}};
+                               },
                                [&](const NewtonianFluid&) {
                                  return json{{"K_Pa", m.bulk}, {"viscosity_Pa_s", m.viscosity}};
                                }},
@@ -673,6 +686,8 @@ std::vector<MaterialParams> reduced_strength(const std::vector<MaterialParams>& 
     p.cohesion /= F;
     p.friction = std::atan(std::tan(p.friction) / F);
     p.dilatancy = std::atan(std::tan(p.dilatancy) / F);
+    p.residual_cohesion /= F;
+    p.residual_friction = std::atan(std::tan(p.residual_friction) / F);
   }
   return r;
 }
