@@ -41,6 +41,35 @@ RunConfig read_config(ConfigReader& r, bool describe) {
                : sc == "column"  ? ScenarioType::Column
                : sc == "biaxial" ? ScenarioType::Biaxial
                                  : ScenarioType::Section;
+  c.analysis = r.get_choice("run.analysis", "dynamic", {"dynamic", "strength_reduction"},
+                            {"",
+                             "dynamic: the main phase in time; strength_reduction: the factor of safety by "
+                             "strength reduction from the geostatic state, with Bishop's factor beside it "
+                             "([strength_reduction])"}) == "dynamic"
+                   ? Analysis::Dynamic
+                   : Analysis::StrengthReduction;
+  {  // read whatever the analysis, so that --set run.analysis=... works on any config
+    const StrengthReductionSettings d;
+    auto& q = c.srm;
+    q.f_min =
+        r.get("strength_reduction.f_min", d.f_min, Range::positive(), {"1", "lower end of the initial F bracket"});
+    q.f_max = r.get("strength_reduction.f_max", d.f_max, Range::positive(),
+                    {"1", "upper end of the initial F bracket (> f_min)"});
+    q.tolerance = r.get("strength_reduction.tolerance", d.tolerance, Range::positive(),
+                        {"1", "bisection stops when the bracket of F is narrower than this"});
+    q.damping = r.get("strength_reduction.damping", d.damping, Range::closed_open(0.0, 1.0),
+                      {"1", "Cundall local damping zeta of the quasi-static trials"});
+    q.trial_duration = r.get("strength_reduction.trial_duration", d.trial_duration, Range::non_negative(),
+                             {"s", "simulated time of each trial (0: 30 H / c_p)"});
+    q.knee_ratio = r.get("strength_reduction.knee_ratio", d.knee_ratio, Range::open_closed(1.0, 1e6),
+                         {"1",
+                          "a trial fails when its largest displacement exceeds this multiple of that of the "
+                          "f_min trial (the knee of the F-displacement curve)"});
+    q.growth_ratio = r.get("strength_reduction.growth_ratio", d.growth_ratio, Range::open_closed(0.0, 1.0),
+                           {"1",
+                            "a trial fails when its largest displacement grew by more than this fraction of its "
+                            "final value over the last quarter of the trial"});
+  }
   c.end_time = r.get("run.end_time", 1.0, Range::positive(), {"s", "simulated time of the main phase"});
   c.output_interval = r.get("run.output_interval", 0.01, Range::positive(), {"s", "time-series interval"});
   c.snapshot_interval = r.get("run.snapshot_interval", 0.1, Range::non_negative(),
@@ -93,6 +122,23 @@ RunConfig read_config(ConfigReader& r, bool describe) {
         kDeg * m.get("dilatancy", 0.0, Range::closed_open(0.0, 90.0), {"deg", "dilatancy angle psi (<= phi)"});
     p.yield_stress = m.get("yield_stress", 1e5, Range::positive(), {"Pa", "uniaxial yield stress (von Mises)"});
     p.viscosity = m.get("viscosity", 1e-3, Range::non_negative(), {"Pa s", "dynamic viscosity (Newtonian fluid)"});
+    p.residual_cohesion =
+        m.get("residual_cohesion", p.cohesion, Range::non_negative(),
+              {"Pa", "residual cohesion c_r <= cohesion (drucker_prager_softening; default: cohesion)"});
+    p.residual_friction =
+        kDeg *
+        m.get("residual_friction", p.friction / kDeg, Range::closed_open(0.0, 90.0),
+              {"deg", "residual friction angle phi_r <= friction (drucker_prager_softening; default: friction)"});
+    p.softening_strain =
+        m.get("softening_strain", p.softening_strain, Range::positive(),
+              {"1", "plastic strain (sum of plastic multipliers) over which c and phi fall to residual"});
+    if (p.residual_cohesion > p.cohesion)
+      throw InputError("residual cohesion must not exceed the peak cohesion (" + std::to_string(p.cohesion) + " Pa)",
+                       r.source(), "material.residual_cohesion", std::to_string(p.residual_cohesion));
+    if (p.residual_friction > p.friction + 1e-12)
+      throw InputError(
+          "residual friction must not exceed the peak friction angle (" + std::to_string(p.friction / kDeg) + " deg)",
+          r.source(), "material.residual_friction", std::to_string(p.residual_friction / kDeg));
     p.fit = dpfit;
     if (p.dilatancy > p.friction + 1e-12)
       throw InputError("dilatancy must not exceed the friction angle", r.source(), "material.dilatancy",

@@ -92,11 +92,12 @@ const char* app_name(App a) {
 }
 
 /// Settings appended after the (mutated) config so every run is short: tiny end times and a
-/// shortened preparation phase. They are --set overrides, so the config's own values are still
-/// parsed and checked.
+/// shortened preparation phase (sph-slope: also the trials of a strength-reduction analysis).
+/// They are --set overrides, so the config's own values are still parsed and checked.
 std::vector<std::string> tiny(App a, const std::string& config_name) {
   if (a == App::Sph)
-    return {"--set", "run.end_time=0.002", "--set", "geostatic.duration=0.002", "--set", "run.velocity_png_times=[]"};
+    return {"--set", "run.end_time=0.002",        "--set", "geostatic.duration=0.002",
+            "--set", "run.velocity_png_times=[]", "--set", "strength_reduction.trial_duration=0.002"};
   if (a == App::Dem) {
     if (config_name.find("avalanche") != std::string::npos)
       return {"--set", "avalanche.settle_time=0.02", "--set", "avalanche.runout_time=0.05"};

@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
-#include "plot.hpp"
 #include "geohaz/core/raster.hpp"
 #include "geohaz/core/snapshot.hpp"
+#include "plot.hpp"
 
 namespace {
 
@@ -251,6 +251,27 @@ TEST(Validation, BiaxialCompression) {
 }
 
 // Figures of docs/validation/sph.md from the runs above (run this test last).
+// Factor of safety of the ACADS 1(a) slope (Giam & Donald 1989: H = 10 m at 2H:1V, c′ = 3 kPa,
+// φ′ = 19.6°, γ = 20 kN/m³; referee F = 1.00, mean Bishop of the survey 0.993) by strength reduction
+// at 1, 0.5 and 0.25 m spacing (10, 20, 40 particles over the height), and Bishop's factor on the
+// same section. The tolerances: SRM within 5 % of the referee at the full resolution
+// (0.25 m), Bishop within 3 %.
+TEST(Validation, AcadsOneAFactorOfSafety) {
+  for (const auto& [name, dx] :
+       {std::pair{"acads_srm_1m", 1.0}, std::pair{"acads_srm_05m", 0.5}, std::pair{"acads_srm_025m", 0.25}}) {
+    const auto s = run_case(name, "acads_1a_srm.toml",
+                            "--set numerics.spacing=" + std::to_string(dx) +
+                                " --set strength_reduction.f_min=0.8 --set strength_reduction.f_max=1.2");
+    ASSERT_EQ(s.value("outcome", ""), "bracketed") << name;
+    EXPECT_NEAR(s["bishop"]["factor"].get<double>(), 1.00, 0.03);
+    if (dx == 0.25) {
+      EXPECT_NEAR(s["factor_of_safety"].get<double>(), 1.00, 0.05);
+      copy_figure(name, "mechanism.png", "acads_srm_mechanism.png");
+      copy_figure(name, "srm_curve.png", "acads_srm_curve.png");
+    }
+  }
+}
+
 TEST(Validation, Figures) {
   // Column collapse: (L∞ − L0)/L0 vs a, model dots (blue) and the experimental laws (black).
   {
@@ -269,8 +290,8 @@ TEST(Validation, Figures) {
   // upper cut at Δx = 5 mm, without (blue) and with the cut (green).
   for (const auto& [file, runs] :
        {std::pair{"seed001_runout_vs_time.png",
-                  std::vector<std::pair<const char*, std::array<std::uint8_t, 3>>>{{"seed001_granular", {30, 90, 200}},
-                                                                                   {"seed001_cohesive", {200, 40, 40}}}},
+                  std::vector<std::pair<const char*, std::array<std::uint8_t, 3>>>{
+                      {"seed001_granular", {30, 90, 200}}, {"seed001_cohesive", {200, 40, 40}}}},
         std::pair{"seed001_upper_cut_runout_vs_time.png",
                   std::vector<std::pair<const char*, std::array<std::uint8_t, 3>>>{
                       {"seed001_nocut_5mm", {30, 90, 200}}, {"seed001_cut_5mm", {40, 160, 60}}}}}) {

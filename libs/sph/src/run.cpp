@@ -17,6 +17,7 @@
 #include "geohaz/core/resources.hpp"
 #include "geohaz/core/snapshot.hpp"
 #include "geohaz/sph/diagnostics.hpp"
+#include "geohaz/sph/limit_equilibrium.hpp"
 
 namespace geohaz::sph {
 
@@ -61,6 +62,19 @@ nlohmann::json model_parameters(const ConstitutiveModel& model, const MaterialPa
                                              {"k_c_Pa", m.dp.kc},
                                              {"alpha_psi", m.dp.alpha_psi},
                                              {"min_density_kg_per_m3", DruckerPrager::min_density(m)}};
+                               },
+                               [&](const DruckerPragerSoftening&) {
+                                 const auto r = drucker_prager_constants(m.residual_cohesion, m.residual_friction,
+                                                                         m.dilatancy, m.fit);
+                                 return json{{"K_Pa", m.bulk},
+                                             {"G_Pa", m.shear},
+                                             {"alpha_phi", m.dp.alpha_phi},
+                                             {"k_c_Pa", m.dp.kc},
+                                             {"alpha_psi", m.dp.alpha_psi},
+                                             {"residual_alpha_phi", r.alpha_phi},
+                                             {"residual_k_c_Pa", r.kc},
+                                             {"softening_strain", m.softening_strain},
+                                             {"min_density_kg_per_m3", DruckerPragerSoftening::min_density(m)}};
                                },
                                [&](const NewtonianFluid&) {
                                  return json{{"K_Pa", m.bulk}, {"viscosity_Pa_s", m.viscosity}};
@@ -322,9 +336,10 @@ Restart load_restart(const std::filesystem::path& path, SphStore<Dim>& s) {
 }
 
 /// Quick-look picture: particles in the x–z plane coloured by `value` (soil) on a ramp, boundary grey.
+/// `overlay` (optional): a polyline in (x, z) drawn in red over the particles (a slip circle).
 template <int Dim>
 void draw_particles(const std::filesystem::path& path, const SphStore<Dim>& s, const std::vector<double>& value,
-                    double vmax, double dx) {
+                    double vmax, double dx, const std::vector<std::array<double, 2>>& overlay = {}) {
   const auto& x = s.template get<Position<Dim>>();
   const auto& kind = s.template get<ParticleKind>();
   double x0 = 1e300, x1 = -1e300, z0 = 1e300, z1 = -1e300;
@@ -348,6 +363,13 @@ void draw_particles(const std::filesystem::path& path, const SphStore<Dim>& s, c
     if (kind[i] == kSoil)
       col = ramp_colour(ColourRamp::Viridis, vmax > 0 ? std::clamp(value[i] / vmax, 0.0, 1.0) : 0.0);
     img.fill_circle(px, pz, r, col);
+  }
+  for (std::size_t k = 1; k < overlay.size(); ++k) {
+    auto px = [&](double xx) { return margin + (xx - x0) * scale + 0.5 * (W - 2 * margin - (x1 - x0) * scale); };
+    auto pz = [&](double zz) { return H - 30 - margin - (zz - z0) * scale; };
+    for (int d = -1; d <= 1; ++d)
+      img.line(px(overlay[k - 1][0]), pz(overlay[k - 1][1]) + d, px(overlay[k][0]), pz(overlay[k][1]) + d,
+               {220, 30, 30});
   }
   // Colour bar along the bottom (0 … vmax).
   for (int px = margin; px < W - margin; ++px) {
@@ -657,6 +679,261 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
   return 0;
 }
 
+/// Every material with c/F, atan(tan φ/F) and atan(tan ψ/F) (strength reduction).
+std::vector<MaterialParams> reduced_strength(const std::vector<MaterialParams>& mats, double F) {
+  auto r = mats;
+  for (auto& p : r) {
+    p.cohesion /= F;
+    p.friction = std::atan(std::tan(p.friction) / F);
+    p.dilatancy = std::atan(std::tan(p.dilatancy) / F);
+    p.residual_cohesion /= F;
+    p.residual_friction = std::atan(std::tan(p.residual_friction) / F);
+  }
+  return r;
+}
+
+template <int Dim>
+double max_soil_displacement(const SphStore<Dim>& s) {
+  double u = 0.0;
+  const auto& d = s.template get<Displacement<Dim>>();
+  const auto& k = s.template get<ParticleKind>();
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (k[i] == kSoil) u = std::max(u, d[i].norm());
+  return u;
+}
+
+/// One strength-reduction trial: its factor and what decided it.
+struct SrmTrial {
+  double factor = 1.0;
+  double displacement = 0.0;  ///< largest soil displacement at the end (m)
+  double growth = 0.0;        ///< its growth over the last quarter of the trial (m)
+  bool failed = false;
+  bool blew_up = false;  ///< the trial stopped with a SimulationError (counted as failed)
+  std::int64_t steps = 0;
+};
+
+/// The Bishop cross-check on the section of a 2D slope scenario (not admissible, F = +∞, for other
+/// scenarios).
+BishopResult bishop_of(const RunConfig& c) {
+  if (c.scenario != ScenarioType::Slope || c.dimension != 2) return {};
+  ProfileDomain d = c.slope.profile();
+  if (!c.layer_materials.empty()) {
+    d.layer_tops = c.layer_tops;
+    d.layer_materials = c.layer_materials;
+  } else {
+    d.layer_tops.clear();
+    d.layer_materials.clear();
+  }
+  std::vector<LimitEquilibriumSoil> soils;
+  for (const auto& m : c.materials) soils.push_back({m.density * c.numerics.gravity, m.cohesion, m.friction});
+  return bishop_critical_circle(SlopeSection::from_profile(d, soils));
+}
+
+/// Factor of safety by strength reduction (docs/sph.md, "Factor of safety by strength reduction").
+template <int Dim>
+int run_strength_reduction(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  Built<Dim> b = build<Dim>(c);
+  auto settings = settings_for<Dim>(c, b.sc);
+  settings.earthquake = EarthquakeLoading{};  // gravity only
+  settings.damping = c.srm.damping;
+  const double href = b.sc.reference_height;
+  SphSolver<Dim> geo(std::move(b.sc.store), c.materials, c.model, settings);
+  const double cmax = geo.max_wave_speed();
+  make_output_dir(out);
+  write_text_file(out / "config.resolved.toml", c.resolved_config);
+  nlohmann::json summary;
+  summary["analysis"] = "strength_reduction";
+  summary["scenario"] = scenario_name(c.scenario);
+  summary["dimension"] = Dim;
+  summary["model"] = geo.model_name();
+  summary["config"] = c.config_source;
+  summary["soil_particles"] = b.sc.soil_count;
+  summary["spacing_m"] = c.numerics.spacing;
+
+  // The geostatic state every trial starts from.
+  if (!c.restart.empty()) {
+    const Restart rs = load_restart<Dim>(c.restart, geo.store());
+    for (auto& v : geo.store().template get<Velocity<Dim>>()) v.setZero();
+    for (auto& u : geo.store().template get<Displacement<Dim>>()) u.setZero();
+    summary["restart"] = {{"file", c.restart.string()}, {"time_s", rs.time}};
+  } else {
+    const double dur = c.geostatic_duration > 0.0 ? c.geostatic_duration : 20.0 * href / cmax;
+    ProgressReporter prog("sph-slope geostatic", dur, quiet);
+    const auto rep = geo.apply_gravity_gradually(dur, c.geostatic_damping, c.geostatic_elastic);
+    prog.finish(dur, rep.steps, geo.store().size());
+    summary["geostatic"] = {{"duration_s", dur}, {"steps", rep.steps}, {"max_speed_m_per_s", rep.max_speed}};
+  }
+  const SphStore<Dim> initial = geo.store();
+  SnapshotWriter snaps(out / "snapshots.h5", "sph-slope", Dim, c.resolved_config);
+  snaps.set_attribute("scenario", scenario_name(c.scenario));
+  snaps.set_attribute("units", "SI: m, s, kg, Pa");
+  snaps.set_attribute("contents", "snapshot 0: geostatic state; snapshot 1: the failed trial at the critical factor");
+  write_fields<Dim>(snaps, initial, 0.0, 0);
+
+  const double T = c.srm.trial_duration > 0.0 ? c.srm.trial_duration : 30.0 * href / cmax;
+  double u_ref = -1.0;  // largest displacement of the f_min trial (the stable reference), m
+  std::vector<SrmTrial> trials;
+  std::optional<SphStore<Dim>> mechanism;  // the store of the failed trial at the upper end of the bracket
+  auto trial = [&](double F) {
+    SrmTrial t;
+    t.factor = F;
+    SphSolver<Dim> s(initial, reduced_strength(c.materials, F), c.model, settings);
+    double u75 = -1.0;
+    try {
+      while (s.time() < T) {
+        s.step();
+        if (u75 < 0.0 && s.time() >= 0.75 * T) u75 = max_soil_displacement(s.store());
+      }
+      t.displacement = max_soil_displacement(s.store());
+      t.growth = t.displacement - std::max(u75, 0.0);
+      // Failure: the displacement has not converged, or (once the stable reference exists) it lies
+      // beyond the knee of the F–displacement curve. SPH follows a failing mass to a new equilibrium
+      // after it has slid, so a trial just above the critical F may have stopped again by T.
+      t.failed = t.growth > c.srm.growth_ratio * t.displacement ||
+                 (u_ref >= 0.0 && t.displacement > c.srm.knee_ratio * std::max(u_ref, 1e-3 * c.numerics.spacing));
+    } catch (const SimulationError& e) {
+      t.failed = t.blew_up = true;
+      t.displacement = max_soil_displacement(s.store());
+      if (!quiet) std::fprintf(stderr, "sph-slope: trial F = %.4g stopped (%s): counted as failed\n", F, e.what());
+    }
+    t.steps = s.step_count();
+    if (!quiet)
+      std::fprintf(stderr, "sph-slope: trial F = %.4f: max displacement %.4g m, last-quarter growth %.3g m -> %s\n", F,
+                   t.displacement, t.growth, t.failed ? "fails" : "stable");
+    trials.push_back(t);
+    if (t.failed) mechanism = s.store();
+    return t.failed;
+  };
+  double lo = c.srm.f_min, hi = c.srm.f_max;
+  std::string outcome = "bracketed";
+  const bool low_fails = trial(lo);
+  u_ref = trials.back().displacement;
+  if (low_fails)
+    outcome = "below_f_min";
+  else if (!trial(hi))
+    outcome = "above_f_max";
+  else {
+    auto best_failed = mechanism;
+    while (hi - lo > c.srm.tolerance * (1.0 + 1e-9)) {
+      const double mid = 0.5 * (lo + hi);
+      if (trial(mid)) {
+        hi = mid;
+        best_failed = mechanism;
+      } else {
+        lo = mid;
+      }
+    }
+    mechanism = best_failed;
+  }
+
+  // Outputs: trials, F–displacement curve (CSV + PNG), mechanism, Bishop beside it.
+  {
+    std::ostringstream os;
+    os << "trial,factor,max_displacement_m,growth_last_quarter_m,failed,steps\n";
+    for (std::size_t k = 0; k < trials.size(); ++k)
+      os << k << ',' << csv_number(trials[k].factor) << ',' << csv_number(trials[k].displacement) << ','
+         << csv_number(trials[k].growth) << ',' << (trials[k].failed ? 1 : 0) << ',' << trials[k].steps << '\n';
+    write_text_file(out / "srm_trials.csv", os.str());
+  }
+  auto sorted = trials;
+  std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.factor < b.factor; });
+  {
+    std::ostringstream os;
+    os << "factor,max_displacement_m,failed\n";
+    for (const auto& t : sorted)
+      os << csv_number(t.factor) << ',' << csv_number(t.displacement) << ',' << (t.failed ? 1 : 0) << '\n';
+    write_text_file(out / "srm_curve.csv", os.str());
+    // Plot: F on x (f_min … f_max), displacement on y (log10, 4 decades below the largest), stable
+    // trials blue, failed red, the bracket as two grey verticals.
+    const int W = 800, H = 500, m = 40;
+    Image img(W, H);
+    double umax = 0.0;
+    for (const auto& t : sorted) umax = std::max(umax, t.displacement);
+    const double ly1 = std::log10(std::max(umax, 1e-12)), ly0 = ly1 - 4.0;
+    auto px = [&](double F) { return m + (F - c.srm.f_min) / (c.srm.f_max - c.srm.f_min) * (W - 2 * m); };
+    auto py = [&](double u) {
+      const double l = std::clamp(std::log10(std::max(u, 1e-300)), ly0, ly1);
+      return H - m - (l - ly0) / (ly1 - ly0) * (H - 2 * m);
+    };
+    img.line(m, H - m, W - m, H - m, {0, 0, 0});
+    img.line(m, m, m, H - m, {0, 0, 0});
+    for (int d = 0; d <= 4; ++d)
+      img.line(m - 5, py(umax * std::pow(10.0, -d)), m, py(umax * std::pow(10.0, -d)), {0, 0, 0});
+    img.line(px(lo), m, px(lo), H - m, {170, 170, 170});
+    img.line(px(hi), m, px(hi), H - m, {170, 170, 170});
+    for (std::size_t k = 1; k < sorted.size(); ++k)
+      img.line(px(sorted[k - 1].factor), py(sorted[k - 1].displacement), px(sorted[k].factor),
+               py(sorted[k].displacement), {90, 90, 90});
+    for (const auto& t : sorted)
+      img.fill_circle(px(t.factor), py(t.displacement), 5.0,
+                      t.failed ? std::array<std::uint8_t, 3>{210, 40, 40} : std::array<std::uint8_t, 3>{40, 80, 210});
+    write_png(out / "srm_curve.png", img);
+  }
+  BishopResult bishop;
+  try {
+    bishop = bishop_of(c);
+  } catch (const InputError& e) {
+    summary["bishop_note"] = e.reason();
+  }
+  std::vector<std::array<double, 2>> circle;
+  if (bishop.admissible()) {
+    const auto& C = bishop.circle;
+    for (int k = 0; k <= 100; ++k) {
+      const double x = bishop.x_entry + (bishop.x_exit - bishop.x_entry) * k / 100.0;
+      circle.push_back({x, C.zc - std::sqrt(std::max(0.0, C.radius * C.radius - (x - C.xc) * (x - C.xc)))});
+    }
+    summary["bishop"] = {{"factor", bishop.factor}, {"centre_x_m", C.xc},          {"centre_z_m", C.zc},
+                         {"radius_m", C.radius},    {"entry_x_m", bishop.x_entry}, {"exit_x_m", bishop.x_exit}};
+    std::ostringstream os;
+    os << "x_m,z_m\n";
+    for (const auto& p : circle) os << csv_number(p[0]) << ',' << csv_number(p[1]) << '\n';
+    write_text_file(out / "bishop_circle.csv", os.str());
+  }
+  if (mechanism) {
+    write_fields<Dim>(snaps, *mechanism, T, 1);
+    std::vector<double> u(mechanism->size());
+    double umax = 0.0;
+    SphStore<Dim> reference = *mechanism;  // drawn where the particles started, with the Bishop circle
+    for (std::size_t i = 0; i < u.size(); ++i) {
+      u[i] = mechanism->template get<Displacement<Dim>>()[i].norm();
+      reference.template get<Position<Dim>>()[i] -= mechanism->template get<Displacement<Dim>>()[i];
+      if (mechanism->template get<ParticleKind>()[i] == kSoil) umax = std::max(umax, u[i]);
+    }
+    draw_particles<Dim>(out / "mechanism.png", reference, u, umax, c.numerics.spacing, circle);
+    draw_particles<Dim>(out / "mechanism_deformed.png", *mechanism, u, umax, c.numerics.spacing, circle);
+    // The slip surface of the mechanism: the lower edge of the soil displaced by more than a tenth
+    // of the largest displacement.
+    std::ostringstream ss;
+    ss << "x_m,z_m\n";
+    for (const auto& p : slip_surface(*mechanism, c.numerics.spacing, 0.1 * umax))
+      ss << csv_number(p[0]) << ',' << csv_number(p[1]) << '\n';
+    write_text_file(out / "slip_surface.csv", ss.str());
+  }
+  summary["outcome"] = outcome;
+  summary["factor_of_safety"] = outcome == "bracketed" ? nlohmann::json(lo) : nlohmann::json(nullptr);
+  summary["bracket"] = {lo, hi};
+  summary["tolerance"] = c.srm.tolerance;
+  summary["trial_duration_s"] = T;
+  summary["trial_damping"] = c.srm.damping;
+  summary["growth_ratio"] = c.srm.growth_ratio;
+  summary["knee_ratio"] = c.srm.knee_ratio;
+  summary["reference_displacement_m"] = u_ref;
+  summary["trials"] = trials.size();
+  summary["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  write_text_file(out / "summary.json", summary.dump(2) + "\n");
+  if (!quiet) {
+    if (outcome == "bracketed")
+      std::fprintf(stderr, "sph-slope: factor of safety (strength reduction) %.4g, failed at %.4g", lo, hi);
+    else
+      std::fprintf(stderr, "sph-slope: factor of safety %s the range [%.4g, %.4g]",
+                   outcome == "below_f_min" ? "below" : "above", c.srm.f_min, c.srm.f_max);
+    if (bishop.admissible()) std::fprintf(stderr, "; Bishop %.4g", bishop.factor);
+    std::fprintf(stderr, "; outputs in %s\n", out.string().c_str());
+  }
+  return 0;
+}
+
 /// Input checks that need the numerics and the geometry together, done before the dry-run build
 /// allocates anything (issue #12): the particle count the domain and spacing ask for against the
 /// memory available, and a 3D periodic width the neighbour search accepts.
@@ -755,6 +1032,19 @@ void validate(const RunConfig& c) {
     check_index(c.section.base_material, "section.base_material");
   }
   if (c.end_time <= 0.0) throw InputError("must be > 0", c.config_source, "run.end_time");
+  if (c.analysis == Analysis::StrengthReduction) {
+    const auto& r = c.srm;
+    if (!(r.f_min > 0.0))
+      throw InputError("must be > 0", c.config_source, "strength_reduction.f_min", csv_number(r.f_min));
+    if (!(r.f_max > r.f_min))
+      throw InputError("must be > strength_reduction.f_min (" + csv_number(r.f_min) + ")", c.config_source,
+                       "strength_reduction.f_max", csv_number(r.f_max));
+    if (!(r.tolerance > 0.0))
+      throw InputError("must be > 0", c.config_source, "strength_reduction.tolerance", csv_number(r.tolerance));
+    if (c.scenario == ScenarioType::Biaxial)
+      throw InputError("strength reduction needs a slope, column or section scenario (gravity-loaded)", c.config_source,
+                       "run.analysis", "strength_reduction");
+  }
   check_resources(c);
   // Build once (dry run) so that geometry errors surface before any output exists.
   if (c.dimension == 2)
@@ -766,6 +1056,8 @@ void validate(const RunConfig& c) {
 }
 
 int run(const RunConfig& cfg, const std::filesystem::path& out, bool quiet) {
+  if (cfg.analysis == Analysis::StrengthReduction)
+    return cfg.dimension == 2 ? run_strength_reduction<2>(cfg, out, quiet) : run_strength_reduction<3>(cfg, out, quiet);
   return cfg.dimension == 2 ? run_dim<2>(cfg, out, quiet) : run_dim<3>(cfg, out, quiet);
 }
 

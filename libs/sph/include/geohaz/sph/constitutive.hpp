@@ -48,12 +48,14 @@
 /// ConstitutiveModel (the name table); parameters it adds go into MaterialParams and the app's
 /// [[material]] table. docs/sph.md, "Adding a constitutive model".
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <concepts>
 #include <limits>
 #include <optional>
 #include <string_view>
+#include <utility>
 #include <variant>
 
 #include "geohaz/core/vec.hpp"
@@ -102,6 +104,11 @@ struct MaterialParams {
   double dilatancy = 0.0;     ///< ψ, rad (Drucker–Prager)
   double yield_stress = 1e5;  ///< σ_y (uniaxial), Pa (von Mises: k = σ_y/√3)
   double viscosity = 1e-3;    ///< μ, Pa·s (Newtonian fluid)
+  // Strain softening (DruckerPragerSoftening): c and φ fall linearly with the accumulated plastic
+  // multiplier κ = Σ Δλ from the peak values above to these residual ones at κ = softening_strain.
+  double residual_cohesion = 0.0;  ///< c_r, Pa (≤ cohesion)
+  double residual_friction = 0.5;  ///< φ_r, rad (≤ friction)
+  double softening_strain = 0.05;  ///< κ_r, 1 (> 0)
   DruckerPragerFit fit = DruckerPragerFit::PlaneStrain;
   // derived
   double bulk = 0.0, shear = 0.0;  ///< K, G (Pa)
@@ -253,6 +260,45 @@ struct DruckerPrager {
   static constexpr bool elastic_loading = true;
 };
 
+/// Drucker–Prager with strain softening: as DruckerPrager, but cohesion and friction fall linearly
+/// with the internal variable κ = Σ Δλ (PlasticStrain; in simple shear Δλ is the increment of the
+/// engineering plastic shear strain γ_p, since Δε_p,dev = Δλ s/(2√J2)) from their peak values
+/// (c, φ) to residual ones (c_r, φ_r) over κ ∈ [0, κ_r] and stay residual beyond:
+///     c(κ) = c_r + (c − c_r) max(0, 1 − κ/κ_r),  φ(κ) = φ_r + (φ − φ_r) max(0, 1 − κ/κ_r),
+/// the shape of the softening laws of strength-reduction and progressive-failure studies (e.g.
+/// Potts, Dounias & Vaughan 1990 in c′–φ′ form, linear over a plastic-strain range). The step's
+/// return mapping uses the strength at κ of the start of the step (explicit in κ; with Δλ per step
+/// ≪ κ_r the lag is negligible), then κ += Δλ. ψ is constant. The density floor is that of the peak
+/// strength (the lowest; the floor of a fully softened cohesionless particle would be ρ0).
+struct DruckerPragerSoftening {
+  static constexpr const char* name = "drucker_prager_softening";
+  static constexpr const char* summary =
+      "Drucker-Prager with cohesion and friction softening linearly from peak (cohesion, friction) to residual "
+      "(residual_cohesion, residual_friction) over the plastic strain softening_strain";
+  using InternalVariables = FieldList<PlasticStrain>;
+  /// c (Pa) and φ (rad) at the accumulated plastic multiplier κ.
+  static std::pair<double, double> strength(const MaterialParams& p, double kappa) noexcept {
+    const double w = std::max(0.0, 1.0 - kappa / p.softening_strain);
+    return {p.residual_cohesion + (p.cohesion - p.residual_cohesion) * w,
+            p.residual_friction + (p.friction - p.residual_friction) * w};
+  }
+  static double update(Mat3& sigma, const Mat3& L, double dt, double /*rho*/, const MaterialParams& p,
+                       double& plastic_strain) noexcept {
+    sigma = elastic_trial(sigma, L, dt, p.bulk, p.shear);
+    const auto [c, phi] = strength(p, plastic_strain);
+    const auto k = drucker_prager_constants(c, phi, p.dilatancy, p.fit);
+    const double dl = drucker_prager_return(sigma, k.alpha_phi, k.alpha_psi, k.kc, p.bulk, p.shear);
+    plastic_strain += dl;
+    return dl;
+  }
+  static double wave_speed(const MaterialParams& p) noexcept { return p.p_wave_speed; }
+  static double time_step_limit(const MaterialParams& /*p*/, double /*h*/) noexcept {
+    return std::numeric_limits<double>::infinity();
+  }
+  static double min_density(const MaterialParams& p) noexcept { return DruckerPrager::min_density(p); }
+  static constexpr bool elastic_loading = true;
+};
+
 /// Weakly compressible Newtonian fluid: σ = −p I + 2μ ė, p = K (ρ/ρ0 − 1) (linear equation of
 /// state with bulk modulus K = E/(3(1−2ν))). Used for the viscous simple-shear check of seed 000.
 struct NewtonianFluid {
@@ -294,7 +340,7 @@ concept ConstitutiveLaw = requires(const MaterialParams& p, double h) {
 /// The run-time choice of model (one per run; all materials of a run share the model type), and
 /// the one name table of the models: its alternatives' `name`s are the values of
 /// `model.constitutive`. A model is added here and nowhere else in the solver or the app.
-using ConstitutiveModel = std::variant<LinearElastic, VonMises, DruckerPrager, NewtonianFluid>;
+using ConstitutiveModel = std::variant<LinearElastic, VonMises, DruckerPrager, DruckerPragerSoftening, NewtonianFluid>;
 
 namespace detail {
 template <class V>

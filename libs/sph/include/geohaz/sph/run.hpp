@@ -48,6 +48,27 @@ struct SectionInput {
   double release_width = 10.0;  ///< W (m): plane-strain particles are spread over this width
 };
 
+/// What a run computes.
+enum class Analysis {
+  Dynamic,           ///< the main phase in time (failure, run-out, shaking)
+  StrengthReduction  ///< the factor of safety by strength reduction (docs/sph.md, "Factor of safety")
+};
+
+/// Strength reduction (Dawson et al. 1999; Griffiths & Lane 1999): from the geostatic state, trials
+/// with every material's c/F, atan(tan φ/F) and atan(tan ψ/F), each a damped quasi-static run of
+/// `trial_duration`; a trial fails when its largest displacement u has not converged (it grew by
+/// more than `growth_ratio` of its final value over the last quarter of the trial) or lies beyond the
+/// knee of the F–u curve (u > `knee_ratio` times u of the f_min trial). F is bisected in
+/// [f_min, f_max] until the bracket is narrower than `tolerance`.
+struct StrengthReductionSettings {
+  double f_min = 0.5, f_max = 2.0;  ///< initial bracket of F
+  double tolerance = 0.01;          ///< ΔF: bisection stops when f_failed − f_stable ≤ tolerance
+  double damping = 0.7;             ///< Cundall ζ of the trials
+  double trial_duration = 0.0;      ///< s; 0 → 30 H / c_p
+  double growth_ratio = 0.05;       ///< failure: u(T) − u(3T/4) > growth_ratio · u(T)
+  double knee_ratio = 5.0;          ///< failure: u(T) > knee_ratio · u(T) of the f_min trial
+};
+
 /// Everything a run needs (SI units; angles already in radians).
 struct RunConfig {
   int dimension = 2;
@@ -76,6 +97,8 @@ struct RunConfig {
   double geostatic_damping = 0.7;
   bool geostatic_elastic = true;
   double rest_tolerance = 0.01;  ///< at rest: max |v| < tol·√(g H)
+  Analysis analysis = Analysis::Dynamic;
+  StrengthReductionSettings srm;
   // Main phase.
   double end_time = 1.0;                   ///< s
   double output_interval = 0.01;           ///< s (time series)

@@ -1,0 +1,96 @@
+#pragma once
+/// \file limit_equilibrium.hpp
+/// Limit-equilibrium cross-check of a 2D slope section: Bishop's simplified method of slices
+/// (Bishop 1955, Géotechnique 5:7–17) on circular slip surfaces, with a search for the circle of the
+/// smallest factor of safety. It reads the same profile, layers and strengths as the SPH scenario
+/// (scenario.hpp ProfileDomain), so sph-slope can report it beside the strength-reduction factor.
+///
+/// For a circle of centre (x_c, z_c) and radius R, the sliding mass lies between the circle's lower
+/// arc z_a(x) = z_c − √(R² − (x − x_c)²) and the surface z_s(x). It is cut into n vertical slices of
+/// width b; slice i has its base mid-point at x_i, weight W_i = b ∫ γ(z) dz over [z_a, z_s] (layers by
+/// elevation), base inclination α_i with sin α_i = s (x_c − x_i)/R (s = ±1 so that the mass moves
+/// down the slope, i.e. Σ W sin α > 0) and base strength c_i, φ_i of the layer at the base. Moment
+/// equilibrium about the centre with the slices' vertical side forces neglected gives, dry soil,
+///     F = Σ [c_i b + W_i tan φ_i] / m_α,i  /  Σ W_i sin α_i ,   m_α = cos α + sin α tan φ / F,
+/// solved by fixed-point iteration from F = 1. For φ = 0 it is the exact moment balance of the
+/// circle (Fellenius), the case of Taylor's (1937) stability chart.
+/// The sliding masses of a circle are the stretches between an entry into the surface and the next
+/// exit (a toe circle may dip under the ground in front of the toe: it leaves the slope at the toe
+/// and the soil it cuts beyond is another mass); the circle's factor is that of its weakest mass.
+/// A mass is admissible when its arc stays above the rigid bottom z_bottom, the circle leaves the
+/// section through the surface (not through an end of the section or its own vertical side while
+/// below the surface), and every
+/// slice whose base rises in the direction of sliding (α < 0, near the toe) has m_α ≥ 0.2
+/// (Whitman & Bailey 1967: there a small m_α makes Bishop's base normal force unreliably large).
+/// Where α > 0, m_α ≥ cos α and a small m_α only means a steep base whose length b/cos α the
+/// cohesion term measures correctly (vertical cuts, φ = 0), so no limit applies.
+/// Units SI (m, Pa, N/m³, radians).
+
+#include <array>
+#include <limits>
+#include <vector>
+
+#include "geohaz/sph/scenario.hpp"
+
+namespace geohaz::sph {
+
+/// Strength and unit weight of one soil for the limit-equilibrium analysis.
+struct LimitEquilibriumSoil {
+  double unit_weight = 18e3;  ///< γ, N/m³
+  double cohesion = 0.0;      ///< c′, Pa
+  double friction = 0.5;      ///< φ′, rad
+};
+
+/// A 2D slope section: the profile domain of the SPH scenario (surface, extent, rigid bottom,
+/// layers by elevation) and a soil per material index.
+struct SlopeSection {
+  std::vector<std::array<double, 2>> surface;  ///< (x, z), non-decreasing x (m)
+  double x_left = 0.0, x_right = 1.0;          ///< ends of the section (m)
+  double z_bottom = 0.0;                       ///< rigid bottom (m)
+  std::vector<double> layer_tops;              ///< as ProfileDomain: layer k holds z < layer_tops[k]
+  std::vector<int> layer_materials;            ///< size layer_tops.size() + 1, or empty (all 0)
+  std::vector<LimitEquilibriumSoil> soils;     ///< by material index
+
+  /// The section of a profile domain. Throws InputError for what it cannot represent (a surface
+  /// layer by depth, bedrock following the surface, a terrain across the width) or a material index
+  /// without a soil.
+  static SlopeSection from_profile(const ProfileDomain& d, std::vector<LimitEquilibriumSoil> soils);
+  /// Material index at elevation z.
+  int material_at(double z) const noexcept;
+};
+
+/// A circular slip surface (m).
+struct SlipCircle {
+  double xc = 0.0, zc = 0.0, radius = 0.0;
+};
+
+/// Bishop's factor of one circle and where the sliding mass meets the surface.
+struct BishopResult {
+  double factor = std::numeric_limits<double>::infinity();  ///< +∞: circle not admissible
+  SlipCircle circle;
+  double x_entry = 0.0, x_exit = 0.0;  ///< ends of the sliding mass on the surface (m)
+  double weight = 0.0;                 ///< weight of the sliding mass per metre (N/m)
+  int iterations = 0;                  ///< fixed-point iterations
+  bool admissible() const noexcept { return factor < std::numeric_limits<double>::infinity(); }
+};
+
+/// Bishop's simplified factor of safety of one circle with `slices` slices.
+BishopResult bishop_factor(const SlopeSection& s, const SlipCircle& c, int slices = 200);
+
+/// Settings of the critical-circle search: a grid of centres × depths, then a pattern search
+/// (step halving) around the best grid circles.
+struct BishopSearchSettings {
+  int grid = 24;           ///< centres per axis and depths per centre of the grid stage
+  int slices = 200;        ///< slices per circle
+  int refine_starts = 4;   ///< best grid circles refined by the pattern search
+  double min_depth = 0.0;  ///< m: circles whose mass is shallower than this are skipped (0: none)
+};
+
+/// The circle of the smallest Bishop factor. The grid spans centres over the section's extent from
+/// the highest surface point up to the larger of twice the section's height and half its length
+/// above it, and circle bottoms (the lowest point of the whole circle, which may lie beyond the
+/// mass) from one section height below z_bottom to the highest surface point. Throws InputError if
+/// no admissible circle exists.
+BishopResult bishop_critical_circle(const SlopeSection& s, const BishopSearchSettings& settings = {});
+
+}  // namespace geohaz::sph
