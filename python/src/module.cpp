@@ -103,6 +103,8 @@ py::dict series_arrays(const std::vector<SeriesRow>& rows) {
   d["mobile_volume_m3"] = column([](const SeriesRow& r) { return r.volumes.mobile; });
   d["deposited_volume_m3"] = column([](const SeriesRow& r) { return r.volumes.deposited; });
   d["lost_volume_m3"] = column([](const SeriesRow& r) { return r.volumes.lost; });
+  d["entrained_volume_m3"] = column([](const SeriesRow& r) { return r.volumes.entrained; });
+  d["injected_volume_m3"] = column([](const SeriesRow& r) { return r.volumes.injected; });
   return d;
 }
 
@@ -146,10 +148,12 @@ py::dict summary_dict(const RunoutSimulation& sim, const RunoutCase& c) {
   vol["deposited"] = b.deposited;
   vol["mobile"] = b.mobile;
   vol["lost"] = b.lost;
+  vol["entrained"] = b.entrained;
+  vol["injected"] = b.injected;
   vol["deposit_raster"] = r.deposit_raster_volume;
   vol["mobile_raster"] = r.mobile_raster_volume;
   s["volumes_m3"] = vol;
-  s["mass_balance_error_relative"] = b.initial > 0.0 ? b.balance_error() / b.initial : 0.0;
+  s["mass_balance_error_relative"] = b.total_in() > 0.0 ? b.balance_error() / b.total_in() : 0.0;
   return s;
 }
 
@@ -266,6 +270,9 @@ py::dict runout_run(const std::string& config, const std::vector<std::string>& o
   maps["deposit"] = grid_array(dsm, sim->deposit());
   maps["mobile_at_end"] = grid_array(dsm, sim->mobile_at_end());
   maps["arrival_time"] = grid_array(dsm, m.arrival_time());
+  maps["max_momentum"] = grid_array(dsm, m.max_momentum());
+  maps["intensity"] = grid_array(dsm, intensity_classes(m, c.output.intensity));
+  if (!sim->solver().eroded_depth().empty()) maps["erosion_depth"] = grid_array(dsm, sim->solver().eroded_depth());
   std::vector<double> z(dsm.data);
   for (double& v : z)
     if (dsm.is_nodata(v)) v = std::numeric_limits<double>::quiet_NaN();

@@ -85,7 +85,8 @@ def test_maps_are_numpy_arrays_on_the_dsm_grid(data):
     assert gt[1] == 2.5 and gt[5] == -2.5 and gt[2] == gt[4] == 0.0
     assert "UTM zone 54N" in r["crs_wkt"]
     maps = r["maps"]
-    assert set(maps) == {"max_depth", "max_speed", "max_pressure", "deposit", "mobile_at_end", "arrival_time"}
+    assert set(maps) == {"max_depth", "max_speed", "max_pressure", "deposit", "mobile_at_end", "arrival_time",
+                         "max_momentum", "intensity"}
     for a in maps.values():
         assert a.shape == (200, 400) and a.dtype == np.float64
     cell = gt[1] * -gt[5]
@@ -97,6 +98,12 @@ def test_maps_are_numpy_arrays_on_the_dsm_grid(data):
     assert np.nanmax(maps["max_speed"]) == s["max_speed_m_s"]
     assert np.nanmax(maps["max_pressure"]) == pytest.approx(1800.0 * s["max_speed_m_s"] ** 2, rel=1e-12)
     reached = maps["max_depth"] > 0
+    # Intensity: every reached cell is medium (2) or strong (3) under the default depth-speed rule;
+    # strong exactly where peak depth and peak speed both exceed 1.
+    assert set(np.unique(maps["intensity"][reached])) <= {2.0, 3.0}
+    strong = reached & (maps["max_depth"] > 1.0) & (maps["max_speed"] > 1.0)
+    assert np.array_equal(maps["intensity"] == 3.0, strong)
+    assert np.nanmax(maps["max_momentum"]) <= np.nanmax(maps["max_depth"]) * np.nanmax(maps["max_speed"]) + 1e-12
     assert np.all(np.isfinite(maps["arrival_time"][reached & (maps["max_speed"] > 0)]))
     assert np.all(maps["arrival_time"][np.isfinite(maps["arrival_time"])] <= 20.0 + 1e-9)
     # Particles: every field, volumes adding up to what is left in the domain.
