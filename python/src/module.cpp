@@ -108,53 +108,9 @@ py::dict series_arrays(const std::vector<SeriesRow>& rows) {
   return d;
 }
 
-/// The key figures, with the names of summary.json.
-py::dict summary_dict(const RunoutSimulation& sim, const RunoutCase& c) {
-  const RunoutResult r = sim.result();
-  const VolumeBudget& b = r.volumes;
-  py::dict s;
-  s["model"] = "debris-runout";
-  s["version"] = GEOHAZ_VERSION;
-  s["dsm"] = c.dsm;
-  s["release"] = sim.inputs().description;
-  s["friction"] = friction_name(sim.parameters().friction);
-  s["particles_released"] = r.particles_released;
-  s["particles_left"] = r.particles_left;
-  s["simulated_time_s"] = r.simulated_time;
-  s["steps"] = r.steps;
-  s["wall_time_s"] = r.wall_time;
-  s["ended_by"] = to_string(r.ended);
-  s["unfinished"] = r.unfinished();
-  s["runout_length_along_path_m"] = r.path.runout_length;
-  py::dict fb;
-  fb["drop_height_m"] = r.path.drop_height;
-  fb["reach_m"] = r.path.reach;
-  fb["ratio_H_over_L"] = r.path.fahrboeschung;
-  fb["angle_deg"] = r.path.fahrboeschung_deg;
-  fb["toe_x_m"] = r.path.toe.x();
-  fb["toe_y_m"] = r.path.toe.y();
-  s["fahrboeschung"] = fb;
-  py::dict com;
-  com["drop_m"] = r.path.com_drop;
-  com["travel_m"] = r.path.com_travel;
-  com["angle_deg"] = r.path.com_angle_deg;
-  s["centre_of_mass"] = com;
-  s["max_speed_m_s"] = r.max_speed;
-  s["max_pressure_pa"] = r.max_pressure;
-  s["area_affected_m2"] = r.affected_area;
-  py::dict vol;
-  vol["release_read"] = sim.inputs().volume;
-  vol["seeded"] = sim.seeded().volume_seeded;
-  vol["deposited"] = b.deposited;
-  vol["mobile"] = b.mobile;
-  vol["lost"] = b.lost;
-  vol["entrained"] = b.entrained;
-  vol["injected"] = b.injected;
-  vol["deposit_raster"] = r.deposit_raster_volume;
-  vol["mobile_raster"] = r.mobile_raster_volume;
-  s["volumes_m3"] = vol;
-  s["mass_balance_error_relative"] = b.total_in() > 0.0 ? b.balance_error() / b.total_in() : 0.0;
-  return s;
+/// The key figures: summary.json's text, parsed by Python's json (the same numbers as the app's).
+py::object summary_dict(const RunoutSimulation& sim, const RunoutCase& c, int threads) {
+  return py::module_::import("json").attr("loads")(summary_json(c, sim, threads));
 }
 
 /// The observer of a run from Python: the progress callback (every `every` steps, and at start
@@ -278,7 +234,7 @@ py::dict runout_run(const std::string& config, const std::vector<std::string>& o
     if (dsm.is_nodata(v)) v = std::numeric_limits<double>::quiet_NaN();
 
   py::dict r;
-  r["summary"] = summary_dict(*sim, c);
+  r["summary"] = summary_dict(*sim, c, nthreads);
   r["maps"] = maps;
   r["dsm"] = grid_array(dsm, z);
   r["release_thickness"] = grid_array(dsm, in->thickness);

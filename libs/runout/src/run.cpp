@@ -397,6 +397,119 @@ RunoutResult RunoutSimulation::result() const {
   return r;
 }
 
+std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int threads) {
+  const IntensityTable& itab = c.output.intensity;
+  const auto& solver = sim.solver();
+  const RunoutResult res = sim.result();
+  const double in_grid_area = sim.inputs().grid().cell_area();
+  const auto& sum = res.path;
+  const VolumeBudget& b = res.volumes;
+  nlohmann::json j;
+  j["model"] = kModel;
+  j["version"] = GEOHAZ_VERSION;
+  j["dsm"] = c.dsm;
+  j["release"] = sim.inputs().description;
+  j["friction"] = friction_name(sim.parameters().friction);
+  j["particles_released"] = res.particles_released;
+  j["particles_left"] = res.particles_left;
+  j["simulated_time_s"] = res.simulated_time;
+  j["steps"] = res.steps;
+  j["wall_time_s"] = res.wall_time;
+  j["threads"] = threads;
+  j["ended_by"] = to_string(res.ended);
+  j["stop_energy_fraction"] = sim.parameters().stop_energy_fraction;
+  j["kinetic_energy_j"] = {{"at_end", b.kinetic_energy}, {"peak", b.peak_kinetic_energy}};
+  j["mobile_at_end"] = {{"volume_m3", b.mobile},
+                        {"fraction", res.mobile_fraction()},
+                        {"max_speed_m_s", res.max_speed_at_end},
+                        {"in_deposit_raster", res.ended != RunEnd::Duration}};
+  j["release_thickness_direction"] = sim.inputs().from_handoff ? "volumes (hand-off)" : to_string(c.release.direction);
+  nlohmann::json warnings = nlohmann::json::array();
+  if (res.unfinished()) warnings.push_back(unfinished_warning(res));
+  j["warnings"] = warnings;
+  j["unfinished"] = res.unfinished();
+  j["runout_length_along_path_m"] = sum.runout_length;
+  j["fahrboeschung"] = {
+      {"drop_height_m", sum.drop_height},   {"reach_m", sum.reach},   {"ratio_H_over_L", sum.fahrboeschung},
+      {"angle_deg", sum.fahrboeschung_deg}, {"toe_x_m", sum.toe.x()}, {"toe_y_m", sum.toe.y()}};
+  j["centre_of_mass"] = {{"drop_m", sum.com_drop}, {"travel_m", sum.com_travel}, {"angle_deg", sum.com_angle_deg}};
+  j["max_speed_m_s"] = res.max_speed;
+  j["max_pressure_pa"] = res.max_pressure;
+  j["area_affected_m2"] = res.affected_area;
+  j["volumes_m3"] = {{"release_read", sim.inputs().volume},
+                     {"seeded", sim.seeded().volume_seeded},
+                     {"deposited", b.deposited},
+                     {"mobile", b.mobile},
+                     {"lost", b.lost},
+                     {"entrained", b.entrained},
+                     {"injected", b.injected},
+                     {"deposit_raster", res.deposit_raster_volume},
+                     {"mobile_raster", res.mobile_raster_volume}};
+  j["lost_particles"] = b.lost_particles;
+  {
+    double a[4] = {0.0, 0.0, 0.0, 0.0};
+    const std::vector<double> cls = intensity_classes(sim.maps(), itab);
+    const Raster& dsm = sim.inputs().dsm;
+    for (std::size_t k = 0; k < cls.size(); ++k)
+      if (!dsm.is_nodata(dsm.data[k]) && cls[k] >= 1.0 && cls[k] <= 3.0) a[static_cast<int>(cls[k])] += in_grid_area;
+    j["intensity"] = {{"scheme", to_string(itab.scheme)},
+                      {"area_low_m2", a[1]},
+                      {"area_medium_m2", a[2]},
+                      {"area_strong_m2", a[3]}};
+    if (itab.scheme == IntensityScheme::DepthSpeed)
+      j["intensity"].update({{"strong_depth_m", itab.strong_depth}, {"strong_speed_m_s", itab.strong_speed}});
+    else
+      j["intensity"].update({{"medium_pressure_pa", itab.medium_pressure}, {"strong_pressure_pa", itab.strong_pressure}});
+  }
+  j["mass_balance_error_relative"] = b.total_in() > 0.0 ? b.balance_error() / b.total_in() : 0.0;
+  // The processes in force (docs/runout.md, "Processes").
+  const EntrainmentParameters& ent = sim.parameters().entrainment;
+  const SpatialProcesses& proc = solver.processes();
+  nlohmann::json jp;
+  jp["entrainment"] = {{"law", to_string(ent.law)}};
+  if (ent.law == EntrainmentLaw::GrowthRate) jp["entrainment"]["growth_rate_per_m"] = ent.growth_rate;
+  if (ent.law == EntrainmentLaw::ShearStress) {
+    jp["entrainment"]["critical_shear_pa"] = ent.critical_shear;
+    jp["entrainment"]["coefficient_m_per_s_pa"] = ent.erosion_coefficient;
+  }
+  if (ent.law != EntrainmentLaw::None) {
+    double eroded_max = 0.0;
+    for (double e : solver.eroded_depth()) eroded_max = std::max(eroded_max, e);
+    jp["entrainment"]["file"] = c.processes.erodible;
+    jp["entrainment"]["entrained_volume_m3"] = b.entrained;
+    jp["entrainment"]["growth_factor"] = b.initial + b.injected > 0.0 ? b.total_in() / (b.initial + b.injected) : 0.0;
+    jp["entrainment"]["max_eroded_depth_m"] = eroded_max;
+    jp["entrainment"]["terrain"] = "fixed (the DSM is not lowered by the eroded depth)";
+  }
+  nlohmann::json zones = nlohmann::json::array();
+  for (int k = 0; k < kFrictionParameters; ++k)
+    if (!proc.friction[static_cast<std::size_t>(k)].empty()) zones.push_back(kFrictionParameterNames[static_cast<std::size_t>(k)]);
+  jp["friction_zones"] = {{"file", c.processes.zones}, {"coefficients", zones}};
+  if (!proc.forest_drag.empty()) {
+    double area = 0.0, kmax = 0.0;
+    for (double k : proc.forest_drag)
+      if (k > 0.0) {
+        area += sim.inputs().grid().cell_area();
+        kmax = std::max(kmax, k);
+      }
+    jp["forest"] = {{"file", c.processes.forest},
+                    {"area_m2", area},
+                    {"max_drag_per_m", kmax},
+                    {"drag_coefficient", c.processes.drag_coefficient}};
+  }
+  if (!proc.inflows.empty()) {
+    const Hydrograph& q = proc.inflows.front();
+    jp["inflow"] = {{"hydrograph", q.source},
+                    {"volume_of_table_m3", q.volume()},
+                    {"injected_m3", b.injected},
+                    {"end_time_s", q.end_time()},
+                    {"speed_m_s", q.speed},
+                    {"direction_xy", {q.direction.x(), q.direction.y()}}};
+  }
+  j["processes"] = jp;
+  return j.dump(2);
+}
+
 void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::path& out, int threads) {
   const Raster& dsm = sim.inputs().dsm;
   // Maps on the DSM's grid and CRS; nodata where the DSM has none.
@@ -491,111 +604,7 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
     csv.commit();
   }
 
-  const RunoutResult res = sim.result();
-  const double in_grid_area = sim.inputs().grid().cell_area();
-  const auto& sum = res.path;
-  const VolumeBudget& b = res.volumes;
-  nlohmann::json j;
-  j["model"] = kModel;
-  j["version"] = GEOHAZ_VERSION;
-  j["dsm"] = c.dsm;
-  j["release"] = sim.inputs().description;
-  j["friction"] = friction_name(sim.parameters().friction);
-  j["particles_released"] = res.particles_released;
-  j["particles_left"] = res.particles_left;
-  j["simulated_time_s"] = res.simulated_time;
-  j["steps"] = res.steps;
-  j["wall_time_s"] = res.wall_time;
-  j["threads"] = threads;
-  j["ended_by"] = to_string(res.ended);
-  j["stop_energy_fraction"] = sim.parameters().stop_energy_fraction;
-  j["kinetic_energy_j"] = {{"at_end", b.kinetic_energy}, {"peak", b.peak_kinetic_energy}};
-  j["mobile_at_end"] = {{"volume_m3", b.mobile},
-                        {"fraction", res.mobile_fraction()},
-                        {"max_speed_m_s", res.max_speed_at_end},
-                        {"in_deposit_raster", res.ended != RunEnd::Duration}};
-  j["release_thickness_direction"] = sim.inputs().from_handoff ? "volumes (hand-off)" : to_string(c.release.direction);
-  nlohmann::json warnings = nlohmann::json::array();
-  if (res.unfinished()) warnings.push_back(unfinished_warning(res));
-  j["warnings"] = warnings;
-  j["runout_length_along_path_m"] = sum.runout_length;
-  j["fahrboeschung"] = {
-      {"drop_height_m", sum.drop_height},   {"reach_m", sum.reach},   {"ratio_H_over_L", sum.fahrboeschung},
-      {"angle_deg", sum.fahrboeschung_deg}, {"toe_x_m", sum.toe.x()}, {"toe_y_m", sum.toe.y()}};
-  j["centre_of_mass"] = {{"drop_m", sum.com_drop}, {"travel_m", sum.com_travel}, {"angle_deg", sum.com_angle_deg}};
-  j["max_speed_m_s"] = res.max_speed;
-  j["max_pressure_pa"] = res.max_pressure;
-  j["area_affected_m2"] = res.affected_area;
-  j["volumes_m3"] = {{"release_read", sim.inputs().volume},
-                     {"seeded", sim.seeded().volume_seeded},
-                     {"deposited", b.deposited},
-                     {"mobile", b.mobile},
-                     {"lost", b.lost},
-                     {"entrained", b.entrained},
-                     {"injected", b.injected},
-                     {"deposit_raster", res.deposit_raster_volume},
-                     {"mobile_raster", res.mobile_raster_volume}};
-  j["lost_particles"] = b.lost_particles;
-  {
-    double a[4] = {0.0, 0.0, 0.0, 0.0};
-    for (std::size_t k = 0; k < r_int.data.size(); ++k)
-      if (r_int.data[k] >= 1.0 && r_int.data[k] <= 3.0) a[static_cast<int>(r_int.data[k])] += in_grid_area;
-    j["intensity"] = {{"scheme", to_string(itab.scheme)},
-                      {"area_low_m2", a[1]},
-                      {"area_medium_m2", a[2]},
-                      {"area_strong_m2", a[3]}};
-    if (itab.scheme == IntensityScheme::DepthSpeed)
-      j["intensity"].update({{"strong_depth_m", itab.strong_depth}, {"strong_speed_m_s", itab.strong_speed}});
-    else
-      j["intensity"].update({{"medium_pressure_pa", itab.medium_pressure}, {"strong_pressure_pa", itab.strong_pressure}});
-  }
-  j["mass_balance_error_relative"] = b.total_in() > 0.0 ? b.balance_error() / b.total_in() : 0.0;
-  // The processes in force (docs/runout.md, "Processes").
-  const EntrainmentParameters& ent = sim.parameters().entrainment;
-  const SpatialProcesses& proc = solver.processes();
-  nlohmann::json jp;
-  jp["entrainment"] = {{"law", to_string(ent.law)}};
-  if (ent.law == EntrainmentLaw::GrowthRate) jp["entrainment"]["growth_rate_per_m"] = ent.growth_rate;
-  if (ent.law == EntrainmentLaw::ShearStress) {
-    jp["entrainment"]["critical_shear_pa"] = ent.critical_shear;
-    jp["entrainment"]["coefficient_m_per_s_pa"] = ent.erosion_coefficient;
-  }
-  if (ent.law != EntrainmentLaw::None) {
-    double eroded_max = 0.0;
-    for (double e : solver.eroded_depth()) eroded_max = std::max(eroded_max, e);
-    jp["entrainment"]["file"] = c.processes.erodible;
-    jp["entrainment"]["entrained_volume_m3"] = b.entrained;
-    jp["entrainment"]["growth_factor"] = b.initial + b.injected > 0.0 ? b.total_in() / (b.initial + b.injected) : 0.0;
-    jp["entrainment"]["max_eroded_depth_m"] = eroded_max;
-    jp["entrainment"]["terrain"] = "fixed (the DSM is not lowered by the eroded depth)";
-  }
-  nlohmann::json zones = nlohmann::json::array();
-  for (int k = 0; k < kFrictionParameters; ++k)
-    if (!proc.friction[static_cast<std::size_t>(k)].empty()) zones.push_back(kFrictionParameterNames[static_cast<std::size_t>(k)]);
-  jp["friction_zones"] = {{"file", c.processes.zones}, {"coefficients", zones}};
-  if (!proc.forest_drag.empty()) {
-    double area = 0.0, kmax = 0.0;
-    for (double k : proc.forest_drag)
-      if (k > 0.0) {
-        area += sim.inputs().grid().cell_area();
-        kmax = std::max(kmax, k);
-      }
-    jp["forest"] = {{"file", c.processes.forest},
-                    {"area_m2", area},
-                    {"max_drag_per_m", kmax},
-                    {"drag_coefficient", c.processes.drag_coefficient}};
-  }
-  if (!proc.inflows.empty()) {
-    const Hydrograph& q = proc.inflows.front();
-    jp["inflow"] = {{"hydrograph", q.source},
-                    {"volume_of_table_m3", q.volume()},
-                    {"injected_m3", b.injected},
-                    {"end_time_s", q.end_time()},
-                    {"speed_m_s", q.speed},
-                    {"direction_xy", {q.direction.x(), q.direction.y()}}};
-  }
-  j["processes"] = jp;
-  write_text_file(out / "summary.json", j.dump(2) + "\n");
+  write_text_file(out / "summary.json", summary_json(c, sim, threads) + "\n");
 }
 
 RunoutResult run_case(const RunoutCase& c, const fs::path& out, bool quiet, int threads) {

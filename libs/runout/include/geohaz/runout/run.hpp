@@ -202,6 +202,10 @@ class RunoutSimulation {
   double wall_time_ = 0.0;
 };
 
+/// The key figures of `sim` as the JSON text of summary.json (the app, the Python module and the
+/// ensemble runner read the same numbers).
+std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int threads);
+
 /// Write the maps (GeoTIFF on the DSM grid and CRS), the quick-look PNGs, series.csv and
 /// summary.json of `sim` into the existing directory `out`.
 void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const std::filesystem::path& out, int threads);
