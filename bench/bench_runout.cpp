@@ -4,9 +4,9 @@
 //  2. wall time of the seed's case at the seed's scale: 10 simulated minutes of a ~5000-particle
 //     release (d0 = 5 m, h0 = 1 m, 2 m thick over 300 m × 200 m) on the synthetic 5 km valley DSM of 2000 × 1000 cells
 //     at 2.5 m, n = 0.06, i_cr = 0.15 (target < 10 s), with the hazard maps recorded every step as the app does.
-// Prints rates; never asserts. Usage: bench_runout [particles=100000] [steps=40] [all|plane|seed|processes] [threads] [skin]
-// (the third argument runs one case only, the fourth one thread count only, the fifth sets
-// numerics.skin in units of d0: for profiling and for comparing list strategies).
+// Prints rates; never asserts. Usage: bench_runout [particles=100000] [steps=40] [all|plane|seed|processes] [threads]
+// [skin] (the third argument runs one case only, the fourth one thread count only, the fifth sets numerics.skin in
+// units of d0: for profiling and for comparing list strategies).
 #include <omp.h>
 
 #include <chrono>

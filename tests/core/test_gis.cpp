@@ -4,7 +4,6 @@
 #include <cpl_minixml.h>
 #include <gdal_priv.h>
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <cmath>
@@ -53,7 +52,8 @@ TEST(GeoTiff, CarriesDescriptionUnitNodataTilesAndOverviews) {
   r.description = "peak flow depth, normal to the bed";
   r.unit = "m";
   r.data.resize(static_cast<std::size_t>(r.nx) * r.ny);
-  for (std::size_t k = 0; k < r.data.size(); ++k) r.data[k] = (k % 97 == 0) ? -9999.0 : 0.001 * static_cast<double>(k % 1000);
+  for (std::size_t k = 0; k < r.data.size(); ++k)
+    r.data[k] = (k % 97 == 0) ? -9999.0 : 0.001 * static_cast<double>(k % 1000);
   const fs::path f = dir() / "depth.tif";
   geohaz::write_geotiff(f, r);
 

@@ -335,9 +335,8 @@ TEST(Fuzz, EveryMutatedRunEndsWithACodeAndAMessage) {
     } else if (target <= 7) {  // an input file the run reads
       std::string text = read_file(config);
       std::vector<std::pair<std::string, fs::path>> files;  // key text in the config → file
-      for (const auto& name :
-           {"valley_small.tif", "valley_small_release.tif", "hillside_dsm.asc", "avaAlr.tif", "relAlr.shp",
-            "erodible_channel.geojson", "forest_fan.geojson", "hydrograph_alr.csv"}) {
+      for (const auto& name : {"valley_small.tif", "valley_small_release.tif", "hillside_dsm.asc", "avaAlr.tif",
+                               "relAlr.shp", "erodible_channel.geojson", "forest_fan.geojson", "hydrograph_alr.csv"}) {
         const auto at = text.find(name);
         if (at != std::string::npos) files.emplace_back(name, fs::path(name));
       }

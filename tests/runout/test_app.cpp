@@ -77,10 +77,11 @@ TEST(DebrisRunoutApp, TinyValleyRunsAndBalancesVolume) {
   const auto r = run(dsm.string() + " --release " + (work_dir() / "tiny_release.tif").string() +
                      " --d0 2.5 --h0 0.75 --duration 60 --out " + out.string() + " --quiet --threads 1");
   ASSERT_EQ(r.code, 0) << r.output;
-  for (const char* f : {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "mobile_at_end.tif",
-                        "arrival_time.tif", "snapshots.h5", "snapshots.xmf", "series.csv", "summary.json",
-                        "config.resolved.toml", "deposit.png", "max_speed.png", "max_depth.png", "intensity.tif",
-                        "intensity.png", "intensity.qml", "max_momentum.tif", "max_depth.qml", "deposit.qml"})
+  for (const char* f :
+       {"max_depth.tif",        "max_speed.tif", "max_pressure.tif", "deposit.tif",   "mobile_at_end.tif",
+        "arrival_time.tif",     "snapshots.h5",  "snapshots.xmf",    "series.csv",    "summary.json",
+        "config.resolved.toml", "deposit.png",   "max_speed.png",    "max_depth.png", "intensity.tif",
+        "intensity.png",        "intensity.qml", "max_momentum.tif", "max_depth.qml", "deposit.qml"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
@@ -394,15 +395,15 @@ TEST(DebrisRunoutApp, ProcessesRunEndToEndAndBalanceVolume) {
   const fs::path dsm = tiny_dsm(), d = work_dir();
   write_boxes(d / "erodible.geojson", {{{480080, 480300, 4309835, 4309915}, R"("depth":0.5)"}});
   write_boxes(d / "zones.geojson", {{{480300, 480500, 4309750, 4310000}, R"("n":0.1)"}});
-  write_boxes(d / "forest.geojson", {{{480350, 480450, 4309750, 4310000}, R"("stem_density":0.1,"stem_diameter":0.3)"}});
+  write_boxes(d / "forest.geojson",
+              {{{480350, 480450, 4309750, 4310000}, R"("stem_density":0.1,"stem_diameter":0.3)"}});
   const fs::path out = d / "processes_out";
   fs::remove_all(out);
-  const auto r = run(dsm.string() + " --release " + (d / "tiny_release.tif").string() +
-                     " --d0 2.5 --h0 0.75 --duration 60 --out " + out.string() + " --quiet --threads 1" +
-                     " --set entrainment.law=growth --set entrainment.growth_rate=0.005" +
-                     " --set entrainment.file=" + (d / "erodible.geojson").string() +
-                     " --set zones.file=" + (d / "zones.geojson").string() +
-                     " --set forest.file=" + (d / "forest.geojson").string());
+  const auto r = run(
+      dsm.string() + " --release " + (d / "tiny_release.tif").string() + " --d0 2.5 --h0 0.75 --duration 60 --out " +
+      out.string() + " --quiet --threads 1" + " --set entrainment.law=growth --set entrainment.growth_rate=0.005" +
+      " --set entrainment.file=" + (d / "erodible.geojson").string() +
+      " --set zones.file=" + (d / "zones.geojson").string() + " --set forest.file=" + (d / "forest.geojson").string());
   ASSERT_EQ(r.code, 0) << r.output;
   for (const char* f : {"erosion_depth.tif", "erosion_depth.png"}) EXPECT_TRUE(fs::exists(out / f)) << f;
   std::ifstream in(out / "summary.json");
@@ -507,10 +508,10 @@ TEST(DebrisRunoutApp, ErodibleRasterOnAnotherGridIsResampled) {
   geohaz::write_geotiff(d / "erodible_coarse.tif", e);
   const fs::path out = d / "erodible_raster_out";
   fs::remove_all(out);
-  const auto r = run(dsm.string() + " --release " + (d / "tiny_release.tif").string() +
-                     " --d0 2.5 --h0 0.75 --duration 40 --out " + out.string() + " --threads 1" +
-                     " --set entrainment.law=shear --set entrainment.critical_shear=500" +
-                     " --set entrainment.coefficient=1e-6 --set entrainment.file=" + (d / "erodible_coarse.tif").string());
+  const auto r = run(
+      dsm.string() + " --release " + (d / "tiny_release.tif").string() + " --d0 2.5 --h0 0.75 --duration 40 --out " +
+      out.string() + " --threads 1" + " --set entrainment.law=shear --set entrainment.critical_shear=500" +
+      " --set entrainment.coefficient=1e-6 --set entrainment.file=" + (d / "erodible_coarse.tif").string());
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("another grid"), std::string::npos) << r.output;
   std::ifstream in(out / "summary.json");

@@ -27,8 +27,8 @@ TEST(Intensity, PressureClassesAtEveryBoundary) {
   const double rho = 1200.0;
   // Speeds giving ρv² just below, at and above 3 kPa and 30 kPa (v = √(p/ρ)).
   const auto v_of = [&](double p) { return std::sqrt(p / rho); };
-  const std::vector<double> v = {v_of(2999.0), v_of(3000.0) * (1 + 1e-12), v_of(29999.0), v_of(30000.0) * (1 + 1e-12),
-                                 v_of(1e6), 0.0, 10.0};
+  const std::vector<double> v = {
+      v_of(2999.0), v_of(3000.0) * (1 + 1e-12), v_of(29999.0), v_of(30000.0) * (1 + 1e-12), v_of(1e6), 0.0, 10.0};
   const std::vector<double> h = {0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.0};
   const std::vector<double> expect = {1, 2, 2, 3, 3, 1, 0};
   EXPECT_EQ(intensity_classes(h, v, rho, t), expect);

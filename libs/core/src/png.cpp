@@ -10,13 +10,12 @@
 #include <cstdio>
 #include <memory>
 
+#include "gdal_common.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
 #include "geohaz/core/raster_extra.hpp"
-#include "gdal_common.hpp"
 
 namespace geohaz {
-
 
 using Rgb = std::array<std::uint8_t, 3>;
 

@@ -44,8 +44,9 @@ std::string number(double v) {
   return o.str();
 }
 
-const char* kHeader = "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n"
-                      "<qgis version=\"3.28.0\" styleCategories=\"Symbology\">\n  <pipe>\n";
+const char* kHeader =
+    "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n"
+    "<qgis version=\"3.28.0\" styleCategories=\"Symbology\">\n  <pipe>\n";
 const char* kFooter = "  </pipe>\n</qgis>\n";
 
 }  // namespace
@@ -56,7 +57,8 @@ void write_qgis_ramp_style(const std::filesystem::path& path, ColourRamp ramp, d
   x << kHeader << "    <rasterrenderer type=\"singlebandpseudocolor\" band=\"1\" opacity=\"0.85\" alphaBand=\"-1\""
     << " classificationMin=\"" << number(vmin) << "\" classificationMax=\"" << number(vmax) << "\">\n"
     << "      <rasterTransparency>\n        <singleValuePixelList>\n"
-    << "          <pixelListEntry min=\"-1e+300\" max=\"" << number(transparent_below) << "\" percentTransparent=\"100\"/>\n"
+    << "          <pixelListEntry min=\"-1e+300\" max=\"" << number(transparent_below)
+    << "\" percentTransparent=\"100\"/>\n"
     << "        </singleValuePixelList>\n      </rasterTransparency>\n"
     << "      <rastershader>\n        <colorrampshader colorRampType=\"INTERPOLATED\" classificationMode=\"1\""
     << " clip=\"0\" minimumValue=\"" << number(vmin) << "\" maximumValue=\"" << number(vmax) << "\""

@@ -15,10 +15,10 @@
 #include <memory>
 #include <mutex>
 
+#include "gdal_common.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster_extra.hpp"
 #include "geohaz/core/resources.hpp"
-#include "gdal_common.hpp"
 
 namespace geohaz {
 

@@ -9,12 +9,11 @@
 #include <iostream>
 #include <memory>
 
+#include "gdal_common.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
-#include "gdal_common.hpp"
 
 namespace geohaz {
-
 
 namespace {
 
@@ -76,8 +75,7 @@ struct VectorLayer {
   int field = -1;
   std::unique_ptr<OGRCoordinateTransformation> ct;
 
-  VectorLayer(const std::string& file, const std::string& attribute, const std::string& target_wkt,
-              const char* what) {
+  VectorLayer(const std::string& file, const std::string& attribute, const std::string& target_wkt, const char* what) {
     ds.reset(GDALDataset::Open(file.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
     if (!ds) throw InputError("cannot read as a vector data source" + detail::gdal_last_error(), file);
     if (ds->GetLayerCount() < 1) throw InputError("the data source has no layer", file);
@@ -103,19 +101,22 @@ struct VectorLayer {
     const OGRSpatialReference* layer_srs = layer->GetSpatialRef();
     OGRSpatialReference target;
     if (target_wkt.empty()) return;
-    if (!detail::parse_srs(target_wkt, target)) throw InputError("the target CRS cannot be interpreted", file, "", target_wkt);
+    if (!detail::parse_srs(target_wkt, target))
+      throw InputError("the target CRS cannot be interpreted", file, "", target_wkt);
     if (!layer_srs || layer_srs->IsEmpty()) {
       std::cerr << "warning: " << file << ": the " << what << " have no CRS; taken to be in the target CRS\n";
       return;
     }
-    const char* options[] = {"IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES", "CRITERION=EQUIVALENT_EXCEPT_AXIS_ORDER_GEOGCRS",
-                             nullptr};
+    const char* options[] = {"IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES",
+                             "CRITERION=EQUIVALENT_EXCEPT_AXIS_ORDER_GEOGCRS", nullptr};
     if (layer_srs->IsSame(&target, options)) return;
     OGRSpatialReference source(*layer_srs);
     source.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
     target.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
     ct.reset(OGRCreateCoordinateTransformation(&source, &target));
-    if (!ct) throw InputError(std::string("cannot transform the ") + what + " to the target CRS" + detail::gdal_last_error(), file);
+    if (!ct)
+      throw InputError(std::string("cannot transform the ") + what + " to the target CRS" + detail::gdal_last_error(),
+                       file);
   }
 
   double value(const OGRFeature& f) const {
@@ -202,9 +203,9 @@ std::vector<Polyline> read_lines(const std::filesystem::path& path, const std::s
       type = wkbFlatten(g->getGeometryType());
     }
     if (type != wkbLineString && type != wkbMultiLineString)
-      throw InputError("feature " + std::to_string(feature->GetFID()) + " is a " + OGRGeometryTypeToName(type) +
-                           ", not a line",
-                       file);
+      throw InputError(
+          "feature " + std::to_string(feature->GetFID()) + " is a " + OGRGeometryTypeToName(type) + ", not a line",
+          file);
     if (v.ct && g->transform(v.ct.get()) != OGRERR_NONE)
       throw InputError("line " + std::to_string(feature->GetFID()) + " cannot be transformed to the target CRS" +
                            detail::gdal_last_error(),

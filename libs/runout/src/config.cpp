@@ -7,7 +7,6 @@
 #include <string>
 
 #include "geohaz/core/errors.hpp"
-
 #include "geohaz/runout/run.hpp"
 
 namespace geohaz::runout {
@@ -69,7 +68,7 @@ void read_processes(ConfigReader& cfg, RunoutCase& c) {
                                          {"",
                                           "bed erosion: none, growth (dV/ds = E_s V, McDougall & Hungr 2005) or "
                                           "shear (rate k_e (τ_b − τ_c) where τ_b > τ_c)"});
-  e.law = law == "growth" ? EntrainmentLaw::GrowthRate
+  e.law = law == "growth"  ? EntrainmentLaw::GrowthRate
           : law == "shear" ? EntrainmentLaw::ShearStress
                            : EntrainmentLaw::None;
   e.growth_rate = cfg.get("entrainment.growth_rate", e.growth_rate, Range::closed(0.0, 1.0),
@@ -79,8 +78,8 @@ void read_processes(ConfigReader& cfg, RunoutCase& c) {
   e.erosion_coefficient =
       cfg.get("entrainment.coefficient", e.erosion_coefficient, Range::closed(0.0, 1.0),
               {"m/(s*Pa)", "k_e of the shear law: erosion rate (m/s of bed depth) per Pa of excess shear"});
-  s.erodible = resolve(cfg, cfg.get_string("entrainment.file", "",
-                                           {"", "erodible layer: depth raster (m, vertical) or polygons"}));
+  s.erodible = resolve(
+      cfg, cfg.get_string("entrainment.file", "", {"", "erodible layer: depth raster (m, vertical) or polygons"}));
   s.erodible_attribute = cfg.get_string("entrainment.attribute", s.erodible_attribute,
                                         {"", "polygon attribute holding the erodible depth (m)"});
   s.erodible_depth = cfg.get("entrainment.depth", s.erodible_depth, Range::closed(0.0, 100.0),
@@ -114,8 +113,8 @@ void read_processes(ConfigReader& cfg, RunoutCase& c) {
   s.drag_coefficient = cfg.get("forest.drag_coefficient", s.drag_coefficient, Range::open_closed(0.0, 10.0),
                                {"1", "drag coefficient C_D of a stem (k_f = ½ C_D n d)"});
 
-  s.hydrograph = resolve(cfg, cfg.get_string("inflow.hydrograph", "",
-                                             {"", "inflow hydrograph table: CSV time_s,discharge_m3_s"}));
+  s.hydrograph =
+      resolve(cfg, cfg.get_string("inflow.hydrograph", "", {"", "inflow hydrograph table: CSV time_s,discharge_m3_s"}));
   s.inflow_points = cfg.get_array("inflow.points", s.inflow_points, Range::closed(-1e8, 1e8),
                                   {"m", "inflow point [x, y] or short line [x1, y1, x2, y2] in the DSM's CRS"});
   s.inflow_azimuth = cfg.get("inflow.azimuth", s.inflow_azimuth, Range::closed_open(-1.0, 360.0),
@@ -202,9 +201,9 @@ RunoutCase read_case(ConfigReader& cfg) {
                             {"m", "depth_speed: peak depth above which (with the speed) a cell is strong"});
   it.strong_speed = cfg.get("intensity.strong_speed", it.strong_speed, Range::open_closed(0.0, 200.0),
                             {"m/s", "depth_speed: peak speed above which (with the depth) a cell is strong"});
-  const std::vector<double> classes =
-      cfg.get_array("intensity.pressure_classes", {it.medium_pressure, it.strong_pressure}, Range::open_closed(0.0, 1e9),
-                    {"Pa", "pressure: [medium, strong] lower bounds of peak ρv², increasing"}, 2);
+  const std::vector<double> classes = cfg.get_array(
+      "intensity.pressure_classes", {it.medium_pressure, it.strong_pressure}, Range::open_closed(0.0, 1e9),
+      {"Pa", "pressure: [medium, strong] lower bounds of peak ρv², increasing"}, 2);
   if (!(classes[0] < classes[1]))
     throw InputError("intensity.pressure_classes must increase: [medium, strong] = [" + std::to_string(classes[0]) +
                          ", " + std::to_string(classes[1]) + "] Pa",

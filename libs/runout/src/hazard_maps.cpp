@@ -190,8 +190,8 @@ const char* to_string(IntensityScheme s) noexcept {
   return s == IntensityScheme::Pressure ? "pressure" : "depth_speed";
 }
 
-std::vector<double> intensity_classes(const std::vector<double>& depth, const std::vector<double>& speed, double density,
-                                      const IntensityTable& t) {
+std::vector<double> intensity_classes(const std::vector<double>& depth, const std::vector<double>& speed,
+                                      double density, const IntensityTable& t) {
   std::vector<double> c(depth.size(), 0.0);
   for (std::size_t k = 0; k < c.size(); ++k) {
     if (!(depth[k] > t.min_depth)) continue;  // not reached

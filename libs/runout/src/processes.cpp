@@ -56,9 +56,10 @@ std::vector<double> raster_on_grid(const std::string& file, const Raster& dsm, c
     for (int col = 0; col < g.nx; ++col) centres.push_back(g.centre(col, row));
   const bool reproject = !r.crs_wkt.empty() && !dsm.crs_wkt.empty() && !crs_equal(r.crs_wkt, dsm.crs_wkt);
   if (reproject) centres = transform_points(centres, dsm.crs_wkt, r.crs_wkt);
-  const bool same_grid = !reproject && r.nx == dsm.nx && r.ny == dsm.ny &&
-                         std::equal(r.geotransform.begin(), r.geotransform.end(), dsm.geotransform.begin(),
-                                    [](double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(1.0, std::abs(a)); });
+  const bool same_grid =
+      !reproject && r.nx == dsm.nx && r.ny == dsm.ny &&
+      std::equal(r.geotransform.begin(), r.geotransform.end(), dsm.geotransform.begin(),
+                 [](double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(1.0, std::abs(a)); });
   if (!same_grid)
     std::cerr << "debris-runout: note: " << key << " = " << file << " is on another grid"
               << (reproject ? " and CRS" : "") << " than the DSM: sampled at the DSM cell centres (nearest cell)\n";
@@ -195,7 +196,8 @@ SpatialProcesses load_processes(const ProcessSpec& s, const RunoutParameters& p,
       any = true;
     }
     if (!any)
-      throw InputError("the friction zones hold no attribute for a coefficient of the " + law + " law (expected one of " +
+      throw InputError("the friction zones hold no attribute for a coefficient of the " + law +
+                           " law (expected one of " +
                            (law == ModifiedManningFriction::name ? std::string("n, icr, m")
                             : law == VoellmyFriction::name       ? std::string("mu, xi")
                                                                  : std::string("mu")) +
@@ -257,9 +259,10 @@ SpatialProcesses load_processes(const ProcessSpec& s, const RunoutParameters& p,
         any = any || out.forest_drag[c] > 0.0;
       }
     if (!any)
-      throw InputError("the forest covers no DSM cell with a positive stem density and diameter (set "
-                       "forest.stem_density / forest.stem_diameter or the attributes)",
-                       s.forest, "forest.file");
+      throw InputError(
+          "the forest covers no DSM cell with a positive stem density and diameter (set "
+          "forest.stem_density / forest.stem_diameter or the attributes)",
+          s.forest, "forest.file");
   }
 
   // Erodible layer (m, vertical).
@@ -290,7 +293,8 @@ SpatialProcesses load_processes(const ProcessSpec& s, const RunoutParameters& p,
         out.erodible_depth[c] = e[c];
         total += e[c];
       }
-    if (!(total > 0.0)) throw InputError("the erodible layer has no positive depth on the DSM", s.erodible, "entrainment.file");
+    if (!(total > 0.0))
+      throw InputError("the erodible layer has no positive depth on the DSM", s.erodible, "entrainment.file");
   } else if (p.entrainment.law != EntrainmentLaw::None) {
     throw InputError(std::string("entrainment.law = ") + to_string(p.entrainment.law) +
                          " needs an erodible layer (entrainment.file: depth raster or polygons)",
@@ -316,8 +320,8 @@ SpatialProcesses load_processes(const ProcessSpec& s, const RunoutParameters& p,
                          "config", "inflow.points");
     }
     if ((q.b - q.a).norm() > 20.0 * p.d0)
-      throw InputError("the inflow line is " + num((q.b - q.a).norm()) + " m long: a short line (≤ 20 d0 = " +
-                           num(20.0 * p.d0) + " m) is expected",
+      throw InputError("the inflow line is " + num((q.b - q.a).norm()) +
+                           " m long: a short line (≤ 20 d0 = " + num(20.0 * p.d0) + " m) is expected",
                        "config", "inflow.points");
     if (s.inflow_azimuth >= 0.0) {
       const double az = s.inflow_azimuth * 3.14159265358979323846 / 180.0;  // clockwise from north

@@ -452,14 +452,13 @@ std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int t
     const Raster& dsm = sim.inputs().dsm;
     for (std::size_t k = 0; k < cls.size(); ++k)
       if (!dsm.is_nodata(dsm.data[k]) && cls[k] >= 1.0 && cls[k] <= 3.0) a[static_cast<int>(cls[k])] += in_grid_area;
-    j["intensity"] = {{"scheme", to_string(itab.scheme)},
-                      {"area_low_m2", a[1]},
-                      {"area_medium_m2", a[2]},
-                      {"area_strong_m2", a[3]}};
+    j["intensity"] = {
+        {"scheme", to_string(itab.scheme)}, {"area_low_m2", a[1]}, {"area_medium_m2", a[2]}, {"area_strong_m2", a[3]}};
     if (itab.scheme == IntensityScheme::DepthSpeed)
       j["intensity"].update({{"strong_depth_m", itab.strong_depth}, {"strong_speed_m_s", itab.strong_speed}});
     else
-      j["intensity"].update({{"medium_pressure_pa", itab.medium_pressure}, {"strong_pressure_pa", itab.strong_pressure}});
+      j["intensity"].update(
+          {{"medium_pressure_pa", itab.medium_pressure}, {"strong_pressure_pa", itab.strong_pressure}});
   }
   j["mass_balance_error_relative"] = b.total_in() > 0.0 ? b.balance_error() / b.total_in() : 0.0;
   // The processes in force (docs/runout.md, "Processes").
@@ -483,7 +482,8 @@ std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int t
   }
   nlohmann::json zones = nlohmann::json::array();
   for (int k = 0; k < kFrictionParameters; ++k)
-    if (!proc.friction[static_cast<std::size_t>(k)].empty()) zones.push_back(kFrictionParameterNames[static_cast<std::size_t>(k)]);
+    if (!proc.friction[static_cast<std::size_t>(k)].empty())
+      zones.push_back(kFrictionParameterNames[static_cast<std::size_t>(k)]);
   jp["friction_zones"] = {{"file", c.processes.zones}, {"coefficients", zones}};
   if (!proc.forest_drag.empty()) {
     double area = 0.0, kmax = 0.0;
@@ -499,12 +499,9 @@ std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int t
   }
   if (!proc.inflows.empty()) {
     const Hydrograph& q = proc.inflows.front();
-    jp["inflow"] = {{"hydrograph", q.source},
-                    {"volume_of_table_m3", q.volume()},
-                    {"injected_m3", b.injected},
-                    {"end_time_s", q.end_time()},
-                    {"speed_m_s", q.speed},
-                    {"direction_xy", {q.direction.x(), q.direction.y()}}};
+    jp["inflow"] = {{"hydrograph", q.source},    {"volume_of_table_m3", q.volume()},
+                    {"injected_m3", b.injected}, {"end_time_s", q.end_time()},
+                    {"speed_m_s", q.speed},      {"direction_xy", {q.direction.x(), q.direction.y()}}};
   }
   j["processes"] = jp;
   return j.dump(2);
@@ -538,13 +535,14 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
     write_qgis_ramp_style(out / (std::string(name) + ".qml"), ramp, 0.0, vmax > 0.0 ? vmax : 1.0, unit, 0.0);
     return r;
   };
-  const Raster r_depth = put("max_depth", maps.max_depth(), 0.0, "peak flow depth, normal to the bed", "m",
-                             ColourRamp::Viridis);
+  const Raster r_depth =
+      put("max_depth", maps.max_depth(), 0.0, "peak flow depth, normal to the bed", "m", ColourRamp::Viridis);
   const Raster r_speed = put("max_speed", maps.max_speed(), 0.0, "peak surface speed", "m/s", ColourRamp::Magma);
   put("max_pressure", maps.max_pressure(), 0.0, "peak dynamic pressure rho v^2", "Pa", ColourRamp::Magma);
   put("max_momentum", maps.max_momentum(), 0.0, "peak momentum per unit area over density, h v", "m2/s",
       ColourRamp::Magma);
-  const Raster r_dep = put("deposit", sim.deposit(), 0.0, "final deposit thickness, vertical", "m", ColourRamp::Viridis);
+  const Raster r_dep =
+      put("deposit", sim.deposit(), 0.0, "final deposit thickness, vertical", "m", ColourRamp::Viridis);
   put("mobile_at_end", sim.mobile_at_end(), 0.0, "thickness still moving when the run ended at its duration, vertical",
       "m", ColourRamp::Viridis);
   put("arrival_time", maps.arrival_time(), -9999.0, "first arrival of the flow (-9999: never)", "s",
@@ -575,10 +573,11 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
   }
   const auto& solver = sim.solver();
   if (!solver.eroded_depth().empty()) {
-    const Raster r_ero = put("erosion_depth", solver.eroded_depth(), 0.0, "depth eroded from the bed, vertical", "m",
-                             ColourRamp::Magma);
+    const Raster r_ero =
+        put("erosion_depth", solver.eroded_depth(), 0.0, "depth eroded from the bed, vertical", "m", ColourRamp::Magma);
     if (c.output.pngs)
-      write_quicklook_png(out / "erosion_depth.png", dsm, &r_ero, ColourRamp::Magma, "eroded depth (m)", 0.0, 0.0, 0.001);
+      write_quicklook_png(out / "erosion_depth.png", dsm, &r_ero, ColourRamp::Magma, "eroded depth (m)", 0.0, 0.0,
+                          0.001);
   }
   if (c.output.pngs) {
     write_quicklook_png(out / "max_depth.png", dsm, &r_depth, ColourRamp::Viridis, "peak flow thickness (m)", 0.0, 0.0,
@@ -594,7 +593,8 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
   {
     AtomicTextFile csv(out / "series.csv");
     csv << "time_s,step,particles,front_x_m,front_y_m,front_travel_m,front_drop_m,mean_speed_m_s,max_speed_m_s,"
-           "mobile_volume_m3,deposited_volume_m3,lost_volume_m3,balance_error_m3,entrained_volume_m3,injected_volume_m3\n";
+           "mobile_volume_m3,deposited_volume_m3,lost_volume_m3,balance_error_m3,entrained_volume_m3,injected_volume_"
+           "m3\n";
     csv.stream() << std::setprecision(10);
     for (const auto& r : sim.series())
       csv << r.time << ',' << r.step << ',' << r.particles << ',' << r.front.x() << ',' << r.front.y() << ','

@@ -91,7 +91,7 @@ struct IndexOf<Tag, First, Rest...> : std::integral_constant<std::size_t, 1 + In
 /// The particle container: one std::vector per field tag.
 template <class... Tags>
 class ParticleStore {
-public:
+ public:
   static constexpr std::size_t kFieldCount = sizeof...(Tags);
 
   /// Number of particles.
@@ -163,7 +163,7 @@ public:
   /// Bytes of per-particle state (for the memory budget in docs/performance.md).
   static constexpr std::size_t bytes_per_particle() noexcept { return (sizeof(typename Tags::type) + ...); }
 
-private:
+ private:
   template <class Tag>
   void resize_one(std::size_t n) {
     auto& v = get<Tag>();

@@ -21,13 +21,13 @@ namespace geohaz {
 
 /// A single-band raster of doubles on a north-up grid.
 struct Raster {
-  int nx = 0, ny = 0;                        ///< columns, rows
-  std::array<double, 6> geotransform{};      ///< GDAL order: x0, dx, 0, y0, 0, dy (dy < 0)
-  std::string crs_wkt;                       ///< WKT of the CRS ("" if none)
-  std::optional<double> nodata;              ///< nodata value, if any
-  std::vector<double> data;                  ///< nx·ny values, row-major, row 0 north
-  std::string description;                   ///< band description (what the values are), "" if none
-  std::string unit;                          ///< unit of the values ("m", "m/s", "Pa", "1"), "" if none
+  int nx = 0, ny = 0;                    ///< columns, rows
+  std::array<double, 6> geotransform{};  ///< GDAL order: x0, dx, 0, y0, 0, dy (dy < 0)
+  std::string crs_wkt;                   ///< WKT of the CRS ("" if none)
+  std::optional<double> nodata;          ///< nodata value, if any
+  std::vector<double> data;              ///< nx·ny values, row-major, row 0 north
+  std::string description;               ///< band description (what the values are), "" if none
+  std::string unit;                      ///< unit of the values ("m", "m/s", "Pa", "1"), "" if none
 
   /// An empty raster on the same grid and CRS, filled with `fill`.
   Raster like(double fill, std::optional<double> nodata_value = std::nullopt) const;
@@ -66,11 +66,12 @@ bool crs_is_geographic(const std::string& wkt);
 /// Whether two WKTs describe the same CRS.
 bool crs_equal(const std::string& a, const std::string& b);
 /// Transform points from one CRS to another (traditional x=east, y=north axis order).
-std::vector<Vec2> transform_points(const std::vector<Vec2>& pts, const std::string& from_wkt, const std::string& to_wkt);
+std::vector<Vec2> transform_points(const std::vector<Vec2>& pts, const std::string& from_wkt,
+                                   const std::string& to_wkt);
 
 /// A bilinear terrain surface over an elevation raster.
 class Terrain {
-public:
+ public:
   explicit Terrain(Raster elevation);
   const Raster& raster() const noexcept { return r_; }
   /// True when the four cell centres around (x, y) all hold data.
@@ -82,7 +83,7 @@ public:
   /// Upward unit normal (−∂z/∂x, −∂z/∂y, 1)/norm.
   Vec3 normal(double x, double y) const noexcept;
 
-private:
+ private:
   Raster r_;
 };
 

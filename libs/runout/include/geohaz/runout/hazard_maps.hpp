@@ -32,7 +32,7 @@ class HazardMaps {
   void record(const RunoutStore& store, double t);
 
   const GridGeometry& grid() const noexcept { return g_; }
-  double density() const noexcept { return density_; }  ///< kg/m³, of the pressure map
+  double density() const noexcept { return density_; }                          ///< kg/m³, of the pressure map
   const std::vector<double>& max_depth() const noexcept { return max_depth_; }  ///< m, normal to the bed
   const std::vector<double>& max_speed() const noexcept { return max_speed_; }  ///< m/s
   std::vector<double> max_pressure() const;  ///< Pa (ρ S²), from max_speed (exact: ρS² is monotone in S)
@@ -69,18 +69,18 @@ const char* to_string(IntensityScheme s) noexcept;
 /// Class thresholds (SI).
 struct IntensityTable {
   IntensityScheme scheme = IntensityScheme::DepthSpeed;
-  double min_depth = 0.0;             ///< a cell is reached when its peak depth exceeds this (m)
-  double strong_depth = 1.0;          ///< m
-  double strong_speed = 1.0;          ///< m/s
-  double medium_pressure = 3.0e3;     ///< Pa
-  double strong_pressure = 30.0e3;    ///< Pa
+  double min_depth = 0.0;           ///< a cell is reached when its peak depth exceeds this (m)
+  double strong_depth = 1.0;        ///< m
+  double strong_speed = 1.0;        ///< m/s
+  double medium_pressure = 3.0e3;   ///< Pa
+  double strong_pressure = 30.0e3;  ///< Pa
 };
 
 /// Intensity class per cell from peak depth (m) and peak speed (m/s) maps (the pressure is
 /// ρ·speed²): 0 not reached, 1 low, 2 medium, 3 strong. The peaks of a cell may come from
 /// different times (the practice of RAMMS and AvaFrame's peak-field maps).
-std::vector<double> intensity_classes(const std::vector<double>& depth, const std::vector<double>& speed, double density,
-                                      const IntensityTable& t);
+std::vector<double> intensity_classes(const std::vector<double>& depth, const std::vector<double>& speed,
+                                      double density, const IntensityTable& t);
 /// The same from a run's maps.
 std::vector<double> intensity_classes(const HazardMaps& maps, const IntensityTable& t);
 

@@ -55,11 +55,11 @@ struct ReleaseSpec {
 struct ProcessSpec {
   std::string zones;  ///< friction zones: polygons with attributes named n, icr, m, mu, xi
   std::array<std::string, kFrictionParameters> zone_rasters;  ///< a raster per coefficient (by FrictionParameter)
-  std::string forest;            ///< forest polygons (attributes stem_density, stem_diameter) or stem-density raster
-  double stem_density = 0.0;     ///< stems per m² where the polygons carry none (1/m²)
-  double stem_diameter = 0.3;    ///< stem diameter where the polygons carry none (m)
+  std::string forest;             ///< forest polygons (attributes stem_density, stem_diameter) or stem-density raster
+  double stem_density = 0.0;      ///< stems per m² where the polygons carry none (1/m²)
+  double stem_diameter = 0.3;     ///< stem diameter where the polygons carry none (m)
   double drag_coefficient = 1.0;  ///< C_D of a stem (1)
-  std::string erodible;          ///< erodible depth raster (m) or polygons
+  std::string erodible;           ///< erodible depth raster (m) or polygons
   std::string erodible_attribute = "depth";  ///< polygon attribute of the erodible depth (m)
   double erodible_depth = 0.0;               ///< uniform polygon depth (m); 0: use the attribute
   std::string hydrograph;                    ///< inflow table (CSV time_s, discharge_m3_s)

@@ -318,48 +318,48 @@ class RunoutSolver {
       const auto one_pass = [&](auto periodic_tag) {
         constexpr bool kPeriodic = decltype(periodic_tag)::value;
 #pragma omp parallel for reduction(max : signal) schedule(static) if (n >= kParallelMin)
-      for (std::int64_t ii = 0; ii < n; ++ii) {
-        const auto i = static_cast<std::size_t>(ii);
-        double depth = vol[i] * (2.0 / 3.0);
-        Vec2 vsum = depth * v[i];
-        double vzsum = depth * vz[i];
-        Vec2 acc = Vec2::Zero();
-        double accz = 0.0;
-        const double ci = cb[i];
-        // W/σ (kernels.hpp) and f (head_pressure.hpp) written out per branch of q; the
-        // arithmetic is exactly that of CubicSpline and HeadPressureForce::shape.
-        const double zi = z[i];
-        neighbours(i, [&](std::size_t j, const Vec2& xij, double r2) {
-          double zij = zi - z[j];
-          if constexpr (kPeriodic) zij += grad[i].dot(xij - (x[i] - x[j]));
-          const double r3 = r2 + zij * zij;
-          if (r3 >= support2) return;  // beyond the support on the bed (or in the list's skin)
-          const double r = std::sqrt(r3);
-          const double q = r * inv_d0;
-          const double vj = vol[j];
-          double w, fr;
-          if (q < 1.0) {
-            w = vj * (2.0 / 3.0 - q * q + 0.5 * q * q * q);
-            fr = r > 0.0 ? coef * vj * (1.0 - q) / ((1.0 + q) * r) : 0.0;  // one division
-          } else {
-            const double t = 2.0 - q;
-            w = vj * (t * t * t / 6.0);
-            fr = coef * vj * (-0.5 * (q - 1.0) * (q - 2.0)) / r;
-          }
-          depth += w;
-          vsum += w * v[j];
-          vzsum += w * vz[j];
-          fr *= ci + cb[j];
-          acc += fr * xij;
-          accz += fr * zij;
-        });
-        vmean[i] = tangent_mean(i, vsum / depth, vzsum / depth);
-        depth *= sigma;
-        h[i] = depth;
-        ap[i] = on_bed(i, acc, accz);
-        dv[i] = Vec2::Zero();
-        signal = std::max(signal, signal_speed(i));
-      }
+        for (std::int64_t ii = 0; ii < n; ++ii) {
+          const auto i = static_cast<std::size_t>(ii);
+          double depth = vol[i] * (2.0 / 3.0);
+          Vec2 vsum = depth * v[i];
+          double vzsum = depth * vz[i];
+          Vec2 acc = Vec2::Zero();
+          double accz = 0.0;
+          const double ci = cb[i];
+          // W/σ (kernels.hpp) and f (head_pressure.hpp) written out per branch of q; the
+          // arithmetic is exactly that of CubicSpline and HeadPressureForce::shape.
+          const double zi = z[i];
+          neighbours(i, [&](std::size_t j, const Vec2& xij, double r2) {
+            double zij = zi - z[j];
+            if constexpr (kPeriodic) zij += grad[i].dot(xij - (x[i] - x[j]));
+            const double r3 = r2 + zij * zij;
+            if (r3 >= support2) return;  // beyond the support on the bed (or in the list's skin)
+            const double r = std::sqrt(r3);
+            const double q = r * inv_d0;
+            const double vj = vol[j];
+            double w, fr;
+            if (q < 1.0) {
+              w = vj * (2.0 / 3.0 - q * q + 0.5 * q * q * q);
+              fr = r > 0.0 ? coef * vj * (1.0 - q) / ((1.0 + q) * r) : 0.0;  // one division
+            } else {
+              const double t = 2.0 - q;
+              w = vj * (t * t * t / 6.0);
+              fr = coef * vj * (-0.5 * (q - 1.0) * (q - 2.0)) / r;
+            }
+            depth += w;
+            vsum += w * v[j];
+            vzsum += w * vz[j];
+            fr *= ci + cb[j];
+            acc += fr * xij;
+            accz += fr * zij;
+          });
+          vmean[i] = tangent_mean(i, vsum / depth, vzsum / depth);
+          depth *= sigma;
+          h[i] = depth;
+          ap[i] = on_bed(i, acc, accz);
+          dv[i] = Vec2::Zero();
+          signal = std::max(signal, signal_speed(i));
+        }
       };
       if (periodic)
         one_pass(std::true_type{});
@@ -481,8 +481,9 @@ class RunoutSolver {
       demand_cell_.resize(store_.size());
     }
     int any_leaving = 0, any_non_finite = 0, any_entraining = 0;
-#pragma omp parallel for reduction(max : any_leaving, any_non_finite, any_entraining) schedule(static) \
-    if (n >= kParallelMin)
+#pragma omp parallel for reduction(max                                            \
+                                   : any_leaving, any_non_finite, any_entraining) \
+    schedule(static) if (n >= kParallelMin)
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
       const std::size_t cell = cells ? proc_.cell(x[i]) : SpatialProcesses::npos;
@@ -505,7 +506,8 @@ class RunoutSolver {
       //    g_n = cos θ (g + vᵀHv)⁺: gravity plus the centripetal acceleration of the bed curvature
       //    along the velocity, zero when the particle would leave the bed.
       const Vec3& H = hess[i];
-      const double kv = curvature ? H[0] * vi.x() * vi.x() + 2.0 * H[1] * vi.x() * vi.y() + H[2] * vi.y() * vi.y() : 0.0;
+      const double kv =
+          curvature ? H[0] * vi.x() * vi.x() + 2.0 * H[1] * vi.x() * vi.y() + H[2] * vi.y() * vi.y() : 0.0;
       const double vz = gz.dot(v_star);
       const double s_star = std::sqrt(v_star.squaredNorm() + vz * vz);
       //    The law's coefficients of the particle's friction zone; forest drag k_f |v|² on top.
@@ -707,11 +709,11 @@ class RunoutSolver {
   CellPairScan<2> scan_;   // without (the default)
   VolumeBudget budget_;
   SpatialProcesses proc_;
-  std::vector<double> eroded_;               // per cell of proc_.grid (m)
-  std::vector<double> demand_;               // per particle, this step (m³)
-  std::vector<std::size_t> demand_cell_;     // the cell it erodes
-  std::vector<double> emitted_;              // per inflow (m³)
-  std::vector<std::int64_t> slot_;           // per inflow: particles emitted
+  std::vector<double> eroded_;            // per cell of proc_.grid (m)
+  std::vector<double> demand_;            // per particle, this step (m³)
+  std::vector<std::size_t> demand_cell_;  // the cell it erodes
+  std::vector<double> emitted_;           // per inflow (m³)
+  std::vector<std::int64_t> slot_;        // per inflow: particles emitted
   std::int64_t next_id_ = 0;
   bool list_valid_ = false;
   bool energy_stop_ = false;
