@@ -113,7 +113,10 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   for (auto& m : mats) {
     MaterialParams p;
     c.material_names.push_back(m.get_string("name", "soil", {"", "label"}));
-    p.density = m.get("density", 1800.0, Range::positive(), {"kg/m^3", "density rho0"});
+    // Bounded to real materials: the time step scales with √(ρ/E), so a density of a few kg/m³
+    // (a slip of the unit) would make a run of seconds take hours (fuzz case 116).
+    p.density = m.get("density", 1800.0, Range::closed(100.0, 30000.0),
+                      {"kg/m^3", "density rho0 (soils 1500-2300, water 1000, rock 2500-3000)"});
     p.young = m.get("young", 1e6, Range::positive(), {"Pa", "Young's modulus E"});
     p.poisson = m.get("poisson", 0.3, Range::closed_open(0.0, 0.5), {"1", "Poisson's ratio"});
     p.cohesion = m.get("cohesion", 0.0, Range::non_negative(), {"Pa", "cohesion c (Drucker-Prager)"});

@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "child_process.hpp"
@@ -162,6 +163,25 @@ TEST_F(Reliability, InfiniteValuesAreBadInput) {
     const auto r = expect_exit(argv, 2, lim);
     EXPECT_TRUE(has(r.err, "not a finite number")) << r.err;
     EXPECT_TRUE(has(r.err, "command line (--set)")) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "o"));
+  }
+}
+
+// Fuzz cases 62 and 116 (seed 20261201): a platen speed of 1e-9 m/s or a soil density of
+// 1.8 kg/m³ made a run of seconds take hours. Both are outside the physical ranges now: exit 2
+// naming the key, at once.
+TEST_F(Reliability, ValuesThatWouldRunForHoursAreBadInput) {
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{DEM_AVALANCHE_EXE, "--config", (kData / "dem/biaxial_compression.toml").string(), "--set",
+        "biaxial.loading_velocity=1e-9", "--out", (dir_ / "o").string(), "--quiet"},
+       "biaxial.loading_velocity"},
+      {sph_column(dir_ / "o") + std::vector<std::string>{"--set", "material[0].density=1.8"}, "density"},
+  };
+  for (const auto& [argv, key] : cases) {
+    ChildLimits lim;
+    lim.timeout_s = 30;
+    const auto r = expect_exit(argv, 2, lim);
+    EXPECT_TRUE(has(r.err, key)) << r.err;
     EXPECT_FALSE(fs::exists(dir_ / "o"));
   }
 }
