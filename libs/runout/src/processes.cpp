@@ -97,8 +97,8 @@ void paint(const std::vector<Polygon>& polys, const std::vector<double>& values,
   }
 }
 
-/// The values of one numeric attribute per polygon (NaN where null); `required`: refuse a layer
-/// without it.
+/// The polygons of `file` (into `polys`) and the value of one numeric attribute per polygon (NaN
+/// where null); a layer without the attribute is an InputError listing its fields.
 std::vector<double> attribute_of(const std::string& file, const std::string& attribute, const Raster& dsm,
                                  std::vector<Polygon>& polys) {
   polys = read_polygons(file, attribute, dsm.crs_wkt);
