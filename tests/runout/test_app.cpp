@@ -2,6 +2,7 @@
 // volumes balance, the flow travels down the valley), and bad inputs (exit code 2, a message naming
 // the input, no output written).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
@@ -42,13 +43,22 @@ fs::path work_dir() {
 
 // The tiny synthetic valley (0.1 scale: 200 × 100 cells of 2.5 m, 500 m long), made once per run
 // by the app's own generator.
+// ctest runs the tests of this file as separate processes, two at a time: each process makes the
+// pair in a folder of its own and renames it into place (atomic, identical contents), so no
+// process reads or replaces a half-written file of another.
 fs::path tiny_dsm() {
-  const fs::path dsm = work_dir() / "tiny.tif";
+  const fs::path dsm = work_dir() / "tiny.tif", rel = work_dir() / "tiny_release.tif";
   static bool made = false;
   if (!made) {
     made = true;
-    const auto r = run("--make-synthetic-dsm " + dsm.string() + " --synthetic-scale 0.1 --release-depth 3");
+    if (fs::exists(dsm) && fs::exists(rel)) return dsm;
+    const fs::path own = work_dir() / ("make_" + std::to_string(::getpid()));
+    fs::create_directories(own);
+    const auto r = run("--make-synthetic-dsm " + (own / "tiny.tif").string() + " --synthetic-scale 0.1 --release-depth 3");
     EXPECT_EQ(r.code, 0) << r.output;
+    fs::rename(own / "tiny_release.tif", rel);
+    fs::rename(own / "tiny.tif", dsm);
+    fs::remove_all(own);
   }
   return dsm;
 }
