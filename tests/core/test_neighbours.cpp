@@ -2,6 +2,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <set>
 
@@ -73,14 +74,30 @@ void check(Layout layout, bool periodic, int threads) {
   EXPECT_GT(pairs, x.size());  // the test is not vacuous
 }
 
-TEST(NeighbourList, Uniform2D) { check<2>(Layout::Uniform, false, 1); }
-TEST(NeighbourList, Uniform2DTwoThreads) { check<2>(Layout::Uniform, false, 2); }
-TEST(NeighbourList, Clustered2D) { check<2>(Layout::Clustered, false, 2); }
-TEST(NeighbourList, Periodic2D) { check<2>(Layout::Uniform, true, 2); }
-TEST(NeighbourList, Uniform3D) { check<3>(Layout::Uniform, false, 1); }
-TEST(NeighbourList, Clustered3DTwoThreads) { check<3>(Layout::Clustered, false, 2); }
-TEST(NeighbourList, Periodic3D) { check<3>(Layout::Uniform, true, 2); }
-TEST(NeighbourList, Periodic3DOneThread) { check<3>(Layout::Clustered, true, 1); }
+TEST(NeighbourList, Uniform2D) {
+  check<2>(Layout::Uniform, false, 1);
+}
+TEST(NeighbourList, Uniform2DTwoThreads) {
+  check<2>(Layout::Uniform, false, 2);
+}
+TEST(NeighbourList, Clustered2D) {
+  check<2>(Layout::Clustered, false, 2);
+}
+TEST(NeighbourList, Periodic2D) {
+  check<2>(Layout::Uniform, true, 2);
+}
+TEST(NeighbourList, Uniform3D) {
+  check<3>(Layout::Uniform, false, 1);
+}
+TEST(NeighbourList, Clustered3DTwoThreads) {
+  check<3>(Layout::Clustered, false, 2);
+}
+TEST(NeighbourList, Periodic3D) {
+  check<3>(Layout::Uniform, true, 2);
+}
+TEST(NeighbourList, Periodic3DOneThread) {
+  check<3>(Layout::Clustered, true, 1);
+}
 
 TEST(NeighbourList, ShortPeriodicAxisHasNoDuplicates) {
   // Period 2.5 × cutoff: only two cells fit; the ±1 neighbour cells coincide and must be visited once.
@@ -208,11 +225,120 @@ void check_scan(Layout layout, bool periodic, int threads) {
   EXPECT_GT(pairs, x.size());  // the test is not vacuous
 }
 
-TEST(CellPairScan, SameNeighboursInTheSameOrderAsTheList2D) { check_scan<2>(Layout::Uniform, false, 1); }
-TEST(CellPairScan, Clustered2DTwoThreads) { check_scan<2>(Layout::Clustered, false, 2); }
-TEST(CellPairScan, Periodic2D) { check_scan<2>(Layout::Uniform, true, 2); }
-TEST(CellPairScan, Clustered3D) { check_scan<3>(Layout::Clustered, false, 1); }
-TEST(CellPairScan, Periodic3D) { check_scan<3>(Layout::Uniform, true, 2); }
+TEST(CellPairScan, SameNeighboursInTheSameOrderAsTheList2D) {
+  check_scan<2>(Layout::Uniform, false, 1);
+}
+TEST(CellPairScan, Clustered2DTwoThreads) {
+  check_scan<2>(Layout::Clustered, false, 2);
+}
+TEST(CellPairScan, Periodic2D) {
+  check_scan<2>(Layout::Uniform, true, 2);
+}
+TEST(CellPairScan, Clustered3D) {
+  check_scan<3>(Layout::Clustered, false, 1);
+}
+TEST(CellPairScan, Periodic3D) {
+  check_scan<3>(Layout::Uniform, true, 2);
+}
+
+// for_each_forward_neighbour visits every unordered pair of for_each_neighbour exactly once, from
+// its lower slot, within forward_reach() slots; a half-pair sum through PairBlocks equals the full
+// sum to round-off and is bit-identical on 1 and 3 threads.
+template <int Dim>
+void check_forward(Layout layout, bool periodic) {
+  const double L = 1.0, rc = 0.09;
+  auto x = make_points<Dim>(1500, layout, 29 + Dim, L);
+  Periodicity<Dim> p;
+  if (periodic) {
+    p.axis.fill(true);
+    p.lo.setZero();
+    p.hi.setConstant(L);
+    for (auto& xi : x) xi = p.wrap(xi);
+  }
+  CellPairScan<Dim> scan;
+  scan.build(x, rc, p);
+  const auto order = scan.cell_order();
+  const auto rank = scan.rank();
+  std::set<std::pair<std::size_t, std::size_t>> full, half;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    scan.for_each_neighbour(i, [&](std::size_t j, const Vec<Dim>&, double) {
+      full.insert({std::min(i, j), std::max(i, j)});
+    });
+  std::size_t visits = 0;
+  for (std::size_t a = 0; a < x.size(); ++a)
+    scan.for_each_forward_neighbour(a, [&](std::size_t s, const Vec<Dim>& xas, double r2) {
+      ASSERT_GT(s, a);
+      ASSERT_LE(s - a, scan.forward_reach());
+      const std::size_t i = order[a], j = order[s];
+      EXPECT_EQ(rank[i], a);
+      const Vec<Dim> d = p.any() ? p.min_image(x[i] - x[j]) : Vec<Dim>(x[i] - x[j]);
+      EXPECT_EQ(xas, d);
+      EXPECT_EQ(r2, d.squaredNorm());
+      half.insert({std::min(i, j), std::max(i, j)});
+      ++visits;
+    });
+  EXPECT_EQ(visits, half.size());  // no pair twice
+  EXPECT_EQ(half, full);
+  EXPECT_GT(visits, x.size());
+
+  // Σ_j φ(r_ij) x_j per particle (asymmetric in i, j), by half pairs with block reactions.
+  const auto half_sum = [&](int threads) {
+    const std::size_t n = x.size();
+    const PairBlocks blocks = PairBlocks::choose(n, scan.forward_reach());
+    EXPECT_GE(blocks.size, 64u);
+    std::vector<double> own(n), buf(blocks.slots()), out(n);
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(threads);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t bb = 0; bb < static_cast<std::int64_t>(blocks.count()); ++bb) {
+      const auto b = static_cast<std::size_t>(bb);
+      double* mine = blocks.buffer(buf.data(), b);
+      std::fill(mine + blocks.first(b), mine + blocks.window_end(b), 0.0);
+      for (std::size_t a = blocks.first(b); a < blocks.last(b); ++a) {
+        double sum = 0.0;
+        scan.for_each_forward_neighbour(a, [&](std::size_t s, const Vec<Dim>&, double r2) {
+          const double phi = std::exp(-r2 / (rc * rc));
+          sum += phi * x[order[s]][0];
+          mine[s] += phi * x[order[a]][0];
+        });
+        own[a] = sum;
+      }
+    }
+#pragma omp parallel for schedule(static)
+    for (std::int64_t bb = 0; bb < static_cast<std::int64_t>(blocks.count()); ++bb) {
+      const auto b = static_cast<std::size_t>(bb);
+      for (std::size_t a = blocks.first(b); a < blocks.last(b); ++a) {
+        double t = own[a];
+        for (std::size_t c = blocks.first_block_reaching(b); c <= b; ++c)
+          if (a < blocks.window_end(c)) t += buf[c * blocks.reach + a];
+        out[order[a]] = t;
+      }
+    }
+    omp_set_num_threads(saved);
+    return out;
+  };
+  const auto one = half_sum(1), three = half_sum(3);
+  EXPECT_EQ(one, three);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    double ref = 0.0;
+    scan.for_each_neighbour(
+        i, [&](std::size_t j, const Vec<Dim>&, double r2) { ref += std::exp(-r2 / (rc * rc)) * x[j][0]; });
+    EXPECT_NEAR(one[i], ref, 1e-12 * (1.0 + std::abs(ref))) << "particle " << i;
+  }
+}
+
+TEST(CellPairScan, ForwardPairsOnceWithBlockReactions2D) {
+  check_forward<2>(Layout::Uniform, false);
+}
+TEST(CellPairScan, ForwardPairsClustered2D) {
+  check_forward<2>(Layout::Clustered, false);
+}
+TEST(CellPairScan, ForwardPairsPeriodic2D) {
+  check_forward<2>(Layout::Uniform, true);
+}
+TEST(CellPairScan, ForwardPairsClustered3D) {
+  check_forward<3>(Layout::Clustered, false);
+}
 
 TEST(CellPairScan, ShortPeriodicAxisAndTooShortAxis) {
   // Period 2.5 × cutoff (the ±1 neighbour cells coincide) and a period below 2 × cutoff (rejected).
@@ -228,7 +354,8 @@ TEST(CellPairScan, ShortPeriodicAxisAndTooShortAxis) {
   const auto ref = brute_force<2>(x, 0.1, p);
   for (std::size_t i = 0; i < x.size(); ++i) {
     std::vector<std::uint32_t> got;
-    scan.for_each_neighbour(i, [&](std::size_t j, const Vec2&, double) { got.push_back(static_cast<std::uint32_t>(j)); });
+    scan.for_each_neighbour(i,
+                            [&](std::size_t j, const Vec2&, double) { got.push_back(static_cast<std::uint32_t>(j)); });
     EXPECT_EQ(std::set<std::uint32_t>(got.begin(), got.end()), ref[i]);
     EXPECT_EQ(got.size(), ref[i].size());
   }

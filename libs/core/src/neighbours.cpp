@@ -201,6 +201,21 @@ void CellPairScan<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const 
     sorted_x_[s] = x[sorted[s]];
     rank_[sorted[s]] = static_cast<std::uint32_t>(s);
   }
+  // The reach of the forward pairs: per occupied cell, the last slot its scan ranges cover.
+  const auto start = cells_.cell_start();
+  const std::int64_t ncell = static_cast<std::int64_t>(cells_.cell_count());
+  std::size_t reach = 0;
+#pragma omp parallel for schedule(static) reduction(max : reach)
+  for (std::int64_t c = 0; c < ncell; ++c) {
+    if (start[c] == start[c + 1]) continue;
+    typename CellList<Dim>::template ScanRanges<kReach> ranges;
+    const int nr = cells_.template scan_ranges<kReach>(static_cast<std::uint32_t>(c), ranges);
+    std::uint32_t end = start[c + 1];
+    for (int q = 0; q < nr; ++q)
+      if (ranges[q][1] > ranges[q][0]) end = std::max(end, ranges[q][1]);
+    reach = std::max<std::size_t>(reach, end - 1 - start[c]);
+  }
+  forward_reach_ = reach;
 }
 
 template class CellList<2>;

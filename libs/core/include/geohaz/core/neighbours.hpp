@@ -68,7 +68,7 @@ constexpr int ipow(int b, int e) noexcept {
 /// Cell-linked list: particles binned into cubic cells of edge ≥ cell_size, sorted by cell.
 template <int Dim>
 class CellList {
-public:
+ public:
   /// Slot ranges [first, last) of sorted() to scan for the neighbours of a particle in `cell`,
   /// R cells deep, and how many of them. Along axis 0 neighbouring cells are contiguous in the
   /// linear index, so each combination of the other axes is one range (two when a periodic axis
@@ -145,7 +145,7 @@ public:
   std::array<int, Dim> cell_coords(std::uint32_t c) const noexcept;
   const Periodicity<Dim>& periodicity() const noexcept { return periodic_; }
 
-private:
+ private:
   Periodicity<Dim> periodic_;
   Vec<Dim> origin_ = Vec<Dim>::Zero();
   Vec<Dim> edge_ = Vec<Dim>::Ones();
@@ -157,7 +157,7 @@ private:
 /// Full neighbour list in CSR form, built from a CellList.
 template <int Dim>
 class NeighbourList {
-public:
+ public:
   /// Cells per cut-off length: the grid has cells of edge cutoff/kReach, scanned kReach cells deep.
   static constexpr int kReach = 2;
 
@@ -204,13 +204,13 @@ public:
     }
   }
 
-private:
+ private:
   CellList<Dim> cells_;
   double cutoff_ = 0.0;
   bool periodic_any_ = false;
   std::vector<std::uint32_t> offsets_, indices_;
   std::vector<std::vector<std::uint32_t>> thread_buffers_;  // reused between builds
-  std::vector<Vec<Dim>> sorted_x_;                         // positions in cell order, reused
+  std::vector<Vec<Dim>> sorted_x_;                          // positions in cell order, reused
 };
 
 /// Pairs closer than a cut-off found on the fly from a cell list, without storing a list.
@@ -230,7 +230,7 @@ private:
 
 template <int Dim>
 class CellPairScan {
-public:
+ public:
   /// Cells per cut-off length, as in NeighbourList (cells of edge cutoff/kReach scanned kReach deep).
   static constexpr int kReach = NeighbourList<Dim>::kReach;
 
@@ -280,12 +280,89 @@ public:
       visit(std::false_type{});
   }
 
-private:
+  /// Positions in cell order: slot s holds particle cell_order()[s].
+  std::span<const Vec<Dim>> sorted_positions() const noexcept { return sorted_x_; }
+  /// Slot of particle i in cell order.
+  std::span<const std::uint32_t> rank() const noexcept { return rank_; }
+  /// An upper bound of s − a over the pairs for_each_forward_neighbour visits: how far ahead of
+  /// its own slot a half-pair pass writes reactions (the window of a block's reaction buffer).
+  std::size_t forward_reach() const noexcept { return forward_reach_; }
+
+  /// Half pairs by slot: call f(s, xas, r2) for every slot s > a whose particle is closer than
+  /// the cut-off to the particle in slot a (xas = x_a − x_s, minimum image), in the order of
+  /// for_each_neighbour. Every unordered pair is visited once, from its lower slot.
+  template <class F>
+  [[gnu::always_inline]] inline void for_each_forward_neighbour(std::size_t a, F&& f) const {
+    constexpr int R = kReach;
+    const auto sorted = cells_.sorted();
+    const auto& per = cells_.periodicity();
+    typename CellList<Dim>::template ScanRanges<R> ranges;
+    const int nranges = cells_.template scan_ranges<R>(cells_.cell_of()[sorted[a]], ranges);
+    const Vec<Dim> xa = sorted_x_[a];
+    const double rc2 = cutoff_ * cutoff_;
+    const Vec<Dim>* sx = sorted_x_.data();
+    const auto first = static_cast<std::uint32_t>(a + 1);
+    const auto visit = [&](auto periodic) {
+      for (int q = 0; q < nranges; ++q)
+        for (std::uint32_t s = std::max(ranges[q][0], first); s < ranges[q][1]; ++s) {
+          Vec<Dim> d;
+          if constexpr (decltype(periodic)::value)
+            d = per.min_image(xa - sx[s]);
+          else
+            d = xa - sx[s];
+          const double r2 = d.squaredNorm();
+          if (r2 < rc2) f(static_cast<std::size_t>(s), d, r2);
+        }
+    };
+    if (periodic_any_)
+      visit(std::true_type{});
+    else
+      visit(std::false_type{});
+  }
+
+ private:
   CellList<Dim> cells_;
   double cutoff_ = 0.0;
   bool periodic_any_ = false;
+  std::size_t forward_reach_ = 0;
   std::vector<Vec<Dim>> sorted_x_;   // positions in cell order
   std::vector<std::uint32_t> rank_;  // rank_[i]: slot of particle i in cell order
+};
+
+/// Fixed-order reactions of a half-pair pass: each pair is evaluated once, by its lower index (or
+/// slot) a, which adds its partner's share (the reaction) to a buffer. The buffers belong to blocks
+/// of B consecutive indices, not to threads, so every sum is grouped the same way whatever the
+/// thread count: block b adds, in the order of its indices, the reactions to [bB, bB + B + W), W
+/// the reach (largest s − a of a pair); index a then adds to its own sum the buffers of the blocks
+/// that reach it, in ascending order (`for_each_block_reaching`). Block b's slots are addressed
+/// as buffer[b·W + s], so the pair loop indexes its buffer by the partner's index.
+struct PairBlocks {
+  std::size_t size = 64;  ///< B, indices per block
+  std::size_t reach = 0;  ///< W, largest s − a of a pair
+  std::size_t n = 0;      ///< indices
+
+  /// B = n/8 (eight blocks, so a static share of blocks is a contiguous share of indices for any
+  /// small thread count, and the buffers hold n (1 + W/B) slots), at least 64 and W/3.
+  static PairBlocks choose(std::size_t n, std::size_t reach) noexcept {
+    return {std::max<std::size_t>({64, (n + 7) / 8, (reach + 2) / 3}), reach, n};
+  }
+  std::size_t count() const noexcept { return (n + size - 1) / size; }
+  std::size_t window() const noexcept { return size + reach; }  ///< reaction slots per block
+  std::size_t slots() const noexcept { return count() * reach + n + size; }
+  std::size_t first(std::size_t b) const noexcept { return b * size; }
+  std::size_t last(std::size_t b) const noexcept { return std::min(n, (b + 1) * size); }
+  /// Block b's buffer, to be indexed by s ∈ [bB, min(n, bB + B + W)).
+  template <class T>
+  T* buffer(T* all, std::size_t b) const noexcept {
+    return all + b * reach;
+  }
+  /// The slots of block b's window that hold reactions: [bB, min(n, bB + B + W)).
+  std::size_t window_end(std::size_t b) const noexcept { return std::min(n, b * size + window()); }
+  /// The earliest block whose window reaches index a of block b.
+  std::size_t first_block_reaching(std::size_t b) const noexcept {
+    const std::size_t f = b * size;
+    return f >= size + reach ? (f - reach) / size : 0;
+  }
 };
 
 extern template class CellList<2>;

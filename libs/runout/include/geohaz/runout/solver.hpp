@@ -253,13 +253,150 @@ class RunoutSolver {
       });
     }
     // No skin: the pairs are used once per build, so they are visited straight from the cell scan
-    // (same pairs in the same order as the list, without writing and re-reading it).
+    // (same pairs in the same order as the list, without writing and re-reading it); without the
+    // velocity smoothing each pair once (half_pair_terms).
     const auto& x = store_.get<Position<2>>();
     scan_.build(std::span<const Vec2>(x.data(), x.size()), HeadPressureForce::support * p_.d0, periodic_);
+    if (p_.smoothing == 0.0) return half_pair_terms();
     return pair_terms([&](std::size_t i, auto&& f) { scan_.for_each_neighbour(i, f); });
   }
 
  private:
+  /// What a particle gathers from its neighbours in the pair pass: the depth sum Σ V_j W_ij and
+  /// the W-weighted velocity sums (per σ), and the head-pressure sums (map and vertical parts).
+  struct PairSums {
+    double depth, vx, vy, vz, ax, ay, az;
+  };
+  /// The pair pass of pair_terms (no smoothing) with each pair evaluated once, by the particle of
+  /// the lower slot in the scan's cell order, which adds its partner's share to a block buffer
+  /// (PairBlocks: fixed-order sums, the same on any thread count). The pair terms are symmetric
+  /// (W, f and the pair average of cos²θ); only the neighbour's volume and velocity differ, and
+  /// the force changes sign. Returns the signal speed max_i (S_i + √(g h_i)).
+  double half_pair_terms() {
+    const auto& vol = store_.get<Volume>();
+    auto& h = store_.get<FlowDepth>();
+    auto& ap = store_.get<HeadAcceleration>();
+    const auto& v = store_.get<Velocity<2>>();
+    const auto& x = store_.get<Position<2>>();
+    const auto& z = store_.get<Elevation>();
+    const auto& grad = store_.get<SurfaceGradient>();
+    const auto& cb = store_.get<BedCos>();
+    const auto& vz = store_.get<VerticalVelocity>();
+    auto& vmean = store_.get<MeanVelocity>();
+    auto& dv = store_.get<VelocityCorrection>();
+    const std::uint32_t* ids = scan_.cell_order().data();
+    const double d0 = p_.d0, inv_d0 = 1.0 / d0;
+    const double coef = 0.5 * p_.pressure_scale * p_.gravity * inv_d0 * inv_d0 * inv_d0;
+    const double g = p_.gravity, support2 = 4.0 * d0 * d0, sigma = CubicSpline<2>::sigma(d0);
+    const std::size_t n = store_.size();
+    const PairBlocks blocks = PairBlocks::choose(n, scan_.forward_reach());
+    own_.resize(n);
+    reactions_.resize(blocks.slots());
+    const auto nblocks = static_cast<std::int64_t>(blocks.count());
+    const bool periodic = periodic_.any();
+    const auto pass = [&](auto periodic_tag) {
+      constexpr bool kPeriodic = decltype(periodic_tag)::value;
+#pragma omp parallel for schedule(static) if (static_cast<std::int64_t>(n) >= kParallelMin)
+      for (std::int64_t bb = 0; bb < nblocks; ++bb) {
+        const auto b = static_cast<std::size_t>(bb);
+        PairSums* mine = blocks.buffer(reactions_.data(), b);  // mine[s]: the reactions to slot s
+        std::fill(mine + blocks.first(b), mine + blocks.window_end(b), PairSums{});
+        for (std::size_t a = blocks.first(b); a < blocks.last(b); ++a) {
+          const std::size_t i = ids[a];
+          const double Vi = vol[i], ci = cb[i], zi = z[i], vzi = vz[i];
+          const Vec2 vi = v[i];
+          double depth = Vi * (2.0 / 3.0);
+          Vec2 vsum = depth * vi;
+          double vzsum = depth * vzi;
+          Vec2 acc = Vec2::Zero();
+          double accz = 0.0;
+          // W/σ (kernels.hpp) and f (head_pressure.hpp) written out per branch of q.
+          scan_.for_each_forward_neighbour(a, [&](std::size_t s, const Vec2& xij, double r2) {
+            const std::size_t j = ids[s];
+            double zij = zi - z[j];
+            if constexpr (kPeriodic) zij += grad[i].dot(xij - (x[i] - x[j]));
+            const double r3 = r2 + zij * zij;
+            if (r3 >= support2) return;  // beyond the support on the bed
+            const double r = std::sqrt(r3);
+            const double q = r * inv_d0;
+            double w, f;
+            if (q < 1.0) {
+              w = 2.0 / 3.0 - q * q + 0.5 * q * q * q;
+              f = r > 0.0 ? coef * (1.0 - q) / ((1.0 + q) * r) : 0.0;
+            } else {
+              const double t = 2.0 - q;
+              w = t * t * t / 6.0;
+              f = coef * (-0.5 * (q - 1.0) * (q - 2.0)) / r;
+            }
+            f *= ci + cb[j];
+            const double Vj = vol[j];
+            const double wj = Vj * w, fj = Vj * f;
+            depth += wj;
+            vsum += wj * v[j];
+            vzsum += wj * vz[j];
+            acc += fj * xij;
+            accz += fj * zij;
+            const double wi = Vi * w, fi = Vi * f;
+            PairSums& r_s = mine[s];
+            r_s.depth += wi;
+            r_s.vx += wi * vi.x();
+            r_s.vy += wi * vi.y();
+            r_s.vz += wi * vzi;
+            r_s.ax -= fi * xij.x();
+            r_s.ay -= fi * xij.y();
+            r_s.az -= fi * zij;
+          });
+          own_[a] = {depth, vsum.x(), vsum.y(), vzsum, acc.x(), acc.y(), accz};
+        }
+      }
+    };
+    if (periodic)
+      pass(std::true_type{});
+    else
+      pass(std::false_type{});
+    // Every particle: its own sums, then the reactions of the blocks that reach it, in block order.
+    const PairSums* all = reactions_.data();
+    double signal = 0.0;
+#pragma omp parallel for reduction(max : signal) schedule(static) if (static_cast<std::int64_t>(n) >= kParallelMin)
+    for (std::int64_t bb = 0; bb < nblocks; ++bb) {
+      const auto b = static_cast<std::size_t>(bb);
+      const std::size_t c0 = blocks.first_block_reaching(b);
+      for (std::size_t a = blocks.first(b); a < blocks.last(b); ++a) {
+        PairSums t = own_[a];
+        for (std::size_t c = c0; c <= b; ++c) {
+          if (a >= blocks.window_end(c)) continue;
+          const PairSums& r = all[c * blocks.reach + a];
+          t.depth += r.depth;
+          t.vx += r.vx;
+          t.vy += r.vy;
+          t.vz += r.vz;
+          t.ax += r.ax;
+          t.ay += r.ay;
+          t.az += r.az;
+        }
+        const std::size_t i = ids[a];
+        vmean[i] = tangent_mean(grad[i], Vec2(t.vx, t.vy) / t.depth, t.vz / t.depth);
+        h[i] = t.depth * sigma;
+        ap[i] = on_bed(grad[i], Vec2(t.ax, t.ay), t.az);
+        dv[i] = Vec2::Zero();
+        const double vzi = grad[i].dot(v[i]);
+        signal = std::max(signal, std::sqrt(v[i].squaredNorm() + vzi * vzi) + std::sqrt(g * h[i]));
+      }
+    }
+    return signal;
+  }
+  /// The head-pressure force F = (F_h, F_z) along the 3D chords, as the map-view acceleration of a
+  /// particle held on a bed of gradient p: P (F_h + p F_z) (docs/runout.md).
+  static Vec2 on_bed(const Vec2& p, const Vec2& fh, double fz) {
+    const Vec2 f = fh + fz * p;
+    return Vec2(f - (p.dot(f) / (1.0 + p.squaredNorm())) * p);
+  }
+  /// A mean 3D velocity (u_h, u_z) with its component normal to a bed of gradient p removed, as a
+  /// map velocity: u_h + p (u_z − p·u_h)/(1 + |p|²).
+  static Vec2 tangent_mean(const Vec2& p, const Vec2& uh, double uz) {
+    return Vec2(uh + ((uz - p.dot(uh)) / (1.0 + p.squaredNorm())) * p);
+  }
+
   /// The pair pass over the neighbours given by `neighbours(i, f)`, which calls f(j, xij, r²) for
   /// every j ≠ i of particle i (possibly including skin pairs beyond the support). Returns the
   /// signal speed max_i (S_i + √(g h_i)).
@@ -298,18 +435,11 @@ class RunoutSolver {
     };
     // The head-pressure force F = (F_h, F_z) along the 3D chords, as the map-view acceleration of a
     // particle held on the bed: P (F_h + p F_z) (docs/runout.md).
-    const auto on_bed = [&](std::size_t i, const Vec2& fh, double fz) {
-      const Vec2 p = grad[i];
-      const Vec2 f = fh + fz * p;
-      return Vec2(f - (p.dot(f) / (1.0 + p.squaredNorm())) * p);
-    };
+    const auto on_bed_i = [&](std::size_t i, const Vec2& fh, double fz) { return on_bed(grad[i], fh, fz); };
     // The neighbours' mean 3D velocity ū = (ū_h, ū_z), with its normal component at i removed, as a
     // map velocity: ū_h + p (ū_z − p·ū_h)/(1 + |p|²). (Averaging map velocities of particles on
     // beds of different slope would hand a steep particle a larger surface speed than any of them.)
-    const auto tangent_mean = [&](std::size_t i, const Vec2& uh, double uz) {
-      const Vec2 p = grad[i];
-      return Vec2(uh + ((uz - p.dot(uh)) / (1.0 + p.squaredNorm())) * p);
-    };
+    const auto tangent_mean_i = [&](std::size_t i, const Vec2& uh, double uz) { return tangent_mean(grad[i], uh, uz); };
     const double eps = p_.smoothing;
     double signal = 0.0;
     if (eps == 0.0) {
@@ -353,10 +483,10 @@ class RunoutSolver {
             acc += fr * xij;
             accz += fr * zij;
           });
-          vmean[i] = tangent_mean(i, vsum / depth, vzsum / depth);
+          vmean[i] = tangent_mean_i(i, vsum / depth, vzsum / depth);
           depth *= sigma;
           h[i] = depth;
-          ap[i] = on_bed(i, acc, accz);
+          ap[i] = on_bed_i(i, acc, accz);
           dv[i] = Vec2::Zero();
           signal = std::max(signal, signal_speed(i));
         }
@@ -382,7 +512,7 @@ class RunoutSolver {
         vzsum += w * vz[j];
       });
       h[i] = depth;
-      vmean[i] = tangent_mean(i, vsum / depth, vzsum / depth);
+      vmean[i] = tangent_mean_i(i, vsum / depth, vzsum / depth);
     }
     // Pass 2: head pressure and velocity smoothing (needs every depth).
 #pragma omp parallel for reduction(max : signal) schedule(static) if (n >= kParallelMin)
@@ -402,7 +532,7 @@ class RunoutSolver {
         }
         corr += (2.0 * vol[j] / (hi + h[j]) * CubicSpline<2>::value(r, d0)) * (v[j] - vi);
       });
-      ap[i] = on_bed(i, acc, accz);
+      ap[i] = on_bed_i(i, acc, accz);
       dv[i] = eps * corr;
       signal = std::max(signal, signal_speed(i));
     }
@@ -707,6 +837,8 @@ class RunoutSolver {
   RunoutStore store_;
   NeighbourList<2> list_;  // with a skin (numerics.skin > 0)
   CellPairScan<2> scan_;   // without (the default)
+  std::vector<PairSums> own_;        // half_pair_terms: each slot's own sums
+  std::vector<PairSums> reactions_;  // half_pair_terms: the blocks' reaction buffers
   VolumeBudget budget_;
   SpatialProcesses proc_;
   std::vector<double> eroded_;            // per cell of proc_.grid (m)
