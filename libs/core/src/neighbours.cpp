@@ -201,10 +201,25 @@ void CellPairScan<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const 
     sorted_x_[s] = x[sorted[s]];
     rank_[sorted[s]] = static_cast<std::uint32_t>(s);
   }
-  // The reach of the forward pairs: per occupied cell, the last slot its scan ranges cover.
+  // The reach of the forward pairs. Without periodic axes the scan ranges of cell c end at or
+  // before cell c + Σ_d kReach·stride_d (the far corner of its block of cells), so the slot
+  // distance to that cell's end bounds it; with periodic axes (a wrapped neighbour may lie at the
+  // other end of the grid), per occupied cell the last slot its scan ranges cover.
   const auto start = cells_.cell_start();
   const std::int64_t ncell = static_cast<std::int64_t>(cells_.cell_count());
   std::size_t reach = 0;
+  if (!periodic_any_) {
+    std::int64_t corner = 0, stride = 1;
+    for (int d = 0; d < Dim; ++d) {
+      corner += kReach * stride;
+      stride *= cells_.dims()[d];
+    }
+#pragma omp parallel for schedule(static) reduction(max : reach)
+    for (std::int64_t c = 0; c < ncell; ++c)
+      reach = std::max<std::size_t>(reach, start[std::min(c + corner + 1, ncell)] - start[c]);
+    forward_reach_ = reach;
+    return;
+  }
 #pragma omp parallel for schedule(static) reduction(max : reach)
   for (std::int64_t c = 0; c < ncell; ++c) {
     if (start[c] == start[c + 1]) continue;
