@@ -10,7 +10,9 @@
 ///     Verlet list within (2 + skin)·d0 (NeighbourList), rebuilt when a particle has moved more
 ///     than skin·d0/2 since the last build and after removals. The particles are reordered by cell
 ///     every reorder_interval steps;
-///  2. pair pass: vertical depth h_i = Σ_j V_j W(r_ij, d0) (cubic spline, self included), the
+///  2. pair pass (each pair once, the partner's share through fixed-order block reactions, so the
+///     sums do not depend on the thread count; with the velocity smoothing or a Verlet list each
+///     particle visits all its neighbours): vertical depth h_i = Σ_j V_j W(r_ij, d0) (cubic spline, self included), the
 ///     neighbours' mean velocity ṽ_i = Σ_j V_j W_ij v_j / h_i, and the head-pressure force
 ///         F_i = C g Σ_j ½(cos²θ_i + cos²θ_j) (V_j/d0³) f(r_ij/d0) x̂_ij        (head_pressure.hpp)
 ///     whose continuum limit is −∇(g cos²θ h): the map gradient of the hydrostatic energy
