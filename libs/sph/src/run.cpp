@@ -448,8 +448,10 @@ class StructureReport {
       p.seen = true;
     }
   }
-  /// A row of the CSV (and of the plot).
+  /// A row of the CSV (and of the plot); its loads count for the peaks too (the first row is the
+  /// state at rest after the geostatic phase, before any main-phase step).
   void record(double t, const std::vector<StructureLoad<Dim>>& loads) {
+    observe(t, loads);
     csv_ << csv_number(t);
     for (std::size_t q = 0; q < shown_.size(); ++q) {
       const auto& l = loads[shown_[q]];
