@@ -62,7 +62,8 @@ TEST(SphSlopeApp, TinySlopeWritesAllOutputs) {
                      "tiny_slope");
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* f : {"summary.json", "series.csv", "surface_final.csv", "slip_surface.csv", "snapshots.h5",
-                        "snapshots.xmf", "final_displacement.png", "velocity_t0.050.png", "config.resolved.toml"})
+                        "snapshots.xmf", "final_displacement.png", "velocity_t0.050.png", "config.resolved.toml",
+                        "structure_forces.csv", "structure_forces.png"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   const auto s = summary(out);
   EXPECT_EQ(s["dimension"], 2);
@@ -71,6 +72,11 @@ TEST(SphSlopeApp, TinySlopeWritesAllOutputs) {
   EXPECT_GT(s["soil_particles"].get<int>(), 100);
   // Time series every 0.01 s over 0.1 s: 10 rows plus the final one.
   EXPECT_NEAR(static_cast<double>(csv_rows(out / "series.csv")), 11.0, 1.0);
+  EXPECT_EQ(csv_rows(out / "structure_forces.csv"), csv_rows(out / "series.csv"));
+  ASSERT_EQ(s["structures"].size(), 3u);  // bottom, left_wall, right_wall
+  EXPECT_EQ(s["structures"][1]["name"], "left_wall");
+  // The slope leans on the left wall: compression on its face.
+  EXPECT_GT(s["structures"][1]["peak_normal_N_per_m"].get<double>(), 0.0);
   // Snapshots: initial, 0.05, 0.1 (+ final).
   geohaz::SnapshotReader snap(out / "snapshots.h5");
   EXPECT_GE(snap.snapshot_count(), 3u);
