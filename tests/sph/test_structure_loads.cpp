@@ -97,7 +97,7 @@ TEST(StructureLoads, FluidColumnAtRestPushesTheWallWithHalfRhoGHSquared) {
   const std::size_t bottom = index_of(sc, "bottom");
   SphSolver<2> solver(std::move(sc.store), {m}, NewtonianFluid{}, s);
   solver.track_structures(bases(sc));
-  const auto rep = solver.apply_gravity_gradually(60.0 * H / c, 0.7, true);
+  const auto rep = solver.apply_gravity_gradually(40.0 * H / c, 0.7, true);
   const auto& L = solver.structure_loads();
   const double F = 0.5 * rho * g * H * H, M = rho * g * H * H * H / 6.0;
   std::printf(
