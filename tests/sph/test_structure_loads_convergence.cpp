@@ -1,4 +1,4 @@
-// Convergence of the wall thrust of a fluid at rest with resolution (label: validation, ~2 min on
+// Convergence of the wall thrust of a fluid at rest with resolution (label: validation, ~2.5 min on
 // one thread): the Newtonian fluid column of test_structure_loads.cpp (H = 0.2 m, c = 20 m/s) at
 // Δx = 10, 5 and 2.5 mm. The thrust on a wall approaches ½ ρ g H² from below as the free-surface
 // kernel deficiency (a layer ~h thick) shrinks: the error must fall with each halving of Δx and be
