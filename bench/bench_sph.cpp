@@ -2,8 +2,9 @@
 // collapse (~1e5 particles) and a 3D slope (~4e4 particles, seed 001's size), on 1 and 2 threads,
 // and the memory per particle. Prints figures; never asserts (docs/performance.md). The state hash
 // after the steps is the same on 1 and 2 threads (results independent of the thread count).
-//   bench_sph [steps] [scale] [2d|3d|all] [threads] [skin]   (scale < 1 shrinks the problems for a
-//   quick look; the others select runs, e.g. `bench_sph 50 1 2d 2 0.3` for one figure)
+//   bench_sph [steps] [scale] [2d|3d|all] [threads] [skin] [structures]   (scale < 1 shrinks the
+//   problems for a quick look; the others select runs, e.g. `bench_sph 50 1 2d 2 0.3` for one figure;
+//   structures = 1 sums the loads on the walls every step, pass 4b, as sph-slope does)
 #include <omp.h>
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include <cstdlib>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "geohaz/sph/scenario.hpp"
 #include "geohaz/sph/solver.hpp"
@@ -36,9 +38,10 @@ unsigned long long state_hash(const SphStore<Dim>& S) {
 
 /// Which runs (all by default): `bench_sph [steps] [scale] [2d|3d|all] [threads] [skin]`.
 struct Selection {
-  int dim = 0;       ///< 0: both
-  int threads = 0;   ///< 0: 1 and 2
-  double skin = -1;  ///< < 0: 0 and 0.3
+  int dim = 0;              ///< 0: both
+  int threads = 0;          ///< 0: 1 and 2
+  double skin = -1;         ///< < 0: 0 and 0.3
+  bool structures = false;  ///< track the loads on the scenario's structures (pass 4b)
 };
 Selection selection;
 
@@ -58,16 +61,21 @@ void run(const char* name, Scenario<Dim> sc, const MaterialParams& m, int steps)
       s.domain_hi = sc.domain_hi;
       s.neighbour_skin = skin;
       SphSolver<Dim> solver(sc.store, {m}, DruckerPrager{}, s);
+      if (selection.structures) {
+        std::vector<Vec<Dim>> bases;
+        for (const auto& st : sc.structures) bases.push_back(st.base);
+        solver.track_structures(std::move(bases));
+      }
       solver.step();  // warm-up (first reorder)
       const auto t0 = std::chrono::steady_clock::now();
       for (int i = 0; i < steps; ++i) solver.step();
       const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       const double rate = static_cast<double>(solver.store().size()) * steps / sec;
       std::printf(
-          "%-26s skin %.1fh threads %d  particles %7zu  steps %4d  %7.3f s  %.3e particle-steps/s  "
+          "%-26s%s skin %.1fh threads %d  particles %7zu  steps %4d  %7.3f s  %.3e particle-steps/s  "
           "%.0f B/particle  %lld list builds  state %016llx\n",
-          name, skin, threads, solver.store().size(), steps, sec, rate, solver.bytes_per_particle(),
-          static_cast<long long>(solver.neighbour_builds()), state_hash(solver.store()));
+          name, selection.structures ? " +loads" : "", skin, threads, solver.store().size(), steps, sec, rate,
+          solver.bytes_per_particle(), static_cast<long long>(solver.neighbour_builds()), state_hash(solver.store()));
     }
 }
 
@@ -77,6 +85,7 @@ int main(int argc, char** argv) {
   if (argc > 3) selection.dim = std::string(argv[3]) == "2d" ? 2 : (std::string(argv[3]) == "3d" ? 3 : 0);
   if (argc > 4) selection.threads = std::atoi(argv[4]);
   if (argc > 5) selection.skin = std::atof(argv[5]);
+  if (argc > 6) selection.structures = std::atoi(argv[6]) != 0;
   MaterialParams m;
   m.density = 1800;
   m.young = 1e6;

@@ -235,6 +235,28 @@ RunConfig read_config(ConfigReader& r, bool describe) {
       r.get("output.bulking_factor", 1.0, Range::closed(1.0, 3.0), {"1", "volume factor for release.h5"});
   c.write_release =
       r.get_bool("output.release", true, {"", "section scenario: write release.h5 and release_thickness.tif"});
+  c.structure_forces =
+      r.get_bool("output.structure_forces", true,
+                 {"",
+                  "sum the force the soil exerts on each wall and pile: structure_forces.csv (N/m and N m/m per unit "
+                  "thickness in 2D, N and N m in 3D), peaks in summary.json, structure_forces.png"});
+  {
+    const auto names = r.get_string("output.structures", "",
+                                    {"",
+                                     "comma-separated names of the structures to report (empty: all): bottom or "
+                                     "bedrock, left_wall, right_wall, side_y0, side_y1 (3D roller sides), pile_1, "
+                                     "pile_2, ... (3D pile row), bottom_platen, top_platen (biaxial)"});
+    std::size_t a = 0;
+    while (a <= names.size()) {
+      std::size_t e = names.find(',', a);
+      if (e == std::string::npos) e = names.size();
+      std::string n = names.substr(a, e - a);
+      n.erase(0, n.find_first_not_of(" \t"));
+      n.erase(n.find_last_not_of(" \t") + 1);
+      if (!n.empty()) c.structures.push_back(n);
+      a = e + 1;
+    }
+  }
 
   // Geometry of the chosen scenario.
   const bool is3d = c.dimension == 3;

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -61,7 +62,8 @@ TEST(SphSlopeApp, TinySlopeWritesAllOutputs) {
                      "tiny_slope");
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* f : {"summary.json", "series.csv", "surface_final.csv", "slip_surface.csv", "snapshots.h5",
-                        "snapshots.xmf", "final_displacement.png", "velocity_t0.050.png", "config.resolved.toml"})
+                        "snapshots.xmf", "final_displacement.png", "velocity_t0.050.png", "config.resolved.toml",
+                        "structure_forces.csv", "structure_forces.png"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   const auto s = summary(out);
   EXPECT_EQ(s["dimension"], 2);
@@ -70,6 +72,11 @@ TEST(SphSlopeApp, TinySlopeWritesAllOutputs) {
   EXPECT_GT(s["soil_particles"].get<int>(), 100);
   // Time series every 0.01 s over 0.1 s: 10 rows plus the final one.
   EXPECT_NEAR(static_cast<double>(csv_rows(out / "series.csv")), 11.0, 1.0);
+  EXPECT_EQ(csv_rows(out / "structure_forces.csv"), csv_rows(out / "series.csv"));
+  ASSERT_EQ(s["structures"].size(), 3u);  // bottom, left_wall, right_wall
+  EXPECT_EQ(s["structures"][1]["name"], "left_wall");
+  // The slope leans on the left wall: compression on its face.
+  EXPECT_GT(s["structures"][1]["peak_normal_N_per_m"].get<double>(), 0.0);
   // Snapshots: initial, 0.05, 0.1 (+ final).
   geohaz::SnapshotReader snap(out / "snapshots.h5");
   EXPECT_GE(snap.snapshot_count(), 3u);
@@ -228,6 +235,14 @@ TEST(SphSlopeApp, OneAndTwoThreadsGiveBitIdenticalResults) {
   ASSERT_EQ(r.code, 0) << r.err;
   const auto d = compare_last_snapshots(a / "snapshots.h5", b / "snapshots.h5");
   EXPECT_EQ(d.differing, 0u) << d.report;
+  // The wall loads too (per-block sums added in block order): the same text.
+  auto text = [](const fs::path& p) {
+    std::ifstream in(p);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string fa = text(a / "structure_forces.csv");
+  EXPECT_GT(fa.size(), 100u);
+  EXPECT_EQ(fa, text(b / "structure_forces.csv"));
 }
 
 TEST(SphSlopeApp, SectionReleaseConservesFailedVolume) {
@@ -303,6 +318,53 @@ TEST(SphSlopeApp, Tiny3DPeriodicSlopeWithPiles) {
   EXPECT_EQ(s["materials"][0]["dp_fit"], "compression_3d");
   EXPECT_TRUE(s.contains("failed_volume_m3"));
   EXPECT_LT(s["bytes_per_particle"].get<double>(), 2048.0);
+  // Loads on each pile of the row: two piles across the periodic width, symmetric, so their loads
+  // agree to round-off grown over the steps (1e-6 of the larger); the peak of every step is at least the largest
+  // resultant of the 0.02 s rows of structure_forces.csv.
+  const auto& st = s["structures"];
+  std::map<std::string, nlohmann::json> by_name;
+  for (const auto& e : st) by_name[e["name"].get<std::string>()] = e;
+  for (const char* n : {"bottom", "left_wall", "right_wall", "pile_1", "pile_2"}) EXPECT_TRUE(by_name.count(n)) << n;
+  const double p1 = by_name["pile_1"]["peak_resultant_N"].get<double>();
+  const double p2 = by_name["pile_2"]["peak_resultant_N"].get<double>();
+  EXPECT_GT(p1, 0.0);
+  EXPECT_NEAR(p1, p2, 1e-6 * std::max(p1, p2));
+  std::ifstream in(out / "structure_forces.csv");
+  std::string header, line;
+  std::getline(in, header);
+  EXPECT_NE(header.find("pile_1_Fx_N,pile_1_Fy_N,pile_1_Fz_N,pile_1_Mx_Nm,pile_1_My_Nm,pile_1_Mz_Nm"),
+            std::string::npos)
+      << header;
+  // Columns of pile_1: after time_s, 6 per structure in the order of summary.json.
+  std::size_t col = 1;
+  for (const auto& e : st) {
+    if (e["name"] == "pile_1") break;
+    col += 6;
+  }
+  double largest = 0.0;
+  while (std::getline(in, line)) {
+    std::vector<double> v;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) v.push_back(std::stod(cell));
+    ASSERT_GT(v.size(), col + 2);
+    largest = std::max(largest, std::sqrt(v[col] * v[col] + v[col + 1] * v[col + 1] + v[col + 2] * v[col + 2]));
+  }
+  EXPECT_GT(largest, 0.0);
+  EXPECT_GE(p1, largest * (1.0 - 1e-8));
+}
+
+TEST(SphSlopeApp, UnknownStructureNameExitsTwoNamingKeyAndWritesNothing) {
+  const fs::path out = kWork / "bad_structure";
+  fs::remove_all(out);
+  const auto r = run("--config " + (kData / "slope_2d_granular.toml").string() + " --out " + out.string() +
+                         " --set output.structures=left_wall,pile_9",
+                     "bad_structure");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("output.structures"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("pile_9"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("right_wall"), std::string::npos) << r.err;  // the names that exist
+  EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(SphSlopeApp, BlowUpStopsWithDiagnosisAndKeepsSnapshots) {

@@ -263,6 +263,7 @@ void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int6
   add_view<Mass>(v, s);
   add_view<WallNormal<Dim>>(v, s);
   add_view<LayerNormal<Dim>>(v, s);
+  add_view<StructureId>(v, s);
   add_view<ParticleId>(v, s);
   add_internal_variables(v, s, std::type_identity<ConstitutiveModel>{});
   add_view<PositionAtBuild<Dim>>(v, s);
@@ -321,6 +322,8 @@ Restart load_restart(const std::filesystem::path& path, SphStore<Dim>& s) {
     s.template get<LayerNormal<Dim>>().assign(s.size(), Vec<Dim>::Zero());
     fill_missing_layer_normals(s);
   }
+  // Files written before structures had ids: no particle belongs to a structure (loads stay zero).
+  if (!r.has_field(k, StructureId::label)) s.template get<StructureId>().assign(s.size(), -1);
   Restart out;
   out.time = r.time(k);
   out.step = r.step(k);
@@ -385,6 +388,143 @@ std::string csv_number(double v) {
   return os.str();
 }
 
+/// The structures a run reports (`output.structures`, all when empty), as indices into the
+/// scenario's table. InputError naming the key, the unknown name and the names that exist.
+template <int Dim>
+std::vector<std::size_t> reported_structures(const RunConfig& c, const std::vector<Structure<Dim>>& table) {
+  std::vector<std::size_t> shown;
+  if (!c.structure_forces) return shown;
+  if (c.structures.empty()) {
+    for (std::size_t k = 0; k < table.size(); ++k) shown.push_back(k);
+    return shown;
+  }
+  for (const auto& name : c.structures) {
+    std::size_t k = 0;
+    while (k < table.size() && table[k].name != name) ++k;
+    if (k == table.size()) {
+      std::string names;
+      for (const auto& s : table) names += (names.empty() ? "" : ", ") + s.name;
+      throw InputError("no structure of this name in the scenario; it has: " + (names.empty() ? "none" : names),
+                       c.config_source, "output.structures", name);
+    }
+    if (std::find(shown.begin(), shown.end(), k) != shown.end())
+      throw InputError("structure named twice", c.config_source, "output.structures", name);
+    shown.push_back(k);
+  }
+  return shown;
+}
+
+/// The loads on the reported structures through a run: the rows of structure_forces.csv, the peaks
+/// of every step for summary.json, and the normal-force histories for the quick-look plot.
+template <int Dim>
+class StructureReport {
+ public:
+  StructureReport(std::vector<Structure<Dim>> table, std::vector<std::size_t> shown)
+      : table_(std::move(table)), shown_(std::move(shown)), peaks_(shown_.size()), normal_(shown_.size()) {
+    // Units per unit thickness in plane strain (the 2D model is per metre out of the plane).
+    const char* f = Dim == 2 ? "_N_per_m" : "_N";
+    const char* m = Dim == 2 ? "_Nm_per_m" : "_Nm";
+    csv_ << "time_s";
+    for (const std::size_t k : shown_) {
+      const std::string& n = table_[k].name;
+      if constexpr (Dim == 2)
+        csv_ << ',' << n << "_Fx" << f << ',' << n << "_Fz" << f << ',' << n << "_My" << m;
+      else
+        csv_ << ',' << n << "_Fx" << f << ',' << n << "_Fy" << f << ',' << n << "_Fz" << f << ',' << n << "_Mx" << m
+             << ',' << n << "_My" << m << ',' << n << "_Mz" << m;
+    }
+    csv_ << '\n';
+  }
+  bool empty() const noexcept { return shown_.empty(); }
+  /// Every step: the peaks (resultant |F|, normal force F·n, moment |M|) and their times.
+  void observe(double t, const std::vector<StructureLoad<Dim>>& loads) {
+    for (std::size_t q = 0; q < shown_.size(); ++q) {
+      const auto& l = loads[shown_[q]];
+      Peak& p = peaks_[q];
+      const double fr = l.force.norm(), fn = l.force.dot(table_[shown_[q]].normal), mm = l.moment.norm();
+      if (!p.seen || fr > p.resultant) p.resultant = fr, p.t_resultant = t;
+      if (!p.seen || fn > p.normal) p.normal = fn, p.t_normal = t;
+      if (!p.seen || mm > p.moment) p.moment = mm, p.t_moment = t;
+      p.seen = true;
+    }
+  }
+  /// A row of the CSV (and of the plot); its loads count for the peaks too (the first row is the
+  /// state at rest after the geostatic phase, before any main-phase step).
+  void record(double t, const std::vector<StructureLoad<Dim>>& loads) {
+    observe(t, loads);
+    csv_ << csv_number(t);
+    for (std::size_t q = 0; q < shown_.size(); ++q) {
+      const auto& l = loads[shown_[q]];
+      for (int d = 0; d < Dim; ++d) csv_ << ',' << csv_number(l.force[d]);
+      if constexpr (Dim == 2)
+        csv_ << ',' << csv_number(l.moment[1]);
+      else
+        csv_ << ',' << csv_number(l.moment[0]) << ',' << csv_number(l.moment[1]) << ',' << csv_number(l.moment[2]);
+      normal_[q].push_back(l.force.dot(table_[shown_[q]].normal));
+    }
+    csv_ << '\n';
+    times_.push_back(t);
+  }
+  std::string csv() const { return csv_.str(); }
+  /// The `structures` block of summary.json.
+  nlohmann::json summary() const {
+    const std::string f = Dim == 2 ? "_N_per_m" : "_N", m = Dim == 2 ? "_Nm_per_m" : "_Nm";
+    nlohmann::json a = nlohmann::json::array();
+    for (std::size_t q = 0; q < shown_.size(); ++q) {
+      const auto& s = table_[shown_[q]];
+      const Peak& p = peaks_[q];
+      a.push_back({{"name", s.name},
+                   {"id", shown_[q]},
+                   {"base_m", std::vector<double>(s.base.data(), s.base.data() + Dim)},
+                   {"normal", std::vector<double>(s.normal.data(), s.normal.data() + Dim)},
+                   {"peak_resultant" + f, p.resultant},
+                   {"time_of_peak_resultant_s", p.t_resultant},
+                   {"peak_normal" + f, p.normal},
+                   {"time_of_peak_normal_s", p.t_normal},
+                   {"peak_moment" + m, p.moment},
+                   {"time_of_peak_moment_s", p.t_moment}});
+    }
+    return a;
+  }
+  /// Quick-look plot of the normal force F·n of each reported structure against time (one colour
+  /// per structure in the order of the CSV columns; grey: zero).
+  void plot(const std::filesystem::path& path) const {
+    if (times_.size() < 2) return;
+    const int W = 900, H = 500, m = 40;
+    Image img(W, H);
+    double lo = 0.0, hi = 0.0;
+    for (const auto& s : normal_)
+      for (const double v : s) lo = std::min(lo, v), hi = std::max(hi, v);
+    if (hi - lo <= 0.0) hi = lo + 1.0;
+    const double t0 = times_.front(), t1 = std::max(times_.back(), t0 + 1e-12);
+    auto px = [&](double t) { return m + (t - t0) / (t1 - t0) * (W - 2 * m); };
+    auto py = [&](double v) { return H - m - (v - lo) / (hi - lo) * (H - 2 * m); };
+    img.line(m, H - m, W - m, H - m, {0, 0, 0});
+    img.line(m, m, m, H - m, {0, 0, 0});
+    img.line(m, py(0.0), W - m, py(0.0), {170, 170, 170});
+    static constexpr std::array<std::array<std::uint8_t, 3>, 6> colours{
+        {{31, 119, 180}, {214, 39, 40}, {44, 160, 44}, {255, 127, 14}, {148, 103, 189}, {140, 86, 75}}};
+    for (std::size_t q = 0; q < normal_.size(); ++q)
+      for (std::size_t k = 1; k < times_.size(); ++k)
+        for (int d = 0; d <= 1; ++d)
+          img.line(px(times_[k - 1]), py(normal_[q][k - 1]) + d, px(times_[k]), py(normal_[q][k]) + d,
+                   colours[q % colours.size()]);
+    write_png(path, img);
+  }
+
+ private:
+  struct Peak {
+    bool seen = false;
+    double resultant = 0.0, t_resultant = 0.0, normal = 0.0, t_normal = 0.0, moment = 0.0, t_moment = 0.0;
+  };
+  std::vector<Structure<Dim>> table_;
+  std::vector<std::size_t> shown_;
+  std::vector<Peak> peaks_;
+  std::ostringstream csv_;
+  std::vector<double> times_;
+  std::vector<std::vector<double>> normal_;  // F·n per reported structure, per row
+};
+
 template <int Dim>
 int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
   auto wall0 = std::chrono::steady_clock::now();
@@ -393,6 +533,14 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
   const std::size_t soil_count = b.sc.soil_count, boundary_count = b.sc.boundary_count;
   const double href = b.sc.reference_height;
   SphSolver<Dim> solver(std::move(b.sc.store), c.materials, c.model, settings);
+  // Loads on the structures, tracked from the geostatic phase on: the first row is the state at rest.
+  StructureReport<Dim> structures(b.sc.structures, reported_structures(c, b.sc.structures));
+  if (!structures.empty()) {
+    std::vector<Vec<Dim>> bases;
+    for (const auto& s : b.sc.structures) bases.push_back(s.base);
+    solver.track_structures(std::move(bases));
+  }
+  bool have_loads = false;  // the loads of a step exist (not before the first step of a restart)
   const auto& mats = solver.materials();
   std::vector<double> rho0;
   for (const auto& m : mats) rho0.push_back(m.density);
@@ -455,6 +603,7 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
       if (++k % 50 == 0) prog.update(solver.time(), k, solver.store().size());
     });
     prog.finish(dur, rep.steps, solver.store().size());
+    have_loads = rep.steps > 0;
     const double tol = c.rest_tolerance * std::sqrt(c.numerics.gravity * href);
     const bool at_rest = rep.max_speed < tol;
     summary["geostatic"] = {{"duration_s", dur},
@@ -502,6 +651,7 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
       nrun = runout / b.frame.base_length;
     }
     max_runout = std::max(max_runout, runout);
+    if (have_loads && !structures.empty()) structures.record(solver.time(), solver.structure_loads());
     series << csv_number(solver.time()) << ',' << csv_number(r.front) << ',' << csv_number(r.tip) << ','
            << csv_number(runout) << ',' << csv_number(nrun) << ',' << csv_number(r.max_speed) << ','
            << csv_number(r.mean_speed) << ',' << csv_number(r.kinetic_energy) << ',' << csv_number(r.plastic_fraction)
@@ -545,6 +695,8 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
         ++next_png;
       }
       solver.step();
+      have_loads = true;
+      if (!structures.empty()) structures.observe(solver.time(), solver.structure_loads());
       const double vmax = solver.last_stats().max_speed;
       max_speed_run = std::max(max_speed_run, vmax);
       if (vmax > c.rest_speed) last_moving = solver.time();
@@ -561,12 +713,18 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
     }
   } catch (const SimulationError&) {
     write_text_file(out / "series.csv", series.str());
+    if (!structures.empty()) write_text_file(out / "structure_forces.csv", structures.csv());
     throw;
   }
   prog.finish(solver.time(), solver.step_count(), solver.store().size());
   const auto last = record();
   write_snapshot<Dim>(snaps, solver, step_offset + solver.step_count());
   write_text_file(out / "series.csv", series.str());
+  if (!structures.empty()) {
+    write_text_file(out / "structure_forces.csv", structures.csv());
+    structures.plot(out / "structure_forces.png");
+    summary["structures"] = structures.summary();
+  }
   if (c.scenario == ScenarioType::Biaxial) write_text_file(out / "stress_strain.csv", biax.str());
 
   // Free surface and slip surface.
@@ -1046,11 +1204,12 @@ void validate(const RunConfig& c) {
                        "run.analysis", "strength_reduction");
   }
   check_resources(c);
-  // Build once (dry run) so that geometry errors surface before any output exists.
+  // Build once (dry run) so that geometry errors surface before any output exists; the structure
+  // names of `output.structures` are checked against the scenario's.
   if (c.dimension == 2)
-    (void)build<2>(c);
+    (void)reported_structures(c, build<2>(c).sc.structures);
   else
-    (void)build<3>(c);
+    (void)reported_structures(c, build<3>(c).sc.structures);
   if (!c.restart.empty() && !std::filesystem::exists(c.restart))
     throw InputError("restart file does not exist", c.config_source, "run.restart", c.restart.string());
 }

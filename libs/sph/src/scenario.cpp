@@ -28,6 +28,7 @@ struct Builder {
   SphStore<Dim> store;
   double dx;
   std::int64_t next_id = 0;
+  std::int32_t structure = 0;  ///< StructureId of the boundary particles added next
   /// `layer` is the layering normal used to extrapolate stress into a boundary particle (default:
   /// vertical, flat-lying soil); soil particles get none.
   void add(const Vec<Dim>& p, Kind kind, int material, double density, const Vec<Dim>& normal,
@@ -41,6 +42,7 @@ struct Builder {
     store.template get<ParticleKind>()[i] = static_cast<std::uint8_t>(kind);
     store.template get<WallNormal<Dim>>()[i] = normal;
     store.template get<LayerNormal<Dim>>()[i] = kind == Kind::Soil ? Vec<Dim>::Zero() : layer;
+    store.template get<StructureId>()[i] = kind == Kind::Soil ? 0 : structure;
     store.template get<ParticleId>()[i] = next_id++;
   }
 };
@@ -105,19 +107,20 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
   Builder<Dim> B;
   B.dx = dx;
   auto material_at = [&](double x, double y, double z) {
-    if (dom.surface_layer_depth > 0.0 && z > zs_at(x, y) - dom.surface_layer_depth)
-      return dom.surface_material;
+    if (dom.surface_layer_depth > 0.0 && z > zs_at(x, y) - dom.surface_layer_depth) return dom.surface_material;
     if (dom.layer_materials.empty()) return 0;
     std::size_t k = 0;
     while (k < dom.layer_tops.size() && z >= dom.layer_tops[k]) ++k;
     return dom.layer_materials[k];
   };
+  // The pile at (x, y), or −1.
   auto in_pile = [&](double x, double y) {
-    for (const auto& p : dom.piles) {
+    for (std::size_t k = 0; k < dom.piles.size(); ++k) {
+      const auto& p = dom.piles[k];
       const double ex = x - p.x, ey = Dim == 3 ? y - p.y : 0.0;
-      if (ex * ex + ey * ey <= 0.25 * p.diameter * p.diameter) return true;
+      if (ex * ex + ey * ey <= 0.25 * p.diameter * p.diameter) return static_cast<int>(k);
     }
-    return false;
+    return -1;
   };
   auto make = [&](double x, double y, double z) {
     Vec<Dim> p;
@@ -134,6 +137,36 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
 
   const int nx = static_cast<int>(std::lround((dom.x_right - dom.x_left) / dx));
   const bool bedrock = dom.bedrock_depth > 0.0;
+
+  // The structures, each named, with the point its moment is taken about (where it meets the
+  // ground); 3D walls at mid-width.
+  std::vector<Structure<Dim>> structures;
+  auto base_point = [&](double x, double y) {
+    return make(x, y, bedrock ? zs_at(x, y) - dom.bedrock_depth : dom.z_bottom);
+  };
+  auto add_structure = [&](std::string name, const Vec<Dim>& base, int axis, double sign) {
+    Vec<Dim> nrm = Vec<Dim>::Zero();
+    nrm[axis] = sign;
+    structures.push_back({std::move(name), base, nrm});
+    return static_cast<std::int32_t>(structures.size() - 1);
+  };
+  const double x_mid = 0.5 * (dom.x_left + dom.x_right), y_mid = 0.5 * y_max;
+  const std::int32_t s_bottom =
+      bedrock || dom.bottom != WallType::None
+          ? add_structure(bedrock ? "bedrock" : "bottom", base_point(x_mid, y_mid), Dim - 1, -1.0)
+          : -1;
+  const std::int32_t s_left =
+      dom.left != WallType::None ? add_structure("left_wall", base_point(dom.x_left, y_mid), 0, -1.0) : -1;
+  const std::int32_t s_right =
+      dom.right != WallType::None ? add_structure("right_wall", base_point(dom.x_right, y_mid), 0, 1.0) : -1;
+  std::int32_t s_side0 = -1, s_side1 = -1;
+  if (Dim == 3 && !dom.periodic_width) {
+    s_side0 = add_structure("side_y0", base_point(x_mid, 0.0), 1, -1.0);
+    s_side1 = add_structure("side_y1", base_point(x_mid, y_max), 1, 1.0);
+  }
+  const std::int32_t s_pile0 = static_cast<std::int32_t>(structures.size());
+  for (std::size_t k = 0; k < dom.piles.size(); ++k)
+    add_structure("pile_" + std::to_string(k + 1), base_point(dom.piles[k].x, dom.piles[k].y), 0, 1.0);
   const int nz = bedrock ? static_cast<int>(std::ceil(dom.bedrock_depth / dx)) + 1
                          : static_cast<int>(std::ceil((zmax_surface - dom.z_bottom) / dx)) + 1;
   double soil_zmax = -1e300;
@@ -142,11 +175,13 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
     for (int i = 0; i < nx; ++i) {
       const double x = dom.x_left + (i + 0.5) * dx;
       const double zs = zs_at(x, y);
-      const bool pile_here = in_pile(x, y);
+      const int pile = in_pile(x, y);
+      const bool pile_here = pile >= 0;
       const double z0 = bedrock ? zs - dom.bedrock_depth : dom.z_bottom;
       for (int k = 0; k < nz; ++k) {
         const double z = z0 + (k + 0.5) * dx;
         if (pile_here) {
+          B.structure = s_pile0 + pile;
           if (z < zs + dom.pile_top_margin)
             B.add(make(x, y, z), Kind::Pile, material_floor, densities[material_floor], Vec<Dim>::Zero());
           continue;
@@ -186,6 +221,7 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
         }
         return Vec<Dim>(nu.normalized());
       };
+      B.structure = s_bottom;
       for (int l = 0; l < layers; ++l)
         for (int i = 0; i < nbx; ++i) {
           const double x = xb0 + (i + 0.5) * dx;
@@ -195,16 +231,19 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
       for (int side = 0; side < 2; ++side) {
         const WallType w = side == 0 ? dom.left : dom.right;
         if (w == WallType::None) continue;
+        B.structure = side == 0 ? s_left : s_right;
         const double xe = side == 0 ? dom.x_left : dom.x_right;
         const double ze = zs_at(xe, y);
         const int nzw = static_cast<int>(std::lround((dom.bedrock_depth + 3 * dx) / dx));
         for (int l = 0; l < layers; ++l)
           for (int k = 0; k < nzw; ++k)
-            B.add(make(side == 0 ? xe - (l + 0.5) * dx : xe + (l + 0.5) * dx, y, ze - dom.bedrock_depth + (k + 0.5) * dx),
-                  wall_kind(w), material_floor, wall_rho, ex);
+            B.add(
+                make(side == 0 ? xe - (l + 0.5) * dx : xe + (l + 0.5) * dx, y, ze - dom.bedrock_depth + (k + 0.5) * dx),
+                wall_kind(w), material_floor, wall_rho, ex);
       }
       continue;
     }
+    B.structure = s_bottom;
     if (dom.bottom != WallType::None)
       for (int l = 0; l < layers; ++l)
         for (int i = 0; i < nbx; ++i)
@@ -214,8 +253,10 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
     for (int l = 0; l < layers; ++l)
       for (int k = 0; k < nzw; ++k) {
         const double z = dom.z_bottom + (k + 0.5) * dx;
+        B.structure = s_left;
         if (dom.left != WallType::None)
           B.add(make(dom.x_left - (l + 0.5) * dx, y, z), wall_kind(dom.left), material_floor, wall_rho, ex);
+        B.structure = s_right;
         if (dom.right != WallType::None)
           B.add(make(dom.x_right + (l + 0.5) * dx, y, z), wall_kind(dom.right), material_floor, wall_rho, ex);
       }
@@ -228,13 +269,15 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
       ey[1] = 1.0;
       const int nzw = static_cast<int>(std::lround((dom.bedrock_depth + 3 * dx) / dx)) + layers;
       for (int side = 0; side < 2; ++side) {
+        B.structure = side == 0 ? s_side0 : s_side1;
         const double y_edge = side == 0 ? 0.0 : y_max;
         for (int l = 0; l < layers; ++l)
           for (int i = 0; i < nbx; ++i) {
             const double x = xb0 + (i + 0.5) * dx;
             const double z0 = zs_at(x, y_edge) - dom.bedrock_depth - layers * dx;
             const double yw = side == 0 ? -(l + 0.5) * dx : y_max + (l + 0.5) * dx;
-            for (int k = 0; k < nzw; ++k) B.add(make(x, yw, z0 + (k + 0.5) * dx), Kind::RollerWall, material_floor, wall_rho, ey);
+            for (int k = 0; k < nzw; ++k)
+              B.add(make(x, yw, z0 + (k + 0.5) * dx), Kind::RollerWall, material_floor, wall_rho, ey);
           }
       }
     } else if (!dom.periodic_width) {
@@ -246,13 +289,16 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
         for (int i = 0; i < nx; ++i)
           for (int k = 0; k < nzw; ++k) {
             const double x = dom.x_left + (i + 0.5) * dx, z = dom.z_bottom + (k + 0.5) * dx;
+            B.structure = s_side0;
             B.add(make(x, -(l + 0.5) * dx, z), Kind::RollerWall, material_floor, wall_rho, ey);
+            B.structure = s_side1;
             B.add(make(x, ny * dx + (l + 0.5) * dx, z), Kind::RollerWall, material_floor, wall_rho, ey);
           }
     }
   }
   sc.store = std::move(B.store);
   sc.boundary_count = sc.store.size() - sc.soil_count;
+  sc.structures = std::move(structures);
   sc.spacing = dx;
   const double span = (xb1 - xb0) + (wall_top - dom.z_bottom);
   sc.domain_lo = Vec<Dim>::Constant(-1e30);
@@ -332,10 +378,14 @@ Scenario<Dim> build_biaxial(const BiaxialGeometry& g, double dx, double density,
   for (int j = 0; j < ny; ++j)
     for (int l = 0; l < layers; ++l)
       for (int i = -extra; i < nx + extra; ++i) {
+        B.structure = 0;
         B.add(make((i + 0.5) * dx, (j + 0.5) * dx, -(l + 0.5) * dx), Kind::FixedWall, 0, density, ez);
+        B.structure = 1;
         B.add(make((i + 0.5) * dx, (j + 0.5) * dx, g.height + (l + 0.5) * dx), Kind::FixedWall, 0, density, ez);
       }
   sc.store = std::move(B.store);
+  sc.structures = {{"bottom_platen", make(0.5 * nx * dx, 0.5 * ny * dx, 0.0), -ez},
+                   {"top_platen", make(0.5 * nx * dx, 0.5 * ny * dx, nz * dx), ez}};
   sc.boundary_count = sc.store.size() - sc.soil_count;
   sc.spacing = dx;
   sc.domain_lo = Vec<Dim>::Constant(-1e30);

@@ -251,6 +251,7 @@ void SphSolver<Dim>::step_impl(const Model& model) {
   velocity_gradient<Kernel>();                // 2. L, dρ/dt, ρ̃, XSPH
   update_stress(model);                       // 3. density, constitutive model, artificial stress
   momentum<Kernel>();                         // 4. pair forces → acceleration
+  structure_forces<Kernel>();                 // 4b. loads on tracked walls and piles (read only)
   integrate(gbar);                            // 5. body force, damping, leap-frog
   time_ += dt_;                               // 6. clock, state check, next Δt
   ++step_;
@@ -656,6 +657,111 @@ void SphSolver<Dim>::momentum() {
   }
   gather_reactions(
       pair_acc_, [&](std::size_t i, const Vec<Dim>& r) { acc[i] += r; }, [&](std::size_t i) { acc[i] /= rho[i]; });
+}
+
+template <int Dim>
+void SphSolver<Dim>::track_structures(std::vector<Vec<Dim>> base_points) {
+  structure_base_ = std::move(base_points);
+  structure_loads_.assign(structure_base_.size(), StructureLoad<Dim>{});
+}
+
+// 4b. Loads on the tracked structures: step 4's soil–boundary pair terms once more, with the state
+//     step 4 used (positions, velocities, stress, volumes before the integration), each summed with
+//     the opposite sign onto the structure of the boundary particle. The force step 4 gives soil
+//     particle i from boundary particle b is m_i/ρ_i times its force-density term,
+//       F_ib = V_i {V_b [σ_i + σ_b + ρ_i ρ_b (f^n (R_i + R_b) − Π_ib I)] ∇W_ib + ρ_i c_i² ((r0/r)⁴ − (r0/r)²) x_ib/r²},
+//     the wall-repulsion part only for r < r0; the structure receives −F_ib at x_b. This pass must
+//     repeat step 4's soil–boundary term exactly: test_physics "StructureLoads" checks that the
+//     loads on all structures balance the soil's momentum change from its boundary pairs.
+//     Summed per block of particles (PairBlocks) and then over the blocks in order: the same sums
+//     on any number of threads.
+template <int Dim>
+template <class Kernel>
+void SphSolver<Dim>::structure_forces() {
+  if (structure_base_.empty()) return;
+  const PairKernel<Kernel> K(h_);
+  const MinimumImage<Dim> image(settings_.periodic);
+  const double w_dx = Kernel::value(settings_.spacing, h_);
+  const double n_as = settings_.artificial_stress_n > 0.0 ? settings_.artificial_stress_n : K.w_self / w_dx;
+  const double alpha = settings_.viscosity_alpha, beta = settings_.viscosity_beta;
+  const double h = h_, eta2 = 0.01 * h * h;
+  const double r_rep = settings_.wall_repulsion * settings_.spacing;
+  const double* wave = wave_speed_.data();
+  const std::int64_t n = static_cast<std::int64_t>(store_.size());
+  const Vec<Dim>* x = field<Position<Dim>>();
+  const Vec<Dim>* v = field<Velocity<Dim>>();
+  const double* rho = field<Density>();
+  const double* vol = field<Volume>();
+  const std::int32_t* mat = field<MaterialId>();
+  const std::uint8_t* kind = field<ParticleKind>();
+  const std::int32_t* sid = field<StructureId>();
+  const Vec<Dim>* nrm = field<WallNormal<Dim>>();
+  const Vec<Dim>* lnrm = field<LayerNormal<Dim>>();
+  const Mat<Dim>* ps = field<PairStress<Dim>>();
+  const Mat<Dim>* R = field<ArtificialStress<Dim>>();
+  const std::uint8_t* has_as = has_as_.data();
+  const std::uint32_t* off = list_.offsets().data();
+  const std::uint32_t* idx = list_.indices().data();
+  const Vec<Dim>* base = structure_base_.data();
+  const auto ns = static_cast<std::int32_t>(structure_base_.size());
+  const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
+  const std::int64_t nblocks = static_cast<std::int64_t>(blocks.count());
+  structure_block_loads_.assign(blocks.count() * structure_base_.size(), StructureLoad<Dim>{});
+  StructureLoad<Dim>* all = structure_block_loads_.data();
+#pragma omp parallel for schedule(static)
+  for (std::int64_t bb = 0; bb < nblocks; ++bb) {
+    const auto b = static_cast<std::size_t>(bb);
+    const std::size_t first = b * blocks.size, last = std::min(blocks.n, first + blocks.size);
+    StructureLoad<Dim>* mine = all + b * structure_base_.size();
+    for (std::size_t i = first; i < last; ++i) {
+      if (kind[i] != kSoil) continue;
+      const Mat<Dim> si = ps[i];
+      const Mat<Dim> Ri = R[i];
+      const bool has_Ri = has_as[i];
+      const double ci = wave[mat[i]];
+      const double Vi = vol[i], rhoi = rho[i];
+      for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+        const std::uint32_t j = idx[k];
+        if (kind[j] == kSoil || sid[j] < 0 || sid[j] >= ns) continue;
+        const Vec<Dim> xij = image(x[i], x[j]);
+        const double r2 = xij.squaredNorm();
+        if (r2 >= K.cutoff2) continue;
+        const double r = std::sqrt(r2);
+        const double q = r * K.inv_h;
+        const Vec<Dim> gw = xij * (r > 0.0 ? K.sigma_h * Kernel::shape_derivative(q) / r : 0.0);
+        const bool roller = kind[j] == kRoller;
+        Mat<Dim> T = si + mirror_stress<Dim>(si, rhoi, xij, lnrm[j], ps[j], nrm[j], roller);
+        const Vec<Dim> vij = v[i] - mirror_velocity<Dim>(v[i], v[j], nrm[j], roller);
+        const double vr = vij.dot(xij);
+        if (vr < 0.0 && alpha + beta > 0.0)
+          T.diagonal().array() -=
+              viscous_pressure(alpha, beta, ci, wave[mat[j]], h * vr / (r * r + eta2), rhoi, rho[j]);
+        if (has_Ri || has_as[j]) {
+          const double f = K.sigma * Kernel::shape(q) / w_dx;
+          T += (std::pow(f, n_as) * rhoi * rho[j]) * (Ri + R[j]);
+        }
+        Vec<Dim> fi = vol[j] * (T * gw);  // force density on i from j
+        if (r < r_rep) {
+          const double q2 = (r_rep * r_rep) / r2;
+          fi.noalias() += (rhoi * ci * ci * (q2 * q2 - q2) / r2) * xij;
+        }
+        const Vec<Dim> F = -Vi * fi;  // on the structure
+        const Vec<Dim> arm = image(x[j], base[sid[j]]);
+        StructureLoad<Dim>& load = mine[sid[j]];
+        load.force += F;
+        if constexpr (Dim == 3)
+          load.moment += arm.cross(F);
+        else
+          load.moment[1] += arm[1] * F[0] - arm[0] * F[1];
+      }
+    }
+  }
+  for (auto& l : structure_loads_) l = StructureLoad<Dim>{};
+  for (std::size_t b = 0; b < blocks.count(); ++b)
+    for (std::size_t k = 0; k < structure_base_.size(); ++k) {
+      structure_loads_[k].force += all[b * structure_base_.size() + k].force;
+      structure_loads_[k].moment += all[b * structure_base_.size() + k].moment;
+    }
 }
 
 // 5. Body force ḡ, Cundall local damping (seed 002 eq. 14), leap-frog update (kick–drift, with

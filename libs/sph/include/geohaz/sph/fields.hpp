@@ -132,6 +132,15 @@ struct Volume {
   static constexpr const char* label = "volume";
   static constexpr const char* unit = "m^3";
 };
+/// Index of the structure a boundary particle belongs to, into the scenario's structure table
+/// (scenario.hpp `Scenario::structures`: each wall, each pile); the solver sums the pair forces
+/// on it per structure (solver.hpp, structure loads). Soil particles carry 0 and are never counted;
+/// a store built by hand without it puts every boundary particle in structure 0.
+struct StructureId {
+  using type = std::int32_t;
+  static constexpr const char* label = "structure_id";
+  static constexpr const char* unit = "1";
+};
 /// Position when the neighbour list was last built (Verlet skin bookkeeping), m.
 template <int Dim>
 struct PositionAtBuild {
@@ -150,7 +159,7 @@ using SphStore =
     ParticleStore<Position<Dim>, Velocity<Dim>, Acceleration<Dim>, Displacement<Dim>, Stress, VelocityGradient<Dim>,
                   Density, DensityRate, Mass, MaterialId, ParticleKind, WallNormal<Dim>, LayerNormal<Dim>,
                   PlasticStrain, StressFree, SummationDensity, XsphCorrection<Dim>, ArtificialStress<Dim>,
-                  PairStress<Dim>, Volume, PositionAtBuild<Dim>, ParticleId>;
+                  PairStress<Dim>, Volume, PositionAtBuild<Dim>, StructureId, ParticleId>;
 
 /// Boundary particles without a layering normal (stores built by hand, snapshots written before the
 /// field existed) take the vertical one, the flat-lying-soil default of the scenario builders.

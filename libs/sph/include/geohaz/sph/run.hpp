@@ -109,7 +109,11 @@ struct RunConfig {
   double failed_threshold = 0.01;  ///< m: displacement above which soil counts as failed
   double front_thickness = 0.0;    ///< m: deposit thickness that defines the front (0: 2Δx)
   double bulking_factor = 1.0;
-  bool write_release = true;      ///< section scenario: release.h5 (+ release_thickness.tif)
+  bool write_release = true;  ///< section scenario: release.h5 (+ release_thickness.tif)
+  /// Loads on the walls and piles (structure_forces.csv, summary.json `structures`, PNG).
+  bool structure_forces = true;
+  /// Names of the structures to report (scenario.hpp Structure::name); empty: all.
+  std::vector<std::string> structures;
   std::filesystem::path restart;  ///< snapshot file to restart from ("" none)
 
   std::string resolved_config;  ///< TOML text of the resolved config (written and stored in HDF5)

@@ -58,6 +58,19 @@ struct ProfileDomain {
   double pile_top_margin = 0.0;  ///< piles stick out of the surface by this (m)
 };
 
+/// A rigid structure made of boundary particles (a wall, a pile, a platen): the solver sums the
+/// force the soil exerts on its particles (solver.hpp, structure loads). Its moment is taken about
+/// `base`, the point where it meets the ground: the foot of a wall's face, the foot of a pile's
+/// axis, the middle of a bottom wall's top face.
+template <int Dim>
+struct Structure {
+  std::string name;                  ///< "bottom", "left_wall", "right_wall", "pile_1", … (unique in a scenario)
+  Vec<Dim> base = Vec<Dim>::Zero();  ///< m
+  /// Unit normal of the loaded face, pointing from the soil into the structure: the normal force
+  /// F·n is positive in compression (a pile: +x, the downslope direction of the section).
+  Vec<Dim> normal = Vec<Dim>::Zero();
+};
+
 /// Result of a builder: the particles and the numbers a run needs for its diagnostics.
 template <int Dim>
 struct Scenario {
@@ -70,6 +83,8 @@ struct Scenario {
   double reference_height = 1.0;  ///< height of the soil body above its base (m)
   double base_top = 0.0;          ///< particles initially above this elevation count for the front (m)
   std::size_t soil_count = 0, boundary_count = 0;
+  /// The structures; a boundary particle's StructureId indexes this table.
+  std::vector<Structure<Dim>> structures;
 };
 
 /// Surface elevation of a profile at x (linear interpolation; first segment wins at a vertical step).

@@ -20,6 +20,10 @@
 ///      a_i = Σ_j m_j ((σ_i + σ_j)/(ρ_i ρ_j) − Π_ij I + f_ij^n (R_i + R_j)) ∇_i W_ij + ḡ
 ///      with Monaghan's viscosity Π_ij (the model's wave speed), f_ij = W(r)/W(Δx),
 ///      ḡ = g + a_earthquake (seed 002 eqs. 25–26);
+///   4b. structure_forces (only when structures are tracked, track_structures): the force the soil
+///      exerts on each structure, F_s = −Σ_{i soil, b ∈ s} V_i [V_b T_ib ∇_i W_ib + a_rep,ib ρ_i], the
+///      reaction of step 4's soil–boundary pair terms, and its moment Σ (x_b − x_base) × F_ib;
+///      read only, the particles move exactly as without it;
 ///   5. integrate: body force ḡ, Cundall local damping −ζ|a_α| sign(v_α) (seed 002 eq. 14),
 ///      leap-frog (kick–drift: v^{n+½} = v^{n−½} + Δt a^n, x^{n+1} = x^n + Δt (v^{n+½} + ε ΔvXSPH));
 ///   6. check_state, update_dt: Δt = min(C_cfl h/(c + |v|max), C_f √(h/|a|max), the model's own
@@ -106,6 +110,21 @@ struct SolverState {
   std::int64_t last_reorder = 0;  ///< step of the last cell reordering of the store
 };
 
+/// The load the soil exerts on one structure (a wall, a pile) in the last step: the sum over the
+/// soil–boundary pairs of step 4 of the pair force on the structure's particles, equal and opposite
+/// to the force those particles exert on the soil (stress, artificial viscosity and artificial
+/// stress terms and the wall repulsion). The 2D model is per unit thickness (plane strain): force in
+/// N/m and moment in N·m/m there, N and N·m in 3D.
+template <int Dim>
+struct StructureLoad {
+  Vec<Dim> force = Vec<Dim>::Zero();  ///< N (3D), N/m (2D)
+  /// Moment about the structure's base point, Σ (x_b − x_base) × F_ib with each pair force applied at
+  /// the structure's particle b, N·m (3D). 2D: the section (x, z) is the plane y = 0 of the 3D frame,
+  /// and the moment about the out-of-plane axis is the y component M_y = r_z F_x − r_x F_z (N·m/m),
+  /// the other two are zero.
+  Vec3 moment = Vec3::Zero();
+};
+
 /// Per-step statistics (cheap, gathered in the integration loop).
 struct StepStats {
   double max_speed = 0.0;          ///< m/s (soil)
@@ -162,6 +181,14 @@ class SphSolver {
   GeostaticReport apply_gravity_gradually(double duration, double damping, bool elastic,
                                           const std::function<void()>& on_step = {});
 
+  /// Sum the soil's load on each structure in every following step (pass 4b): structure k consists
+  /// of the boundary particles with StructureId k and its moment is taken about base_points[k]
+  /// (scenario.hpp, Scenario::structures). Boundary particles with an id outside the table are not
+  /// counted. An empty table switches it off. It does not change the motion.
+  void track_structures(std::vector<Vec<Dim>> base_points);
+  /// The loads of the last step, one per tracked structure (zero before the first step).
+  const std::vector<StructureLoad<Dim>>& structure_loads() const noexcept { return structure_loads_; }
+
   /// Number of neighbour-list builds so far.
   std::int64_t neighbour_builds() const noexcept { return builds_; }
   /// Memory actually held per particle (store + neighbour list), bytes.
@@ -182,7 +209,9 @@ class SphSolver {
   template <class T, class Add, class Finish>
   void gather_reactions(const std::vector<T>& buffer, Add&& add, Finish&& finish);  // 2, 4
   template <class Kernel>
-  void momentum();                       // 4
+  void momentum();  // 4
+  template <class Kernel>
+  void structure_forces();               // 4b (tracked structures only)
   void integrate(const Vec<Dim>& gbar);  // 5
   void check_state() const;              // 6
   void update_dt();                      // 6
@@ -234,6 +263,11 @@ class SphSolver {
     double rsum;  // summation density
   };
   std::vector<GradientReaction> pair_grad_;
+  // Tracked structures (pass 4b): base points, the loads of the last step, and the per-block sums
+  // (structure count per PairBlocks block, added in block order: the same on any thread count).
+  std::vector<Vec<Dim>> structure_base_;
+  std::vector<StructureLoad<Dim>> structure_loads_;
+  std::vector<StructureLoad<Dim>> structure_block_loads_;
   std::int64_t last_reorder_ = -1000000;
   std::int64_t builds_ = 0;
   StepStats stats_;
