@@ -117,8 +117,12 @@ class Coordinator : public RunObserver {
       if (workers_ > 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
   }
-  void started(const RunoutSimulation&) override { service(); }
-  void stepped(const RunoutSimulation&) override { service(); }
+  void started(const RunoutSimulation&) override {
+    service();
+  }
+  void stepped(const RunoutSimulation&) override {
+    service();
+  }
 
  private:
   const World& w_;
@@ -203,8 +207,9 @@ int run(int argc, char** argv, const World& world) {
     if (fs::exists(out / "plan.csv")) {
       if (slurp(out / "plan.csv") != plan || slurp(out / "base.resolved.toml") != setup.base_resolved) {
         resume_ok = 0;
-        resume_error = "the output folder holds another ensemble (plan.csv or base.resolved.toml differ): choose "
-                       "another --out or delete it";
+        resume_error =
+            "the output folder holds another ensemble (plan.csv or base.resolved.toml differ): choose "
+            "another --out or delete it";
       }
     }
     if (resume_ok) {

@@ -10,8 +10,8 @@
 //  - A member forced to fail is reported and the maps use the others.
 //  - A killed and resumed ensemble gives the same maps as an uninterrupted one.
 //  - Bad input: exit 2 naming the key, nothing written.
-#include <gtest/gtest.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -71,13 +71,15 @@ fs::path make_case(const fs::path& d) {
 
 void write_ensemble(const fs::path& path, int members, const std::string& sampling, const std::string& extra = "") {
   std::ofstream e(path);
-  e << "[ensemble]\nbase = \"base.toml\"\nmembers = " << members << "\nsampling = \"" << sampling
-    << "\"\nseed = 11\n" << extra << "\n[[ensemble.parameter]]\nkey = \"model.mu\"\ndistribution = \"uniform\"\nmin = "
-    << kMuA << "\nmax = " << kMuB
+  e << "[ensemble]\nbase = \"base.toml\"\nmembers = " << members << "\nsampling = \"" << sampling << "\"\nseed = 11\n"
+    << extra << "\n[[ensemble.parameter]]\nkey = \"model.mu\"\ndistribution = \"uniform\"\nmin = " << kMuA
+    << "\nmax = " << kMuB
     << "\n[products]\ndepth_thresholds = [1e-6]\npressure_thresholds = [1000.0]\nintensity_classes = [2]\n";
 }
 
-std::string app(const std::string& args) { return std::string(GEOHAZ_ENSEMBLE_EXE) + " " + args; }
+std::string app(const std::string& args) {
+  return std::string(GEOHAZ_ENSEMBLE_EXE) + " " + args;
+}
 
 std::string mpirun(int np, const std::string& args) {
   std::string cmd = std::string(GEOHAZ_MPIEXEC) + " --oversubscribe -np " + std::to_string(np) + " ";
@@ -85,7 +87,9 @@ std::string mpirun(int np, const std::string& args) {
   return cmd + app(args);
 }
 
-geohaz::Raster read(const fs::path& p) { return geohaz::read_raster(p, geohaz::CrsPolicy::Any); }
+geohaz::Raster read(const fs::path& p) {
+  return geohaz::read_raster(p, geohaz::CrsPolicy::Any);
+}
 
 nlohmann::json summary(const fs::path& out) {
   std::ifstream in(out / "summary.json");
@@ -110,7 +114,8 @@ TEST(EnsembleApp, ExceedanceMatchesTheAnalyticStoppingDistribution) {
   const int n = 64;
   write_ensemble(d / "ens.toml", n, "monte_carlo");
   const fs::path out = d / "mc";
-  const auto r = geohaz::testing::run_command(app((d / "ens.toml").string() + " --out " + out.string() + " --threads 1 --quiet"));
+  const auto r =
+      geohaz::testing::run_command(app((d / "ens.toml").string() + " --out " + out.string() + " --threads 1 --quiet"));
   ASSERT_EQ(r.code, 0) << r.output;
   // Per member: the toe's horizontal distance from the release is L tan θ/μ (slope L + flat s).
   std::ifstream csv(out / "members.csv");
@@ -209,8 +214,8 @@ TEST(EnsembleApp, KilledAndResumedEnsembleGivesTheUninterruptedResult) {
     const int null = ::open("/dev/null", O_WRONLY);
     ::dup2(null, 1), ::dup2(null, 2);
     const std::string out_arg = resumed.string();
-    ::execl(GEOHAZ_ENSEMBLE_EXE, GEOHAZ_ENSEMBLE_EXE, cfg.c_str(), "--threads", "1", "--quiet", "--out", out_arg.c_str(),
-            static_cast<char*>(nullptr));
+    ::execl(GEOHAZ_ENSEMBLE_EXE, GEOHAZ_ENSEMBLE_EXE, cfg.c_str(), "--threads", "1", "--quiet", "--out",
+            out_arg.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }
   const auto count_done = [&] {
@@ -251,7 +256,8 @@ TEST(EnsembleApp, BadInputExitsWithTwoNamingTheKeyAndWritesNothing) {
   };
   for (const auto& c : cases) {
     std::ofstream e(d / "bad.toml");
-    e << "[ensemble]\nbase = \"base.toml\"\nmembers = 4\n[[ensemble.parameter]]\nkey = \"model.mu\"\n" << c.param << "\n";
+    e << "[ensemble]\nbase = \"base.toml\"\nmembers = 4\n[[ensemble.parameter]]\nkey = \"model.mu\"\n"
+      << c.param << "\n";
     e.close();
     const fs::path out = d / "never";
     const auto r = geohaz::testing::run_command(app((d / "bad.toml").string() + " --out " + out.string()));

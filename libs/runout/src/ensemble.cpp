@@ -1,6 +1,8 @@
 // Ensembles of debris-runout runs (ensemble.hpp, docs/ensemble.md): plan, members, aggregation.
 #include "geohaz/runout/ensemble.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <boost/math/special_functions/erf.hpp>
 #include <chrono>
@@ -15,7 +17,6 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
-#include <unistd.h>
 
 #include "geohaz/core/config.hpp"
 #include "geohaz/core/errors.hpp"
@@ -41,8 +42,12 @@ std::uint64_t splitmix64(std::uint64_t x) noexcept {
   return x ^ (x >> 31);
 }
 
-double normal_cdf(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
-double normal_quantile(double p) { return std::sqrt(2.0) * boost::math::erf_inv(2.0 * p - 1.0); }
+double normal_cdf(double z) {
+  return 0.5 * std::erfc(-z / std::sqrt(2.0));
+}
+double normal_quantile(double p) {
+  return std::sqrt(2.0) * boost::math::erf_inv(2.0 * p - 1.0);
+}
 
 const char* const kFieldNames[3] = {"max_depth", "max_speed", "max_pressure"};
 const char* const kFieldUnits[3] = {"m", "m/s", "Pa"};
@@ -61,12 +66,16 @@ const char* to_string(DistributionKind k) noexcept {
       return "lognormal";
     case DistributionKind::Discrete:
       return "discrete";
+    case DistributionKind::Fixed:
+      return "fixed";
   }
   return "?";
 }
 
 double ParameterDistribution::quantile(double u) const {
   switch (kind) {
+    case DistributionKind::Fixed:
+      return a;
     case DistributionKind::Uniform:
       return a + u * (b - a);
     case DistributionKind::Normal:
@@ -279,7 +288,8 @@ std::vector<double> EnsembleAggregator::mean(int field) const {
   if (n_ == 0) return out;
   for (int r = 0; r < h_; ++r)
     for (int c = 0; c < w_; ++c)
-      out[static_cast<std::size_t>(r0_ + r) * nx_ + c0_ + c] = sum_[3 * (static_cast<std::size_t>(r) * w_ + c) + field] / n_;
+      out[static_cast<std::size_t>(r0_ + r) * nx_ + c0_ + c] =
+          sum_[3 * (static_cast<std::size_t>(r) * w_ + c) + field] / n_;
   return out;
 }
 
@@ -328,7 +338,8 @@ std::string member_json(const MemberRecord& r, const EnsemblePlan& plan) {
   j["reach_m"] = r.reach_m;
   j["ratio_H_over_L"] = r.hl;
   j["angle_deg"] = r.hl_deg;
-  j["volumes_m3"] = {{"release", r.release_m3}, {"deposited", r.deposited_m3}, {"mobile", r.mobile_m3}, {"lost", r.lost_m3}};
+  j["volumes_m3"] = {
+      {"release", r.release_m3}, {"deposited", r.deposited_m3}, {"mobile", r.mobile_m3}, {"lost", r.lost_m3}};
   j["max_speed_m_s"] = r.max_speed;
   j["area_affected_m2"] = r.affected_area_m2;
   j["simulated_time_s"] = r.simulated_time_s;
@@ -380,7 +391,9 @@ std::string resolve_path(const ConfigReader& cfg, std::string p) {
   return p;
 }
 
-std::string origin(const ConfigReader& cfg) { return cfg.source().empty() ? "command line" : cfg.source(); }
+std::string origin(const ConfigReader& cfg) {
+  return cfg.source().empty() ? "command line" : cfg.source();
+}
 
 /// The numeric keys of a debris-runout case (what a parameter may name).
 std::set<std::string> numeric_case_keys() {
@@ -393,12 +406,14 @@ std::set<std::string> numeric_case_keys() {
 }
 
 void read_parameter_keys(ConfigReader& t, ParameterDistribution& p, bool describe) {
-  const auto kind = t.get_choice("distribution", "uniform", {"uniform", "normal", "lognormal", "discrete"},
-                                 {"", "uniform (min, max), normal (mean, sd), lognormal (median, sigma) or discrete "
-                                      "(values, weights)"});
+  const auto kind = t.get_choice("distribution", "uniform", {"uniform", "normal", "lognormal", "discrete", "fixed"},
+                                 {"",
+                                  "uniform (min, max), normal (mean, sd), lognormal (median, sigma), discrete "
+                                  "(values, weights) or fixed (value: the same for every member)"});
   p.kind = kind == "normal"      ? DistributionKind::Normal
            : kind == "lognormal" ? DistributionKind::LogNormal
            : kind == "discrete"  ? DistributionKind::Discrete
+           : kind == "fixed"     ? DistributionKind::Fixed
                                  : DistributionKind::Uniform;
   const Range any = Range::closed(-1e12, 1e12);
   if (describe || p.kind == DistributionKind::Uniform) {
@@ -417,6 +432,7 @@ void read_parameter_keys(ConfigReader& t, ParameterDistribution& p, bool describ
     p.lower = t.get("lower", p.lower, Range{}, {"key's unit", "normal, lognormal: truncate below (optional)"});
     p.upper = t.get("upper", p.upper, Range{}, {"key's unit", "normal, lognormal: truncate above (optional)"});
   }
+  if (describe || p.kind == DistributionKind::Fixed) p.a = t.require("value", any, {"key's unit", "fixed: the value"});
   if (describe || p.kind == DistributionKind::Discrete) {
     p.values = t.require_array("values", any, {"key's unit", "discrete: the values"});
     p.weights = t.get_array("weights", {}, Range::non_negative(),
@@ -431,18 +447,20 @@ void describe_ensemble(ConfigReader& cfg) {
   cfg.get_int("ensemble.members", 10, Range::closed(1, 65535), {"1", "number of members N"});
   cfg.get_choice("ensemble.sampling", "latin_hypercube", {"latin_hypercube", "monte_carlo"},
                  {"", "sampling plan: Latin hypercube (McKay et al. 1979) or plain Monte Carlo"});
-  cfg.get_int("ensemble.seed", 1, Range::closed(0, 9.0e15), {"1", "seed of the plan: member i's values depend on (seed, i)"});
+  cfg.get_int("ensemble.seed", 1, Range::closed(0, 9.0e15),
+              {"1", "seed of the plan: member i's values depend on (seed, i)"});
   cfg.get_array("ensemble.inject_failure", {}, Range::closed(0, 65535),
                 {"1", "test hook: these member indices fail on purpose (a SimulationError at their first step)"});
-  for (ConfigReader& t : cfg.tables("ensemble.parameter",
-                                    {"", "uncertain parameters: key (a numeric debris-runout key, "
-                                         "release.thickness_factor) and distribution"})) {
+  for (ConfigReader& t : cfg.tables("ensemble.parameter", {"",
+                                                           "uncertain parameters: key (a numeric debris-runout key, "
+                                                           "release.thickness_factor) and distribution"})) {
     t.require_string("key", {"", "numeric debris-runout key (model.mu, model.n, ...) or release.thickness_factor"});
     ParameterDistribution p;
     read_parameter_keys(t, p, true);
   }
-  for (ConfigReader& t : cfg.tables("ensemble.release_alternative",
-                                    {"", "alternative release files: member picks one (parameter release.alternative)"})) {
+  for (ConfigReader& t :
+       cfg.tables("ensemble.release_alternative",
+                  {"", "alternative release files: member picks one (parameter release.alternative)"})) {
     t.require_string("file", {"", "release polygons or thickness raster (path relative to this file)"});
     t.get("weight", 1.0, Range::positive(), {"1", "relative probability of this release"});
   }
@@ -459,9 +477,11 @@ void describe_ensemble(ConfigReader& cfg) {
 EnsembleSetup read_ensemble(ConfigReader& cfg) {
   EnsembleSetup s;
   const std::string src = origin(cfg);
-  s.base_config = resolve_path(cfg, cfg.require_string("ensemble.base", {"", "the debris-runout config of the base case"}));
+  s.base_config =
+      resolve_path(cfg, cfg.require_string("ensemble.base", {"", "the debris-runout config of the base case"}));
   EnsemblePlan& plan = s.plan;
-  plan.members = static_cast<int>(cfg.get_int("ensemble.members", 10, Range::closed(1, 65535), {"1", "number of members N"}));
+  plan.members =
+      static_cast<int>(cfg.get_int("ensemble.members", 10, Range::closed(1, 65535), {"1", "number of members N"}));
   plan.sampling = cfg.get_choice("ensemble.sampling", "latin_hypercube", {"latin_hypercube", "monte_carlo"},
                                  {"", "sampling plan"}) == "monte_carlo"
                       ? SamplingMethod::MonteCarlo
@@ -490,8 +510,7 @@ EnsembleSetup read_ensemble(ConfigReader& cfg) {
     if (p.kind == DistributionKind::Uniform && !(p.a <= p.b))
       throw InputError("uniform distribution needs min ≤ max (min = " + fmt(p.a) + ", max = " + fmt(p.b) + ")", src,
                        where + ".min", fmt(p.a));
-    if (!(p.lower < p.upper))
-      throw InputError("truncation needs lower < upper", src, where + ".lower", fmt(p.lower));
+    if (!(p.lower < p.upper)) throw InputError("truncation needs lower < upper", src, where + ".lower", fmt(p.lower));
     if (p.kind == DistributionKind::Discrete) {
       if (p.weights.empty()) p.weights.assign(p.values.size(), 1.0);
       if (p.weights.size() != p.values.size())
@@ -528,14 +547,16 @@ EnsembleSetup read_ensemble(ConfigReader& cfg) {
       cfg.get_array("products.pressure_thresholds", {30e3}, Range::positive(), {"Pa", "P(peak pressure > t)"});
   a.intensity_classes.clear();
   for (double k : cfg.get_array("products.intensity_classes", {2}, Range::closed(1, 3), {"1", "P(class ≥ k)"})) {
-    if (k != std::floor(k)) throw InputError("intensity classes are 1, 2 or 3", src, "products.intensity_classes", fmt(k));
+    if (k != std::floor(k))
+      throw InputError("intensity classes are 1, 2 or 3", src, "products.intensity_classes", fmt(k));
     a.intensity_classes.push_back(static_cast<int>(k));
   }
   a.percentiles = cfg.get_array("products.percentiles", {10, 50, 90}, Range::open_closed(0, 100), {"%", "percentiles"});
   a.bins = static_cast<int>(cfg.get_int("products.bins", 96, Range::closed(8, 1024), {"1", "histogram bins"}));
   cfg.finish();
   s.resolved_config = cfg.resolved();
-  if (!fs::exists(s.base_config)) throw InputError("base case config not found", src, "ensemble.base", s.base_config.string());
+  if (!fs::exists(s.base_config))
+    throw InputError("base case config not found", src, "ensemble.base", s.base_config.string());
 
   // The base case, checked once; then every member's case (a value outside its key's range is an
   // input error naming the member, before anything is written).
@@ -555,15 +576,17 @@ EnsembleSetup read_ensemble(ConfigReader& cfg) {
       const double v = s.values[static_cast<std::size_t>(i)][d];
       if (key == kThicknessFactorKey) {
         if (!(v > 0.0))
-          throw InputError("member " + std::to_string(i) + " draws a release thickness factor ≤ 0: the factor must be "
-                           "> 0 (set 'lower' to truncate the distribution)",
+          throw InputError("member " + std::to_string(i) +
+                               " draws a release thickness factor ≤ 0: the factor must be "
+                               "> 0 (set 'lower' to truncate the distribution)",
                            src, "ensemble.parameter[" + std::to_string(d) + "]", fmt(v));
         continue;
       }
       if (key == kReleaseAlternativeKey) continue;
       std::ostringstream o;
       o << key << '=' << std::setprecision(17) << v;
-      m.apply_override(o.str(), src + " (ensemble.parameter[" + std::to_string(d) + "], member " + std::to_string(i) + ")");
+      m.apply_override(o.str(),
+                       src + " (ensemble.parameter[" + std::to_string(d) + "], member " + std::to_string(i) + ")");
     }
     (void)read_case(m);
   }
@@ -589,7 +612,9 @@ fs::path member_dir(const fs::path& out, int i) {
   return out / "members" / o.str();
 }
 
-bool member_done(const fs::path& out, int i) { return fs::exists(member_dir(out, i) / "member.json"); }
+bool member_done(const fs::path& out, int i) {
+  return fs::exists(member_dir(out, i) / "member.json");
+}
 
 // ---- running a member -----------------------------------------------------------------------
 
@@ -599,7 +624,9 @@ struct MemberRunner::Cache {
 };
 
 MemberRunner::MemberRunner(const EnsembleSetup& s) : s_(s), cache_(new Cache) {}
-MemberRunner::~MemberRunner() { delete cache_; }
+MemberRunner::~MemberRunner() {
+  delete cache_;
+}
 
 namespace {
 
@@ -776,8 +803,8 @@ void write_distribution_svg(const fs::path& path, std::vector<double> v, const s
   s << std::setprecision(6);
   s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H
     << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  s << "<text x=\"" << W / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"14\">" << xml_escape(title) << " (N = "
-    << v.size() << ")</text>\n";
+  s << "<text x=\"" << W / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"14\">" << xml_escape(title)
+    << " (N = " << v.size() << ")</text>\n";
   if (!v.empty()) {
     double lo = v.front(), hi = v.back();
     if (!(hi > lo)) lo -= 0.5 * std::max(1e-9, std::abs(lo)), hi += 0.5 * std::max(1e-9, std::abs(hi));
@@ -800,7 +827,8 @@ void write_distribution_svg(const fs::path& path, std::vector<double> v, const s
     s << "\"/>\n";
     for (int t = 0; t <= 4; ++t) {
       const double x = lo + t * (hi - lo) / 4;
-      s << "<text x=\"" << X(x) << "\" y=\"" << mt + ph + 18 << "\" text-anchor=\"middle\">" << fmt(x, 4) << "</text>\n";
+      s << "<text x=\"" << X(x) << "\" y=\"" << mt + ph + 18 << "\" text-anchor=\"middle\">" << fmt(x, 4)
+        << "</text>\n";
       s << "<text x=\"" << W - mr + 6 << "\" y=\"" << mt + ph * (1 - t / 4.0) + 4 << "\">" << t * 25 << " %</text>\n";
     }
     s << "<text x=\"" << 12 << "\" y=\"" << mt + ph / 2 << "\" transform=\"rotate(-90 12 " << mt + ph / 2
@@ -838,7 +866,8 @@ void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, 
     recs.push_back(parse_member_json(text.str()));
     if (!recs.back().ok) continue;
     const MemberPeaks p = read_member_peaks(d / "peaks.bin", true);
-    if (p.nx != dsm.nx || p.ny != dsm.ny) throw InputError("member peaks on another grid than the DSM", (d / "peaks.bin").string());
+    if (p.nx != dsm.nx || p.ny != dsm.ny)
+      throw InputError("member peaks on another grid than the DSM", (d / "peaks.bin").string());
     if (p.w > 0) {
       c0 = std::min(c0, p.c0), r0 = std::min(r0, p.r0);
       c1 = std::max(c1, p.c0 + p.w - 1), r1 = std::max(r1, p.r0 + p.h - 1);
@@ -974,6 +1003,7 @@ void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, 
     if (p.kind == DistributionKind::Normal) q.update({{"mean", p.a}, {"sd", p.b}});
     if (p.kind == DistributionKind::LogNormal) q.update({{"median", p.a}, {"sigma", p.b}});
     if (p.kind == DistributionKind::Discrete) q.update({{"values", p.values}, {"weights", p.weights}});
+    if (p.kind == DistributionKind::Fixed) q["value"] = p.a;
     if (std::isfinite(p.lower)) q["lower"] = p.lower;
     if (std::isfinite(p.upper)) q["upper"] = p.upper;
     params.push_back(q);
@@ -1001,8 +1031,7 @@ void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, 
   write_text_file(out / "summary.json", j.dump(2) + "\n");
   if (!quiet)
     std::cerr << "geohaz-ensemble: " << agg.members() << " of " << n << " members aggregated (" << failed.size()
-              << " failed); run-out P10/P50/P90 "
-              << fmt(j["runout_length_along_path_m"]["p10"].get<double>(), 5)
+              << " failed); run-out P10/P50/P90 " << fmt(j["runout_length_along_path_m"]["p10"].get<double>(), 5)
               << " / " << fmt(j["runout_length_along_path_m"]["p50"].get<double>(), 5) << " / "
               << fmt(j["runout_length_along_path_m"]["p90"].get<double>(), 5) << " m; products in " << out.string()
               << "\n";

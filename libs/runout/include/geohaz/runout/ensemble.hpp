@@ -40,7 +40,8 @@ enum class DistributionKind {
   Uniform,    ///< on [min, max]
   Normal,     ///< mean, sd; optionally truncated to [lower, upper]
   LogNormal,  ///< ln X normal with median e^μ and σ of ln X; optionally truncated to [lower, upper]
-  Discrete    ///< values with weights (equal when none given)
+  Discrete,   ///< values with weights (equal when none given)
+  Fixed       ///< one value for every member (a setting of the base case changed for the ensemble)
 };
 const char* to_string(DistributionKind k) noexcept;
 
@@ -50,7 +51,7 @@ const char* to_string(DistributionKind k) noexcept;
 struct ParameterDistribution {
   std::string key;
   DistributionKind kind = DistributionKind::Uniform;
-  double a = 0.0, b = 1.0;  ///< uniform: min, max; normal: mean, sd; log-normal: median, σ of ln
+  double a = 0.0, b = 1.0;  ///< uniform: min, max; normal: mean, sd; log-normal: median, σ of ln; fixed: value
   double lower = -std::numeric_limits<double>::infinity();  ///< truncation (normal, log-normal)
   double upper = std::numeric_limits<double>::infinity();
   std::vector<double> values, weights;  ///< discrete
@@ -87,8 +88,8 @@ struct AggregationSettings {
   std::vector<double> pressure_thresholds{30.0e3};  ///< Pa: P(peak pressure > t)
   std::vector<int> intensity_classes{2};            ///< P(intensity class ≥ k), k ∈ {1, 2, 3}
   std::vector<double> percentiles{10.0, 50.0, 90.0};
-  int bins = 96;              ///< log-spaced histogram bins per field and cell
-  IntensityTable intensity;   ///< class thresholds (those of the base case)
+  int bins = 96;             ///< log-spaced histogram bins per field and cell
+  IntensityTable intensity;  ///< class thresholds (those of the base case)
 };
 
 /// Log-binned histogram ranges of the three fields (values below the low end go into one bin,
@@ -96,9 +97,9 @@ struct AggregationSettings {
 struct HistogramRange {
   double lo, hi;
 };
-inline constexpr HistogramRange kDepthRange{1e-3, 1e2};     ///< m
-inline constexpr HistogramRange kSpeedRange{1e-2, 1e2};     ///< m/s
-inline constexpr HistogramRange kPressureRange{1.0, 1e7};   ///< Pa
+inline constexpr HistogramRange kDepthRange{1e-3, 1e2};    ///< m
+inline constexpr HistogramRange kSpeedRange{1e-2, 1e2};    ///< m/s
+inline constexpr HistogramRange kPressureRange{1.0, 1e7};  ///< Pa
 
 /// Percentile of a set of values from its histogram (nearest rank k = ⌈q·n/100⌉, 1-based): `zeros`
 /// exact zeros first, then `below` values in (0, lo), then `counts[j]` in bin j of `bins` log-spaced
@@ -112,9 +113,9 @@ double histogram_percentile(double q, std::uint32_t zeros, std::uint32_t below, 
 
 /// Peak maps of one member cropped to the window of the cells it reached.
 struct MemberPeaks {
-  int nx = 0, ny = 0;                     ///< the full grid
-  int c0 = 0, r0 = 0, w = 0, h = 0;       ///< window (w = h = 0: nothing reached)
-  double density = 0.0;                   ///< kg/m³ of the member (intensity classes)
+  int nx = 0, ny = 0;                          ///< the full grid
+  int c0 = 0, r0 = 0, w = 0, h = 0;            ///< window (w = h = 0: nothing reached)
+  double density = 0.0;                        ///< kg/m³ of the member (intensity classes)
   std::vector<double> depth, speed, pressure;  ///< w·h each, row-major
 };
 void write_member_peaks(const std::filesystem::path& path, const MemberPeaks& p);
@@ -140,11 +141,11 @@ class EnsembleAggregator {
   int bin_of(int field, double v) const;
   int nx_, ny_, c0_, r0_, w_, h_, n_ = 0;
   AggregationSettings s_;
-  std::vector<double> sum_;                 // 3 per cell
-  std::vector<double> vmin_, vmax_;         // 3 per cell, non-zero values
-  std::vector<std::uint32_t> zeros_;        // 3 per cell
-  std::vector<std::uint16_t> hist_;         // 3 × (bins + 2) per cell: below, bins, above
-  std::vector<std::uint32_t> exceed_;       // per threshold (depth, speed, pressure, intensity) per cell
+  std::vector<double> sum_;                         // 3 per cell
+  std::vector<double> vmin_, vmax_;                 // 3 per cell, non-zero values
+  std::vector<std::uint32_t> zeros_;                // 3 per cell
+  std::vector<std::uint16_t> hist_;                 // 3 × (bins + 2) per cell: below, bins, above
+  std::vector<std::uint32_t> exceed_;               // per threshold (depth, speed, pressure, intensity) per cell
   std::vector<std::pair<int, double>> thresholds_;  // (field, threshold) in exceed_ order
 };
 
@@ -167,14 +168,14 @@ MemberRecord parse_member_json(const std::string& text);
 
 /// The base case and the plan, checked: what every rank needs to run members.
 struct EnsembleSetup {
-  std::filesystem::path base_config;   ///< the debris-runout config of the base case
+  std::filesystem::path base_config;  ///< the debris-runout config of the base case
   EnsemblePlan plan;
   std::vector<std::vector<double>> values;  ///< sample_plan(plan)
   AggregationSettings aggregation;
-  std::vector<int> inject_failure;          ///< members made to fail (tests of failure handling)
-  std::string resolved_config;              ///< resolved ensemble config (TOML)
-  std::string base_resolved;                ///< resolved base config (TOML)
-  std::string dsm;                          ///< the base case's DSM
+  std::vector<int> inject_failure;  ///< members made to fail (tests of failure handling)
+  std::string resolved_config;      ///< resolved ensemble config (TOML)
+  std::string base_resolved;        ///< resolved base config (TOML)
+  std::string dsm;                  ///< the base case's DSM
 };
 
 /// Read the ensemble keys (every one declared with unit, range and help), the base case and
