@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -347,6 +348,7 @@ std::string member_json(const MemberRecord& r, const EnsemblePlan& plan) {
   j["ended_by"] = r.ended_by;
   j["unfinished"] = r.unfinished;
   j["wall_time_s"] = r.wall_time_s;
+  j["cpu_time_s"] = r.cpu_time_s;
   j["rank"] = r.rank;
   j["threads"] = r.threads;
   return j.dump(2);
@@ -376,6 +378,7 @@ MemberRecord parse_member_json(const std::string& text) {
   r.ended_by = j.at("ended_by").get<std::string>();
   r.unfinished = j.at("unfinished").get<bool>();
   r.wall_time_s = j.at("wall_time_s").get<double>();
+  r.cpu_time_s = j.at("cpu_time_s").get<double>();
   r.rank = j.at("rank").get<int>();
   r.threads = j.at("threads").get<int>();
   return r;
@@ -705,6 +708,7 @@ MemberRecord MemberRunner::run(int i, const fs::path& out, int rank, int threads
   fs::remove_all(tmp);
   fs::create_directories(tmp);
   const auto wall0 = std::chrono::steady_clock::now();
+  const std::clock_t cpu0 = std::clock();
   const bool inject = std::find(s_.inject_failure.begin(), s_.inject_failure.end(), i) != s_.inject_failure.end();
   try {
     RunoutSimulation sim(*in, c.params, c.output);
@@ -764,6 +768,7 @@ MemberRecord MemberRunner::run(int i, const fs::path& out, int rank, int threads
     rec.diagnosis = std::string("member input rejected: ") + e.what();
   }
   rec.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  rec.cpu_time_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
   write_text_file(tmp / "member.json", member_json(rec, plan) + "\n");
   // Publish atomically: a folder members/<i> exists only complete.
   std::error_code ec;
@@ -851,6 +856,7 @@ std::string threshold_name(double t) {
 
 void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, int threads, double wall_time_s,
                         bool quiet) {
+  const auto agg_wall0 = std::chrono::steady_clock::now();
   const int n = s.plan.members;
   // 1. Member records in index order; the union window of the successful members' peak maps.
   std::vector<MemberRecord> recs;
@@ -940,7 +946,8 @@ void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, 
     csv << "member,status";
     for (const auto& p : s.plan.parameters) csv << ',' << p.key;
     csv << ",runout_m,drop_height_m,reach_m,H_over_L,angle_deg,release_m3,deposited_m3,mobile_m3,lost_m3,max_speed_m_"
-           "s,area_affected_m2,simulated_time_s,steps,ended_by,unfinished,wall_time_s,rank,threads,diagnosis\n";
+           "s,area_affected_m2,simulated_time_s,steps,ended_by,unfinished,wall_time_s,cpu_time_s,rank,threads,"
+           "diagnosis\n";
     csv.stream() << std::setprecision(10);
     for (const auto& r : recs) {
       csv << r.index << ',' << (r.ok ? "ok" : "failed");
@@ -951,16 +958,17 @@ void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, 
       csv << ',' << r.runout_m << ',' << r.drop_height_m << ',' << r.reach_m << ',' << r.hl << ',' << r.hl_deg << ','
           << r.release_m3 << ',' << r.deposited_m3 << ',' << r.mobile_m3 << ',' << r.lost_m3 << ',' << r.max_speed
           << ',' << r.affected_area_m2 << ',' << r.simulated_time_s << ',' << r.steps << ",\"" << r.ended_by << "\","
-          << (r.unfinished ? 1 : 0) << ',' << r.wall_time_s << ',' << r.rank << ',' << r.threads << ",\"" << diag
-          << "\"\n";
+          << (r.unfinished ? 1 : 0) << ',' << r.wall_time_s << ',' << r.cpu_time_s << ',' << r.rank << ',' << r.threads
+          << ",\"" << diag << "\"\n";
     }
     csv.commit();
   }
-  std::vector<double> runout, hl, member_wall;
+  std::vector<double> runout, hl, member_wall, member_cpu;
   nlohmann::json failed = nlohmann::json::array();
   int unfinished = 0;
   for (const auto& r : recs) {
     member_wall.push_back(r.wall_time_s);
+    member_cpu.push_back(r.cpu_time_s);
     if (!r.ok) {
       failed.push_back({{"member", r.index}, {"diagnosis", r.diagnosis}, {"values", r.values}});
       continue;
@@ -1013,6 +1021,10 @@ void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, 
   j["runout_length_along_path_m"] = stats(runout);
   j["fahrboeschung_ratio_H_over_L"] = stats(hl);
   j["member_wall_time_s"] = stats(member_wall);
+  j["member_cpu_time_s"] = stats(member_cpu);
+  double cpu_total = 0.0;
+  for (double c : member_cpu) cpu_total += c;
+  j["members_cpu_time_total_s"] = cpu_total;
   j["products"] = products;
   const auto ratio = [&](HistogramRange r) { return std::pow(r.hi / r.lo, 1.0 / a.bins) - 1.0; };
   j["percentile_accuracy"] = {{"method", "log-binned histogram per cell, clamped to the cell's exact extremes"},
@@ -1028,6 +1040,7 @@ void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, 
   j["ranks"] = ranks;
   j["threads_per_rank"] = threads;
   j["wall_time_s"] = wall_time_s;
+  j["aggregation_wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - agg_wall0).count();
   write_text_file(out / "summary.json", j.dump(2) + "\n");
   if (!quiet)
     std::cerr << "geohaz-ensemble: " << agg.members() << " of " << n << " members aggregated (" << failed.size()

@@ -158,6 +158,7 @@ struct MemberRecord {
   double runout_m = 0.0, drop_height_m = 0.0, reach_m = 0.0, hl = 0.0, hl_deg = 0.0;
   double release_m3 = 0.0, deposited_m3 = 0.0, mobile_m3 = 0.0, lost_m3 = 0.0;
   double max_speed = 0.0, affected_area_m2 = 0.0, simulated_time_s = 0.0, wall_time_s = 0.0;
+  double cpu_time_s = 0.0;  ///< CPU time of the process during the member (all its threads)
   std::int64_t steps = 0;
   std::string ended_by;
   bool unfinished = false;
