@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -145,13 +146,6 @@ int request_member(int finished, bool ok) {
 #endif
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 void report(const MemberRecord& r, int n, bool quiet) {
   if (quiet) return;
   std::ostringstream o;
@@ -198,49 +192,33 @@ int run(int argc, char** argv, const World& world) {
   const EnsembleSetup setup = read_ensemble(cfg);
   const fs::path out(common.out);
   const int n = setup.plan.members;
-  const std::string plan = plan_csv(setup);
 
-  // Rank 0 prepares the folder: a new one, or the same ensemble to resume.
+  // Rank 0 prepares the folder: a new one, or the same ensemble to resume (all ranks learn whether
+  // it could, so none waits for a rank 0 that stopped).
   int resume_ok = 1;
-  std::string resume_error;
+  std::deque<int> queue;
+  std::unique_ptr<InputError> folder_error;
   if (world.rank == 0) {
-    if (fs::exists(out / "plan.csv")) {
-      if (slurp(out / "plan.csv") != plan || slurp(out / "base.resolved.toml") != setup.base_resolved) {
-        resume_ok = 0;
-        resume_error =
-            "the output folder holds another ensemble (plan.csv or base.resolved.toml differ): choose "
-            "another --out or delete it";
-      }
-    }
-    if (resume_ok) {
-      make_output_dir(out);
-      fs::create_directories(out / "members");
-      // Folders of members a killed run left unfinished.
-      for (const auto& e : fs::directory_iterator(out / "members"))
-        if (e.path().filename().string().find(".partial") != std::string::npos) fs::remove_all(e.path());
-      write_text_file(out / "plan.csv", plan);
-      write_text_file(out / "base.resolved.toml", setup.base_resolved);
-      write_text_file(out / "config.resolved.toml", setup.resolved_config);
+    try {
+      const std::vector<int> pending = prepare_output(setup, out);
+      queue.assign(pending.begin(), pending.end());
+    } catch (const InputError& e) {
+      resume_ok = 0;
+      folder_error = std::make_unique<InputError>(e);
     }
   }
 #ifdef GEOHAZ_HAVE_MPI
   if (world.mpi) MPI_Bcast(&resume_ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
 #endif
   if (!resume_ok) {
-    if (world.rank == 0) throw InputError(resume_error, "command line", "--out", out.string());
+    if (folder_error) throw *folder_error;
     return kExitInputError;
   }
 
   const auto wall0 = std::chrono::steady_clock::now();
   MemberRunner runner(setup);
   if (world.rank == 0) {
-    std::deque<int> queue;
-    int skipped = 0;
-    for (int i = 0; i < n; ++i)
-      if (member_done(out, i))
-        ++skipped;
-      else
-        queue.push_back(i);
+    const std::size_t skipped = static_cast<std::size_t>(n) - queue.size();
     if (!quiet)
       std::cerr << kApp << ": " << n << " members (" << skipped << " finished before, " << queue.size()
                 << " to run) on " << world.size << " rank(s) × " << threads << " thread(s)\n";

@@ -65,7 +65,7 @@ fs::path make_case(const fs::path& d) {
   std::ofstream b(d / "base.toml");
   b << "[terrain]\ndsm = \"dsm.tif\"\n[release]\nfile = \"release.tif\"\nthickness_direction = \"vertical\"\n"
        "[model]\nfriction = \"coulomb\"\nmu = 0.3\nd0 = 0.5\nh0 = 1.0\ncurvature = false\n"
-       "[run]\nduration = 60.0\nstop_energy_fraction = 0.0\n[numerics]\ndt_max = 0.002\n";
+       "[run]\nduration = 60.0\nstop_energy_fraction = 0.0\n[numerics]\ndt_max = 0.005\n";
   return d / "base.toml";
 }
 
@@ -130,8 +130,8 @@ TEST(EnsembleApp, ExceedanceMatchesTheAnalyticStoppingDistribution) {
     for (auto& x : f) std::getline(s, x, ',');
     ASSERT_EQ(f[1], "ok");
     const double mu = std::stod(f[2]), reach = std::stod(f[5]);
-    // The step across the break mixes the two slopes over S·dt ≤ 0.03 m; the bilinear DSM rounds
-    // the break over one cell (0.5 m): 0.3 m.
+    // The step across the break mixes the two slopes over S·dt ≤ 0.06 m (S ≤ 11 m/s, dt ≤ 5 ms); the bilinear DSM
+    // rounds the break over one cell (0.5 m): 0.3 m.
     EXPECT_NEAR(reach, L * kTanTheta / mu, 0.3) << "mu " << mu;
     ++rows;
   }
@@ -193,7 +193,8 @@ TEST(EnsembleApp, FailedMemberIsReportedAndTheOthersAggregated) {
   // Probabilities are counts over the 7 members that ran.
   const auto p = read(out / "prob_max_depth_gt_1e-06m.tif");
   for (double v : p.data) {
-    if (v != -9999.0) EXPECT_NEAR(v * 7.0, std::round(v * 7.0), 1e-5) << v;
+    if (v == -9999.0) continue;
+    EXPECT_NEAR(v * 7.0, std::round(v * 7.0), 1e-5) << v;
   }
   fs::remove_all(d);
 }

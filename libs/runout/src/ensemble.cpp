@@ -609,6 +609,50 @@ std::string plan_csv(const EnsembleSetup& s) {
   return o.str();
 }
 
+namespace {
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+}  // namespace
+
+std::vector<int> prepare_output(const EnsembleSetup& s, const fs::path& out) {
+  const std::string plan = plan_csv(s);
+  if (fs::exists(out / "plan.csv") &&
+      (slurp(out / "plan.csv") != plan || slurp(out / "base.resolved.toml") != s.base_resolved))
+    throw InputError(
+        "the output folder holds another ensemble (plan.csv or base.resolved.toml differ): choose "
+        "another --out or delete it",
+        "command line", "--out", out.string());
+  make_output_dir(out);
+  fs::create_directories(out / "members");
+  for (const auto& e : fs::directory_iterator(out / "members"))
+    if (e.path().filename().string().find(".partial") != std::string::npos) fs::remove_all(e.path());
+  write_text_file(out / "plan.csv", plan);
+  write_text_file(out / "base.resolved.toml", s.base_resolved);
+  write_text_file(out / "config.resolved.toml", s.resolved_config);
+  std::vector<int> pending;
+  for (int i = 0; i < s.plan.members; ++i)
+    if (!member_done(out, i)) pending.push_back(i);
+  return pending;
+}
+
+void run_ensemble_serial(const EnsembleSetup& s, const fs::path& out, int threads, bool quiet) {
+  const std::vector<int> pending = prepare_output(s, out);
+  const auto wall0 = std::chrono::steady_clock::now();
+  MemberRunner runner(s);
+  for (int i : pending) {
+    const MemberRecord r = runner.run(i, out, 0, threads);
+    if (!quiet)
+      std::cerr << "geohaz-ensemble: member " << i << "/" << s.plan.members << (r.ok ? " done" : " FAILED: ")
+                << r.diagnosis << "\n";
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  aggregate_ensemble(s, out, 1, threads, wall, quiet);
+}
+
 fs::path member_dir(const fs::path& out, int i) {
   std::ostringstream o;
   o << std::setw(6) << std::setfill('0') << i;

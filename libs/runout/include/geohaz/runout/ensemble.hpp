@@ -190,6 +190,15 @@ void describe_ensemble(ConfigReader& cfg);
 /// rerun (a folder of another ensemble is not resumed).
 std::string plan_csv(const EnsembleSetup& s);
 
+/// Prepare the output folder (rank 0, or a lone process): a folder of another ensemble (plan.csv or
+/// base.resolved.toml differ) is an InputError and is left untouched; otherwise create it and
+/// members/, remove the member folders a killed run left unfinished, write plan.csv and the
+/// resolved configs. Returns the members still to run, in index order.
+std::vector<int> prepare_output(const EnsembleSetup& s, const std::filesystem::path& out);
+
+/// Run every pending member in this process and aggregate (one rank; the Python module).
+void run_ensemble_serial(const EnsembleSetup& s, const std::filesystem::path& out, int threads, bool quiet);
+
 /// Folder of member i below the output folder.
 std::filesystem::path member_dir(const std::filesystem::path& out, int i);
 /// Whether member i has finished (ok or failed) in a previous or concurrent run.
