@@ -73,14 +73,33 @@ struct World {
 #endif
     (void)code;
   }
-  void barrier() const {
-#ifdef GEOHAZ_HAVE_MPI
-    if (mpi) MPI_Barrier(MPI_COMM_WORLD);
-#endif
-  }
+  void barrier() const;
 };
 
 constexpr int kTagRequest = 1, kTagAssign = 2;
+
+#ifdef GEOHAZ_HAVE_MPI
+/// Wait for a request without spinning: Open MPI's blocking calls poll at full speed, which takes a
+/// core away from the members of other ranks (or other jobs) on the same node while this rank waits
+/// for rank 0's answer or the final barrier (up to one member's time).
+void wait_quietly(MPI_Request* request) {
+  int done = 0;
+  for (;;) {
+    MPI_Test(request, &done, MPI_STATUS_IGNORE);
+    if (done) return;
+    std::this_thread::sleep_for(std::chrono::microseconds(500));
+  }
+}
+#endif
+
+void World::barrier() const {
+#ifdef GEOHAZ_HAVE_MPI
+  if (!mpi) return;
+  MPI_Request r;
+  MPI_Ibarrier(MPI_COMM_WORLD, &r);
+  wait_quietly(&r);
+#endif
+}
 
 /// Rank 0's queue of members and its answers to the other ranks.
 class Coordinator : public RunObserver {
@@ -138,7 +157,9 @@ int request_member(int finished, bool ok) {
   int done[2] = {finished, ok ? 1 : 0};
   MPI_Send(done, 2, MPI_INT, 0, kTagRequest, MPI_COMM_WORLD);
   int next = -1;
-  MPI_Recv(&next, 1, MPI_INT, 0, kTagAssign, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  MPI_Request r;
+  MPI_Irecv(&next, 1, MPI_INT, 0, kTagAssign, MPI_COMM_WORLD, &r);
+  wait_quietly(&r);
   return next;
 #else
   (void)finished, (void)ok;
