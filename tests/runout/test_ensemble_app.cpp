@@ -124,6 +124,7 @@ TEST(EnsembleApp, ExceedanceMatchesTheAnalyticStoppingDistribution) {
   const double x_rel = kX0 + 10.5 * kCell;  // centre of the release cell
   const double L = -x_rel;
   int rows = 0;
+  std::vector<double> mus;
   while (std::getline(csv, line)) {
     std::stringstream s(line);
     std::string f[6];
@@ -133,6 +134,7 @@ TEST(EnsembleApp, ExceedanceMatchesTheAnalyticStoppingDistribution) {
     // The step across the break mixes the two slopes over S·dt ≤ 0.06 m (S ≤ 11 m/s, dt ≤ 5 ms); the bilinear DSM
     // rounds the break over one cell (0.5 m): 0.3 m.
     EXPECT_NEAR(reach, L * kTanTheta / mu, 0.3) << "mu " << mu;
+    mus.push_back(mu);
     ++rows;
   }
   EXPECT_EQ(rows, n);
@@ -146,6 +148,16 @@ TEST(EnsembleApp, ExceedanceMatchesTheAnalyticStoppingDistribution) {
     const double exact = std::clamp((mu_star - kMuA) / (kMuB - kMuA), 0.0, 1.0);
     const double sigma = std::sqrt(std::max(exact * (1.0 - exact), 1.0 / n) / n);
     EXPECT_LE(std::abs(p.at(c, row) - exact), 3.0 * sigma) << "x = " << x << " exact " << exact;
+    // Sharper: the map counts exactly the members whose analytic stop s(μ_i) + r lies beyond x,
+    // give or take those within the 0.3 m of the reach tolerance.
+    int surely = 0, possibly = 0;
+    for (double mu : mus) {
+      const double s_mu = L * (kTanTheta - mu) / mu;
+      surely += s_mu + kRadius >= x + 0.3;
+      possibly += s_mu + kRadius >= x - 0.3;
+    }
+    EXPECT_GE(p.at(c, row) * n, surely - 1e-4) << "x = " << x;
+    EXPECT_LE(p.at(c, row) * n, possibly + 1e-4) << "x = " << x;
     ++checked;
   }
   EXPECT_GT(checked, 50);
