@@ -953,7 +953,12 @@ void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, 
   std::string first_label;
   const auto prob = [&](int field, double t, const std::string& name, const std::string& what) {
     Raster r = put(name, agg.exceedance(field, t), what + of_n, "1", ColourRamp::BlueRed, 1.0);
-    if (first_probability.data.empty()) first_probability = r, first_label = what;
+    if (first_probability.data.empty()) {
+      // The picture's font has no '>': words instead.
+      first_probability = r, first_label = what;
+      for (const auto& [sym, word] : {std::pair<std::string, std::string>{" >= ", " at least "}, {" > ", " above "}})
+        for (std::size_t k; (k = first_label.find(sym)) != std::string::npos;) first_label.replace(k, sym.size(), word);
+    }
   };
   for (double t : a.depth_thresholds)
     prob(0, t, "prob_max_depth_gt_" + threshold_name(t) + "m", "probability peak depth > " + threshold_name(t) + " m");
