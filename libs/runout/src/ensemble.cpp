@@ -670,10 +670,8 @@ struct MemberRunner::Cache {
   std::unique_ptr<RunoutInputs> inputs;
 };
 
-MemberRunner::MemberRunner(const EnsembleSetup& s) : s_(s), cache_(new Cache) {}
-MemberRunner::~MemberRunner() {
-  delete cache_;
-}
+MemberRunner::MemberRunner(const EnsembleSetup& s) : s_(s), cache_(std::make_unique<Cache>()) {}
+MemberRunner::~MemberRunner() = default;
 
 namespace {
 

@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -217,7 +218,7 @@ class MemberRunner {
  private:
   struct Cache;
   const EnsembleSetup& s_;
-  Cache* cache_;
+  std::unique_ptr<Cache> cache_;
 };
 
 /// Aggregate the members in index order and write the products, members.csv, the plots and
