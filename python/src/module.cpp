@@ -6,15 +6,18 @@
 //
 // The GIL is released for the whole run; it is taken back only to call a progress callback (when
 // one is given) and, every few hundred steps, to let Ctrl-C interrupt the run.
+#include <omp.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -25,6 +28,7 @@
 #include "geohaz/core/output.hpp"
 #include "geohaz/core/progress.hpp"
 #include "geohaz/core/snapshot.hpp"
+#include "geohaz/runout/ensemble.hpp"
 #include "geohaz/runout/run.hpp"
 
 namespace py = pybind11;
@@ -256,6 +260,31 @@ std::string runout_help_config() {
   return ConfigReader::format_reference(d.reference());
 }
 
+/// An ensemble (geohaz-ensemble's config) run in this process on one rank: members and products in
+/// `out` (resumed when it holds the same ensemble); returns the text of its summary.json.
+std::string ensemble_run(const std::string& config, const std::vector<std::string>& overrides, const std::string& out,
+                         int threads, bool quiet) {
+  ConfigReader cfg = ConfigReader::from_file(config);
+  for (const auto& o : overrides) cfg.apply_override(o);
+  const EnsembleSetup s = read_ensemble(cfg);
+  const int nthreads = threads > 0 ? setup_threads(threads) : omp_get_max_threads();
+  {
+    py::gil_scoped_release release;
+    run_ensemble_serial(s, out, nthreads, quiet);
+  }
+  std::ifstream in(fs::path(out) / "summary.json");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+/// The config keys of geohaz-ensemble (as its --help-config).
+std::string ensemble_help_config() {
+  ConfigReader d = ConfigReader::describe();
+  describe_ensemble(d);
+  return ConfigReader::format_reference(d.reference());
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_geohaz, m) {
@@ -287,4 +316,7 @@ PYBIND11_MODULE(_geohaz, m) {
   m.def("runout_run", &runout_run, py::arg("config"), py::arg("overrides"), py::arg("out"), py::arg("progress"),
         py::arg("progress_every"), py::arg("quiet"), py::arg("threads"), py::arg("particles"));
   m.def("runout_help_config", &runout_help_config);
+  m.def("ensemble_run", &ensemble_run, py::arg("config"), py::arg("overrides"), py::arg("out"), py::arg("threads"),
+        py::arg("quiet"));
+  m.def("ensemble_help_config", &ensemble_help_config);
 }

@@ -1,4 +1,5 @@
-# bash completion for the geohaz apps (sph-slope, debris-runout, dem-avalanche, geohaz-report).
+# bash completion for the geohaz apps (sph-slope, debris-runout, dem-avalanche, geohaz-report,
+# geohaz-ensemble).
 # Installed as share/bash-completion/completions/<app>; to try it from a source tree:
 #   source scripts/completion/geohaz.bash
 # Options come from the app's own --help and config keys (after --set) from its --help-config, so
@@ -44,4 +45,4 @@ _geohaz_complete() {
   mapfile -t COMPREPLY < <(compgen -f -- "$cur")
 }
 
-complete -o filenames -F _geohaz_complete sph-slope debris-runout dem-avalanche geohaz-report
+complete -o filenames -F _geohaz_complete sph-slope debris-runout dem-avalanche geohaz-report geohaz-ensemble

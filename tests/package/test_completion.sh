@@ -23,6 +23,7 @@ expect() {  # expect "<words>" "<reply>"
 runout=$build/apps/debris-runout/debris-runout
 sph=$build/apps/sph-slope/sph-slope
 dem=$build/apps/dem-avalanche/dem-avalanche
+ens=$build/apps/geohaz-ensemble/geohaz-ensemble
 expect "$runout --fri" "--friction"
 expect "$runout --release-f" "--release-from"
 expect "$runout --friction v" "voellmy"
@@ -31,4 +32,5 @@ expect "$sph --set material.coh" "material.cohesion="
 expect "$sph --help-c" "--help-config"
 expect "$dem --set bond.tensile_strength_" "bond.tensile_strength_std="
 expect "$dem --threads 1" "1"
+[ -x "$ens" ] && expect "$ens --set ensemble.samp" "ensemble.sampling="
 [ $fails -eq 0 ]

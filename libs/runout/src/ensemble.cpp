@@ -1,0 +1,1100 @@
+// Ensembles of debris-runout runs (ensemble.hpp, docs/ensemble.md): plan, members, aggregation.
+#include "geohaz/runout/ensemble.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <boost/math/special_functions/erf.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "geohaz/core/config.hpp"
+#include "geohaz/core/errors.hpp"
+#include "geohaz/core/output.hpp"
+#include "geohaz/runout/run.hpp"
+
+namespace fs = std::filesystem;
+
+namespace geohaz::runout {
+
+namespace {
+
+std::string fmt(double v, int prec = 6) {
+  std::ostringstream o;
+  o << std::setprecision(prec) << v;
+  return o.str();
+}
+
+std::uint64_t splitmix64(std::uint64_t x) noexcept {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+double normal_cdf(double z) {
+  return 0.5 * std::erfc(-z / std::sqrt(2.0));
+}
+double normal_quantile(double p) {
+  return std::sqrt(2.0) * boost::math::erf_inv(2.0 * p - 1.0);
+}
+
+const char* const kFieldNames[3] = {"max_depth", "max_speed", "max_pressure"};
+const char* const kFieldUnits[3] = {"m", "m/s", "Pa"};
+const char* const kFieldDescriptions[3] = {"peak flow depth, normal to the bed", "peak surface speed",
+                                           "peak dynamic pressure rho v^2"};
+
+}  // namespace
+
+const char* to_string(DistributionKind k) noexcept {
+  switch (k) {
+    case DistributionKind::Uniform:
+      return "uniform";
+    case DistributionKind::Normal:
+      return "normal";
+    case DistributionKind::LogNormal:
+      return "lognormal";
+    case DistributionKind::Discrete:
+      return "discrete";
+    case DistributionKind::Fixed:
+      return "fixed";
+  }
+  return "?";
+}
+
+double ParameterDistribution::quantile(double u) const {
+  switch (kind) {
+    case DistributionKind::Fixed:
+      return a;
+    case DistributionKind::Uniform:
+      return a + u * (b - a);
+    case DistributionKind::Normal:
+    case DistributionKind::LogNormal: {
+      // Standardised bounds of the truncation; u is mapped into [F(lo), F(hi)].
+      const bool log = kind == DistributionKind::LogNormal;
+      const double mu = log ? std::log(a) : a;
+      const auto z_of = [&](double x) {
+        if (log) return x > 0.0 ? (std::log(x) - mu) / b : -std::numeric_limits<double>::infinity();
+        return (x - mu) / b;
+      };
+      const double f_lo = std::isfinite(lower) ? normal_cdf(z_of(lower)) : 0.0;
+      const double f_hi = std::isfinite(upper) ? normal_cdf(z_of(upper)) : 1.0;
+      const double p = std::clamp(f_lo + u * (f_hi - f_lo), 1e-300, 1.0 - 1e-16);
+      const double x = mu + b * normal_quantile(p);
+      return std::clamp(log ? std::exp(x) : x, lower, upper);
+    }
+    case DistributionKind::Discrete: {
+      double total = 0.0;
+      for (double w : weights) total += w;
+      double acc = 0.0;
+      for (std::size_t k = 0; k < values.size(); ++k) {
+        acc += weights[k] / total;
+        if (u < acc) return values[k];
+      }
+      return values.back();
+    }
+  }
+  return a;
+}
+
+double counter_uniform(std::uint64_t seed, std::uint64_t a, std::uint64_t b, std::uint64_t c) noexcept {
+  const std::uint64_t h = splitmix64(splitmix64(splitmix64(splitmix64(seed) ^ a) ^ b) ^ c);
+  return (static_cast<double>(h >> 11) + 0.5) * 0x1.0p-53;  // in (0, 1)
+}
+
+std::vector<std::vector<double>> sample_plan(const EnsemblePlan& plan) {
+  const int n = plan.members;
+  const std::size_t np = plan.parameters.size();
+  std::vector<std::vector<double>> out(static_cast<std::size_t>(n), std::vector<double>(np));
+  for (std::size_t d = 0; d < np; ++d) {
+    std::vector<int> stratum(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) stratum[static_cast<std::size_t>(i)] = i;
+    if (plan.sampling == SamplingMethod::LatinHypercube) {
+      // Fisher–Yates with the counter generator: stream 1 = permutations, stream 2 = jitter.
+      for (int i = n - 1; i > 0; --i) {
+        const double u = counter_uniform(plan.seed, 1, d, static_cast<std::uint64_t>(i));
+        const int j = std::min(i, static_cast<int>(u * (i + 1)));
+        std::swap(stratum[static_cast<std::size_t>(i)], stratum[static_cast<std::size_t>(j)]);
+      }
+    }
+    for (int i = 0; i < n; ++i) {
+      const double jitter = counter_uniform(plan.seed, 2, d, static_cast<std::uint64_t>(i));
+      const double u = plan.sampling == SamplingMethod::LatinHypercube
+                           ? (stratum[static_cast<std::size_t>(i)] + jitter) / n
+                           : jitter;
+      out[static_cast<std::size_t>(i)][d] = plan.parameters[d].quantile(u);
+    }
+  }
+  return out;
+}
+
+template <class Count>
+double histogram_percentile(double q, std::uint32_t zeros, std::uint32_t below, const Count* counts, int bins,
+                            std::uint32_t above, HistogramRange range, double vmin, double vmax) {
+  std::uint64_t n = static_cast<std::uint64_t>(zeros) + below + above;
+  for (int j = 0; j < bins; ++j) n += counts[j];
+  if (n == 0) return 0.0;
+  const std::uint64_t k = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::ceil(q / 100.0 * n - 1e-9)));
+  if (k <= zeros) return 0.0;
+  std::uint64_t acc = zeros + below;
+  if (k <= acc) return vmin;
+  const double ratio = std::log(range.hi / range.lo) / bins;
+  for (int j = 0; j < bins; ++j) {
+    if (counts[j] == 0) continue;
+    if (k <= acc + counts[j]) {
+      const double m = static_cast<double>(k - acc) - 0.5;  // mid-position of the rank in the bin
+      const double v = range.lo * std::exp(ratio * (j + m / counts[j]));
+      return std::clamp(v, vmin, vmax);
+    }
+    acc += counts[j];
+  }
+  return vmax;
+}
+template double histogram_percentile<std::uint16_t>(double, std::uint32_t, std::uint32_t, const std::uint16_t*, int,
+                                                    std::uint32_t, HistogramRange, double, double);
+template double histogram_percentile<std::uint32_t>(double, std::uint32_t, std::uint32_t, const std::uint32_t*, int,
+                                                    std::uint32_t, HistogramRange, double, double);
+
+// ---- member peaks on disk -------------------------------------------------------------------
+
+namespace {
+constexpr char kPeaksMagic[8] = {'G', 'H', 'Z', 'P', 'E', 'A', 'K', '1'};
+}
+
+void write_member_peaks(const fs::path& path, const MemberPeaks& p) {
+  const fs::path tmp = path.string() + ".partial";
+  {
+    std::ofstream o(tmp, std::ios::binary);
+    const std::int32_t hdr[6] = {p.nx, p.ny, p.c0, p.r0, p.w, p.h};
+    o.write(kPeaksMagic, 8);
+    o.write(reinterpret_cast<const char*>(hdr), sizeof hdr);
+    o.write(reinterpret_cast<const char*>(&p.density), sizeof(double));
+    for (const auto* v : {&p.depth, &p.speed, &p.pressure})
+      o.write(reinterpret_cast<const char*>(v->data()), static_cast<std::streamsize>(v->size() * sizeof(double)));
+    o.flush();
+    if (!o) {
+      std::error_code ec;
+      fs::remove(tmp, ec);
+      throw IoError("cannot write the member's peak maps", path.string());
+    }
+  }
+  fs::rename(tmp, path);
+}
+
+MemberPeaks read_member_peaks(const fs::path& path, bool header_only) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[8];
+  std::int32_t hdr[6];
+  MemberPeaks p;
+  in.read(magic, 8);
+  in.read(reinterpret_cast<char*>(hdr), sizeof hdr);
+  in.read(reinterpret_cast<char*>(&p.density), sizeof(double));
+  if (!in || std::memcmp(magic, kPeaksMagic, 8) != 0)
+    throw InputError("not a member peak file (damaged? delete the member's folder to rerun it)", path.string());
+  p.nx = hdr[0], p.ny = hdr[1], p.c0 = hdr[2], p.r0 = hdr[3], p.w = hdr[4], p.h = hdr[5];
+  if (header_only) return p;
+  const std::size_t cells = static_cast<std::size_t>(p.w) * static_cast<std::size_t>(p.h);
+  for (auto* v : {&p.depth, &p.speed, &p.pressure}) {
+    v->resize(cells);
+    in.read(reinterpret_cast<char*>(v->data()), static_cast<std::streamsize>(cells * sizeof(double)));
+  }
+  if (!in) throw InputError("member peak file is truncated (delete the member's folder to rerun it)", path.string());
+  return p;
+}
+
+// ---- aggregation ----------------------------------------------------------------------------
+
+EnsembleAggregator::EnsembleAggregator(int nx, int ny, int c0, int r0, int w, int h, AggregationSettings s)
+    : nx_(nx), ny_(ny), c0_(c0), r0_(r0), w_(w), h_(h), s_(std::move(s)) {
+  const std::size_t cells = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  sum_.assign(3 * cells, 0.0);
+  vmin_.assign(3 * cells, std::numeric_limits<double>::infinity());
+  vmax_.assign(3 * cells, 0.0);
+  zeros_.assign(3 * cells, 0);
+  hist_.assign(3 * cells * static_cast<std::size_t>(s_.bins + 2), 0);
+  for (double t : s_.depth_thresholds) thresholds_.emplace_back(0, t);
+  for (double t : s_.speed_thresholds) thresholds_.emplace_back(1, t);
+  for (double t : s_.pressure_thresholds) thresholds_.emplace_back(2, t);
+  for (int k : s_.intensity_classes) thresholds_.emplace_back(3, static_cast<double>(k));
+  exceed_.assign(thresholds_.size() * cells, 0);
+}
+
+HistogramRange EnsembleAggregator::range_of(int field) {
+  return field == 0 ? kDepthRange : field == 1 ? kSpeedRange : kPressureRange;
+}
+
+int EnsembleAggregator::bin_of(int field, double v) const {
+  const HistogramRange r = range_of(field);
+  if (v < r.lo) return 0;
+  if (v >= r.hi) return s_.bins + 1;
+  const int j = static_cast<int>(std::log(v / r.lo) / std::log(r.hi / r.lo) * s_.bins);
+  return 1 + std::clamp(j, 0, s_.bins - 1);
+}
+
+std::size_t EnsembleAggregator::bytes_per_cell() const noexcept {
+  return 3 * (3 * sizeof(double) + sizeof(std::uint32_t) + (s_.bins + 2) * sizeof(std::uint16_t)) +
+         thresholds_.size() * sizeof(std::uint32_t);
+}
+
+void EnsembleAggregator::add(const MemberPeaks& p) {
+  if (p.nx != nx_ || p.ny != ny_) throw std::logic_error("member peaks on another grid");
+  if (n_ >= 65535) throw std::logic_error("more than 65535 members: histogram counts would overflow");
+  ++n_;
+  const std::size_t cells = static_cast<std::size_t>(w_) * static_cast<std::size_t>(h_);
+  const std::size_t nb = static_cast<std::size_t>(s_.bins + 2);
+  // Intensity classes of the member on its own window.
+  std::vector<double> cls;
+  if (s_.intensity_classes.size() && p.w > 0) cls = intensity_classes(p.depth, p.speed, p.density, s_.intensity);
+  for (int r = 0; r < h_; ++r)
+    for (int c = 0; c < w_; ++c) {
+      const std::size_t k = static_cast<std::size_t>(r) * w_ + c;
+      const int gc = c0_ + c - p.c0, gr = r0_ + r - p.r0;  // in the member's window
+      const bool inside = gc >= 0 && gr >= 0 && gc < p.w && gr < p.h;
+      const std::size_t m = inside ? static_cast<std::size_t>(gr) * p.w + gc : 0;
+      double v[3] = {0.0, 0.0, 0.0};
+      if (inside) v[0] = p.depth[m], v[1] = p.speed[m], v[2] = p.pressure[m];
+      for (int f = 0; f < 3; ++f) {
+        const std::size_t kf = 3 * k + f;
+        const double x = std::isfinite(v[f]) && v[f] > 0.0 ? v[f] : 0.0;
+        sum_[kf] += x;
+        if (x == 0.0) {
+          ++zeros_[kf];
+          continue;
+        }
+        vmin_[kf] = std::min(vmin_[kf], x);
+        vmax_[kf] = std::max(vmax_[kf], x);
+        ++hist_[kf * nb + static_cast<std::size_t>(bin_of(f, x))];
+      }
+      for (std::size_t t = 0; t < thresholds_.size(); ++t) {
+        const auto [f, thr] = thresholds_[t];
+        const bool hit = f == 3 ? (inside && cls[m] >= thr) : v[f] > thr;
+        if (hit) ++exceed_[t * cells + k];
+      }
+    }
+}
+
+std::vector<double> EnsembleAggregator::mean(int field) const {
+  std::vector<double> out(static_cast<std::size_t>(nx_) * ny_, 0.0);
+  if (n_ == 0) return out;
+  for (int r = 0; r < h_; ++r)
+    for (int c = 0; c < w_; ++c)
+      out[static_cast<std::size_t>(r0_ + r) * nx_ + c0_ + c] =
+          sum_[3 * (static_cast<std::size_t>(r) * w_ + c) + field] / n_;
+  return out;
+}
+
+std::vector<double> EnsembleAggregator::percentile(int field, double q) const {
+  std::vector<double> out(static_cast<std::size_t>(nx_) * ny_, 0.0);
+  const std::size_t nb = static_cast<std::size_t>(s_.bins + 2);
+  for (int r = 0; r < h_; ++r)
+    for (int c = 0; c < w_; ++c) {
+      const std::size_t kf = 3 * (static_cast<std::size_t>(r) * w_ + c) + field;
+      const std::uint16_t* hst = &hist_[kf * nb];
+      out[static_cast<std::size_t>(r0_ + r) * nx_ + c0_ + c] = histogram_percentile(
+          q, zeros_[kf], hst[0], hst + 1, s_.bins, hst[nb - 1], range_of(field), vmin_[kf], vmax_[kf]);
+    }
+  return out;
+}
+
+std::vector<double> EnsembleAggregator::exceedance(int field, double threshold) const {
+  std::vector<double> out(static_cast<std::size_t>(nx_) * ny_, 0.0);
+  const std::size_t cells = static_cast<std::size_t>(w_) * static_cast<std::size_t>(h_);
+  for (std::size_t t = 0; t < thresholds_.size(); ++t) {
+    if (thresholds_[t].first != field || thresholds_[t].second != threshold) continue;
+    if (n_ == 0) return out;
+    for (int r = 0; r < h_; ++r)
+      for (int c = 0; c < w_; ++c)
+        out[static_cast<std::size_t>(r0_ + r) * nx_ + c0_ + c] =
+            static_cast<double>(exceed_[t * cells + static_cast<std::size_t>(r) * w_ + c]) / n_;
+    return out;
+  }
+  throw std::logic_error("exceedance of a threshold that was not configured");
+}
+
+// ---- member records -------------------------------------------------------------------------
+
+std::string member_json(const MemberRecord& r, const EnsemblePlan& plan) {
+  nlohmann::json j;
+  j["member"] = r.index;
+  j["status"] = r.ok ? "ok" : "failed";
+  j["diagnosis"] = r.diagnosis;
+  nlohmann::json params = nlohmann::json::object();
+  for (std::size_t d = 0; d < plan.parameters.size() && d < r.values.size(); ++d)
+    params[plan.parameters[d].key] = r.values[d];
+  j["parameters"] = params;
+  j["values"] = r.values;
+  j["runout_length_along_path_m"] = r.runout_m;
+  j["drop_height_m"] = r.drop_height_m;
+  j["reach_m"] = r.reach_m;
+  j["ratio_H_over_L"] = r.hl;
+  j["angle_deg"] = r.hl_deg;
+  j["volumes_m3"] = {
+      {"release", r.release_m3}, {"deposited", r.deposited_m3}, {"mobile", r.mobile_m3}, {"lost", r.lost_m3}};
+  j["max_speed_m_s"] = r.max_speed;
+  j["area_affected_m2"] = r.affected_area_m2;
+  j["simulated_time_s"] = r.simulated_time_s;
+  j["steps"] = r.steps;
+  j["ended_by"] = r.ended_by;
+  j["unfinished"] = r.unfinished;
+  j["wall_time_s"] = r.wall_time_s;
+  j["cpu_time_s"] = r.cpu_time_s;
+  j["rank"] = r.rank;
+  j["threads"] = r.threads;
+  return j.dump(2);
+}
+
+MemberRecord parse_member_json(const std::string& text) {
+  const nlohmann::json j = nlohmann::json::parse(text);
+  MemberRecord r;
+  r.index = j.at("member").get<int>();
+  r.ok = j.at("status").get<std::string>() == "ok";
+  r.diagnosis = j.at("diagnosis").get<std::string>();
+  r.values = j.at("values").get<std::vector<double>>();
+  r.runout_m = j.at("runout_length_along_path_m").get<double>();
+  r.drop_height_m = j.at("drop_height_m").get<double>();
+  r.reach_m = j.at("reach_m").get<double>();
+  r.hl = j.at("ratio_H_over_L").get<double>();
+  r.hl_deg = j.at("angle_deg").get<double>();
+  const auto& v = j.at("volumes_m3");
+  r.release_m3 = v.at("release").get<double>();
+  r.deposited_m3 = v.at("deposited").get<double>();
+  r.mobile_m3 = v.at("mobile").get<double>();
+  r.lost_m3 = v.at("lost").get<double>();
+  r.max_speed = j.at("max_speed_m_s").get<double>();
+  r.affected_area_m2 = j.at("area_affected_m2").get<double>();
+  r.simulated_time_s = j.at("simulated_time_s").get<double>();
+  r.steps = j.at("steps").get<std::int64_t>();
+  r.ended_by = j.at("ended_by").get<std::string>();
+  r.unfinished = j.at("unfinished").get<bool>();
+  r.wall_time_s = j.at("wall_time_s").get<double>();
+  r.cpu_time_s = j.at("cpu_time_s").get<double>();
+  r.rank = j.at("rank").get<int>();
+  r.threads = j.at("threads").get<int>();
+  return r;
+}
+
+// ---- configuration --------------------------------------------------------------------------
+
+namespace {
+
+std::string resolve_path(const ConfigReader& cfg, std::string p) {
+  if (!p.empty() && !cfg.source().empty() && fs::path(p).is_relative() && !fs::exists(p))
+    return (cfg.base_dir() / p).string();
+  return p;
+}
+
+std::string origin(const ConfigReader& cfg) {
+  return cfg.source().empty() ? "command line" : cfg.source();
+}
+
+/// The numeric keys of a debris-runout case (what a parameter may name).
+std::set<std::string> numeric_case_keys() {
+  ConfigReader d = ConfigReader::describe();
+  read_case(d);
+  std::set<std::string> keys;
+  for (const KeyReference& r : d.reference())
+    if (r.type == "number" || r.type == "integer") keys.insert(r.key);
+  return keys;
+}
+
+void read_parameter_keys(ConfigReader& t, ParameterDistribution& p, bool describe) {
+  const auto kind = t.get_choice("distribution", "uniform", {"uniform", "normal", "lognormal", "discrete", "fixed"},
+                                 {"",
+                                  "uniform (min, max), normal (mean, sd), lognormal (median, sigma), discrete "
+                                  "(values, weights) or fixed (value: the same for every member)"});
+  p.kind = kind == "normal"      ? DistributionKind::Normal
+           : kind == "lognormal" ? DistributionKind::LogNormal
+           : kind == "discrete"  ? DistributionKind::Discrete
+           : kind == "fixed"     ? DistributionKind::Fixed
+                                 : DistributionKind::Uniform;
+  const Range any = Range::closed(-1e12, 1e12);
+  if (describe || p.kind == DistributionKind::Uniform) {
+    p.a = t.require("min", any, {"key's unit", "uniform: lower end a"});
+    p.b = t.require("max", any, {"key's unit", "uniform: upper end b (≥ min)"});
+  }
+  if (describe || p.kind == DistributionKind::Normal) {
+    p.a = t.require("mean", any, {"key's unit", "normal: mean"});
+    p.b = t.require("sd", Range::positive(), {"key's unit", "normal: standard deviation (> 0)"});
+  }
+  if (describe || p.kind == DistributionKind::LogNormal) {
+    p.a = t.require("median", Range::positive(), {"key's unit", "lognormal: median e^μ (> 0)"});
+    p.b = t.require("sigma", Range::positive(), {"1", "lognormal: standard deviation σ of ln X (> 0)"});
+  }
+  if (describe || p.kind == DistributionKind::Normal || p.kind == DistributionKind::LogNormal) {
+    p.lower = t.get("lower", p.lower, Range{}, {"key's unit", "normal, lognormal: truncate below (optional)"});
+    p.upper = t.get("upper", p.upper, Range{}, {"key's unit", "normal, lognormal: truncate above (optional)"});
+  }
+  if (describe || p.kind == DistributionKind::Fixed) p.a = t.require("value", any, {"key's unit", "fixed: the value"});
+  if (describe || p.kind == DistributionKind::Discrete) {
+    p.values = t.require_array("values", any, {"key's unit", "discrete: the values"});
+    p.weights = t.get_array("weights", {}, Range::non_negative(),
+                            {"1", "discrete: relative weights, one per value (default: equal)"});
+  }
+}
+
+}  // namespace
+
+void describe_ensemble(ConfigReader& cfg) {
+  cfg.require_string("ensemble.base", {"", "the debris-runout config of the base case (DSM, release, law, numerics)"});
+  cfg.get_int("ensemble.members", 10, Range::closed(1, 65535), {"1", "number of members N"});
+  cfg.get_choice("ensemble.sampling", "latin_hypercube", {"latin_hypercube", "monte_carlo"},
+                 {"", "sampling plan: Latin hypercube (McKay et al. 1979) or plain Monte Carlo"});
+  cfg.get_int("ensemble.seed", 1, Range::closed(0, 9.0e15),
+              {"1", "seed of the plan: member i's values depend on (seed, i)"});
+  cfg.get_array("ensemble.inject_failure", {}, Range::closed(0, 65535),
+                {"1", "test hook: these member indices fail on purpose (a SimulationError at their first step)"});
+  for (ConfigReader& t : cfg.tables("ensemble.parameter", {"",
+                                                           "uncertain parameters: key (a numeric debris-runout key, "
+                                                           "release.thickness_factor) and distribution"})) {
+    t.require_string("key", {"", "numeric debris-runout key (model.mu, model.n, ...) or release.thickness_factor"});
+    ParameterDistribution p;
+    read_parameter_keys(t, p, true);
+  }
+  for (ConfigReader& t :
+       cfg.tables("ensemble.release_alternative",
+                  {"", "alternative release files: member picks one (parameter release.alternative)"})) {
+    t.require_string("file", {"", "release polygons or thickness raster (path relative to this file)"});
+    t.get("weight", 1.0, Range::positive(), {"1", "relative probability of this release"});
+  }
+  cfg.get_array("products.depth_thresholds", {0.5}, Range::positive(), {"m", "P(peak depth > t) maps, t > 0"});
+  cfg.get_array("products.speed_thresholds", {}, Range::positive(), {"m/s", "P(peak speed > t) maps, t > 0"});
+  cfg.get_array("products.pressure_thresholds", {30e3}, Range::positive(), {"Pa", "P(peak pressure > t) maps, t > 0"});
+  cfg.get_array("products.intensity_classes", {2}, Range::closed(1, 3),
+                {"1", "P(intensity class ≥ k) maps, k = 1 low, 2 medium, 3 strong"});
+  cfg.get_array("products.percentiles", {10, 50, 90}, Range::open_closed(0, 100), {"%", "percentile maps (0, 100]"});
+  cfg.get_int("products.bins", 96, Range::closed(8, 1024),
+              {"1", "log-spaced histogram bins per cell and field (percentile accuracy, docs/ensemble.md)"});
+}
+
+EnsembleSetup read_ensemble(ConfigReader& cfg) {
+  EnsembleSetup s;
+  const std::string src = origin(cfg);
+  s.base_config =
+      resolve_path(cfg, cfg.require_string("ensemble.base", {"", "the debris-runout config of the base case"}));
+  EnsemblePlan& plan = s.plan;
+  plan.members =
+      static_cast<int>(cfg.get_int("ensemble.members", 10, Range::closed(1, 65535), {"1", "number of members N"}));
+  plan.sampling = cfg.get_choice("ensemble.sampling", "latin_hypercube", {"latin_hypercube", "monte_carlo"},
+                                 {"", "sampling plan"}) == "monte_carlo"
+                      ? SamplingMethod::MonteCarlo
+                      : SamplingMethod::LatinHypercube;
+  plan.seed = static_cast<std::uint64_t>(cfg.get_int("ensemble.seed", 1, Range::closed(0, 9.0e15), {"1", "seed"}));
+  for (double v : cfg.get_array("ensemble.inject_failure", {}, Range::closed(0, 65535), {"1", "test hook"}))
+    s.inject_failure.push_back(static_cast<int>(v));
+
+  const std::set<std::string> numeric = numeric_case_keys();
+  auto tables = cfg.tables("ensemble.parameter", {"", "uncertain parameters"});
+  for (std::size_t k = 0; k < tables.size(); ++k) {
+    ConfigReader& t = tables[k];
+    const std::string where = "ensemble.parameter[" + std::to_string(k) + "]";
+    ParameterDistribution p;
+    p.key = t.require_string("key", {"", "parameter key"});
+    if (p.key != kThicknessFactorKey && !numeric.count(p.key)) {
+      std::string list = kThicknessFactorKey;
+      for (const auto& n : numeric) list += ", " + n;
+      throw InputError("unknown parameter name (a numeric debris-runout key or " + std::string(kThicknessFactorKey) +
+                           "; release alternatives come from [[ensemble.release_alternative]]); allowed: " + list,
+                       src, where + ".key", p.key);
+    }
+    for (const auto& q : plan.parameters)
+      if (q.key == p.key) throw InputError("parameter given twice", src, where + ".key", p.key);
+    read_parameter_keys(t, p, false);
+    if (p.kind == DistributionKind::Uniform && !(p.a <= p.b))
+      throw InputError("uniform distribution needs min ≤ max (min = " + fmt(p.a) + ", max = " + fmt(p.b) + ")", src,
+                       where + ".min", fmt(p.a));
+    if (!(p.lower < p.upper)) throw InputError("truncation needs lower < upper", src, where + ".lower", fmt(p.lower));
+    if (p.kind == DistributionKind::Discrete) {
+      if (p.weights.empty()) p.weights.assign(p.values.size(), 1.0);
+      if (p.weights.size() != p.values.size())
+        throw InputError("weights needs one entry per value (" + std::to_string(p.values.size()) + ")", src,
+                         where + ".weights", std::to_string(p.weights.size()) + " entries");
+      double total = 0.0;
+      for (double w : p.weights) total += w;
+      if (!(total > 0.0)) throw InputError("weights must not all be zero", src, where + ".weights");
+    }
+    if (p.kind == DistributionKind::LogNormal && p.lower < 0.0) p.lower = 0.0;
+    plan.parameters.push_back(p);
+  }
+  auto alts = cfg.tables("ensemble.release_alternative", {"", "alternative release files"});
+  if (!alts.empty()) {
+    ParameterDistribution p;
+    p.key = kReleaseAlternativeKey;
+    p.kind = DistributionKind::Discrete;
+    for (std::size_t k = 0; k < alts.size(); ++k) {
+      const std::string file = resolve_path(cfg, alts[k].require_string("file", {"", "release file"}));
+      if (!fs::exists(file))
+        throw InputError("release file not found", src, "ensemble.release_alternative[" + std::to_string(k) + "].file",
+                         file);
+      plan.release_alternatives.push_back(file);
+      p.values.push_back(static_cast<double>(k));
+      p.weights.push_back(alts[k].get("weight", 1.0, Range::positive(), {"1", "relative probability"}));
+    }
+    plan.parameters.push_back(p);
+  }
+
+  AggregationSettings& a = s.aggregation;
+  a.depth_thresholds = cfg.get_array("products.depth_thresholds", {0.5}, Range::positive(), {"m", "P(peak depth > t)"});
+  a.speed_thresholds = cfg.get_array("products.speed_thresholds", {}, Range::positive(), {"m/s", "P(peak speed > t)"});
+  a.pressure_thresholds =
+      cfg.get_array("products.pressure_thresholds", {30e3}, Range::positive(), {"Pa", "P(peak pressure > t)"});
+  a.intensity_classes.clear();
+  for (double k : cfg.get_array("products.intensity_classes", {2}, Range::closed(1, 3), {"1", "P(class ≥ k)"})) {
+    if (k != std::floor(k))
+      throw InputError("intensity classes are 1, 2 or 3", src, "products.intensity_classes", fmt(k));
+    a.intensity_classes.push_back(static_cast<int>(k));
+  }
+  a.percentiles = cfg.get_array("products.percentiles", {10, 50, 90}, Range::open_closed(0, 100), {"%", "percentiles"});
+  a.bins = static_cast<int>(cfg.get_int("products.bins", 96, Range::closed(8, 1024), {"1", "histogram bins"}));
+  cfg.finish();
+  s.resolved_config = cfg.resolved();
+  if (!fs::exists(s.base_config))
+    throw InputError("base case config not found", src, "ensemble.base", s.base_config.string());
+
+  // The base case, checked once; then every member's case (a value outside its key's range is an
+  // input error naming the member, before anything is written).
+  {
+    ConfigReader base = ConfigReader::from_file(s.base_config);
+    const RunoutCase c = read_case(base);
+    base.finish();
+    s.base_resolved = base.resolved();
+    s.dsm = c.dsm;
+    a.intensity = c.output.intensity;
+  }
+  s.values = sample_plan(plan);
+  for (int i = 0; i < plan.members; ++i) {
+    ConfigReader m = ConfigReader::from_file(s.base_config);
+    for (std::size_t d = 0; d < plan.parameters.size(); ++d) {
+      const std::string& key = plan.parameters[d].key;
+      const double v = s.values[static_cast<std::size_t>(i)][d];
+      if (key == kThicknessFactorKey) {
+        if (!(v > 0.0))
+          throw InputError("member " + std::to_string(i) +
+                               " draws a release thickness factor ≤ 0: the factor must be "
+                               "> 0 (set 'lower' to truncate the distribution)",
+                           src, "ensemble.parameter[" + std::to_string(d) + "]", fmt(v));
+        continue;
+      }
+      if (key == kReleaseAlternativeKey) continue;
+      std::ostringstream o;
+      o << key << '=' << std::setprecision(17) << v;
+      m.apply_override(o.str(),
+                       src + " (ensemble.parameter[" + std::to_string(d) + "], member " + std::to_string(i) + ")");
+    }
+    (void)read_case(m);
+  }
+  return s;
+}
+
+std::string plan_csv(const EnsembleSetup& s) {
+  std::ostringstream o;
+  o << "member";
+  for (const auto& p : s.plan.parameters) o << ',' << p.key;
+  o << '\n' << std::setprecision(17);
+  for (std::size_t i = 0; i < s.values.size(); ++i) {
+    o << i;
+    for (double v : s.values[i]) o << ',' << v;
+    o << '\n';
+  }
+  return o.str();
+}
+
+namespace {
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+}  // namespace
+
+std::vector<int> prepare_output(const EnsembleSetup& s, const fs::path& out) {
+  const std::string plan = plan_csv(s);
+  if (fs::exists(out / "plan.csv") &&
+      (slurp(out / "plan.csv") != plan || slurp(out / "base.resolved.toml") != s.base_resolved))
+    throw InputError(
+        "the output folder holds another ensemble (plan.csv or base.resolved.toml differ): choose "
+        "another --out or delete it",
+        "command line", "--out", out.string());
+  make_output_dir(out);
+  fs::create_directories(out / "members");
+  for (const auto& e : fs::directory_iterator(out / "members"))
+    if (e.path().filename().string().find(".partial") != std::string::npos) fs::remove_all(e.path());
+  write_text_file(out / "plan.csv", plan);
+  write_text_file(out / "base.resolved.toml", s.base_resolved);
+  write_text_file(out / "config.resolved.toml", s.resolved_config);
+  std::vector<int> pending;
+  for (int i = 0; i < s.plan.members; ++i)
+    if (!member_done(out, i)) pending.push_back(i);
+  return pending;
+}
+
+void run_ensemble_serial(const EnsembleSetup& s, const fs::path& out, int threads, bool quiet) {
+  const std::vector<int> pending = prepare_output(s, out);
+  const auto wall0 = std::chrono::steady_clock::now();
+  MemberRunner runner(s);
+  for (int i : pending) {
+    const MemberRecord r = runner.run(i, out, 0, threads);
+    if (!quiet)
+      std::cerr << "geohaz-ensemble: member " << i << "/" << s.plan.members << (r.ok ? " done" : " FAILED: ")
+                << r.diagnosis << "\n";
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  aggregate_ensemble(s, out, 1, threads, wall, quiet);
+}
+
+fs::path member_dir(const fs::path& out, int i) {
+  std::ostringstream o;
+  o << std::setw(6) << std::setfill('0') << i;
+  return out / "members" / o.str();
+}
+
+bool member_done(const fs::path& out, int i) {
+  return fs::exists(member_dir(out, i) / "member.json");
+}
+
+// ---- running a member -----------------------------------------------------------------------
+
+struct MemberRunner::Cache {
+  std::string key;
+  std::unique_ptr<RunoutInputs> inputs;
+};
+
+MemberRunner::MemberRunner(const EnsembleSetup& s) : s_(s), cache_(std::make_unique<Cache>()) {}
+MemberRunner::~MemberRunner() = default;
+
+namespace {
+
+/// Makes a member fail on purpose at its first step (ensemble.inject_failure).
+class FailingObserver : public RunObserver {
+ public:
+  explicit FailingObserver(RunObserver* next) : next_(next) {}
+  void started(const RunoutSimulation& s) override {
+    if (next_) next_->started(s);
+  }
+  void stepped(const RunoutSimulation&) override {
+    throw SimulationError("failure injected on purpose (ensemble.inject_failure) at the first step");
+  }
+
+ private:
+  RunObserver* next_;
+};
+
+std::string inputs_key(const RunoutCase& c) {
+  std::ostringstream o;
+  o << std::setprecision(17) << c.dsm << '|' << c.release.file << '|' << c.release.handoff << '|' << c.release.attribute
+    << '|' << c.release.depth << '|' << to_string(c.release.direction) << '|' << c.params.d0 << '|'
+    << friction_name(c.params.friction) << '|' << c.processes.zones << '|' << c.processes.forest << '|'
+    << c.processes.stem_density << '|' << c.processes.stem_diameter << '|' << c.processes.drag_coefficient << '|'
+    << c.processes.erodible << '|' << c.processes.erodible_attribute << '|' << c.processes.erodible_depth << '|'
+    << c.processes.hydrograph << '|' << c.processes.inflow_azimuth << '|' << c.processes.inflow_speed;
+  for (const auto& z : c.processes.zone_rasters) o << '|' << z;
+  for (double v : c.processes.inflow_points) o << '|' << v;
+  return o.str();
+}
+
+}  // namespace
+
+MemberRecord MemberRunner::run(int i, const fs::path& out, int rank, int threads, RunObserver* observer) {
+  const EnsemblePlan& plan = s_.plan;
+  const std::vector<double>& values = s_.values.at(static_cast<std::size_t>(i));
+  MemberRecord rec;
+  rec.index = i;
+  rec.values = values;
+  rec.rank = rank;
+  rec.threads = threads;
+  ConfigReader m = ConfigReader::from_file(s_.base_config);
+  double factor = 1.0;
+  for (std::size_t d = 0; d < plan.parameters.size(); ++d) {
+    const std::string& key = plan.parameters[d].key;
+    if (key == kThicknessFactorKey) {
+      factor = values[d];
+    } else if (key == kReleaseAlternativeKey) {
+      m.apply_override("release.file=\"" + plan.release_alternatives.at(static_cast<std::size_t>(values[d])) + "\"");
+    } else {
+      std::ostringstream o;
+      o << key << '=' << std::setprecision(17) << values[d];
+      m.apply_override(o.str());
+    }
+  }
+  RunoutCase c = read_case(m);
+  c.output.snapshots = false;
+  c.output.pngs = false;
+  const std::string key = inputs_key(c);
+  if (!cache_->inputs || cache_->key != key) {
+    cache_->inputs.reset();
+    cache_->inputs = std::make_unique<RunoutInputs>(load_inputs(c));
+    cache_->key = key;
+  }
+  const RunoutInputs* in = cache_->inputs.get();
+  std::unique_ptr<RunoutInputs> scaled;
+  if (factor != 1.0) {
+    scaled = std::make_unique<RunoutInputs>(*in);
+    for (double& t : scaled->thickness) t *= factor;
+    scaled->volume *= factor;
+    in = scaled.get();
+  }
+
+  const fs::path dir = member_dir(out, i);
+  const fs::path tmp = dir.string() + ".partial." + std::to_string(::getpid());
+  fs::remove_all(tmp);
+  fs::create_directories(tmp);
+  const auto wall0 = std::chrono::steady_clock::now();
+  const std::clock_t cpu0 = std::clock();
+  const bool inject = std::find(s_.inject_failure.begin(), s_.inject_failure.end(), i) != s_.inject_failure.end();
+  try {
+    RunoutSimulation sim(*in, c.params, c.output);
+    FailingObserver failing(observer);
+    sim.run(inject ? &failing : observer);
+    const RunoutResult r = sim.result();
+    rec.ok = true;
+    rec.runout_m = r.path.runout_length;
+    rec.drop_height_m = r.path.drop_height;
+    rec.reach_m = r.path.reach;
+    rec.hl = r.path.fahrboeschung;
+    rec.hl_deg = r.path.fahrboeschung_deg;
+    rec.release_m3 = in->volume;
+    rec.deposited_m3 = r.volumes.deposited;
+    rec.mobile_m3 = r.volumes.mobile;
+    rec.lost_m3 = r.volumes.lost;
+    rec.max_speed = r.max_speed;
+    rec.affected_area_m2 = r.affected_area;
+    rec.simulated_time_s = r.simulated_time;
+    rec.steps = r.steps;
+    rec.ended_by = to_string(r.ended);
+    rec.unfinished = r.unfinished();
+    // Peak maps cropped to the cells reached (nodata cells of the DSM count as not reached).
+    const HazardMaps& maps = sim.maps();
+    const GridGeometry& g = in->grid();
+    const std::vector<double> pressure = maps.max_pressure();
+    int c0 = g.nx, c1 = -1, r0 = g.ny, r1 = -1;
+    for (int row = 0; row < g.ny; ++row)
+      for (int col = 0; col < g.nx; ++col) {
+        const std::size_t k = g.index(col, row);
+        if (maps.max_depth()[k] > 0.0 && !in->dsm.is_nodata(in->dsm.data[k])) {
+          c0 = std::min(c0, col), c1 = std::max(c1, col), r0 = std::min(r0, row), r1 = std::max(r1, row);
+        }
+      }
+    MemberPeaks p;
+    p.nx = g.nx, p.ny = g.ny, p.density = sim.parameters().density;
+    if (c1 >= 0) {
+      p.c0 = c0, p.r0 = r0, p.w = c1 - c0 + 1, p.h = r1 - r0 + 1;
+      const std::size_t cells = static_cast<std::size_t>(p.w) * p.h;
+      p.depth.resize(cells), p.speed.resize(cells), p.pressure.resize(cells);
+      for (int row = 0; row < p.h; ++row)
+        for (int col = 0; col < p.w; ++col) {
+          const std::size_t k = g.index(c0 + col, r0 + row), m2 = static_cast<std::size_t>(row) * p.w + col;
+          const bool nod = in->dsm.is_nodata(in->dsm.data[k]);
+          const auto val = [&](double v) { return nod || !std::isfinite(v) ? 0.0 : v; };
+          p.depth[m2] = val(maps.max_depth()[k]);
+          p.speed[m2] = val(maps.max_speed()[k]);
+          p.pressure[m2] = val(pressure[k]);
+        }
+    }
+    write_member_peaks(tmp / "peaks.bin", p);
+  } catch (const SimulationError& e) {
+    rec.ok = false;
+    rec.diagnosis = std::string("simulation failed: ") + e.what();
+  } catch (const InputError& e) {
+    rec.ok = false;
+    rec.diagnosis = std::string("member input rejected: ") + e.what();
+  }
+  rec.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  rec.cpu_time_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  write_text_file(tmp / "member.json", member_json(rec, plan) + "\n");
+  // Publish atomically: a folder members/<i> exists only complete.
+  std::error_code ec;
+  fs::rename(tmp, dir, ec);
+  if (ec) {
+    // Another process finished the same member first (a resumed run next to a live one): keep theirs.
+    fs::remove_all(tmp);
+  }
+  return rec;
+}
+
+// ---- aggregation and products ---------------------------------------------------------------
+
+namespace {
+
+/// Quantile of a sorted sample (nearest rank).
+double sample_quantile(const std::vector<double>& sorted, double q) {
+  if (sorted.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const std::size_t n = sorted.size();
+  const std::size_t k = std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(q / 100.0 * n - 1e-9)));
+  return sorted[std::min(n, k) - 1];
+}
+
+std::string xml_escape(const std::string& s) {
+  std::string o;
+  for (char c : s) o += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : std::string(1, c);
+  return o;
+}
+
+/// Histogram and empirical CDF of a sample as an SVG plot.
+void write_distribution_svg(const fs::path& path, std::vector<double> v, const std::string& label,
+                            const std::string& title) {
+  std::sort(v.begin(), v.end());
+  const double W = 640, H = 400, ml = 60, mr = 60, mt = 40, mb = 50;
+  const double pw = W - ml - mr, ph = H - mt - mb;
+  std::ostringstream s;
+  s << std::setprecision(6);
+  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H
+    << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  s << "<text x=\"" << W / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"14\">" << xml_escape(title)
+    << " (N = " << v.size() << ")</text>\n";
+  if (!v.empty()) {
+    double lo = v.front(), hi = v.back();
+    if (!(hi > lo)) lo -= 0.5 * std::max(1e-9, std::abs(lo)), hi += 0.5 * std::max(1e-9, std::abs(hi));
+    const int nb = std::clamp(static_cast<int>(std::sqrt(static_cast<double>(v.size()))), 5, 40);
+    std::vector<int> cnt(static_cast<std::size_t>(nb), 0);
+    for (double x : v) cnt[static_cast<std::size_t>(std::min(nb - 1, static_cast<int>((x - lo) / (hi - lo) * nb)))]++;
+    const int cmax = *std::max_element(cnt.begin(), cnt.end());
+    const auto X = [&](double x) { return ml + (x - lo) / (hi - lo) * pw; };
+    for (int b = 0; b < nb; ++b) {
+      const double bh = ph * cnt[static_cast<std::size_t>(b)] / cmax;
+      s << "<rect x=\"" << ml + b * pw / nb << "\" y=\"" << mt + ph - bh << "\" width=\"" << pw / nb * 0.95
+        << "\" height=\"" << bh << "\" fill=\"#9ecae1\" stroke=\"#3182bd\"/>\n";
+    }
+    s << "<polyline fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\" points=\"";
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      const double y0 = mt + ph * (1.0 - static_cast<double>(k) / v.size());
+      const double y1 = mt + ph * (1.0 - static_cast<double>(k + 1) / v.size());
+      s << X(v[k]) << ',' << y0 << ' ' << X(v[k]) << ',' << y1 << ' ';
+    }
+    s << "\"/>\n";
+    for (int t = 0; t <= 4; ++t) {
+      const double x = lo + t * (hi - lo) / 4;
+      s << "<text x=\"" << X(x) << "\" y=\"" << mt + ph + 18 << "\" text-anchor=\"middle\">" << fmt(x, 4)
+        << "</text>\n";
+      s << "<text x=\"" << W - mr + 6 << "\" y=\"" << mt + ph * (1 - t / 4.0) + 4 << "\">" << t * 25 << " %</text>\n";
+    }
+    s << "<text x=\"" << 12 << "\" y=\"" << mt + ph / 2 << "\" transform=\"rotate(-90 12 " << mt + ph / 2
+      << ")\" text-anchor=\"middle\">members per bin (bars; max " << cmax << ")</text>\n";
+  }
+  s << "<rect x=\"" << ml << "\" y=\"" << mt << "\" width=\"" << pw << "\" height=\"" << ph
+    << "\" fill=\"none\" stroke=\"black\"/>\n";
+  s << "<text x=\"" << ml + pw / 2 << "\" y=\"" << H - 10 << "\" text-anchor=\"middle\">" << xml_escape(label)
+    << "; red: empirical CDF (right axis)</text>\n</svg>\n";
+  write_text_file(path, s.str());
+}
+
+std::string threshold_name(double t) {
+  std::ostringstream o;
+  o << t;
+  return o.str();
+}
+
+}  // namespace
+
+void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, int threads, double wall_time_s,
+                        bool quiet) {
+  const auto agg_wall0 = std::chrono::steady_clock::now();
+  const int n = s.plan.members;
+  // 1. Member records in index order; the union window of the successful members' peak maps.
+  std::vector<MemberRecord> recs;
+  recs.reserve(static_cast<std::size_t>(n));
+  const Raster dsm = read_raster(s.dsm);
+  int c0 = dsm.nx, r0 = dsm.ny, c1 = -1, r1 = -1;
+  for (int i = 0; i < n; ++i) {
+    const fs::path d = member_dir(out, i);
+    std::ifstream in(d / "member.json");
+    if (!in) throw std::logic_error("member " + std::to_string(i) + " has not finished");
+    std::stringstream text;
+    text << in.rdbuf();
+    recs.push_back(parse_member_json(text.str()));
+    if (!recs.back().ok) continue;
+    const MemberPeaks p = read_member_peaks(d / "peaks.bin", true);
+    if (p.nx != dsm.nx || p.ny != dsm.ny)
+      throw InputError("member peaks on another grid than the DSM", (d / "peaks.bin").string());
+    if (p.w > 0) {
+      c0 = std::min(c0, p.c0), r0 = std::min(r0, p.r0);
+      c1 = std::max(c1, p.c0 + p.w - 1), r1 = std::max(r1, p.r0 + p.h - 1);
+    }
+  }
+  if (c1 < 0) c0 = r0 = 0, c1 = r1 = -1;
+  // 2. Stream the peak maps (one member in memory at a time).
+  EnsembleAggregator agg(dsm.nx, dsm.ny, c0, r0, c1 - c0 + 1, r1 - r0 + 1, s.aggregation);
+  for (const MemberRecord& r : recs)
+    if (r.ok) agg.add(read_member_peaks(member_dir(out, r.index) / "peaks.bin"));
+
+  // 3. Rasters on the DSM grid with description, unit, nodata and a QGIS style beside each.
+  std::vector<std::string> products;
+  const auto put = [&](const std::string& name, const std::vector<double>& v, const std::string& description,
+                       const std::string& unit, ColourRamp ramp, double vmax_fixed) {
+    Raster r = dsm.like(0.0, -9999.0);
+    double vmax = 0.0;
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      r.data[k] = dsm.is_nodata(dsm.data[k]) ? -9999.0 : v[k];
+      if (r.data[k] != -9999.0) vmax = std::max(vmax, r.data[k]);
+    }
+    r.description = description;
+    r.unit = unit;
+    write_geotiff(out / (name + ".tif"), r);
+    write_qgis_ramp_style(out / (name + ".qml"), ramp, 0.0, vmax_fixed > 0.0 ? vmax_fixed : (vmax > 0.0 ? vmax : 1.0),
+                          unit, 0.0);
+    products.push_back(name + ".tif");
+    return r;
+  };
+  const AggregationSettings& a = s.aggregation;
+  const std::string of_n = " over " + std::to_string(agg.members()) + " members";
+  Raster first_probability;
+  std::string first_label;
+  const auto prob = [&](int field, double t, const std::string& name, const std::string& what) {
+    Raster r = put(name, agg.exceedance(field, t), what + of_n, "1", ColourRamp::BlueRed, 1.0);
+    if (first_probability.data.empty()) {
+      // The picture's font has no '>': words instead.
+      first_probability = r, first_label = what;
+      for (const auto& [sym, word] : {std::pair<std::string, std::string>{" >= ", " at least "}, {" > ", " above "}})
+        for (std::size_t k; (k = first_label.find(sym)) != std::string::npos;) first_label.replace(k, sym.size(), word);
+    }
+  };
+  for (double t : a.depth_thresholds)
+    prob(0, t, "prob_max_depth_gt_" + threshold_name(t) + "m", "probability peak depth > " + threshold_name(t) + " m");
+  for (double t : a.speed_thresholds)
+    prob(1, t, "prob_max_speed_gt_" + threshold_name(t) + "m_s",
+         "probability peak speed > " + threshold_name(t) + " m/s");
+  for (double t : a.pressure_thresholds)
+    prob(2, t, "prob_max_pressure_gt_" + threshold_name(t) + "Pa",
+         "probability peak pressure > " + threshold_name(t) + " Pa");
+  for (int k : a.intensity_classes)
+    prob(3, k, "prob_intensity_ge_" + std::to_string(k),
+         "probability intensity class >= " + std::to_string(k) + " (" + to_string(a.intensity.scheme) + ")");
+  for (int f = 0; f < 3; ++f) {
+    const ColourRamp ramp = f == 0 ? ColourRamp::Viridis : ColourRamp::Magma;
+    put(std::string("mean_") + kFieldNames[f], agg.mean(f), std::string("mean ") + kFieldDescriptions[f] + of_n,
+        kFieldUnits[f], ramp, 0.0);
+    for (double q : a.percentiles) {
+      std::string name = "p";  // built step by step: GCC 12 warns (-Wrestrict, a false positive) on "p" + string
+      name += threshold_name(q);
+      name += '_';
+      name += kFieldNames[f];
+      put(name, agg.percentile(f, q),
+          "percentile " + threshold_name(q) + " of the " + kFieldDescriptions[f] + of_n + " (log-binned histogram)",
+          kFieldUnits[f], ramp, 0.0);
+    }
+  }
+  if (!first_probability.data.empty())
+    write_quicklook_png(out / "probability.png", dsm, &first_probability, ColourRamp::BlueRed, first_label, 0.0, 1.0,
+                        1e-9);
+
+  // 4. The member table, the distributions of run-out and H/L, the summary.
+  {
+    AtomicTextFile csv(out / "members.csv");
+    csv << "member,status";
+    for (const auto& p : s.plan.parameters) csv << ',' << p.key;
+    csv << ",runout_m,drop_height_m,reach_m,H_over_L,angle_deg,release_m3,deposited_m3,mobile_m3,lost_m3,max_speed_m_"
+           "s,area_affected_m2,simulated_time_s,steps,ended_by,unfinished,wall_time_s,cpu_time_s,rank,threads,"
+           "diagnosis\n";
+    csv.stream() << std::setprecision(10);
+    for (const auto& r : recs) {
+      csv << r.index << ',' << (r.ok ? "ok" : "failed");
+      for (double v : r.values) csv << ',' << v;
+      std::string diag = r.diagnosis;
+      std::replace(diag.begin(), diag.end(), '"', '\'');
+      std::replace(diag.begin(), diag.end(), '\n', ' ');
+      csv << ',' << r.runout_m << ',' << r.drop_height_m << ',' << r.reach_m << ',' << r.hl << ',' << r.hl_deg << ','
+          << r.release_m3 << ',' << r.deposited_m3 << ',' << r.mobile_m3 << ',' << r.lost_m3 << ',' << r.max_speed
+          << ',' << r.affected_area_m2 << ',' << r.simulated_time_s << ',' << r.steps << ",\"" << r.ended_by << "\","
+          << (r.unfinished ? 1 : 0) << ',' << r.wall_time_s << ',' << r.cpu_time_s << ',' << r.rank << ',' << r.threads
+          << ",\"" << diag << "\"\n";
+    }
+    csv.commit();
+  }
+  std::vector<double> runout, hl, member_wall, member_cpu;
+  nlohmann::json failed = nlohmann::json::array();
+  int unfinished = 0;
+  for (const auto& r : recs) {
+    member_wall.push_back(r.wall_time_s);
+    member_cpu.push_back(r.cpu_time_s);
+    if (!r.ok) {
+      failed.push_back({{"member", r.index}, {"diagnosis", r.diagnosis}, {"values", r.values}});
+      continue;
+    }
+    runout.push_back(r.runout_m);
+    hl.push_back(r.hl);
+    unfinished += r.unfinished ? 1 : 0;
+  }
+  write_distribution_svg(out / "runout_distribution.svg", runout, "run-out length along the path (m)",
+                         "Run-out length of the members");
+  write_distribution_svg(out / "hl_distribution.svg", hl, "fahrböschung H/L (1)", "H/L of the members");
+  const auto stats = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    nlohmann::json j;
+    double mean = 0.0;
+    for (double x : v) mean += x;
+    j["mean"] = v.empty() ? 0.0 : mean / v.size();
+    j["min"] = v.empty() ? 0.0 : v.front();
+    j["p10"] = v.empty() ? 0.0 : sample_quantile(v, 10);
+    j["p50"] = v.empty() ? 0.0 : sample_quantile(v, 50);
+    j["p90"] = v.empty() ? 0.0 : sample_quantile(v, 90);
+    j["max"] = v.empty() ? 0.0 : v.back();
+    return j;
+  };
+  nlohmann::json j;
+  j["model"] = "geohaz-ensemble";
+  j["version"] = GEOHAZ_VERSION;
+  j["base_case"] = s.base_config.string();
+  j["dsm"] = s.dsm;
+  j["members"] = n;
+  j["succeeded"] = agg.members();
+  j["failed"] = failed;
+  j["unfinished_members"] = unfinished;
+  j["sampling"] = s.plan.sampling == SamplingMethod::LatinHypercube ? "latin_hypercube" : "monte_carlo";
+  j["seed"] = s.plan.seed;
+  nlohmann::json params = nlohmann::json::array();
+  for (const auto& p : s.plan.parameters) {
+    nlohmann::json q = {{"key", p.key}, {"distribution", to_string(p.kind)}};
+    if (p.kind == DistributionKind::Uniform) q.update({{"min", p.a}, {"max", p.b}});
+    if (p.kind == DistributionKind::Normal) q.update({{"mean", p.a}, {"sd", p.b}});
+    if (p.kind == DistributionKind::LogNormal) q.update({{"median", p.a}, {"sigma", p.b}});
+    if (p.kind == DistributionKind::Discrete) q.update({{"values", p.values}, {"weights", p.weights}});
+    if (p.kind == DistributionKind::Fixed) q["value"] = p.a;
+    if (std::isfinite(p.lower)) q["lower"] = p.lower;
+    if (std::isfinite(p.upper)) q["upper"] = p.upper;
+    params.push_back(q);
+  }
+  j["parameters"] = params;
+  j["release_alternatives"] = s.plan.release_alternatives;
+  j["runout_length_along_path_m"] = stats(runout);
+  j["fahrboeschung_ratio_H_over_L"] = stats(hl);
+  j["member_wall_time_s"] = stats(member_wall);
+  j["member_cpu_time_s"] = stats(member_cpu);
+  double cpu_total = 0.0;
+  for (double c : member_cpu) cpu_total += c;
+  j["members_cpu_time_total_s"] = cpu_total;
+  j["products"] = products;
+  const auto ratio = [&](HistogramRange r) { return std::pow(r.hi / r.lo, 1.0 / a.bins) - 1.0; };
+  j["percentile_accuracy"] = {{"method", "log-binned histogram per cell, clamped to the cell's exact extremes"},
+                              {"bins", a.bins},
+                              {"max_relative_error_depth", ratio(kDepthRange)},
+                              {"max_relative_error_speed", ratio(kSpeedRange)},
+                              {"max_relative_error_pressure", ratio(kPressureRange)},
+                              {"depth_range_m", {kDepthRange.lo, kDepthRange.hi}},
+                              {"speed_range_m_s", {kSpeedRange.lo, kSpeedRange.hi}},
+                              {"pressure_range_pa", {kPressureRange.lo, kPressureRange.hi}}};
+  j["aggregation_window_cells"] = static_cast<std::int64_t>(std::max(0, c1 - c0 + 1)) * std::max(0, r1 - r0 + 1);
+  j["aggregation_bytes_per_cell"] = agg.bytes_per_cell();
+  j["ranks"] = ranks;
+  j["threads_per_rank"] = threads;
+  j["wall_time_s"] = wall_time_s;
+  j["aggregation_wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - agg_wall0).count();
+  write_text_file(out / "summary.json", j.dump(2) + "\n");
+  if (!quiet)
+    std::cerr << "geohaz-ensemble: " << agg.members() << " of " << n << " members aggregated (" << failed.size()
+              << " failed); run-out P10/P50/P90 " << fmt(j["runout_length_along_path_m"]["p10"].get<double>(), 5)
+              << " / " << fmt(j["runout_length_along_path_m"]["p50"].get<double>(), 5) << " / "
+              << fmt(j["runout_length_along_path_m"]["p90"].get<double>(), 5) << " m; products in " << out.string()
+              << "\n";
+}
+
+}  // namespace geohaz::runout
