@@ -2,8 +2,9 @@
 // collapse (~1e5 particles) and a 3D slope (~4e4 particles, seed 001's size), on 1 and 2 threads,
 // and the memory per particle. Prints figures; never asserts (docs/performance.md). The state hash
 // after the steps is the same on 1 and 2 threads (results independent of the thread count).
-//   bench_sph [steps] [scale] [2d|3d|all] [threads] [skin]   (scale < 1 shrinks the problems for a
-//   quick look; the others select runs, e.g. `bench_sph 50 1 2d 2 0.3` for one figure)
+//   bench_sph [steps] [scale] [2d|3d|all] [threads] [skin] [correction]   (scale < 1 shrinks the
+//   problems for a quick look; the others select runs, e.g. `bench_sph 50 1 2d 2 0.3` for one figure;
+//   correction 1 turns numerics.kernel_correction on, 0 off, default: the solver's default)
 #include <omp.h>
 
 #include <algorithm>
@@ -36,9 +37,10 @@ unsigned long long state_hash(const SphStore<Dim>& S) {
 
 /// Which runs (all by default): `bench_sph [steps] [scale] [2d|3d|all] [threads] [skin]`.
 struct Selection {
-  int dim = 0;       ///< 0: both
-  int threads = 0;   ///< 0: 1 and 2
-  double skin = -1;  ///< < 0: 0 and 0.3
+  int dim = 0;          ///< 0: both
+  int threads = 0;      ///< 0: 1 and 2
+  double skin = -1;     ///< < 0: 0 and 0.3
+  int correction = -1;  ///< kernel-gradient correction: 1 on, 0 off, < 0 the solver's default
 };
 Selection selection;
 
@@ -57,6 +59,7 @@ void run(const char* name, Scenario<Dim> sc, const MaterialParams& m, int steps)
       s.domain_lo = sc.domain_lo;
       s.domain_hi = sc.domain_hi;
       s.neighbour_skin = skin;
+      if (selection.correction >= 0) s.kernel_correction = selection.correction == 1;
       SphSolver<Dim> solver(sc.store, {m}, DruckerPrager{}, s);
       solver.step();  // warm-up (first reorder)
       const auto t0 = std::chrono::steady_clock::now();
@@ -65,9 +68,9 @@ void run(const char* name, Scenario<Dim> sc, const MaterialParams& m, int steps)
       const double rate = static_cast<double>(solver.store().size()) * steps / sec;
       std::printf(
           "%-26s skin %.1fh threads %d  particles %7zu  steps %4d  %7.3f s  %.3e particle-steps/s  "
-          "%.0f B/particle  %lld list builds  state %016llx\n",
+          "%.0f B/particle  %lld list builds  correction %d  state %016llx\n",
           name, skin, threads, solver.store().size(), steps, sec, rate, solver.bytes_per_particle(),
-          static_cast<long long>(solver.neighbour_builds()), state_hash(solver.store()));
+          static_cast<long long>(solver.neighbour_builds()), s.kernel_correction ? 1 : 0, state_hash(solver.store()));
     }
 }
 
@@ -77,6 +80,7 @@ int main(int argc, char** argv) {
   if (argc > 3) selection.dim = std::string(argv[3]) == "2d" ? 2 : (std::string(argv[3]) == "3d" ? 3 : 0);
   if (argc > 4) selection.threads = std::atoi(argv[4]);
   if (argc > 5) selection.skin = std::atof(argv[5]);
+  if (argc > 6) selection.correction = std::atoi(argv[6]);
   MaterialParams m;
   m.density = 1800;
   m.young = 1e6;
