@@ -478,8 +478,9 @@ std::vector<double> zero_crossings(const fs::path& series, int col) {
 // docs/validation/sph.md). Stored value: T = 0.1253 s (+5.2 %) from the code that added the
 // correction; tolerance 1 % (the crossing is interpolated between outputs 0.5 ms apart, 0.8 % of
 // T/2 at worst; runs on other compilers differ by round-off only). The plain gradient gives
-// 0.1357 s (+14 %) and fails the physics bound of 8 % (the 3 % of the issue is met only at finer
-// resolution: validation). Also: the clamped particles have not moved.
+// 0.1357 s (+14 %) and fails the physics bound of 8 % (the issue's 3 % is not met at this
+// resolution, nor reliably at finer ones: docs/validation/sph.md). Also: the clamped particles have
+// not moved.
 TEST(SphSlopeApp, ClampedCantileverHalfPeriodNearBeamTheory) {
   const fs::path out = kWork / "cantilever";
   fs::remove_all(out);
