@@ -420,7 +420,7 @@ void SphSolver<Dim>::gather_reactions(const std::vector<T>& buffer, Add&& add, F
 // (The pair loops of steps 2 and 4 repeat the same ten-line neighbour header on purpose: folded
 //  into a shared lambda it cost 20 % of the 2D speed, the captures defeating register reuse.)
 
-// 2. Kernel-gradient correction (Bonet & Lok 1999, eq. 40; Randles & Libersky 1996), only with
+// 2. Kernel-gradient correction (Bonet & Lok 1999; Randles & Libersky 1996), only with
 //    `kernel_correction`: C_i = M_i⁻¹ with the moment matrix M_i = Σ_j V_j ∇W_ij ⊗ (x_j − x_i), so
 //    that the corrected gradient ∇̃W_ij = C_i ∇W_ij gives Σ_j V_j (v_j − v_i) ⊗ ∇̃W_ij = A exactly for
 //    any linear field v = A x + b, at the free surface too (where the plain sum loses the missing
