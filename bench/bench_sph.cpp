@@ -2,9 +2,10 @@
 // collapse (~1e5 particles) and a 3D slope (~4e4 particles, seed 001's size), on 1 and 2 threads,
 // and the memory per particle. Prints figures; never asserts (docs/performance.md). The state hash
 // after the steps is the same on 1 and 2 threads (results independent of the thread count).
-//   bench_sph [steps] [scale] [2d|3d|all] [threads] [skin] [structures]   (scale < 1 shrinks the
-//   problems for a quick look; the others select runs, e.g. `bench_sph 50 1 2d 2 0.3` for one figure;
-//   structures = 1 sums the loads on the walls every step, pass 4b, as sph-slope does)
+//   bench_sph [steps] [scale] [2d|3d|all] [threads] [skin] [structures] [correction]   (scale < 1
+//   shrinks the problems for a quick look; the others select runs, e.g. `bench_sph 50 1 2d 2 0.3` for
+//   one figure; structures = 1 sums the loads on the walls every step, pass 4b, as sph-slope does;
+//   correction 1 turns numerics.kernel_correction on, 0 off, default: the solver's default)
 #include <omp.h>
 
 #include <algorithm>
@@ -42,6 +43,7 @@ struct Selection {
   int threads = 0;          ///< 0: 1 and 2
   double skin = -1;         ///< < 0: 0 and 0.3
   bool structures = false;  ///< track the loads on the scenario's structures (pass 4b)
+  int correction = -1;      ///< kernel-gradient correction: 1 on, 0 off, < 0 the solver's default
 };
 Selection selection;
 
@@ -60,6 +62,7 @@ void run(const char* name, Scenario<Dim> sc, const MaterialParams& m, int steps)
       s.domain_lo = sc.domain_lo;
       s.domain_hi = sc.domain_hi;
       s.neighbour_skin = skin;
+      if (selection.correction >= 0) s.kernel_correction = selection.correction == 1;
       SphSolver<Dim> solver(sc.store, {m}, DruckerPrager{}, s);
       if (selection.structures) {
         std::vector<Vec<Dim>> bases;
@@ -73,9 +76,10 @@ void run(const char* name, Scenario<Dim> sc, const MaterialParams& m, int steps)
       const double rate = static_cast<double>(solver.store().size()) * steps / sec;
       std::printf(
           "%-26s%s skin %.1fh threads %d  particles %7zu  steps %4d  %7.3f s  %.3e particle-steps/s  "
-          "%.0f B/particle  %lld list builds  state %016llx\n",
+          "%.0f B/particle  %lld list builds  correction %d  state %016llx\n",
           name, selection.structures ? " +loads" : "", skin, threads, solver.store().size(), steps, sec, rate,
-          solver.bytes_per_particle(), static_cast<long long>(solver.neighbour_builds()), state_hash(solver.store()));
+          solver.bytes_per_particle(), static_cast<long long>(solver.neighbour_builds()), s.kernel_correction ? 1 : 0,
+          state_hash(solver.store()));
     }
 }
 
@@ -86,6 +90,7 @@ int main(int argc, char** argv) {
   if (argc > 4) selection.threads = std::atoi(argv[4]);
   if (argc > 5) selection.skin = std::atof(argv[5]);
   if (argc > 6) selection.structures = std::atoi(argv[6]) != 0;
+  if (argc > 7) selection.correction = std::atoi(argv[7]);
   MaterialParams m;
   m.density = 1800;
   m.young = 1e6;

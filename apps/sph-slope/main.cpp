@@ -4,6 +4,7 @@
 #include <cmath>
 #include <iostream>
 #include <numbers>
+#include <variant>
 
 #include "geohaz/core/app.hpp"
 #include "geohaz/core/config.hpp"
@@ -33,13 +34,15 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   c.config_source = r.source();
   // [run]
   c.dimension = static_cast<int>(r.get_int("run.dimension", 2, Range::closed(2, 3), {"1", "2 (plane strain) or 3"}));
-  const auto sc = r.get_choice("run.scenario", "slope", {"slope", "column", "biaxial", "section"},
+  const auto sc = r.get_choice("run.scenario", "slope", {"slope", "column", "biaxial", "section", "block"},
                                {"",
                                 "scenario type: parametric slope, granular column collapse, biaxial specimen, "
-                                "DSM cross-section"});
+                                "DSM cross-section, block (a rectangle of soil, e.g. an elastic beam with "
+                                "clamp.boxes)"});
   c.scenario = sc == "slope"     ? ScenarioType::Slope
                : sc == "column"  ? ScenarioType::Column
                : sc == "biaxial" ? ScenarioType::Biaxial
+               : sc == "block"   ? ScenarioType::Block
                                  : ScenarioType::Section;
   c.analysis = r.get_choice("run.analysis", "dynamic", {"dynamic", "strength_reduction"},
                             {"",
@@ -190,6 +193,15 @@ RunConfig read_config(ConfigReader& r, bool describe) {
                                                {"1", "steps between cell reorderings (0: never)"}));
   n.wall_repulsion = r.get("numerics.wall_repulsion", d.wall_repulsion, Range::closed(0.0, 1.0),
                            {"1", "soil closer than this x dx to a wall particle is pushed back (0: off)"});
+  {  // auto: the solver's default (off) except for linear_elastic, where it was validated (docs/sph.md)
+    const auto kc = r.get_choice("numerics.kernel_correction", "auto", {"auto", "on", "off"},
+                                 {"",
+                                  "first-order consistent kernel gradients (Bonet & Lok 1999) in the strain-rate "
+                                  "and momentum sums: auto = on for model.constitutive = linear_elastic (elastic "
+                                  "bending, docs/validation/sph.md), off for the other models"});
+    n.kernel_correction =
+        kc == "on" || (kc == "auto" && (d.kernel_correction || std::holds_alternative<LinearElastic>(c.model)));
+  }
   n.neighbour_skin = r.get("numerics.neighbour_skin", d.neighbour_skin, Range::closed(0.0, 1.0),
                            {"1", "Verlet skin in units of h (0: rebuild the neighbour list every step)"});
 
@@ -305,11 +317,36 @@ RunConfig read_config(ConfigReader& r, bool describe) {
         r.get_bool("geometry.periodic", c.scenario != ScenarioType::Section,
                    {"", "3D: periodic across the width (seed 001), else roller walls (default for a DSM section)"});
   }
-  const char* left_default = c.scenario == ScenarioType::Section ? "fixed" : "fixed";
-  const char* right_default = c.scenario == ScenarioType::Column ? "none" : "fixed";
+  const bool block = c.scenario == ScenarioType::Block;
+  const char* left_default = block ? "none" : "fixed";
+  const char* right_default = c.scenario == ScenarioType::Column || block ? "none" : "fixed";
   c.left_wall = wall(r, "walls.left", left_default);
   c.right_wall = wall(r, "walls.right", right_default);
-  c.bottom_wall = wall(r, "walls.bottom", "fixed");
+  c.bottom_wall = wall(r, "walls.bottom", block ? "none" : "fixed");
+  if (block || describe) {
+    c.block_length = r.get("block.length", 1.0, Range::positive(), {"m", "block scenario: length along x"});
+    c.block_height = r.get("block.height", 0.1, Range::positive(), {"m", "block scenario: height along z"});
+  }
+  // [clamp] and [initial_velocity]: any scenario.
+  c.clamp_boxes = r.get_array("clamp.boxes", {}, {},
+                              {"m",
+                               "clamped regions, 2*dimension numbers per box: x_lo, [y_lo,] z_lo, x_hi, [y_hi,] "
+                               "z_hi; soil particles inside are held at rest in place (each box must hold soil)"});
+  {
+    auto& iv = c.initial_velocity;
+    const auto type = r.get_choice("initial_velocity.type", "none", {"none", "uniform", "cantilever_mode"},
+                                   {"",
+                                    "velocity of the soil at the start of the main phase: none, uniform "
+                                    "(initial_velocity.value) or cantilever_mode (v_z = amplitude phi1((x - root)/"
+                                    "length), the first bending mode of a clamped-free beam, 1 at the free end)"});
+    iv.type = type == "uniform"           ? InitialVelocity::Type::Uniform
+              : type == "cantilever_mode" ? InitialVelocity::Type::CantileverMode
+                                          : InitialVelocity::Type::None;
+    iv.value = r.get_array("initial_velocity.value", {}, {}, {"m/s", "uniform: one component per axis"});
+    iv.amplitude = r.get("initial_velocity.amplitude", 0.0, {}, {"m/s", "cantilever_mode: v_z at the free end"});
+    iv.root = r.get("initial_velocity.root", 0.0, {}, {"m", "cantilever_mode: x of the clamped end"});
+    iv.length = r.get("initial_velocity.length", 1.0, Range::positive(), {"m", "cantilever_mode: free length"});
+  }
   if (c.scenario == ScenarioType::Section || describe) {
     const auto dsm = r.get_string("section.dsm", "", {"", "DSM raster (GeoTIFF, projected CRS)"});
     const auto poly = r.get_array("section.polyline", {}, {}, {"m", "x0, y0, x1, y1, ... in the DSM CRS"});

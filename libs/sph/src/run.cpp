@@ -35,6 +35,8 @@ const char* scenario_name(ScenarioType t) {
       return "biaxial";
     case ScenarioType::Section:
       return "section";
+    case ScenarioType::Block:
+      return "block";
   }
   return "?";
 }
@@ -94,6 +96,47 @@ double strip_width(const RunConfig& c) {
   return static_cast<double>(std::lround(c.width / c.numerics.spacing)) * c.numerics.spacing;
 }
 
+std::string csv_number(double v) {
+  std::ostringstream os;
+  os << std::setprecision(9) << v;
+  return os.str();
+}
+
+/// Mark the soil particles inside the clamped regions (clamp.boxes); a box without soil is bad input.
+template <int Dim>
+void clamp_regions(const RunConfig& c, SphStore<Dim>& S) {
+  const std::size_t per = 2 * Dim;
+  if (c.clamp_boxes.size() % per != 0)
+    throw InputError("needs " + std::to_string(per) + " numbers per box (lower corner, then upper corner, m)",
+                     c.config_source, "clamp.boxes", std::to_string(c.clamp_boxes.size()) + " numbers");
+  const auto& x = S.template get<Position<Dim>>();
+  const auto& kind = S.template get<ParticleKind>();
+  auto& cl = S.template get<Clamped>();
+  for (std::size_t b = 0; b < c.clamp_boxes.size(); b += per) {
+    Vec<Dim> lo, hi;
+    for (int d = 0; d < Dim; ++d) {
+      lo[d] = c.clamp_boxes[b + d];
+      hi[d] = c.clamp_boxes[b + Dim + d];
+    }
+    std::ostringstream box;
+    for (std::size_t k = 0; k < per; ++k) box << (k ? ", " : "[") << csv_number(c.clamp_boxes[b + k]);
+    box << "]";
+    if (!(lo.array() < hi.array()).all())
+      throw InputError("box " + std::to_string(b / per) + ": every lower corner coordinate must be below the upper one",
+                       c.config_source, "clamp.boxes", box.str());
+    std::size_t held = 0;
+    for (std::size_t i = 0; i < S.size(); ++i)
+      if (kind[i] == kSoil && (x[i].array() >= lo.array()).all() && (x[i].array() <= hi.array()).all()) {
+        cl[i] = 1;
+        ++held;
+      }
+    if (held == 0)
+      throw InputError(
+          "box " + std::to_string(b / per) + " holds no soil particle: a clamped region must overlap the body",
+          c.config_source, "clamp.boxes", box.str());
+  }
+}
+
 /// The particles of the configured scenario.
 template <int Dim>
 Built<Dim> build(const RunConfig& c) {
@@ -146,6 +189,22 @@ Built<Dim> build(const RunConfig& c) {
       b.frame.toe_x = a;
       b.frame.base_length = a;
       b.frame.base_top = 0.0;
+      break;
+    }
+    case ScenarioType::Block: {
+      ProfileDomain d;
+      d.surface = {{0.0, c.block_height}, {c.block_length, c.block_height}};
+      d.x_left = 0.0;
+      d.x_right = c.block_length;
+      d.left = c.left_wall;
+      d.right = c.right_wall;
+      d.bottom = c.bottom_wall;
+      d.width = c.width;
+      d.periodic_width = c.periodic_width;
+      b.sc = build_profile<Dim>(d, dx, rho, hf);
+      b.frame.toe_x = c.block_length;
+      b.frame.base_length = c.block_length;
+      b.frame.base_top = -1e300;
       break;
     }
     case ScenarioType::Biaxial: {
@@ -207,6 +266,7 @@ Built<Dim> build(const RunConfig& c) {
   }
   b.frame.spacing = dx;
   b.frame.front_thickness = c.front_thickness;
+  clamp_regions<Dim>(c, b.sc.store);
   return b;
 }
 
@@ -265,6 +325,7 @@ void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int6
   add_view<LayerNormal<Dim>>(v, s);
   add_view<StructureId>(v, s);
   add_view<ParticleId>(v, s);
+  add_view<Clamped>(v, s);
   add_internal_variables(v, s, std::type_identity<ConstitutiveModel>{});
   add_view<PositionAtBuild<Dim>>(v, s);
   w.write(t, step, v);
@@ -382,10 +443,22 @@ void draw_particles(const std::filesystem::path& path, const SphStore<Dim>& s, c
   write_png(path, img);
 }
 
-std::string csv_number(double v) {
-  std::ostringstream os;
-  os << std::setprecision(9) << v;
-  return os.str();
+/// The initial velocity of the main phase (initial_velocity.*); clamped particles stay at rest.
+template <int Dim>
+void set_initial_velocity(const RunConfig& c, SphStore<Dim>& S) {
+  const auto& iv = c.initial_velocity;
+  if (iv.type == InitialVelocity::Type::None) return;
+  const auto& x = S.template get<Position<Dim>>();
+  auto& v = S.template get<Velocity<Dim>>();
+  for (std::size_t i = 0; i < S.size(); ++i) {
+    if (S.template get<ParticleKind>()[i] != kSoil || S.template get<Clamped>()[i]) continue;
+    if (iv.type == InitialVelocity::Type::Uniform) {
+      for (int d = 0; d < Dim; ++d) v[i][d] = iv.value[static_cast<std::size_t>(d)];
+    } else {
+      v[i].setZero();
+      v[i][Dim - 1] = iv.amplitude * cantilever_mode_shape((x[i][0] - iv.root) / iv.length);
+    }
+  }
 }
 
 /// The structures a run reports (`output.structures`, all when empty), as indices into the
@@ -628,11 +701,46 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
     }
   }
 
+  if (c.restart.empty()) set_initial_velocity<Dim>(c, solver.store());
+  // With clamped regions: the free end's particles (initial x within Δx/2 of the largest soil x,
+  // not clamped), whose mean vertical displacement is the series' tip_displacement_m.
+  std::vector<std::uint8_t> free_end;
+  if (!c.clamp_boxes.empty()) {
+    const auto& S = solver.store();
+    const auto& x = S.template get<Position<Dim>>();
+    const auto& u = S.template get<Displacement<Dim>>();
+    const auto& id = S.template get<ParticleId>();
+    double xmax = -1e300;
+    std::int64_t idmax = 0;
+    for (std::size_t i = 0; i < S.size(); ++i) {
+      idmax = std::max(idmax, id[i]);
+      if (S.template get<ParticleKind>()[i] == kSoil) xmax = std::max(xmax, x[i][0] - u[i][0]);
+    }
+    free_end.assign(static_cast<std::size_t>(idmax) + 1, 0);
+    for (std::size_t i = 0; i < S.size(); ++i)
+      if (S.template get<ParticleKind>()[i] == kSoil && !S.template get<Clamped>()[i] &&
+          x[i][0] - u[i][0] >= xmax - 0.5 * c.numerics.spacing)
+        free_end[static_cast<std::size_t>(id[i])] = 1;
+  }
+  auto tip_displacement = [&] {
+    const auto& S = solver.store();
+    const auto& id = S.template get<ParticleId>();
+    double sum = 0.0;
+    int count = 0;
+    for (std::size_t i = 0; i < S.size(); ++i)
+      if (free_end[static_cast<std::size_t>(id[i])]) {
+        sum += S.template get<Displacement<Dim>>()[i][Dim - 1];
+        ++count;
+      }
+    return sum / std::max(count, 1);
+  };
+
   // Main phase.
   write_snapshot<Dim>(snaps, solver, step_offset);
   std::ostringstream series;
   series << "time_s,front_m,tip_m,runout_m,normalised_runout,max_speed_m_per_s,mean_speed_m_per_s,kinetic_energy_J,"
-            "plastic_fraction,max_displacement_m,earthquake_acceleration_m_per_s2\n";
+            "plastic_fraction,max_displacement_m,earthquake_acceleration_m_per_s2"
+         << (free_end.empty() ? "" : ",tip_displacement_m") << '\n';
   std::ostringstream biax;
   biax << "time_s,axial_strain,sigma_axial_Pa,sigma_lateral_Pa,deviator_Pa\n";
   auto png_times = c.velocity_png_times;
@@ -655,8 +763,9 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
     series << csv_number(solver.time()) << ',' << csv_number(r.front) << ',' << csv_number(r.tip) << ','
            << csv_number(runout) << ',' << csv_number(nrun) << ',' << csv_number(r.max_speed) << ','
            << csv_number(r.mean_speed) << ',' << csv_number(r.kinetic_energy) << ',' << csv_number(r.plastic_fraction)
-           << ',' << csv_number(r.max_displacement) << ',' << csv_number(settings.earthquake.horizontal(solver.time()))
-           << '\n';
+           << ',' << csv_number(r.max_displacement) << ',' << csv_number(settings.earthquake.horizontal(solver.time()));
+    if (!free_end.empty()) series << ',' << csv_number(tip_displacement());
+    series << '\n';
     if (c.scenario == ScenarioType::Biaxial) {
       const auto& S = solver.store();
       double sa = 0, sl = 0;
@@ -1116,6 +1225,11 @@ void check_resources(const RunConfig& c) {
       height = c.biaxial.height;
       what = "biaxial specimen (biaxial.width, biaxial.height)";
       break;
+    case ScenarioType::Block:
+      length = c.block_length;
+      height = c.block_height;
+      what = "block (block.length, block.height)";
+      break;
     case ScenarioType::Section: {
       const auto& P = c.section.profile;
       double zmin = 1e300, zmax = -1e300;
@@ -1170,6 +1284,13 @@ Vec2 section_map_point(const std::vector<ProfilePoint>& P, double s, double t) {
   return a + w * (b - a) + t * Vec2(-tan.y(), tan.x());
 }
 
+double cantilever_mode_shape(double xi) {
+  constexpr double k = 1.8751040687119611;  // first root of 1 + cos k cosh k = 0
+  const double s = (std::cosh(k) + std::cos(k)) / (std::sinh(k) + std::sin(k));
+  auto phi = [&](double z) { return std::cosh(k * z) - std::cos(k * z) - s * (std::sinh(k * z) - std::sin(k * z)); };
+  return phi(std::clamp(xi, 0.0, 1.0)) / phi(1.0);
+}
+
 void validate(const RunConfig& c) {
   if (c.materials.empty()) throw InputError("at least one [[material]] is required", c.config_source, "material");
   auto check_index = [&](int m, const char* key) {
@@ -1203,6 +1324,11 @@ void validate(const RunConfig& c) {
       throw InputError("strength reduction needs a slope, column or section scenario (gravity-loaded)", c.config_source,
                        "run.analysis", "strength_reduction");
   }
+  if (c.initial_velocity.type == InitialVelocity::Type::Uniform &&
+      c.initial_velocity.value.size() != static_cast<std::size_t>(c.dimension))
+    throw InputError(
+        "initial_velocity.type = uniform needs one component per axis (" + std::to_string(c.dimension) + ", m/s)",
+        c.config_source, "initial_velocity.value", std::to_string(c.initial_velocity.value.size()) + " numbers");
   check_resources(c);
   // Build once (dry run) so that geometry errors surface before any output exists; the structure
   // names of `output.structures` are checked against the scenario's.

@@ -223,7 +223,8 @@ double SphSolver<Dim>::bytes_per_particle() const {
   return static_cast<double>(SphStore<Dim>::bytes_per_particle()) + 4.0 * static_cast<double>(list_.pair_count()) / n +
          4.0 + 3.0 * 4.0 + 1.0 +  // CSR indices + offsets + cell data + artificial-stress flag
          static_cast<double>(pair_acc_.size() * sizeof(Vec<Dim>) + pair_grad_.size() * sizeof(GradientReaction)) /
-             n;  // block buffers of the pair reactions (n (1 + W/B) slots each)
+             n +  // block buffers of the pair reactions (n (1 + W/B) slots each)
+         static_cast<double>(correction_.size() * sizeof(Mat<Dim>)) / n;  // C_i (kernel_correction)
 }
 
 template <int Dim>
@@ -248,12 +249,19 @@ void SphSolver<Dim>::step_impl(const Model& model) {
   update_neighbours(Kernel::support * h_);    // 0. neighbour list (and cell reordering)
   const Vec<Dim> gbar = body_acceleration();  //    ḡ = g + a_earthquake of this step
   prepare_boundary_pairs(gbar);               // 1. volumes; the walls' stress extrapolation
-  velocity_gradient<Kernel>();                // 2. L, dρ/dt, ρ̃, XSPH
-  update_stress(model);                       // 3. density, constitutive model, artificial stress
-  momentum<Kernel>();                         // 4. pair forces → acceleration
-  structure_forces<Kernel>();                 // 4b. loads on tracked walls and piles (read only)
-  integrate(gbar);                            // 5. body force, damping, leap-frog
-  time_ += dt_;                               // 6. clock, state check, next Δt
+  const bool corrected = settings_.kernel_correction;
+  if (corrected) gradient_correction<Kernel>();  // 2. C_i = M_i⁻¹ (consistent kernel gradients)
+  velocity_gradient<Kernel>();                   //    L, dρ/dt, ρ̃, XSPH
+  update_stress(model);                          // 3. density, constitutive model, artificial stress
+  if (corrected) {                               // 4. pair forces → acceleration
+    momentum<Kernel, true>();
+    structure_forces<Kernel, true>();  // 4b. loads on tracked walls and piles (read only)
+  } else {
+    momentum<Kernel, false>();
+    structure_forces<Kernel, false>();
+  }
+  integrate(gbar);  // 5. body force, damping, leap-frog
+  time_ += dt_;     // 6. clock, state check, next Δt
   ++step_;
   check_state();
   update_dt();
@@ -415,11 +423,61 @@ void SphSolver<Dim>::gather_reactions(const std::vector<T>& buffer, Add&& add, F
 // (The pair loops of steps 2 and 4 repeat the same ten-line neighbour header on purpose: folded
 //  into a shared lambda it cost 20 % of the 2D speed, the captures defeating register reuse.)
 
+// 2. Kernel-gradient correction (Bonet & Lok 1999; Randles & Libersky 1996), only with
+//    `kernel_correction`: C_i = M_i⁻¹ with the moment matrix M_i = Σ_j V_j ∇W_ij ⊗ (x_j − x_i), so
+//    that the corrected gradient ∇̃W_ij = C_i ∇W_ij gives Σ_j V_j (v_j − v_i) ⊗ ∇̃W_ij = A exactly for
+//    any linear field v = A x + b, at the free surface too (where the plain sum loses the missing
+//    half of the support: M_i ≈ diag(1, ½) at a flat surface). The sum runs over every neighbour the
+//    velocity-gradient sum uses, boundary particles included (they stand in for the missing support
+//    at a wall, M_i ≈ I there, and the correction is small). Guard: where det M_i < 0.2^Dim (the
+//    geometric mean of M_i's eigenvalues below 0.2) the particle keeps the plain gradient (C_i = I):
+//    a particle with few neighbours or all of them near one line (a detached grain, a thin tongue
+//    after failure) has a near-singular M_i whose inverse would amplify noise into the stress. The
+//    surfaces, edges and corners of an intact lattice are corrected: det M_i (cubic spline, h =
+//    1.2–1.5Δx, lattice sums) is 0.95–1.03 inside, 0.37–0.39 on a face (2D) and 0.12–0.14 at a
+//    corner; in 3D 0.28–0.30 on a face, 0.07–0.09 on an edge, 0.014–0.025 at a corner (threshold
+//    0.008). Boundary particles keep C = I. Each particle sums its own row (no reactions): the sum
+//    is then the same on any thread count.
+template <int Dim>
+template <class Kernel>
+void SphSolver<Dim>::gradient_correction() {
+  constexpr double kMinMomentDet = Dim == 2 ? 0.2 * 0.2 : 0.2 * 0.2 * 0.2;
+  const PairKernel<Kernel> K(h_);
+  const MinimumImage<Dim> image(settings_.periodic);
+  const std::int64_t n = static_cast<std::int64_t>(store_.size());
+  const Vec<Dim>* x = field<Position<Dim>>();
+  const double* vol = field<Volume>();
+  const std::uint8_t* kind = field<ParticleKind>();
+  const std::uint32_t* off = list_.offsets().data();
+  const std::uint32_t* idx = list_.indices().data();
+  correction_.resize(static_cast<std::size_t>(n));
+  Mat<Dim>* C = correction_.data();
+#pragma omp parallel for schedule(static)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    C[i].setIdentity();
+    if (kind[i] != kSoil) continue;
+    Mat<Dim> M = Mat<Dim>::Zero();
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+      const std::uint32_t j = idx[k];
+      const Vec<Dim> xij = image(x[i], x[j]);
+      const double r2 = xij.squaredNorm();
+      if (r2 >= K.cutoff2 || r2 == 0.0) continue;
+      const double r = std::sqrt(r2);
+      const Vec<Dim> gw = xij * (K.sigma_h * Kernel::shape_derivative(r * K.inv_h) / r);
+      M.noalias() -= vol[j] * gw * xij.transpose();  // V_j ∇W_ij ⊗ (x_j − x_i)
+    }
+    if (M.determinant() >= kMinMomentDet) C[i] = M.inverse();
+  }
+}
+
 // 2. Velocity gradient, continuity, summation density, XSPH (soil particles):
 //    L_i = Σ_j V_j (v_j − v_i) ⊗ ∇W_ij, dρ_i/dt = −Σ_j m_j (v_j − v_i)·∇W_ij,
 //    ρ̃_i = Σ_j m_j W_ij, ξ_i = Σ_j V_j W_ij (v_j − v_i), v_j the mirror velocity of a boundary j.
 //    As in step 4, each soil–soil pair is evaluated once; j's share (V_i dv ⊗ ∇W_ij,
 //    −m_i dv·∇W_ij, m_i W_ij, −V_i W_ij dv with dv = v_j − v_i) goes to a block buffer (PairBlocks).
+//    With the kernel-gradient correction L_i = Σ_j V_j dv ⊗ C_i ∇W_ij = (Σ_j V_j dv ⊗ ∇W_ij) C_iᵀ: the
+//    plain sum, multiplied by C_iᵀ once it is complete. Continuity, ρ̃ and XSPH keep the plain kernel.
 template <int Dim>
 template <class Kernel>
 void SphSolver<Dim>::velocity_gradient() {
@@ -488,15 +546,18 @@ void SphSolver<Dim>::velocity_gradient() {
       xs[i] = xi_sum;
     }
   }
-  gather_reactions(
-      pair_grad_,
-      [&](std::size_t i, const GradientReaction& g) {
-        L[i] += g.L;
-        drho[i] += g.drho;
-        rsum[i] += g.rsum;
-        xs[i] += g.xs;
-      },
-      [](std::size_t) {});
+  const auto add = [&](std::size_t i, const GradientReaction& g) {
+    L[i] += g.L;
+    drho[i] += g.drho;
+    rsum[i] += g.rsum;
+    xs[i] += g.xs;
+  };
+  if (settings_.kernel_correction) {
+    const Mat<Dim>* C = correction_.data();
+    gather_reactions(pair_grad_, add, [&](std::size_t i) { L[i] = (L[i] * C[i].transpose()).eval(); });
+  } else {
+    gather_reactions(pair_grad_, add, [](std::size_t) {});
+  }
 }
 
 // 3. Density, stress (constitutive model), stress vanishing, artificial stress.
@@ -576,11 +637,16 @@ void SphSolver<Dim>::update_stress(const Model& /*model*/) {
 //    block buffer (PairBlocks: no two threads write the same slot, and the sums are grouped alike
 //    on any number of threads) gathered after the pass; soil–boundary pairs act on the soil
 //    particle only.
+//    With the kernel-gradient correction (Corrected, step 2) the stress pair becomes
+//    V_j (σ_i C_i + σ_j C_j) ∇W_ij (Bonet & Lok 1999, the form whose work rate is Σ_i V_i σ_i : L̃_i
+//    with the corrected L̃ of step 2); it is still symmetric in i and j, so the reactions and linear
+//    momentum are as before. A boundary particle, the mirror image of i, takes C_i. Viscosity and
+//    artificial stress keep the plain gradient (they are stabilisation terms, not the continuum).
 //    Last-resort wall repulsion (Monaghan 1994 form, exponents 4 and 2): only a soil particle closer
 //    than r0 = wall_repulsion·Δx to a boundary particle feels it — nothing in a normal configuration
 //    (spacing ≈ Δx) — and it stops particles from being squeezed through walls.
 template <int Dim>
-template <class Kernel>
+template <class Kernel, bool Corrected>
 void SphSolver<Dim>::momentum() {
   const PairKernel<Kernel> K(h_);
   const MinimumImage<Dim> image(settings_.periodic);
@@ -603,6 +669,7 @@ void SphSolver<Dim>::momentum() {
   const Mat<Dim>* R = field<ArtificialStress<Dim>>();
   const std::uint8_t* has_as = has_as_.data();
   Vec<Dim>* acc = field<Acceleration<Dim>>();
+  const Mat<Dim>* C = Corrected ? correction_.data() : nullptr;
   const std::uint32_t* off = list_.offsets().data();
   const std::uint32_t* idx = list_.indices().data();
   const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
@@ -632,8 +699,13 @@ void SphSolver<Dim>::momentum() {
         const double r = std::sqrt(r2);
         const double q = r * K.inv_h;
         const Vec<Dim> gw = xij * (r > 0.0 ? K.sigma_h * Kernel::shape_derivative(q) / r : 0.0);
-        Mat<Dim> T =
-            si + (soil_j ? ps[j] : mirror_stress<Dim>(si, rhoi, xij, lnrm[j], ps[j], nrm[j], kind[j] == kRoller));
+        const Mat<Dim> sj =
+            soil_j ? ps[j] : mirror_stress<Dim>(si, rhoi, xij, lnrm[j], ps[j], nrm[j], kind[j] == kRoller);
+        Mat<Dim> T;
+        if constexpr (Corrected)
+          T.setZero();  // the stress pair is added below with the corrected gradients
+        else
+          T = si + sj;
         const Vec<Dim> vij = v[i] - (soil_j ? v[j] : mirror_velocity<Dim>(v[i], v[j], nrm[j], kind[j] == kRoller));
         const double vr = vij.dot(xij);
         if (vr < 0.0 && alpha + beta > 0.0)
@@ -643,7 +715,14 @@ void SphSolver<Dim>::momentum() {
           const double f = K.sigma * Kernel::shape(q) / w_dx;
           T += (std::pow(f, n_as) * rhoi * rho[j]) * (Ri + R[j]);
         }
-        const Vec<Dim> Tg = T * gw;
+        Vec<Dim> Tg = T * gw;
+        if constexpr (Corrected) {
+          const Vec<Dim> cgi = C[i] * gw;
+          if (soil_j)
+            Tg.noalias() += si * cgi + sj * (C[j] * gw);
+          else
+            Tg.noalias() += (si + sj) * cgi;
+        }
         ai.noalias() += vol[j] * Tg;
         if (soil_j) {
           mine[j].noalias() -= Vi * Tg;
@@ -670,13 +749,14 @@ void SphSolver<Dim>::track_structures(std::vector<Vec<Dim>> base_points) {
 //     the opposite sign onto the structure of the boundary particle. The force step 4 gives soil
 //     particle i from boundary particle b is m_i/ρ_i times its force-density term,
 //       F_ib = V_i {V_b [σ_i + σ_b + ρ_i ρ_b (f^n (R_i + R_b) − Π_ib I)] ∇W_ib + ρ_i c_i² ((r0/r)⁴ − (r0/r)²) x_ib/r²},
-//     the wall-repulsion part only for r < r0; the structure receives −F_ib at x_b. This pass must
+//     the wall-repulsion part only for r < r0 (with the kernel-gradient correction the stress pair
+//     is (σ_i + σ_b) C_i ∇W_ib, as in step 4); the structure receives −F_ib at x_b. This pass must
 //     repeat step 4's soil–boundary term exactly: test_physics "StructureLoads" checks that the
 //     loads on all structures balance the soil's momentum change from its boundary pairs.
 //     Summed per block of particles (PairBlocks) and then over the blocks in order: the same sums
 //     on any number of threads.
 template <int Dim>
-template <class Kernel>
+template <class Kernel, bool Corrected>
 void SphSolver<Dim>::structure_forces() {
   if (structure_base_.empty()) return;
   const PairKernel<Kernel> K(h_);
@@ -703,6 +783,7 @@ void SphSolver<Dim>::structure_forces() {
   const std::uint32_t* off = list_.offsets().data();
   const std::uint32_t* idx = list_.indices().data();
   const Vec<Dim>* base = structure_base_.data();
+  const Mat<Dim>* C = Corrected ? correction_.data() : nullptr;
   const auto ns = static_cast<std::int32_t>(structure_base_.size());
   const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
   const std::int64_t nblocks = static_cast<std::int64_t>(blocks.count());
@@ -730,7 +811,12 @@ void SphSolver<Dim>::structure_forces() {
         const double q = r * K.inv_h;
         const Vec<Dim> gw = xij * (r > 0.0 ? K.sigma_h * Kernel::shape_derivative(q) / r : 0.0);
         const bool roller = kind[j] == kRoller;
-        Mat<Dim> T = si + mirror_stress<Dim>(si, rhoi, xij, lnrm[j], ps[j], nrm[j], roller);
+        const Mat<Dim> sj = mirror_stress<Dim>(si, rhoi, xij, lnrm[j], ps[j], nrm[j], roller);
+        Mat<Dim> T;
+        if constexpr (Corrected)
+          T.setZero();  // the stress pair with the corrected gradient, as in step 4
+        else
+          T = si + sj;
         const Vec<Dim> vij = v[i] - mirror_velocity<Dim>(v[i], v[j], nrm[j], roller);
         const double vr = vij.dot(xij);
         if (vr < 0.0 && alpha + beta > 0.0)
@@ -740,7 +826,9 @@ void SphSolver<Dim>::structure_forces() {
           const double f = K.sigma * Kernel::shape(q) / w_dx;
           T += (std::pow(f, n_as) * rhoi * rho[j]) * (Ri + R[j]);
         }
-        Vec<Dim> fi = vol[j] * (T * gw);  // force density on i from j
+        Vec<Dim> Tg = T * gw;
+        if constexpr (Corrected) Tg.noalias() += (si + sj) * (C[i] * gw);
+        Vec<Dim> fi = vol[j] * Tg;  // force density on i from j
         if (r < r_rep) {
           const double q2 = (r_rep * r_rep) / r2;
           fi.noalias() += (rhoi * ci * ci * (q2 * q2 - q2) / r2) * xij;
@@ -765,7 +853,8 @@ void SphSolver<Dim>::structure_forces() {
 }
 
 // 5. Body force ḡ, Cundall local damping (seed 002 eq. 14), leap-frog update (kick–drift, with
-//    the XSPH correction in the drift); boundary particles move with their prescribed velocity.
+//    the XSPH correction in the drift); boundary particles move with their prescribed velocity, clamped
+//    soil particles stay at rest.
 //    The step statistics (max speed, max acceleration) and the drift since the last neighbour
 //    build (Verlet skin) are gathered here.
 template <int Dim>
@@ -784,6 +873,7 @@ void SphSolver<Dim>::integrate(const Vec<Dim>& gbar) {
   Vec<Dim>* v = field<Velocity<Dim>>();
   Vec<Dim>* acc = field<Acceleration<Dim>>();
   Vec<Dim>* disp = field<Displacement<Dim>>();
+  const std::uint8_t* clamped = field<Clamped>();
   double vmax = 0.0, amax = 0.0, drift = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : vmax, amax, drift)
   for (std::int64_t ii = 0; ii < n; ++ii) {
@@ -804,6 +894,10 @@ void SphSolver<Dim>::integrate(const Vec<Dim>& gbar) {
       }
     }
     acc[i] = a;
+    if (clamped[i]) {  // held at rest in place (a clamped region); acc keeps the force that holds it
+      v[i].setZero();
+      continue;
+    }
     v[i] += dt * a;
     const Vec<Dim> dx = dt * (v[i] + eps_x * xs[i]);
     x[i] += dx;

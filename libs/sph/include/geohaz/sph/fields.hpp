@@ -149,6 +149,14 @@ struct PositionAtBuild {
   static constexpr const char* unit = "m";
 };
 
+/// 1 when a soil particle is clamped (held at rest in place: a clamped region of the scenario,
+/// e.g. the built-in end of a cantilever); it still takes part in every pair sum. Else 0.
+struct Clamped {
+  using type = std::uint8_t;
+  static constexpr const char* label = "clamped";
+  static constexpr const char* unit = "1";
+};
+
 /// A list of field tags: the internal variables a constitutive model evolves (constitutive.hpp).
 template <class... Tags>
 struct FieldList {};
@@ -159,7 +167,7 @@ using SphStore =
     ParticleStore<Position<Dim>, Velocity<Dim>, Acceleration<Dim>, Displacement<Dim>, Stress, VelocityGradient<Dim>,
                   Density, DensityRate, Mass, MaterialId, ParticleKind, WallNormal<Dim>, LayerNormal<Dim>,
                   PlasticStrain, StressFree, SummationDensity, XsphCorrection<Dim>, ArtificialStress<Dim>,
-                  PairStress<Dim>, Volume, PositionAtBuild<Dim>, StructureId, ParticleId>;
+                  PairStress<Dim>, Volume, PositionAtBuild<Dim>, StructureId, ParticleId, Clamped>;
 
 /// Boundary particles without a layering normal (stores built by hand, snapshots written before the
 /// field existed) take the vertical one, the flat-lying-soil default of the scenario builders.

@@ -19,8 +19,24 @@
 
 namespace geohaz::sph {
 
-/// Where the particles come from.
-enum class ScenarioType { Slope, Column, Biaxial, Section };
+/// Where the particles come from (Block: a free rectangle of soil, e.g. an elastic beam).
+enum class ScenarioType { Slope, Column, Biaxial, Section, Block };
+
+/// Shape of the first bending mode of a clamped–free Euler–Bernoulli beam, normalised to 1 at the
+/// free end: φ(ξ) ∝ cosh kξ − cos kξ − s (sinh kξ − sin kξ), k = 1.87510, s = (cosh k + cos k)/(sinh k +
+/// sin k), ξ = distance from the clamp / free length, clipped to [0, 1] (e.g. Timoshenko & Young 1955).
+double cantilever_mode_shape(double xi);
+
+/// Velocity given to the soil at the start of the main phase (after any geostatic phase).
+struct InitialVelocity {
+  enum class Type { None, Uniform, CantileverMode };
+  Type type = Type::None;
+  std::vector<double> value;  ///< m/s, one component per axis (Uniform)
+  /// CantileverMode: v_z = amplitude·φ((x − root)/length) (cantilever_mode_shape), axis Dim−1 (m/s).
+  double amplitude = 0.0;
+  double root = 0.0;    ///< m: x of the clamped end of the beam
+  double length = 1.0;  ///< m: free length of the beam
+};
 
 /// Pile rows of seed 001 Fig. 17 (3D): one row across the width at a position along the face.
 struct PileRows {
@@ -87,6 +103,11 @@ struct RunConfig {
   PileRows piles;
   double column_width = 0.1, column_height = 0.1, floor_length = 0.4;  ///< m
   BiaxialGeometry biaxial;
+  double block_length = 1.0, block_height = 0.1;  ///< m: the block scenario's rectangle [0, L] × [0, H]
+  /// Clamped regions: boxes of 2·Dim numbers each (x_lo, [y_lo,] z_lo, x_hi, [y_hi,] z_hi), m. Soil
+  /// particles inside are held at rest in place (field Clamped); each box must hold soil.
+  std::vector<double> clamp_boxes;
+  InitialVelocity initial_velocity;
   double biaxial_strain_rate = 0.5;  ///< 1/s, > 0 compression, < 0 tension
   SectionInput section;
 

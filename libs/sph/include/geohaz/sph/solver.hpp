@@ -9,7 +9,11 @@
 ///      soil particle i as its mirror image (Bui et al. 2008): full fixity v_B = 2v_wall − v_i, roller
 ///      v_i with the normal component mirrored; stress σ_B = σ_i − ρ_i d [ḡ_n I + ḡ_t ⊗ ν + ν ⊗ ḡ_t]
 ///      extrapolated along the layering normal ν (d = (x_B − x_i)·ν), shear mirrored for a roller;
-///   2. velocity_gradient: L_i = Σ_j V_j (v_j − v_i) ⊗ ∇_i W_ij (seed 001 eqs. 24–25), continuity
+///   2. gradient_correction (only with `kernel_correction`): C_i = M_i⁻¹, M_i = Σ_j V_j ∇_i W_ij ⊗
+///      (x_j − x_i) over all neighbours (boundary particles included), C_i = I where det M_i < 0.2^Dim
+///      (Bonet & Lok 1999; Randles & Libersky 1996; docs/sph.md "Kernel-gradient correction");
+///      velocity_gradient: L_i = Σ_j V_j (v_j − v_i) ⊗ ∇_i W_ij (seed 001 eqs. 24–25), with the
+///      correction ∇̃_i W_ij = C_i ∇_i W_ij, i.e. L_i ← L_i C_iᵀ; continuity
 ///      dρ_i/dt = Σ_j m_j (v_i − v_j)·∇_i W_ij (seed 001 eq. 11), kernel-summation density and the
 ///      XSPH term Σ_j V_j (v_j − v_i) W_ij (seed 000); each soil–soil pair evaluated once;
 ///   3. update_stress: density and stress update (the constitutive model, chosen once per step,
@@ -19,12 +23,15 @@
 ///   4. momentum (seed 002 eq. 12 with the stress pair in its energy-consistent form):
 ///      a_i = Σ_j m_j ((σ_i + σ_j)/(ρ_i ρ_j) − Π_ij I + f_ij^n (R_i + R_j)) ∇_i W_ij + ḡ
 ///      with Monaghan's viscosity Π_ij (the model's wave speed), f_ij = W(r)/W(Δx),
-///      ḡ = g + a_earthquake (seed 002 eqs. 25–26);
+///      ḡ = g + a_earthquake (seed 002 eqs. 25–26); with `kernel_correction` the stress pair is
+///      (σ_i C_i + σ_j C_j) ∇_i W_ij / (ρ_i ρ_j) (Bonet & Lok 1999: conserves linear momentum and
+///      pairs with the corrected L of step 2), a boundary particle taking the C_i of its soil partner;
 ///   4b. structure_forces (only when structures are tracked, track_structures): the force the soil
 ///      exerts on each structure, F_s = −Σ_{i soil, b ∈ s} V_i [V_b T_ib ∇_i W_ib + a_rep,ib ρ_i], the
 ///      reaction of step 4's soil–boundary pair terms, and its moment Σ (x_b − x_base) × F_ib;
 ///      read only, the particles move exactly as without it;
 ///   5. integrate: body force ḡ, Cundall local damping −ζ|a_α| sign(v_α) (seed 002 eq. 14),
+///      a clamped soil particle (field Clamped) held at rest in place,
 ///      leap-frog (kick–drift: v^{n+½} = v^{n−½} + Δt a^n, x^{n+1} = x^n + Δt (v^{n+½} + ε ΔvXSPH));
 ///   6. check_state, update_dt: Δt = min(C_cfl h/(c + |v|max), C_f √(h/|a|max), the model's own
 ///      limit, Δt_max), c the model's wave speed (constitutive.hpp: P-wave speed of a solid; a
@@ -81,6 +88,12 @@ struct NumericalSettings {
   /// Soil particles closer than this many Δx to a boundary particle are pushed back with
   /// a = c_p² ((r0/r)⁴ − (r0/r)²) x/r² (Monaghan 1994 form); 0 switches it off.
   double wall_repulsion = 0.5;
+  /// First-order consistent kernel gradients (Bonet & Lok 1999; Randles & Libersky 1996) in the
+  /// velocity-gradient and momentum sums (solver.cpp, steps 2 and 4); false: the plain kernel
+  /// gradient. One Dim×Dim matrix per particle and one extra pair pass (docs/performance.md).
+  /// sph-slope's `numerics.kernel_correction = "auto"` keeps this default except for the
+  /// linear_elastic model, where it turns it on (docs/sph.md, "Kernel-gradient correction").
+  bool kernel_correction = false;
   EarthquakeLoading earthquake;  ///< applied in the main phase (time from 0 after the geostatic phase)
 };
 
@@ -203,15 +216,17 @@ class SphSolver {
   Vec<Dim> body_acceleration() const;                 //   ḡ = g + a_earthquake
   void prepare_boundary_pairs(const Vec<Dim>& gbar);  // 1
   template <class Kernel>
+  void gradient_correction();  // 2 (kernel_correction only)
+  template <class Kernel>
   void velocity_gradient();  // 2
   template <class Model>
   void update_stress(const Model& model);  // 3
   template <class T, class Add, class Finish>
   void gather_reactions(const std::vector<T>& buffer, Add&& add, Finish&& finish);  // 2, 4
-  template <class Kernel>
+  template <class Kernel, bool Corrected>
   void momentum();  // 4
-  template <class Kernel>
-  void structure_forces();               // 4b (tracked structures only)
+  template <class Kernel, bool Corrected>
+  void structure_forces();  // 4b (tracked structures only)
   void integrate(const Vec<Dim>& gbar);  // 5
   void check_state() const;              // 6
   void update_dt();                      // 6
@@ -268,6 +283,9 @@ class SphSolver {
   std::vector<Vec<Dim>> structure_base_;
   std::vector<StructureLoad<Dim>> structure_loads_;
   std::vector<StructureLoad<Dim>> structure_block_loads_;
+  // Scratch of the kernel-gradient correction (steps 2 and 4, `kernel_correction` only): C_i of
+  // every particle (identity for boundary particles; empty when the correction is off).
+  std::vector<Mat<Dim>> correction_;
   std::int64_t last_reorder_ = -1000000;
   std::int64_t builds_ = 0;
   StepStats stats_;
