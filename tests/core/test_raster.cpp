@@ -10,10 +10,10 @@
 #include <random>
 #include <string>
 
+#include "child_process.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
 #include "geohaz/core/raster_extra.hpp"
-#include "child_process.hpp"
 #include "tiff_header.hpp"
 
 namespace fs = std::filesystem;
@@ -545,6 +545,88 @@ TEST_F(RasterTest, QuicklookHasHillshadeOverlayAndColourBar) {
   const Raster small = make_grid(10, 10, 5.0, 5.0);
   EXPECT_THROW(write_quicklook_png(dir_ / "bad.png", dem, &small, ColourRamp::Magma, "x"), InputError);
   EXPECT_FALSE(fs::exists(dir_ / "bad.png"));
+}
+
+// Issue #16: maps an engineer can hand on. A 300 × 200 grid of 5 m cells with an overlay block of
+// 50 × 50 cells (cols 100–149, rows 50–99), cropped with a 50 m margin (10 cells): the window is
+// cols 90–159 × rows 40–109 (70 cells), enlarged 8× (600 / 70) to 560 px, so 0.625 m per pixel.
+TEST_F(RasterTest, QuicklookCropsScalesAndDrawsScaleBarArrowLinesAndClasses) {
+  Raster dem = make_grid(300, 200, 5.0, 5.0);
+  fill(dem, [](double x, double y) { return 1000.0 + 0.2 * (x - 500000.0) - 0.1 * (y - 5200000.0); });
+  Raster over = dem.like(0.0, -9999.0);
+  for (int row = 50; row < 100; ++row)
+    for (int col = 100; col < 150; ++col) over.at(col, row) = 2.6;
+  QuicklookOptions o;
+  o.title = "peak flow depth";
+  o.unit = "m";
+  o.crop_margin_m = 50.0;
+  o.scale_bar = true;
+  o.north_arrow = true;
+  o.classes = {{1.0, "low", {255, 221, 51}}, {3.0, "strong", {200, 30, 45}}};
+  // A line along the centre of cell row 45 from cell 95 to cell 155 (pixel row (45.5 − 40)·8 = 44).
+  o.lines = {{dem.cell_centre(95, 45), dem.cell_centre(155, 45)}};
+  write_quicklook_png(dir_ / "map.png", dem, &over, o);
+  const Image img = read_image(dir_ / "map.png");
+  ASSERT_EQ(img.width, 560);
+  ASSERT_GT(img.height, 560);
+  auto px = [&](int x, int y) {
+    const std::size_t i = (static_cast<std::size_t>(y) * img.width + x) * 3;
+    return std::array<int, 3>{img.rgb[i], img.rgb[i + 1], img.rgb[i + 2]};
+  };
+  auto grey = [](std::array<int, 3> c) { return c[0] == c[1] && c[1] == c[2]; };
+  // The overlay block is pixels 80–479 both ways, nothing else in the map is coloured; the value
+  // 2.6 is nearest the "strong" class, drawn red.
+  int coloured = 0, stray = 0;
+  for (int y = 0; y < 560; ++y)
+    for (int x = 0; x < 560; ++x) {
+      const bool in = x >= 80 && x < 480 && y >= 80 && y < 480;
+      if (!grey(px(x, y))) (in ? coloured : stray) += 1;
+    }
+  EXPECT_EQ(coloured, 400 * 400);
+  EXPECT_EQ(stray, 0);
+  const auto centre = px(280, 280);
+  EXPECT_GT(centre[0], 2 * centre[1]);
+  EXPECT_GT(centre[0], 2 * centre[2]);
+  // Scale bar: 50 m (the longest 1/2/5 × 10^k within a quarter of 560 px · 0.625 m) is 80 px;
+  // its black half is 40 px from x = 12, in the rows just above y = 560 − 12.
+  EXPECT_EQ(px(12, 545), (std::array<int, 3>{0, 0, 0}));
+  EXPECT_EQ(px(51, 545), (std::array<int, 3>{0, 0, 0}));
+  EXPECT_EQ(px(60, 545), (std::array<int, 3>{255, 255, 255}));
+  EXPECT_EQ(px(92, 545), (std::array<int, 3>{0, 0, 0}));  // the frame's right end: 12 + 80
+  EXPECT_EQ(px(100, 545), px(100, 520));                  // hillshade beyond it
+  // North arrow: black pixels in the upper right corner box.
+  int arrow = 0;
+  for (int y = 0; y < 80; ++y)
+    for (int x = 500; x < 560; ++x) arrow += px(x, y) == std::array<int, 3>{0, 0, 0};
+  EXPECT_GT(arrow, 50);
+  // The line: dark on pixel rows 44–45 between its ends (x 44–524), not two rows below.
+  EXPECT_EQ(px(300, 44), (std::array<int, 3>{20, 20, 20}));
+  EXPECT_EQ(px(300, 45), (std::array<int, 3>{20, 20, 20}));
+  EXPECT_NE(px(300, 47), (std::array<int, 3>{20, 20, 20}));
+  EXPECT_NE(px(30, 44), (std::array<int, 3>{20, 20, 20}));
+  // The class legend below the map shows both swatches in their exact colours.
+  int low = 0, strong = 0;
+  for (int y = 560; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      low += px(x, y) == std::array<int, 3>{255, 221, 51};
+      strong += px(x, y) == std::array<int, 3>{200, 30, 45};
+    }
+  EXPECT_EQ(low, 100);  // 10 × 10 swatches at text scale 1
+  EXPECT_EQ(strong, 100);
+}
+
+TEST(QuicklookTicks, NiceTicksFallOnOneTwoFiveSteps) {
+  const auto u = nice_ticks(0.0, 1.0, 5);  // step 0.2, both ends included
+  ASSERT_EQ(u.size(), 6u);
+  for (std::size_t k = 0; k < u.size(); ++k) EXPECT_NEAR(u[k], 0.2 * k, 1e-12);
+  const auto t = nice_ticks(0.3, 2.7, 5);  // raw step 0.48 → 0.5: 0.5 … 2.5
+  ASSERT_EQ(t.size(), 5u);
+  EXPECT_DOUBLE_EQ(t.front(), 0.5);
+  EXPECT_DOUBLE_EQ(t.back(), 2.5);
+  EXPECT_TRUE(nice_ticks(1.0, 1.0, 4).empty());
+  EXPECT_EQ(format_tick(1e6), "1e+06");
+  EXPECT_EQ(format_tick(0.25), "0.25");
+  EXPECT_EQ(format_tick(-1e-320), "0");
 }
 
 // ---------------------------------------------------------------------------------------------
