@@ -222,8 +222,21 @@ std::vector<double> ticks(double lo, double hi, int n) {
 std::string tick_text(double v, double span) {
   if (std::abs(v) < 1e-12 * span) v = 0;
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4g", v);
+  std::snprintf(buf, sizeof buf, std::abs(v) < 1e6 ? "%.6g" : "%.4g", v);
   return buf;
+}
+
+/// A word for the axis of a panel holding several quantities of one unit.
+std::string unit_word(const std::string& unit) {
+  static const std::pair<const char*, const char*> kWords[] = {{"m", "length"},         {"m/s", "speed"},
+                                                               {"m³", "volume"},        {"m²", "area"},
+                                                               {"s", "time"},           {"Pa", "stress"},
+                                                               {"N", "force"},          {"N/m", "force per metre"},
+                                                               {"J", "energy"},         {"J/m", "energy per metre"},
+                                                               {"m/s²", "acceleration"}};
+  for (const auto& [u, w] : kWords)
+    if (unit == u) return w;
+  return unit.empty() ? "value" : "";
 }
 
 /// Round a range out to nice ticks.
@@ -306,10 +319,10 @@ std::string svg_plot(const Csv& csv, const std::string& title) {
     s << "<rect x=\"" << ml << "\" y=\"" << y0 << "\" width=\"" << pw << "\" height=\"" << ph
       << "\" fill=\"none\" stroke=\"black\"/>\n";
     // Axis titles: y from the panel's unit (and the quantity when alone), x from the abscissa.
-    std::string ytitle = panels[p].cols.size() == 1 ? quantity_from_name(csv.names[panels[p].cols[0]]).label : "";
     const std::string& u = panels[p].unit;
+    std::string ytitle =
+        panels[p].cols.size() == 1 ? quantity_from_name(csv.names[panels[p].cols[0]]).label : unit_word(u);
     ytitle += u.empty() ? "" : (ytitle.empty() ? "" : " ") + std::string("(") + u + ")";
-    if (ytitle.empty()) ytitle = "value";
     s << "<text transform=\"translate(" << 18 << ',' << y0 + ph / 2 << ") rotate(-90)\" text-anchor=\"middle\">"
       << escape(ytitle) << "</text>\n";
     s << "<text x=\"" << ml + pw / 2 << "\" y=\"" << y0 + ph + 32 << "\" text-anchor=\"middle\">" << escape(xq.label)
@@ -492,6 +505,15 @@ std::pair<std::string, std::string> label_from_key(const std::string& key) {
   return {prefix.empty() ? q.label : prefix + ": " + q.label, q.unit};
 }
 
+/// The unit of a dotted key: from its last segment, else from the nearest parent that names one
+/// ("volumes_m3.deposited" → m³, "kinetic_energy_j.peak" → J).
+std::string unit_of_key(const std::string& key) {
+  const auto seg = split(key, '.');
+  for (auto it = seg.rbegin(); it != seg.rend(); ++it)
+    if (const Quantity q = quantity_from_name(*it); !q.unit.empty()) return q.unit;
+  return "";
+}
+
 void flatten(const json& j, const std::string& prefix, Summary& out, std::vector<Row> (&groups)[kGroups]) {
   for (auto it = j.begin(); it != j.end(); ++it) {
     const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
@@ -543,6 +565,7 @@ void flatten(const json& j, const std::string& prefix, Summary& out, std::vector
     if (it->is_array() && it->size() > 8) continue;  // long arrays are left to the files
     const KeyLabel* kl = find_key(key);
     auto [label, unit] = label_from_key(key);
+    unit = unit_of_key(key);
     GroupId g = kOther;
     if (kl) {
       label = kl->label;
@@ -561,18 +584,18 @@ Summary summarise(const json& summary) {
   Summary s;
   std::vector<Row> groups[kGroups];
   flatten(summary, "", s, groups);
+  // Labelled keys in the label table's order (the headline in group order); the rest alphabetically.
+  const auto rank = [](const Row& r) {
+    const auto it = std::find_if(std::begin(kKeys), std::end(kKeys), [&](const KeyLabel& k) { return r.key == k.key; });
+    return std::pair<int, long>{it == std::end(kKeys) ? kGroups : static_cast<int>(it->group), it - std::begin(kKeys)};
+  };
+  const auto by_rank = [&](const Row& a, const Row& b) { return rank(a) < rank(b); };
   for (int g = 0; g < kGroups; ++g) {
-    // Labelled keys in the label table's order; the rest alphabetically (as flattened).
     auto& rows = groups[g];
-    std::stable_sort(rows.begin(), rows.end(), [](const Row& a, const Row& b) {
-      const auto ia =
-          std::find_if(std::begin(kKeys), std::end(kKeys), [&](const KeyLabel& k) { return a.key == k.key; });
-      const auto ib =
-          std::find_if(std::begin(kKeys), std::end(kKeys), [&](const KeyLabel& k) { return b.key == k.key; });
-      return ia < ib;
-    });
+    std::stable_sort(rows.begin(), rows.end(), by_rank);
     if (!rows.empty()) s.groups.push_back({kGroupTitles[g], rows});
   }
+  std::stable_sort(s.headline.begin(), s.headline.end(), by_rank);
   return s;
 }
 
@@ -663,18 +686,24 @@ std::vector<Row> input_parameters(const fs::path& resolved_config) {
     const auto n = t.at_path(w.substr(0, eq));
     return n && n.value<std::string>() == w.substr(eq + 1);
   };
+  bool materials_done = false;
   for (const auto& p : kParams) {
     if (!holds(p.when)) continue;
     const std::string key = p.key;
     if (key.rfind("material[].", 0) == 0) {
+      // Each material's parameters together, in the table's order.
       const auto* arr = t["material"].as_array();
-      if (!arr) continue;
-      const std::string field = key.substr(11);
+      if (!arr || materials_done) continue;
+      materials_done = true;
       for (const auto& m : *arr) {
         const auto* mt = m.as_table();
-        if (!mt || !mt->contains(field)) continue;
+        if (!mt) continue;
         const std::string name = (*mt)["name"].value_or(std::string("material"));
-        rows.push_back({key, name + ": " + p.label, toml_value_text(*mt->get(field), p.unit)});
+        for (const auto& q : kParams) {
+          const std::string qk = q.key;
+          if (qk.rfind("material[].", 0) != 0 || !mt->contains(qk.substr(11))) continue;
+          rows.push_back({qk, name + ": " + q.label, toml_value_text(*mt->get(qk.substr(11)), q.unit)});
+        }
       }
       continue;
     }

@@ -98,6 +98,7 @@ TEST(ReportSummary, KeysAreGroupedLabelledAndUnknownKeysKept) {
   const auto j = nlohmann::json::parse(R"({
     "fahrboeschung": {"ratio_H_over_L": 0.5131776, "reach_m": 2802.16},
     "max_pressure_pa": 2.208e6,
+    "volumes_m3": {"deposited": 3911.4},
     "bytes_per_particle": 610.2,
     "barrier_peak_force_N": 12500.0,
     "tests": [{"name": "sigma3_5MPa", "confining_stress_Pa": 5e6, "peak_stress_Pa": 9.76e7}],
@@ -110,6 +111,9 @@ TEST(ReportSummary, KeysAreGroupedLabelledAndUnknownKeysKept) {
   ASSERT_NE(hl, nullptr);
   EXPECT_EQ(hl->label, "H/L (Fahrböschung: release top to toe)");
   EXPECT_EQ(hl->value, "0.5132");
+  const Group* volumes = find_group(s, "Volumes and areas");
+  ASSERT_NE(volumes, nullptr);
+  EXPECT_EQ(find_row(volumes->rows, "volumes_m3.deposited")->value, "3911 m³");  // the unit from the parent key
   const Group* peak = find_group(s, "Peak values");
   ASSERT_NE(peak, nullptr);
   EXPECT_EQ(find_row(peak->rows, "max_pressure_pa")->value, "2.208 MPa");
