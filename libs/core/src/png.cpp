@@ -339,20 +339,28 @@ namespace {
 
 /// Where the drawn map sits in the raster: a window of cells [c0, c0 + nc) × [r0, r0 + nr), shown
 /// either downsampled by `down` (one pixel per down × down cells, the block centre sampled) or
-/// enlarged by `up` (up × up pixels per cell).
+/// enlarged by `zoom` > 1 pixels per cell (nearest cell).
 struct MapWindow {
-  int c0 = 0, r0 = 0, nc = 0, nr = 0, down = 1, up = 1;
-  int width() const noexcept { return up > 1 ? nc * up : (nc + down - 1) / down; }
-  int height() const noexcept { return up > 1 ? nr * up : (nr + down - 1) / down; }
+  int c0 = 0, r0 = 0, nc = 0, nr = 0, down = 1;
+  double zoom = 1.0;
+  bool zoomed() const noexcept { return zoom > 1.0; }
+  int width() const noexcept {
+    return zoomed() ? static_cast<int>(std::ceil(nc * zoom - 1e-9)) : (nc + down - 1) / down;
+  }
+  int height() const noexcept {
+    return zoomed() ? static_cast<int>(std::ceil(nr * zoom - 1e-9)) : (nr + down - 1) / down;
+  }
   /// Raster cell shown at pixel (i, j).
   std::pair<int, int> cell(int i, int j) const noexcept {
-    if (up > 1) return {c0 + i / up, r0 + j / up};
+    if (zoomed())
+      return {c0 + std::min(nc - 1, static_cast<int>((i + 0.5) / zoom)),
+              r0 + std::min(nr - 1, static_cast<int>((j + 0.5) / zoom))};
     return {c0 + std::min(nc - 1, i * down + down / 2), r0 + std::min(nr - 1, j * down + down / 2)};
   }
   /// Pixel coordinates of a fractional cell position (edge-based: cell (0, 0) spans [0, 1)).
-  double px(double col) const noexcept { return up > 1 ? (col - c0) * up : (col - c0) / down; }
-  double py(double row) const noexcept { return up > 1 ? (row - r0) * up : (row - r0) / down; }
-  double pixel_size(double cell) const noexcept { return up > 1 ? cell / up : cell * down; }
+  double px(double col) const noexcept { return zoomed() ? (col - c0) * zoom : (col - c0) / down; }
+  double py(double row) const noexcept { return zoomed() ? (row - r0) * zoom : (row - r0) / down; }
+  double pixel_size(double cell) const noexcept { return zoomed() ? cell / zoom : cell * down; }
 };
 
 /// A white box behind map decorations so they read over any colour.
@@ -418,11 +426,12 @@ void write_quicklook_png(const std::filesystem::path& path, const Raster& elevat
     }
   }
   // Downsample by an integer factor so the map is at most kMaxSide pixels on either side; enlarge a
-  // cropped map by an integer factor to at least kMinSide.
-  constexpr int kMaxSide = 1600, kMinSide = 600;
+  // cropped map to kMinSide on its longer side (so its legend is drawn at text scale 2), at most
+  // 16 pixels per cell.
+  constexpr int kMaxSide = 1600, kMinSide = 840;
   const int longest = std::max(win.nc, win.nr);
   win.down = std::max(1, static_cast<int>(std::ceil(longest / double(kMaxSide))));
-  if (opt.crop_margin_m >= 0.0 && longest < kMinSide) win.up = std::min(8, kMinSide / longest);
+  if (opt.crop_margin_m >= 0.0 && longest < kMinSide) win.zoom = std::min(16.0, double(kMinSide) / longest);
   const int mw = win.width(), mh = win.height();
   const int scale = mw >= 800 ? 2 : 1;  // text scale
   const int margin = 6 * scale, text_h = kGlyphH * scale;

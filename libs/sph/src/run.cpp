@@ -355,7 +355,9 @@ void draw_particles(const std::filesystem::path& path, const SphStore<Dim>& s, c
   // Fit the x–z extent into at most 1200 × 1200 pixels of drawing area.
   const double scale =
       std::min((W - 2 * margin) / std::max(x1 - x0 + dx, 1e-12), (1200.0 - 2 * margin) / std::max(z1 - z0 + dx, 1e-12));
-  constexpr int kLegend = 70;  // colour bar, numbers and title below the particles
+  // Below the particles: 10 px gap, then draw_colour_bar at text scale 2 (bar 20, ticks 6 + 4,
+  // numbers 14, gap 8, title 14 = 66 px), and 8 px to spare.
+  constexpr int kLegend = 84;
   const int H = std::max(static_cast<int>((z1 - z0 + dx) * scale) + 2 * margin + kLegend, 100);
   Image img(W, H);
   const double r = std::max(1.0, 0.5 * dx * scale);
