@@ -245,8 +245,9 @@ int draw_colour_bar(Image& img, int x, int y, int width, ColourRamp ramp, double
     for (int py = y; py < y + bar_h; ++py) img.set(px, py, c);
   }
   img.line(x, y + bar_h, x + width - 1, y + bar_h, black);
-  // About one tick per 70 pixels of bar, at most 8.
-  const int n = std::clamp(width / (70 * scale), 2, 8);
+  // About one tick per 60 pixels of bar, at most 8, and at least three numbers where they fit.
+  int n = std::clamp(width / (60 * scale), 3, 8);
+  if (nice_ticks(vmin, vmax, n).size() < 3) n *= 2;
   const int num_y = y + bar_h + tick + 2 * scale;
   int last_right = -1000000;
   for (double v : nice_ticks(vmin, vmax, n)) {

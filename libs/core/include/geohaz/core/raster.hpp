@@ -158,7 +158,7 @@ struct QuicklookOptions {
   /// value is nearest to its own.
   std::vector<StyleClass> classes;
   /// Crop to the cells where the overlay is drawn plus this margin in metres (negative: the whole
-  /// raster). A cropped map smaller than 600 px is enlarged by an integer factor.
+  /// raster). A cropped map is enlarged to 840 px on its longer side (nearest cell, ≤ 16 px a cell).
   double crop_margin_m = -1.0;
   bool scale_bar = false;    ///< a scale bar (1, 2 or 5 × 10^k m) in the lower left corner of the map
   bool north_arrow = false;  ///< a north arrow in the upper right corner (the raster is north-up)
