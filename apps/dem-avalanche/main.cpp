@@ -196,9 +196,9 @@ RunConfig read_config(ConfigReader& r, bool describe) {
                               {"Pa", "confining stresses sigma_3 of the compression tests (one test each)"});
     l.loading_velocity =
         r.get("biaxial.loading_velocity", 0.25, Range::closed(1e-3, 100.0),
-                {"m/s",
-                 "speed of each platen / grip (quasi-static tests: 0.01-1; the test lasts strain·height/speed "
-                 "at a step of ~1e-7 s, so slower is impractically long)"});
+              {"m/s",
+               "speed of each platen / grip (quasi-static tests: 0.01-1; the test lasts strain·height/speed "
+               "at a step of ~1e-7 s, so slower is impractically long)"});
     l.max_axial_strain =
         r.get("biaxial.max_axial_strain", 0.02, Range::open_closed(0.0, 0.5), {"1", "stop at this axial strain"});
     l.post_peak_stop = r.get("biaxial.post_peak_stop", 0.7, Range::closed(0.0, 1.0),
@@ -427,7 +427,12 @@ int run_lab(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
     progress.finish(s.time(), s.step_count(), s.discs.size());
     write_curve_csv(out / ("curve_" + name + ".csv"), r.curve);
     write_ae_csv(out / ("ae_" + name + ".csv"), r.events);
-    write_sample_png(out / ("cracks_" + name + ".png"), s);
+    {
+      std::ostringstream title;
+      title << (tension ? "tension test" : "biaxial test, confining stress sigma3 = ") << std::setprecision(4);
+      if (!tension) title << sig3 / 1e6 << " MPa";
+      write_sample_png(out / ("cracks_" + name + ".png"), s, title.str());
+    }
     json j = lab_json(r);
     j["name"] = name;
     j["confining_stress_Pa"] = sig3;

@@ -10,10 +10,10 @@
 #include <random>
 #include <string>
 
+#include "child_process.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
 #include "geohaz/core/raster_extra.hpp"
-#include "child_process.hpp"
 #include "tiff_header.hpp"
 
 namespace fs = std::filesystem;
@@ -545,6 +545,89 @@ TEST_F(RasterTest, QuicklookHasHillshadeOverlayAndColourBar) {
   const Raster small = make_grid(10, 10, 5.0, 5.0);
   EXPECT_THROW(write_quicklook_png(dir_ / "bad.png", dem, &small, ColourRamp::Magma, "x"), InputError);
   EXPECT_FALSE(fs::exists(dir_ / "bad.png"));
+}
+
+// Issue #16: maps an engineer can hand on. A 300 × 200 grid of 5 m cells with an overlay block of
+// 50 × 50 cells (cols 100–149, rows 50–99), cropped with a 50 m margin (10 cells): the window is
+// cols 90–159 × rows 40–109 (70 cells), enlarged to 840 px (12 px per cell), so 5/12 m per pixel;
+// at that width the text scale is 2 (margins 12 px).
+TEST_F(RasterTest, QuicklookCropsScalesAndDrawsScaleBarArrowLinesAndClasses) {
+  Raster dem = make_grid(300, 200, 5.0, 5.0);
+  fill(dem, [](double x, double y) { return 1000.0 + 0.2 * (x - 500000.0) - 0.1 * (y - 5200000.0); });
+  Raster over = dem.like(0.0, -9999.0);
+  for (int row = 50; row < 100; ++row)
+    for (int col = 100; col < 150; ++col) over.at(col, row) = 2.6;
+  QuicklookOptions o;
+  o.title = "peak flow depth";
+  o.unit = "m";
+  o.crop_margin_m = 50.0;
+  o.scale_bar = true;
+  o.north_arrow = true;
+  o.classes = {{1.0, "low", {255, 221, 51}}, {3.0, "strong", {200, 30, 45}}};
+  // A line along the centre of cell row 45 from cell 95 to cell 155 (pixel row (45.5 − 40)·12 = 66).
+  o.lines = {{dem.cell_centre(95, 45), dem.cell_centre(155, 45)}};
+  write_quicklook_png(dir_ / "map.png", dem, &over, o);
+  const Image img = read_image(dir_ / "map.png");
+  ASSERT_EQ(img.width, 840);
+  ASSERT_GT(img.height, 840);
+  auto px = [&](int x, int y) {
+    const std::size_t i = (static_cast<std::size_t>(y) * img.width + x) * 3;
+    return std::array<int, 3>{img.rgb[i], img.rgb[i + 1], img.rgb[i + 2]};
+  };
+  auto grey = [](std::array<int, 3> c) { return c[0] == c[1] && c[1] == c[2]; };
+  // The overlay block is pixels 120–719 both ways, nothing else in the map is coloured; the value
+  // 2.6 is nearest the "strong" class, drawn red.
+  int coloured = 0, stray = 0;
+  for (int y = 0; y < 840; ++y)
+    for (int x = 0; x < 840; ++x) {
+      const bool in = x >= 120 && x < 720 && y >= 120 && y < 720;
+      if (!grey(px(x, y))) (in ? coloured : stray) += 1;
+    }
+  EXPECT_EQ(coloured, 600 * 600);
+  EXPECT_EQ(stray, 0);
+  const auto centre = px(420, 420);
+  EXPECT_GT(centre[0], 2 * centre[1]);
+  EXPECT_GT(centre[0], 2 * centre[2]);
+  // Scale bar: 50 m (the longest 1/2/5 × 10^k within a quarter of 840 px · 5/12 m) is 120 px;
+  // its black half is 60 px from x = 24, in the 10 rows just above y = 840 − 24.
+  EXPECT_EQ(px(24, 810), (std::array<int, 3>{0, 0, 0}));
+  EXPECT_EQ(px(83, 810), (std::array<int, 3>{0, 0, 0}));
+  EXPECT_EQ(px(100, 810), (std::array<int, 3>{255, 255, 255}));
+  EXPECT_EQ(px(144, 810), (std::array<int, 3>{0, 0, 0}));  // the frame's right end: 24 + 120
+  EXPECT_EQ(px(160, 810), px(160, 770));                   // hillshade beyond it
+  // North arrow: black pixels in the upper right corner box.
+  int arrow = 0;
+  for (int y = 0; y < 110; ++y)
+    for (int x = 760; x < 840; ++x) arrow += px(x, y) == std::array<int, 3>{0, 0, 0};
+  EXPECT_GT(arrow, 200);
+  // The line: dark on pixel rows 66–69 (4 px at text scale 2) between its ends (x 66–786).
+  EXPECT_EQ(px(300, 66), (std::array<int, 3>{20, 20, 20}));
+  EXPECT_EQ(px(300, 69), (std::array<int, 3>{20, 20, 20}));
+  EXPECT_NE(px(300, 72), (std::array<int, 3>{20, 20, 20}));
+  EXPECT_NE(px(40, 66), (std::array<int, 3>{20, 20, 20}));
+  // The class legend below the map shows both swatches in their exact colours.
+  int low = 0, strong = 0;
+  for (int y = 840; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      low += px(x, y) == std::array<int, 3>{255, 221, 51};
+      strong += px(x, y) == std::array<int, 3>{200, 30, 45};
+    }
+  EXPECT_EQ(low, 400);  // 20 × 20 swatches at text scale 2
+  EXPECT_EQ(strong, 400);
+}
+
+TEST(QuicklookTicks, NiceTicksFallOnOneTwoFiveSteps) {
+  const auto u = nice_ticks(0.0, 1.0, 5);  // step 0.2, both ends included
+  ASSERT_EQ(u.size(), 6u);
+  for (std::size_t k = 0; k < u.size(); ++k) EXPECT_NEAR(u[k], 0.2 * k, 1e-12);
+  const auto t = nice_ticks(0.3, 2.7, 5);  // raw step 0.48 → 0.5: 0.5 … 2.5
+  ASSERT_EQ(t.size(), 5u);
+  EXPECT_DOUBLE_EQ(t.front(), 0.5);
+  EXPECT_DOUBLE_EQ(t.back(), 2.5);
+  EXPECT_TRUE(nice_ticks(1.0, 1.0, 4).empty());
+  EXPECT_EQ(format_tick(1e6), "1e+06");
+  EXPECT_EQ(format_tick(0.25), "0.25");
+  EXPECT_EQ(format_tick(-1e-320), "0");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -151,6 +151,9 @@ constexpr Glyph kFont[] = {
     {':', {0x00, 0x0C, 0x0C, 0x00, 0x0C, 0x0C, 0x00}}, {'^', {0x04, 0x0A, 0x11, 0x00, 0x00, 0x00, 0x00}},
     {'_', {0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x1F}}, {'%', {0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03}},
     {',', {0x00, 0x00, 0x00, 0x00, 0x0C, 0x04, 0x08}}, {'=', {0x00, 0x00, 0x1F, 0x00, 0x1F, 0x00, 0x00}},
+    {'<', {0x02, 0x04, 0x08, 0x10, 0x08, 0x04, 0x02}}, {'>', {0x08, 0x04, 0x02, 0x01, 0x02, 0x04, 0x08}},
+    {'[', {0x0E, 0x08, 0x08, 0x08, 0x08, 0x08, 0x0E}}, {']', {0x0E, 0x02, 0x02, 0x02, 0x02, 0x02, 0x0E}},
+    {'*', {0x00, 0x04, 0x15, 0x0E, 0x15, 0x04, 0x00}}, {'\'', {0x04, 0x04, 0x08, 0x00, 0x00, 0x00, 0x00}},
     {'A', {0x0E, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11}}, {'B', {0x1E, 0x11, 0x11, 0x1E, 0x11, 0x11, 0x1E}},
     {'C', {0x0E, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0E}}, {'D', {0x1C, 0x12, 0x11, 0x11, 0x11, 0x12, 0x1C}},
     {'E', {0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x1F}}, {'F', {0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x10}},
@@ -187,6 +190,8 @@ const Glyph* find_glyph(char c) noexcept {
   return nullptr;
 }
 
+}  // namespace
+
 /// Width in pixels of a text at a given scale (non-ASCII bytes are skipped, unknown ASCII is a gap).
 int text_width(const std::string& s, int scale) noexcept {
   int n = 0;
@@ -209,11 +214,58 @@ void draw_text(Image& img, int x, int y, const std::string& s, int scale, Rgb co
   }
 }
 
-std::string format_number(double v) {
+std::string format_tick(double v) {
+  if (std::abs(v) < 1e-300) v = 0.0;  // no "-0"
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.4g", v);
   return buf;
 }
+
+std::vector<double> nice_ticks(double lo, double hi, int n) {
+  std::vector<double> t;
+  if (!std::isfinite(lo) || !std::isfinite(hi) || !(hi > lo) || n < 1) return t;
+  const double raw = (hi - lo) / n, p = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = 10.0 * p;
+  for (double m : {1.0, 2.0, 5.0})
+    if (m * p >= raw) {
+      step = m * p;
+      break;
+    }
+  const double eps = 1e-9 * step;
+  for (double k = std::ceil((lo - eps) / step); k * step <= hi + eps; k += 1.0) t.push_back(k * step);
+  return t;
+}
+
+int draw_colour_bar(Image& img, int x, int y, int width, ColourRamp ramp, double vmin, double vmax,
+                    const std::string& title, int scale) {
+  const Rgb black{0, 0, 0};
+  const int bar_h = 10 * scale, tick = 3 * scale;
+  for (int px = x; px < x + width; ++px) {
+    const Rgb c = ramp_colour(ramp, double(px - x) / std::max(1, width - 1));
+    for (int py = y; py < y + bar_h; ++py) img.set(px, py, c);
+  }
+  img.line(x, y + bar_h, x + width - 1, y + bar_h, black);
+  // About one tick per 60 pixels of bar, at most 8, and at least three numbers where they fit.
+  int n = std::clamp(width / (60 * scale), 3, 8);
+  if (nice_ticks(vmin, vmax, n).size() < 3) n *= 2;
+  const int num_y = y + bar_h + tick + 2 * scale;
+  int last_right = -1000000;
+  for (double v : nice_ticks(vmin, vmax, n)) {
+    const int px = x + static_cast<int>(std::lround((v - vmin) / (vmax - vmin) * (width - 1)));
+    img.line(px, y + bar_h, px, y + bar_h + tick, black);
+    const std::string s = format_tick(v);
+    const int w = text_width(s, scale);
+    const int left = std::clamp(px - w / 2, x, x + width - w);
+    if (left <= last_right + 4 * scale) continue;  // no overlapping numbers
+    draw_text(img, left, num_y, s, scale, black);
+    last_right = left + w;
+  }
+  const int title_y = num_y + kGlyphH * scale + 4 * scale;
+  draw_text(img, std::max(x, x + (width - text_width(title, scale)) / 2), title_y, title, scale, black);
+  return title_y + kGlyphH * scale - y;
+}
+
+namespace {
 
 /// Write an RGB image through GDAL's MEM and PNG drivers, to "<path>.partial" then renamed.
 void write_rgb_png(const std::filesystem::path& path, int w, int h, const std::vector<std::uint8_t>& rgb) {
@@ -284,8 +336,55 @@ Image read_image(const std::filesystem::path& path) {
 // ---------------------------------------------------------------------------------------------
 // Quick-look
 
+namespace {
+
+/// Where the drawn map sits in the raster: a window of cells [c0, c0 + nc) × [r0, r0 + nr), shown
+/// either downsampled by `down` (one pixel per down × down cells, the block centre sampled) or
+/// enlarged by `zoom` > 1 pixels per cell (nearest cell).
+struct MapWindow {
+  int c0 = 0, r0 = 0, nc = 0, nr = 0, down = 1;
+  double zoom = 1.0;
+  bool zoomed() const noexcept { return zoom > 1.0; }
+  int width() const noexcept {
+    return zoomed() ? static_cast<int>(std::ceil(nc * zoom - 1e-9)) : (nc + down - 1) / down;
+  }
+  int height() const noexcept {
+    return zoomed() ? static_cast<int>(std::ceil(nr * zoom - 1e-9)) : (nr + down - 1) / down;
+  }
+  /// Raster cell shown at pixel (i, j).
+  std::pair<int, int> cell(int i, int j) const noexcept {
+    if (zoomed())
+      return {c0 + std::min(nc - 1, static_cast<int>((i + 0.5) / zoom)),
+              r0 + std::min(nr - 1, static_cast<int>((j + 0.5) / zoom))};
+    return {c0 + std::min(nc - 1, i * down + down / 2), r0 + std::min(nr - 1, j * down + down / 2)};
+  }
+  /// Pixel coordinates of a fractional cell position (edge-based: cell (0, 0) spans [0, 1)).
+  double px(double col) const noexcept { return zoomed() ? (col - c0) * zoom : (col - c0) / down; }
+  double py(double row) const noexcept { return zoomed() ? (row - r0) * zoom : (row - r0) / down; }
+  double pixel_size(double cell) const noexcept { return zoomed() ? cell / zoom : cell * down; }
+};
+
+/// A white box behind map decorations so they read over any colour.
+void fill_box(Image& img, int x0, int y0, int x1, int y1, Rgb c) noexcept {
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) img.set(x, y, c);
+}
+
+}  // namespace
+
 void write_quicklook_png(const std::filesystem::path& path, const Raster& elevation, const Raster* overlay,
                          ColourRamp ramp, const std::string& label, double vmin, double vmax, double overlay_min) {
+  QuicklookOptions opt;
+  opt.ramp = ramp;
+  opt.title = label;
+  opt.vmin = vmin;
+  opt.vmax = vmax;
+  opt.overlay_min = overlay_min;
+  write_quicklook_png(path, elevation, overlay, opt);
+}
+
+void write_quicklook_png(const std::filesystem::path& path, const Raster& elevation, const Raster* overlay,
+                         const QuicklookOptions& opt) {
   const std::string file = path.string();
   if (elevation.nx <= 0 || elevation.ny <= 0 ||
       elevation.data.size() != static_cast<std::size_t>(elevation.nx) * static_cast<std::size_t>(elevation.ny))
@@ -297,71 +396,124 @@ void write_quicklook_png(const std::filesystem::path& path, const Raster& elevat
                          ") differs from the elevation grid (" + std::to_string(elevation.nx) + " x " +
                          std::to_string(elevation.ny) + ")",
                      file);
-
-  // Downsample by an integer factor so the map is at most kMaxSide pixels on either side.
-  constexpr int kMaxSide = 1600;
-  const int f = std::max(1, static_cast<int>(std::ceil(std::max(elevation.nx, elevation.ny) / double(kMaxSide))));
-  const int mw = (elevation.nx + f - 1) / f, mh = (elevation.ny + f - 1) / f;
-  const int scale = mw >= 800 ? 2 : 1;  // text scale
-  const int bar_h = 10 * scale, margin = 6 * scale, text_h = kGlyphH * scale;
-  const int legend_h = margin + bar_h + 3 * scale + text_h + 3 * scale + text_h + margin;
-  const int width = std::max(mw, 200);  // room for the colour bar and its numbers
-  const int height = mh + legend_h;
-  Image img(width, height, {255, 255, 255});
-
-  // Sample cell (block centre) of output pixel (i, j).
-  auto cell = [&](int i, int j) -> std::pair<int, int> {
-    return {std::min(elevation.nx - 1, i * f + f / 2), std::min(elevation.ny - 1, j * f + f / 2)};
-  };
-  auto overlay_value = [&](int i, int j, double& v) {
-    const auto [c, r] = cell(i, j);
+  const auto drawn = [&](int c, int r, double& v) {
     v = over.at(c, r);
-    return std::isfinite(v) && !over.is_nodata(v) && v > overlay_min;
+    return std::isfinite(v) && !over.is_nodata(v) && v > opt.overlay_min;
   };
 
-  // Colour range: automatic over the shown overlay values when vmin ≥ vmax.
+  // 1. The window: the whole raster, or the cells drawn plus the margin.
+  MapWindow win;
+  win.nc = elevation.nx;
+  win.nr = elevation.ny;
+  if (opt.crop_margin_m >= 0.0) {
+    int ca = elevation.nx, cb = -1, ra = elevation.ny, rb = -1;
+    for (int r = 0; r < elevation.ny; ++r)
+      for (int c = 0; c < elevation.nx; ++c) {
+        double v;
+        if (drawn(c, r, v)) {
+          ca = std::min(ca, c);
+          cb = std::max(cb, c);
+          ra = std::min(ra, r);
+          rb = std::max(rb, r);
+        }
+      }
+    if (cb >= 0) {  // nothing drawn: the whole raster
+      const int mc = static_cast<int>(std::ceil(opt.crop_margin_m / elevation.cell_size_x()));
+      const int mr = static_cast<int>(std::ceil(opt.crop_margin_m / elevation.cell_size_y()));
+      win.c0 = std::max(0, ca - mc);
+      win.r0 = std::max(0, ra - mr);
+      win.nc = std::min(elevation.nx - 1, cb + mc) - win.c0 + 1;
+      win.nr = std::min(elevation.ny - 1, rb + mr) - win.r0 + 1;
+    }
+  }
+  // Downsample by an integer factor so the map is at most kMaxSide pixels on either side; enlarge a
+  // cropped map to kMinSide on its longer side (so its legend is drawn at text scale 2), at most
+  // 16 pixels per cell.
+  constexpr int kMaxSide = 1600, kMinSide = 840;
+  const int longest = std::max(win.nc, win.nr);
+  win.down = std::max(1, static_cast<int>(std::ceil(longest / double(kMaxSide))));
+  if (opt.crop_margin_m >= 0.0 && longest < kMinSide) win.zoom = std::min(16.0, double(kMinSide) / longest);
+  const int mw = win.width(), mh = win.height();
+  const int scale = mw >= 800 ? 2 : 1;  // text scale
+  const int margin = 6 * scale, text_h = kGlyphH * scale;
+  const int width = std::max(mw, 200);  // room for the colour bar and its numbers
+  const Rgb black{0, 0, 0}, white{255, 255, 255};
+
+  // 2. The legend's height: a colour bar, or rows of class swatches.
+  const std::string title = opt.unit.empty() ? opt.title : opt.title + " (" + opt.unit + ")";
+  const int swatch = 10 * scale, gap = 12 * scale;
+  std::vector<std::pair<int, int>> class_pos;  // top left of each class entry
+  int legend_h = 0;
+  if (!opt.classes.empty()) {
+    int x = margin, y = mh + margin + text_h + 4 * scale;
+    for (const auto& k : opt.classes) {
+      const int w = swatch + 4 * scale + text_width(k.label, scale);
+      if (x > margin && x + w > width - margin) {
+        x = margin;
+        y += swatch + 4 * scale;
+      }
+      class_pos.emplace_back(x, y);
+      x += w + gap;
+    }
+    legend_h = y + swatch + margin - mh;
+  } else {
+    legend_h = margin + 10 * scale + 5 * scale + text_h + 4 * scale + text_h + margin;
+  }
+  Image img(width, mh + legend_h, white);
+
+  // 3. Colour range: automatic over the drawn overlay values when vmin ≥ vmax.
+  double vmin = opt.vmin, vmax = opt.vmax;
   if (!(vmin < vmax)) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (int j = 0; j < mh; ++j)
       for (int i = 0; i < mw; ++i) {
+        const auto [c, r] = win.cell(i, j);
         double v;
-        if (overlay_value(i, j, v)) {
+        if (drawn(c, r, v)) {
           lo = std::min(lo, v);
           hi = std::max(hi, v);
         }
       }
-    if (lo > hi) lo = hi = overlay_min;
+    if (lo > hi) lo = hi = opt.overlay_min;
     if (!(hi > lo)) hi = lo + 1.0;
     vmin = lo;
     vmax = hi;
   }
+  const auto colour_of = [&](double v) -> Rgb {
+    if (opt.classes.empty()) return ramp_colour(opt.ramp, (v - vmin) / (vmax - vmin));
+    const StyleClass* best = &opt.classes.front();
+    for (const auto& k : opt.classes)
+      if (std::abs(k.value - v) < std::abs(best->value - v)) best = &k;
+    return best->colour;
+  };
 
-  // Hillshade: sun from azimuth 315° (north-west), altitude 45°; central differences on the
-  // sampled grid (one-sided at edges and next to nodata).
+  // 4. Hillshade: sun from azimuth 315° (north-west), altitude 45°; central differences over the
+  // cells one pixel apart (one-sided at edges and next to nodata).
   const double pi = std::acos(-1.0);
   const double az = 315.0 * pi / 180.0, alt = 45.0 * pi / 180.0;
   const double sx = std::sin(az) * std::cos(alt), sy = std::cos(az) * std::cos(alt), sz = std::sin(alt);
-  const double hx = f * elevation.cell_size_x(), hy = f * elevation.cell_size_y();
-  auto z_at = [&](int i, int j, double& z) {
-    if (i < 0 || j < 0 || i >= mw || j >= mh) return false;
-    const auto [c, r] = cell(i, j);
+  const int d = win.down;
+  const double hx = d * elevation.cell_size_x(), hy = d * elevation.cell_size_y();
+  auto z_at = [&](int c, int r, double& z) {
+    if (c < 0 || r < 0 || c >= elevation.nx || r >= elevation.ny) return false;
     z = elevation.at(c, r);
     return std::isfinite(z) && !elevation.is_nodata(z);
   };
   for (int j = 0; j < mh; ++j)
     for (int i = 0; i < mw; ++i) {
+      const auto [cc, rr] = win.cell(i, j);
       double z;
-      if (!z_at(i, j, z)) continue;  // nodata stays white
+      if (!z_at(cc, rr, z)) continue;  // nodata stays white
       double ze = 0.0, zw = 0.0, zn = 0.0, zs = 0.0;
-      const bool e = z_at(i + 1, j, ze), w = z_at(i - 1, j, zw), n = z_at(i, j - 1, zn), s = z_at(i, j + 1, zs);
+      const bool e = z_at(cc + d, rr, ze), w = z_at(cc - d, rr, zw), n = z_at(cc, rr - d, zn), s = z_at(cc, rr + d, zs);
       const double gx = (e && w) ? (ze - zw) / (2 * hx) : e ? (ze - z) / hx : w ? (z - zw) / hx : 0.0;
       const double gy = (n && s) ? (zn - zs) / (2 * hy) : n ? (zn - z) / hy : s ? (z - zs) / hy : 0.0;
       const double shade = std::max(0.0, (-gx * sx - gy * sy + sz) / std::sqrt(gx * gx + gy * gy + 1.0));
       const double grey = 40.0 + 215.0 * shade;
       Rgb c{};
       double v;
-      if (overlay_value(i, j, v)) {
-        const Rgb rc = ramp_colour(ramp, (v - vmin) / (vmax - vmin));
+      if (drawn(cc, rr, v)) {
+        const Rgb rc = colour_of(v);
         // Blend: mostly the ramp colour, modulated by the shade so the relief stays readable.
         for (int k = 0; k < 3; ++k)
           c[k] = static_cast<std::uint8_t>(std::clamp(std::lround(rc[k] * (0.55 + 0.45 * shade * 1.414)), 0L, 255L));
@@ -372,20 +524,67 @@ void write_quicklook_png(const std::filesystem::path& path, const Raster& elevat
       img.set(i, j, c);
     }
 
-  // Colour bar along the bottom, numbers at its ends, label centred below.
-  const int bar_x0 = margin, bar_x1 = width - margin;
-  const int bar_y0 = mh + margin;
-  for (int x = bar_x0; x < bar_x1; ++x) {
-    const Rgb c = ramp_colour(ramp, double(x - bar_x0) / std::max(1, bar_x1 - bar_x0 - 1));
-    for (int y = bar_y0; y < bar_y0 + bar_h; ++y) img.set(x, y, c);
+  // 5. Lines in map coordinates (dark, two pixels wide).
+  const Rgb dark{20, 20, 20};
+  for (const auto& pl : opt.lines)
+    for (std::size_t k = 1; k < pl.size(); ++k) {
+      const Vec2 a = elevation.to_pixel(pl[k - 1]), b = elevation.to_pixel(pl[k]);
+      // to_pixel is centre-based; the window is edge-based.
+      const double ax = win.px(a.x() + 0.5), ay = win.py(a.y() + 0.5), bx = win.px(b.x() + 0.5),
+                   by = win.py(b.y() + 0.5);
+      for (int o = 0; o < 2 * scale; ++o) {
+        img.line(ax + o, ay, bx + o, by, dark);
+        img.line(ax, ay + o, bx, by + o, dark);
+      }
+    }
+  // Clear what a line may have drawn below the map.
+  fill_box(img, 0, mh, width, img.height, white);
+
+  // 6. Scale bar (lower left) and north arrow (upper right), on white boxes.
+  if (opt.scale_bar) {
+    // The longest 1, 2 or 5 × 10^k metres within a quarter of the map's width.
+    const double pix_m = win.pixel_size(elevation.cell_size_x());
+    const double target = 0.25 * mw * pix_m, p10 = std::pow(10.0, std::floor(std::log10(target)));
+    const double len_m = 5 * p10 <= target ? 5 * p10 : 2 * p10 <= target ? 2 * p10 : p10;
+    const int len_px = static_cast<int>(std::lround(len_m / pix_m));
+    if (len_px >= 10) {
+      const std::string s = len_m >= 1000.0 ? format_tick(len_m / 1000.0) + " km" : format_tick(len_m) + " m";
+      const int bh = 5 * scale, x0 = 2 * margin, y1 = mh - 2 * margin;
+      const int y0 = y1 - bh - 3 * scale - text_h;
+      fill_box(img, x0 - 3 * scale, y0 - 3 * scale, x0 + std::max(len_px, text_width(s, scale)) + 3 * scale,
+               y1 + 3 * scale, white);
+      draw_text(img, x0, y0, s, scale, black);
+      // Two halves, black and white, framed.
+      fill_box(img, x0, y1 - bh, x0 + len_px / 2, y1, black);
+      img.line(x0, y1 - bh, x0 + len_px, y1 - bh, black);
+      img.line(x0, y1 - 1, x0 + len_px, y1 - 1, black);
+      img.line(x0 + len_px, y1 - bh, x0 + len_px, y1 - 1, black);
+    }
   }
-  const Rgb black{0, 0, 0};
-  const int num_y = bar_y0 + bar_h + 3 * scale;
-  const std::string lo = format_number(vmin), hi = format_number(vmax);
-  draw_text(img, bar_x0, num_y, lo, scale, black);
-  draw_text(img, bar_x1 - text_width(hi, scale), num_y, hi, scale, black);
-  const int label_y = num_y + text_h + 3 * scale;
-  draw_text(img, std::max(margin, (width - text_width(label, scale)) / 2), label_y, label, scale, black);
+  if (opt.north_arrow) {
+    const int h = 24 * scale, w = 14 * scale;
+    const int xc = mw - 2 * margin - w / 2, y0 = 2 * margin + text_h + 2 * scale;
+    fill_box(img, xc - w / 2 - 3 * scale, 2 * margin - 3 * scale, xc + w / 2 + 3 * scale, y0 + h + 3 * scale, white);
+    draw_text(img, xc - text_width("N", scale) / 2, 2 * margin, "N", scale, black);
+    // A filled arrow head pointing up (north) on a shaft.
+    for (int y = 0; y < h / 2; ++y) {
+      const int half = static_cast<int>(std::lround(double(y) / (h / 2) * (w / 2)));
+      img.line(xc - half, y0 + y, xc + half, y0 + y, black);
+    }
+    fill_box(img, xc - scale, y0 + h / 2, xc + scale + 1, y0 + h, black);
+  }
+
+  // 7. The legend below the map.
+  if (!opt.classes.empty()) {
+    draw_text(img, margin, mh + margin, title, scale, black);
+    for (std::size_t k = 0; k < opt.classes.size(); ++k) {
+      const auto [x, y] = class_pos[k];
+      fill_box(img, x, y, x + swatch, y + swatch, opt.classes[k].colour);
+      draw_text(img, x + swatch + 4 * scale, y + (swatch - text_h) / 2, opt.classes[k].label, scale, black);
+    }
+  } else {
+    draw_colour_bar(img, margin, mh + margin, width - 2 * margin, opt.ramp, vmin, vmax, title, scale);
+  }
 
   write_rgb_png(path, img.width, img.height, img.rgb);
 }

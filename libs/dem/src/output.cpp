@@ -98,9 +98,73 @@ Frame make_frame(Vec2 lo, Vec2 hi, int width_px) {
   return f;
 }
 
+/// One entry of a picture's legend: a colour swatch and its text.
+struct LegendEntry {
+  std::array<std::uint8_t, 3> colour;
+  std::string text;
+};
+
+/// The picture `plot` drawn in `f` framed with numbered axes in metres (`x_title`, `y_title`), a
+/// title above and a legend below.
+Image with_axes(const Image& plot, const Frame& f, const std::string& title, const std::string& x_title,
+                const std::string& y_title, const std::vector<LegendEntry>& legend) {
+  constexpr int s = 2, ml = 110, mr = 30, mt = 56, mb = 70;
+  const int th = 7 * s;
+  // Legend rows.
+  const int W = plot.width + ml + mr;
+  std::vector<std::pair<int, int>> pos;
+  int lx = ml, ly = mt + plot.height + mb;
+  for (const auto& e : legend) {
+    const int w = 14 * s + text_width(e.text, s);
+    if (lx > ml && lx + w > W - mr) {
+      lx = ml;
+      ly += th + 8;
+    }
+    pos.emplace_back(lx, ly);
+    lx += w + 20;
+  }
+  const int H = (legend.empty() ? mt + plot.height + mb : ly + th + 10);
+  Image img(W, H);
+  for (int y = 0; y < plot.height; ++y)
+    for (int x = 0; x < plot.width; ++x) {
+      const std::size_t i = (static_cast<std::size_t>(y) * plot.width + x) * 3;
+      img.set(ml + x, mt + y, {plot.rgb[i], plot.rgb[i + 1], plot.rgb[i + 2]});
+    }
+  const std::array<std::uint8_t, 3> black{0, 0, 0};
+  const int x0 = ml, x1 = ml + plot.width - 1, y0 = mt, y1 = mt + plot.height - 1;
+  img.line(x0, y0, x1, y0, black);
+  img.line(x0, y1, x1, y1, black);
+  img.line(x0, y0, x0, y1, black);
+  img.line(x1, y0, x1, y1, black);
+  const double xlo = f.lo.x(), xhi = f.lo.x() + (plot.width - 1) / f.scale;
+  const double ylo = f.lo.y(), yhi = f.lo.y() + (plot.height - 1) / f.scale;
+  for (double v : nice_ticks(xlo, xhi, std::max(2, plot.width / 140))) {
+    const int px = ml + static_cast<int>(std::lround(f.px(v)));
+    img.line(px, y1, px, y1 + 6, black);
+    const std::string t = format_tick(v);
+    draw_text(img, px - text_width(t, s) / 2, y1 + 10, t, s);
+  }
+  for (double v : nice_ticks(ylo, yhi, std::max(2, plot.height / 90))) {
+    const int py = mt + static_cast<int>(std::lround(f.py(v)));
+    img.line(x0 - 6, py, x0, py, black);
+    const std::string t = format_tick(v);
+    draw_text(img, x0 - 10 - text_width(t, s), py - th / 2, t, s);
+  }
+  draw_text(img, ml + (plot.width - text_width(x_title, s)) / 2, y1 + 16 + th, x_title, s);
+  draw_text(img, 8, mt - th - 8, y_title, s);
+  draw_text(img, ml + (plot.width - text_width(title, s)) / 2, 8, title, s);
+  for (std::size_t k = 0; k < legend.size(); ++k) {
+    const auto [x, y] = pos[k];
+    for (int a = 0; a < th; ++a)
+      for (int b = 0; b < th; ++b) img.set(x + b, y + a, legend[k].colour);
+    draw_text(img, x + th + 8, y, legend[k].text, s);
+  }
+  return img;
+}
+
 }  // namespace
 
-void write_sample_png(const std::filesystem::path& path, const DemSolver& s, int width_px) {
+void write_sample_png(const std::filesystem::path& path, const DemSolver& s, const std::string& title, int width_px) {
   const auto& x = s.discs.get<Position<2>>();
   const auto& R = s.discs.get<Radius>();
   Vec2 lo = Vec2::Constant(1e300), hi = Vec2::Constant(-1e300);
@@ -139,7 +203,11 @@ void write_sample_png(const std::filesystem::path& path, const DemSolver& s, int
       img.fill_circle(f.px(m.x()), f.py(m.y()), std::max(1.5, 0.4 * s.bonds.radius[b] * f.scale), c);
     }
   }
-  write_png(path, img);
+  write_png(path, with_axes(img, f, title, "x (m)", "y (m)",
+                            {{{40, 90, 200}, "intact bond"},
+                             {{220, 30, 30}, "tensile crack"},
+                             {{250, 150, 0}, "shear crack"},
+                             {{20, 160, 60}, "cut by a joint"}}));
 }
 
 void write_avalanche_png(const std::filesystem::path& path, const DemSolver& s, const std::vector<Vec2>& terrain,
@@ -172,39 +240,12 @@ void write_avalanche_png(const std::filesystem::path& path, const DemSolver& s, 
     const double t = frag[i] <= 0 ? 0.0 : 0.15 + 0.85 * std::fmod(0.618034 * frag[i], 1.0);
     img.fill_circle(f.px(x[i].x()), f.py(x[i].y()), std::max(0.8, R[i] * f.scale), ramp_colour(ColourRamp::Viridis, t));
   }
-  write_png(path, img);
+  write_png(path, with_axes(img, f, "rock avalanche at the end (discs coloured by fragment)",
+                            "distance along the section (m)", "elevation (m)",
+                            {{{60, 40, 20}, "terrain"}, {{150, 150, 150}, "source outline"}}));
 }
 
 namespace {
-
-/// 3×5 pixel glyphs for tick labels: digits, '.', '-' (rows top to bottom, 3 bits each).
-const std::array<std::uint16_t, 12> kGlyphs{{
-    0b111101101101111,  // 0
-    0b010110010010111,  // 1
-    0b111001111100111,  // 2
-    0b111001111001111,  // 3
-    0b101101111001001,  // 4
-    0b111100111001111,  // 5
-    0b111100111101111,  // 6
-    0b111001001001001,  // 7
-    0b111101111101111,  // 8
-    0b111101111001111,  // 9
-    0b000000000000010,  // .
-    0b000000111000000,  // -
-}};
-
-void draw_text(Image& img, int x, int y, const std::string& text, int scale) {
-  for (char ch : text) {
-    int g = ch == '.' ? 10 : ch == '-' ? 11 : (ch >= '0' && ch <= '9' ? ch - '0' : -1);
-    if (g >= 0)
-      for (int r = 0; r < 5; ++r)
-        for (int c = 0; c < 3; ++c)
-          if (kGlyphs[g] >> (14 - (3 * r + c)) & 1)
-            for (int a = 0; a < scale; ++a)
-              for (int b = 0; b < scale; ++b) img.set(x + c * scale + b, y + r * scale + a, {0, 0, 0});
-    x += 4 * scale;
-  }
-}
 
 /// A "nice" tick step (1, 2 or 5 × 10^k) giving about n ticks over span.
 double nice_step(double span, int n) {
@@ -223,7 +264,7 @@ std::string tick_label(double v, double step) {
 }  // namespace
 
 void write_deposit_png(const std::filesystem::path& path, const std::vector<std::pair<double, double>>& deposit) {
-  const int W = 900, H = 360, ml = 60, mr = 20, mt = 20, mb = 40;
+  const int W = 900, H = 380, ml = 90, mr = 20, mt = 30, mb = 56;
   Image img(W, H);
   double x0 = 0, x1 = 1, hmax = 0;
   if (!deposit.empty()) {
@@ -244,17 +285,20 @@ void write_deposit_png(const std::filesystem::path& path, const std::vector<std:
   for (double x = x0; x <= x1 + 1e-9 * xs; x += xs) {
     img.line(px(x), py(0), px(x), py(y1), grid);
     const std::string l = tick_label(x, xs);
-    draw_text(img, static_cast<int>(px(x)) - 4 * static_cast<int>(l.size()), H - mb + 8, l, 2);
+    draw_text(img, static_cast<int>(px(x)) - text_width(l, 2) / 2, H - mb + 8, l, 2);
   }
   for (double y = 0; y <= y1 + 1e-9 * ys; y += ys) {
     img.line(px(x0), py(y), px(x1), py(y), grid);
     const std::string l = tick_label(y, ys);
-    draw_text(img, ml - 8 - 8 * static_cast<int>(l.size()), static_cast<int>(py(y)) - 5, l, 2);
+    draw_text(img, ml - 8 - text_width(l, 2), static_cast<int>(py(y)) - 7, l, 2);
   }
   for (std::size_t k = 1; k < deposit.size(); ++k)  // deposit surface
     img.line(px(deposit[k - 1].first), py(deposit[k - 1].second), px(deposit[k].first), py(deposit[k].second), black);
   img.line(px(x0), py(0), px(x1), py(0), black);
   img.line(px(x0), py(0), px(x0), py(y1), black);
+  const std::string xt = "distance along the profile (m)";
+  draw_text(img, ml + (W - ml - mr - text_width(xt, 2)) / 2, H - 22, xt, 2);
+  draw_text(img, 8, 6, "deposit thickness (m)", 2);
   write_png(path, img);
 }
 

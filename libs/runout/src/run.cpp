@@ -538,15 +538,16 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
   const Raster r_depth =
       put("max_depth", maps.max_depth(), 0.0, "peak flow depth, normal to the bed", "m", ColourRamp::Viridis);
   const Raster r_speed = put("max_speed", maps.max_speed(), 0.0, "peak surface speed", "m/s", ColourRamp::Magma);
-  put("max_pressure", maps.max_pressure(), 0.0, "peak dynamic pressure rho v^2", "Pa", ColourRamp::Magma);
+  const Raster r_pressure =
+      put("max_pressure", maps.max_pressure(), 0.0, "peak dynamic pressure rho v^2", "Pa", ColourRamp::Magma);
   put("max_momentum", maps.max_momentum(), 0.0, "peak momentum per unit area over density, h v", "m2/s",
       ColourRamp::Magma);
   const Raster r_dep =
       put("deposit", sim.deposit(), 0.0, "final deposit thickness, vertical", "m", ColourRamp::Viridis);
   put("mobile_at_end", sim.mobile_at_end(), 0.0, "thickness still moving when the run ended at its duration, vertical",
       "m", ColourRamp::Viridis);
-  put("arrival_time", maps.arrival_time(), -9999.0, "first arrival of the flow (-9999: never)", "s",
-      ColourRamp::Viridis);
+  const Raster r_arrival = put("arrival_time", maps.arrival_time(), -9999.0, "first arrival of the flow (-9999: never)",
+                               "s", ColourRamp::Viridis);
   // Intensity classes (0 not reached, 1 low, 2 medium, 3 strong) with their labelled palette.
   const IntensityTable& itab = c.output.intensity;
   Raster r_int = map_raster(intensity_classes(maps, itab), 0.0);
@@ -555,8 +556,9 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
                           : "intensity class (pressure: 1 low, 2 medium, 3 strong; 0 not reached)";
   r_int.unit = "1";
   write_geotiff(out / "intensity.tif", r_int);
+  std::vector<StyleClass> intensity_classes_legend;
   {
-    std::vector<StyleClass> cls;
+    std::vector<StyleClass>& cls = intensity_classes_legend;
     const auto col = [](double t) { return ramp_colour(ColourRamp::Intensity, t); };
     std::ostringstream strong, medium, low;
     if (itab.scheme == IntensityScheme::DepthSpeed) {
@@ -571,23 +573,37 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
     }
     write_qgis_class_style(out / "intensity.qml", cls);
   }
+  // Quick-look maps for the report (docs/report.md): cropped to the affected area with a 200 m
+  // margin, over the hillshade, with scale bar, north arrow and a legend with units.
+  const auto map_png = [&](const char* name, const Raster& r, ColourRamp ramp, const char* title, const char* unit,
+                           double overlay_min, const std::vector<StyleClass>& classes = {}) {
+    QuicklookOptions o;
+    o.ramp = ramp;
+    o.title = title;
+    o.unit = unit;
+    o.overlay_min = overlay_min;
+    o.classes = classes;
+    o.crop_margin_m = 200.0;
+    o.scale_bar = true;
+    o.north_arrow = true;
+    write_quicklook_png(out / (std::string(name) + ".png"), dsm, &r, o);
+  };
   const auto& solver = sim.solver();
   if (!solver.eroded_depth().empty()) {
     const Raster r_ero =
         put("erosion_depth", solver.eroded_depth(), 0.0, "depth eroded from the bed, vertical", "m", ColourRamp::Magma);
-    if (c.output.pngs)
-      write_quicklook_png(out / "erosion_depth.png", dsm, &r_ero, ColourRamp::Magma, "eroded depth (m)", 0.0, 0.0,
-                          0.001);
+    if (c.output.pngs) map_png("erosion_depth", r_ero, ColourRamp::Magma, "eroded depth", "m", 0.001);
   }
   if (c.output.pngs) {
-    write_quicklook_png(out / "max_depth.png", dsm, &r_depth, ColourRamp::Viridis, "peak flow thickness (m)", 0.0, 0.0,
-                        0.01);
-    write_quicklook_png(out / "deposit.png", dsm, &r_dep, ColourRamp::Viridis, "deposit thickness (m)", 0.0, 0.0, 0.01);
-    write_quicklook_png(out / "max_speed.png", dsm, &r_speed, ColourRamp::Magma, "maximum speed (m/s)", 0.0, 0.0, 0.01);
-    write_quicklook_png(out / "intensity.png", dsm, &r_int, ColourRamp::Intensity,
-                        itab.scheme == IntensityScheme::DepthSpeed ? "intensity: 2 medium, 3 strong"
-                                                                   : "intensity: 1 low, 2 medium, 3 strong",
-                        0.5, 3.5, 0.5);
+    map_png("max_depth", r_depth, ColourRamp::Viridis, "peak flow depth", "m", 0.01);
+    map_png("deposit", r_dep, ColourRamp::Viridis, "deposit thickness", "m", 0.01);
+    map_png("max_speed", r_speed, ColourRamp::Magma, "peak speed", "m/s", 0.01);
+    Raster r_kpa = r_pressure;  // kPa reads better than 2.2e+06 Pa
+    for (double& v : r_kpa.data)
+      if (v != -9999.0) v *= 1e-3;
+    map_png("max_pressure", r_kpa, ColourRamp::Magma, "peak pressure rho v^2", "kPa", 0.01);
+    map_png("arrival_time", r_arrival, ColourRamp::Viridis, "arrival time", "s", -1.0);
+    map_png("intensity", r_int, ColourRamp::Intensity, "intensity class", "", 0.5, intensity_classes_legend);
   }
 
   {

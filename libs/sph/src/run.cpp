@@ -399,11 +399,13 @@ Restart load_restart(const std::filesystem::path& path, SphStore<Dim>& s) {
   return out;
 }
 
-/// Quick-look picture: particles in the x–z plane coloured by `value` (soil) on a ramp, boundary grey.
+/// Quick-look picture: particles in the x–z plane coloured by `value` (soil) on a ramp, boundary grey,
+/// with a colour bar numbered from 0 to vmax and titled `title` ("displacement (m)").
 /// `overlay` (optional): a polyline in (x, z) drawn in red over the particles (a slip circle).
 template <int Dim>
 void draw_particles(const std::filesystem::path& path, const SphStore<Dim>& s, const std::vector<double>& value,
-                    double vmax, double dx, const std::vector<std::array<double, 2>>& overlay = {}) {
+                    double vmax, double dx, const std::string& title,
+                    const std::vector<std::array<double, 2>>& overlay = {}) {
   const auto& x = s.template get<Position<Dim>>();
   const auto& kind = s.template get<ParticleKind>();
   double x0 = 1e300, x1 = -1e300, z0 = 1e300, z1 = -1e300;
@@ -417,12 +419,15 @@ void draw_particles(const std::filesystem::path& path, const SphStore<Dim>& s, c
   // Fit the x–z extent into at most 1200 × 1200 pixels of drawing area.
   const double scale =
       std::min((W - 2 * margin) / std::max(x1 - x0 + dx, 1e-12), (1200.0 - 2 * margin) / std::max(z1 - z0 + dx, 1e-12));
-  const int H = std::max(static_cast<int>((z1 - z0 + dx) * scale) + 2 * margin + 30, 60);
+  // Below the particles: 10 px gap, then draw_colour_bar at text scale 2 (bar 20, ticks 6 + 4,
+  // numbers 14, gap 8, title 14 = 66 px), and 8 px to spare.
+  constexpr int kLegend = 84;
+  const int H = std::max(static_cast<int>((z1 - z0 + dx) * scale) + 2 * margin + kLegend, 100);
   Image img(W, H);
   const double r = std::max(1.0, 0.5 * dx * scale);
   for (std::size_t i = 0; i < s.size(); ++i) {
     const double px = margin + (x[i][0] - x0) * scale + 0.5 * (W - 2 * margin - (x1 - x0) * scale);
-    const double pz = H - 30 - margin - (x[i][Dim - 1] - z0) * scale;
+    const double pz = H - kLegend - margin - (x[i][Dim - 1] - z0) * scale;
     std::array<std::uint8_t, 3> col{160, 160, 160};
     if (kind[i] == kSoil)
       col = ramp_colour(ColourRamp::Viridis, vmax > 0 ? std::clamp(value[i] / vmax, 0.0, 1.0) : 0.0);
@@ -430,16 +435,13 @@ void draw_particles(const std::filesystem::path& path, const SphStore<Dim>& s, c
   }
   for (std::size_t k = 1; k < overlay.size(); ++k) {
     auto px = [&](double xx) { return margin + (xx - x0) * scale + 0.5 * (W - 2 * margin - (x1 - x0) * scale); };
-    auto pz = [&](double zz) { return H - 30 - margin - (zz - z0) * scale; };
+    auto pz = [&](double zz) { return H - kLegend - margin - (zz - z0) * scale; };
     for (int d = -1; d <= 1; ++d)
       img.line(px(overlay[k - 1][0]), pz(overlay[k - 1][1]) + d, px(overlay[k][0]), pz(overlay[k][1]) + d,
                {220, 30, 30});
   }
-  // Colour bar along the bottom (0 … vmax).
-  for (int px = margin; px < W - margin; ++px) {
-    const auto col = ramp_colour(ColourRamp::Viridis, static_cast<double>(px - margin) / (W - 2 * margin));
-    for (int py = H - 22; py < H - 8; ++py) img.set(px, py, col);
-  }
+  draw_colour_bar(img, margin, H - kLegend + 10, W - 2 * margin, ColourRamp::Viridis, 0.0, vmax > 0 ? vmax : 1.0, title,
+                  2);
   write_png(path, img);
 }
 
@@ -800,7 +802,7 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
         const double vm = *std::max_element(v.begin(), v.end());
         std::ostringstream name;
         name << "velocity_t" << std::fixed << std::setprecision(3) << png_times[next_png] << ".png";
-        draw_particles<Dim>(out / name.str(), solver.store(), v, vm, c.numerics.spacing);
+        draw_particles<Dim>(out / name.str(), solver.store(), v, vm, c.numerics.spacing, "speed (m/s)");
         ++next_png;
       }
       solver.step();
@@ -857,10 +859,12 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
       u[i] = solver.store().template get<Displacement<Dim>>()[i].norm();
       if (solver.store().template get<ParticleKind>()[i] == kSoil) umax = std::max(umax, u[i]);
     }
-    draw_particles<Dim>(out / "final_displacement.png", solver.store(), u, umax, c.numerics.spacing);
+    draw_particles<Dim>(out / "final_displacement.png", solver.store(), u, umax, c.numerics.spacing,
+                        "displacement (m)");
     const auto& ep = solver.store().template get<PlasticStrain>();
     const double epmax = ep.empty() ? 0.0 : *std::max_element(ep.begin(), ep.end());
-    draw_particles<Dim>(out / "final_plastic_strain.png", solver.store(), ep, epmax, c.numerics.spacing);
+    draw_particles<Dim>(out / "final_plastic_strain.png", solver.store(), ep, epmax, c.numerics.spacing,
+                        "accumulated plastic strain (1)");
     summary["max_plastic_strain"] = epmax;
   }
   const auto fm = failed_mass(solver.store(), rho0, c.failed_threshold);
@@ -1167,8 +1171,9 @@ int run_strength_reduction(const RunConfig& c, const std::filesystem::path& out,
       reference.template get<Position<Dim>>()[i] -= mechanism->template get<Displacement<Dim>>()[i];
       if (mechanism->template get<ParticleKind>()[i] == kSoil) umax = std::max(umax, u[i]);
     }
-    draw_particles<Dim>(out / "mechanism.png", reference, u, umax, c.numerics.spacing, circle);
-    draw_particles<Dim>(out / "mechanism_deformed.png", *mechanism, u, umax, c.numerics.spacing, circle);
+    draw_particles<Dim>(out / "mechanism.png", reference, u, umax, c.numerics.spacing, "displacement (m)", circle);
+    draw_particles<Dim>(out / "mechanism_deformed.png", *mechanism, u, umax, c.numerics.spacing, "displacement (m)",
+                        circle);
     // The slip surface of the mechanism: the lower edge of the soil displaced by more than a tenth
     // of the largest displacement.
     std::ostringstream ss;

@@ -145,9 +145,35 @@ struct StyleClass {
 /// A QGIS layer style (.qml) for a categorical raster (paletted renderer).
 void write_qgis_class_style(const std::filesystem::path& path, const std::vector<StyleClass>& classes);
 
-/// Write a quick-look PNG: a hillshade of `elevation`, overlaid where `overlay` is present, finite,
-/// not nodata and above `overlay_min` by the colour ramp between vmin and vmax (auto when vmin ≥ vmax).
-/// A colour bar with `label` is drawn along the bottom. Goes through GDAL's PNG driver.
+/// How a quick-look map is drawn (write_quicklook_png). The defaults draw the whole raster with a
+/// numbered colour bar and nothing else, as the positional overload always did.
+struct QuicklookOptions {
+  ColourRamp ramp = ColourRamp::Viridis;
+  std::string title;              ///< what the overlay shows, e.g. "peak flow depth"
+  std::string unit;               ///< unit of the overlay values, e.g. "m" ("" for none): "title (unit)"
+  double vmin = 0.0, vmax = 0.0;  ///< colour range; automatic over the drawn values when vmin ≥ vmax
+  double overlay_min = 0.0;       ///< overlay values at or below this are not drawn
+  /// A class legend (swatch and label per class) instead of the colour bar, for categorical
+  /// overlays such as the intensity classes: a cell is drawn in the colour of the class whose
+  /// value is nearest to its own.
+  std::vector<StyleClass> classes;
+  /// Crop to the cells where the overlay is drawn plus this margin in metres (negative: the whole
+  /// raster). A cropped map is enlarged to 840 px on its longer side (nearest cell, ≤ 16 px a cell).
+  double crop_margin_m = -1.0;
+  bool scale_bar = false;    ///< a scale bar (1, 2 or 5 × 10^k m) in the lower left corner of the map
+  bool north_arrow = false;  ///< a north arrow in the upper right corner (the raster is north-up)
+  /// Polylines in map (CRS) coordinates, drawn as dark lines two pixels wide (barriers, sections).
+  std::vector<std::vector<Vec2>> lines;
+};
+
+/// Write a quick-look PNG: a hillshade of `elevation` (sun from the north-west, 45° high),
+/// overlaid where `overlay` is present, finite, not nodata and above `opt.overlay_min` by the
+/// colour ramp between vmin and vmax, then the legend below the map (colour bar with ticks and
+/// "title (unit)", or the class legend). Without an overlay the elevation itself is tinted.
+/// InputError when the grids differ or are empty (nothing written). Goes through GDAL's PNG driver.
+void write_quicklook_png(const std::filesystem::path& path, const Raster& elevation, const Raster* overlay,
+                         const QuicklookOptions& opt);
+/// The positional form of the above (whole raster, colour bar titled `label`, no scale bar).
 void write_quicklook_png(const std::filesystem::path& path, const Raster& elevation, const Raster* overlay,
                          ColourRamp ramp, const std::string& label, double vmin = 0.0, double vmax = 0.0,
                          double overlay_min = 0.0);
@@ -164,5 +190,21 @@ struct Image {
 void write_png(const std::filesystem::path& path, const Image& img);
 /// Colour of value t ∈ [0, 1] on a ramp.
 std::array<std::uint8_t, 3> ramp_colour(ColourRamp ramp, double t) noexcept;
+
+/// Draw `text` in the 5×7 bitmap font (ASCII letters, digits, + - . , : / ( ) % = ^ _; other
+/// bytes are skipped), its top left corner at (x, y), each font pixel `scale` × `scale` pixels.
+void draw_text(Image& img, int x, int y, const std::string& text, int scale,
+               std::array<std::uint8_t, 3> colour = {0, 0, 0}) noexcept;
+/// Width in pixels of `text` drawn by draw_text (its height is 7 · scale).
+int text_width(const std::string& text, int scale) noexcept;
+/// Tick values at a "nice" step (1, 2 or 5 × 10^k) giving about `n` ticks within [lo, hi], both
+/// ends included when they fall on the step (empty when hi ≤ lo or either is not finite).
+std::vector<double> nice_ticks(double lo, double hi, int n);
+/// A number for a tick or legend: at most 4 significant digits, no trailing zeros ("0.25", "1e+06").
+std::string format_tick(double v);
+/// A horizontal colour bar from vmin to vmax at (x, y), `width` pixels long, with ticks numbered
+/// at nice_ticks and `title` centred below. Returns the height drawn in pixels.
+int draw_colour_bar(Image& img, int x, int y, int width, ColourRamp ramp, double vmin, double vmax,
+                    const std::string& title, int scale);
 
 }  // namespace geohaz

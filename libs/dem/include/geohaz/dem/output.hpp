@@ -30,9 +30,12 @@ void write_deposit_csv(const std::filesystem::path& path, const std::vector<std:
 void write_deposit_png(const std::filesystem::path& path, const std::vector<std::pair<double, double>>& deposit);
 
 /// Quick look of a sample: discs in grey, bonds coloured by state (intact blue, broken in tension
-/// red, in shear orange, cut by a joint green), walls black.
-void write_sample_png(const std::filesystem::path& path, const DemSolver& s, int width_px = 800);
-/// Quick look of an avalanche: terrain profile, the source outline and the discs coloured by fragment.
+/// red, in shear orange, cut by a joint green), walls black; numbered axes in metres, `title`
+/// above and the legend of the bond states below.
+void write_sample_png(const std::filesystem::path& path, const DemSolver& s, const std::string& title = "",
+                      int width_px = 800);
+/// Quick look of an avalanche: terrain profile, the source outline and the discs coloured by
+/// fragment, with numbered axes (distance along the section, elevation; m) and a legend.
 void write_avalanche_png(const std::filesystem::path& path, const DemSolver& s, const std::vector<Vec2>& terrain,
                          const std::vector<Vec2>& source, int width_px = 1200);
 

@@ -1,0 +1,974 @@
+/// \file report.cpp
+/// geohaz-report's page (see report.hpp and docs/report.md).
+
+#include "report.hpp"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "geohaz/core/errors.hpp"
+#include "geohaz/core/output.hpp"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace geohaz::report {
+
+namespace {
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : s) {
+    if (c == sep) {
+      out.push_back(cur);
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  out.push_back(cur);
+  return out;
+}
+
+std::string join(const std::vector<std::string>& v, std::size_t from, std::size_t to, const char* sep) {
+  std::string s;
+  for (std::size_t k = from; k < to; ++k) s += (k > from ? sep : "") + v[k];
+  return s;
+}
+
+std::string escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    switch (c) {
+      case '<':
+        o += "&lt;";
+        break;
+      case '>':
+        o += "&gt;";
+        break;
+      case '&':
+        o += "&amp;";
+        break;
+      case '"':
+        o += "&quot;";
+        break;
+      default:
+        o += c;
+    }
+  }
+  return o;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// Unit suffixes as "_"-separated tokens, and how they are shown.
+struct UnitName {
+  const char* tokens;
+  const char* shown;
+};
+constexpr UnitName kUnits[] = {
+    {"m_per_s2", "m/s²"}, {"m_s2", "m/s²"},   {"m2_per_m", "m²/m"}, {"J_per_m", "J/m"}, {"N_per_m", "N/m"},
+    {"kN_per_m", "kN/m"}, {"m_per_s", "m/s"}, {"m3_s", "m³/s"},     {"m2_s", "m²/s"},   {"m_s", "m/s"},
+    {"per_m", "1/m"},     {"m3", "m³"},       {"m2", "m²"},         {"kg_m3", "kg/m³"}, {"kg", "kg"},
+    {"Pa", "Pa"},         {"pa", "Pa"},       {"kPa", "kPa"},       {"MPa", "MPa"},     {"N", "N"},
+    {"kN", "kN"},         {"J", "J"},         {"j", "J"},           {"W", "W"},         {"deg", "°"},
+    {"Hz", "Hz"},         {"s", "s"},         {"m", "m"},           {"percent", "%"},
+};
+
+}  // namespace
+
+Quantity quantity_from_name(const std::string& name) {
+  const auto tok = split(name, '_');
+  // The longest unit suffix wins ("m_per_s" over "s"); at least one word must remain.
+  for (std::size_t n = std::min<std::size_t>(3, tok.size() - 1); n >= 1; --n) {
+    const std::string tail = join(tok, tok.size() - n, tok.size(), "_");
+    for (const auto& u : kUnits)
+      if (tail == u.tokens) return {join(tok, 0, tok.size() - n, " "), u.shown};
+  }
+  return {join(tok, 0, tok.size(), " "), ""};
+}
+
+namespace {
+
+/// Digits grouped by three with a narrow no-break space (U+202F).
+std::string group_thousands(const std::string& digits) {
+  std::string sign, s = digits;
+  if (!s.empty() && s[0] == '-') {
+    sign = "-";
+    s = s.substr(1);
+  }
+  const std::size_t dot = s.find('.');
+  std::string ip = s.substr(0, dot), frac = dot == std::string::npos ? "" : s.substr(dot);
+  if (ip.size() <= 4) return sign + ip + frac;
+  std::string o;
+  for (std::size_t k = 0; k < ip.size(); ++k) {
+    if (k > 0 && (ip.size() - k) % 3 == 0) o += "\u202F";
+    o += ip[k];
+  }
+  return sign + o + frac;
+}
+
+std::string format_number(double v) {
+  if (!std::isfinite(v)) return std::isnan(v) ? "n/a" : (v > 0 ? "∞" : "−∞");
+  const double a = std::abs(v);
+  char buf[64];
+  if (a == std::round(a) && a < 1e15) {
+    std::snprintf(buf, sizeof buf, "%.0f", v);
+    return group_thousands(buf);
+  }
+  if (a >= 1e-3 && a < 1e9) {
+    const int digits = std::max(0, 3 - static_cast<int>(std::floor(std::log10(a))));
+    std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+    std::string s = buf;
+    if (s.find('.') != std::string::npos) {  // no trailing zeros
+      while (s.back() == '0') s.pop_back();
+      if (s.back() == '.') s.pop_back();
+    }
+    return group_thousands(s);
+  }
+  std::snprintf(buf, sizeof buf, "%.3e", v);
+  return buf;
+}
+
+}  // namespace
+
+std::string format_quantity(double value, const std::string& unit) {
+  // Large stresses, energies and forces in the prefixed unit an engineer would write.
+  static const char* kPrefixed[] = {"Pa", "J", "J/m", "N", "N/m", "W"};
+  for (const char* u : kPrefixed)
+    if (unit == u && std::isfinite(value)) {
+      const double a = std::abs(value);
+      const char* p = a >= 1e12 ? "T" : a >= 1e9 ? "G" : a >= 1e6 ? "M" : a >= 1e3 ? "k" : "";
+      const double f = a >= 1e12 ? 1e12 : a >= 1e9 ? 1e9 : a >= 1e6 ? 1e6 : a >= 1e3 ? 1e3 : 1.0;
+      return format_number(value / f) + " " + p + unit;
+    }
+  const std::string n = format_number(value);
+  if (unit.empty()) return n;
+  return unit == "°" || unit == "%" ? n + unit : n + " " + unit;
+}
+
+// ---------------------------------------------------------------------------------------------
+// CSV and SVG plots
+
+Csv read_csv(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError("cannot open the CSV file", path.string());
+  Csv c;
+  std::string line;
+  if (!std::getline(in, line)) return c;
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  c.names = split(line, ',');
+  c.columns.assign(c.names.size(), {});
+  c.numeric.assign(c.names.size(), true);
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    const auto cells = split(line, ',');
+    for (std::size_t k = 0; k < c.names.size(); ++k) {
+      double v = std::numeric_limits<double>::quiet_NaN();
+      if (k < cells.size()) {
+        char* end = nullptr;
+        v = std::strtod(cells[k].c_str(), &end);
+        if (end == cells[k].c_str() || *end != '\0') {
+          v = std::numeric_limits<double>::quiet_NaN();
+          if (cells[k] != "nan" && cells[k] != "NaN") c.numeric[k] = false;
+        }
+      } else {
+        c.numeric[k] = false;
+      }
+      c.columns[k].push_back(v);
+    }
+  }
+  return c;
+}
+
+bool is_plottable(const Csv& csv) {
+  if (csv.names.size() < 2 || csv.columns.front().size() < 2) return false;
+  static const char* kAbscissae[] = {"time_s", "x_m", "s_m", "distance_m"};
+  if (std::find(std::begin(kAbscissae), std::end(kAbscissae), csv.names.front()) == std::end(kAbscissae)) return false;
+  return std::all_of(csv.numeric.begin(), csv.numeric.end(), [](bool b) { return b; });
+}
+
+namespace {
+
+/// Tick values at a nice step (1, 2, 5 × 10^k) within [lo, hi].
+std::vector<double> ticks(double lo, double hi, int n) {
+  std::vector<double> t;
+  if (!(hi > lo)) return t;
+  const double raw = (hi - lo) / n, p = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = 10 * p;
+  for (double m : {1.0, 2.0, 5.0})
+    if (m * p >= raw) {
+      step = m * p;
+      break;
+    }
+  for (double k = std::ceil(lo / step - 1e-9); k * step <= hi + 1e-9 * step; k += 1) t.push_back(k * step);
+  return t;
+}
+
+std::string tick_text(double v, double span) {
+  if (std::abs(v) < 1e-12 * span) v = 0;
+  char buf[32];
+  std::snprintf(buf, sizeof buf, std::abs(v) < 1e6 ? "%.6g" : "%.4g", v);
+  return buf;
+}
+
+/// A word for the axis of a panel holding several quantities of one unit.
+std::string unit_word(const std::string& unit) {
+  static const std::pair<const char*, const char*> kWords[] = {{"m", "length"},         {"m/s", "speed"},
+                                                               {"m³", "volume"},        {"m²", "area"},
+                                                               {"s", "time"},           {"Pa", "stress"},
+                                                               {"N", "force"},          {"N/m", "force per metre"},
+                                                               {"J", "energy"},         {"J/m", "energy per metre"},
+                                                               {"m/s²", "acceleration"}};
+  for (const auto& [u, w] : kWords)
+    if (unit == u) return w;
+  return unit.empty() ? "value" : "";
+}
+
+/// Round a range out to nice ticks.
+void nice_range(double& lo, double& hi) {
+  if (!(hi > lo)) {
+    const double d = std::max(1e-9, std::abs(lo) * 0.05 + (lo == 0 ? 1 : 0));
+    lo -= d;
+    hi += d;
+  }
+  const auto t = ticks(lo, hi, 5);
+  if (t.size() >= 2) {
+    const double step = t[1] - t[0];
+    lo = std::floor(lo / step + 1e-9) * step;
+    hi = std::ceil(hi / step - 1e-9) * step;
+  }
+}
+
+constexpr const char* kLineColours[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#17becf"};
+
+}  // namespace
+
+std::string svg_plot(const Csv& csv, const std::string& title) {
+  // Panels: columns grouped by unit, in order of first appearance.
+  struct Panel {
+    std::string unit;
+    std::vector<std::size_t> cols;
+  };
+  std::vector<Panel> panels;
+  for (std::size_t k = 1; k < csv.names.size(); ++k) {
+    const std::string& n = csv.names[k];
+    if (n == "step" || (n.size() >= 3 && (n.ends_with("x_m") || n.ends_with("y_m")))) continue;
+    const auto& col = csv.columns[k];
+    if (std::all_of(col.begin(), col.end(), [](double v) { return v == 0.0 || std::isnan(v); })) continue;
+    const Quantity q = quantity_from_name(n);
+    auto it = std::find_if(panels.begin(), panels.end(), [&](const Panel& p) { return p.unit == q.unit; });
+    if (it == panels.end()) {
+      panels.push_back({q.unit, {}});
+      it = panels.end() - 1;
+    }
+    it->cols.push_back(k);
+  }
+  const int W = 760, ml = 80, mr = 200, ph = 200, gap = 50, top = 36;
+  const int H = top + static_cast<int>(std::max<std::size_t>(panels.size(), 1)) * (ph + gap) + 10;
+  const Quantity xq = quantity_from_name(csv.names.front());
+  const auto& x = csv.columns.front();
+  double x0 = *std::min_element(x.begin(), x.end()), x1 = *std::max_element(x.begin(), x.end());
+  nice_range(x0, x1);
+  std::ostringstream s;
+  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H << "\" viewBox=\"0 0 " << W
+    << ' ' << H << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
+    << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
+    << "<text x=\"" << W / 2 << "\" y=\"20\" text-anchor=\"middle\" font-size=\"15\">" << escape(title) << "</text>\n";
+  const int pw = W - ml - mr;
+  for (std::size_t p = 0; p < panels.size(); ++p) {
+    const int y0 = top + static_cast<int>(p) * (ph + gap);  // panel top
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (auto k : panels[p].cols)
+      for (double v : csv.columns[k])
+        if (std::isfinite(v)) {
+          lo = std::min(lo, v);
+          hi = std::max(hi, v);
+        }
+    if (lo > 0 && lo < 0.3 * hi) lo = 0;  // start positive quantities at zero when it costs little
+    nice_range(lo, hi);
+    auto px = [&](double v) { return ml + (v - x0) / (x1 - x0) * pw; };
+    auto py = [&](double v) { return y0 + ph - (v - lo) / (hi - lo) * ph; };
+    s << "<g>\n";
+    for (double t : ticks(x0, x1, 8)) {
+      s << "<line x1=\"" << px(t) << "\" y1=\"" << y0 << "\" x2=\"" << px(t) << "\" y2=\"" << y0 + ph
+        << "\" stroke=\"#e4e4e4\"/>";
+      s << "<text x=\"" << px(t) << "\" y=\"" << y0 + ph + 15 << "\" text-anchor=\"middle\">" << tick_text(t, x1 - x0)
+        << "</text>\n";
+    }
+    for (double t : ticks(lo, hi, 5)) {
+      s << "<line x1=\"" << ml << "\" y1=\"" << py(t) << "\" x2=\"" << ml + pw << "\" y2=\"" << py(t)
+        << "\" stroke=\"#e4e4e4\"/>";
+      s << "<text x=\"" << ml - 6 << "\" y=\"" << py(t) + 4 << "\" text-anchor=\"end\">" << tick_text(t, hi - lo)
+        << "</text>\n";
+    }
+    s << "<rect x=\"" << ml << "\" y=\"" << y0 << "\" width=\"" << pw << "\" height=\"" << ph
+      << "\" fill=\"none\" stroke=\"black\"/>\n";
+    // Axis titles: y from the panel's unit (and the quantity when alone), x from the abscissa.
+    const std::string& u = panels[p].unit;
+    std::string ytitle =
+        panels[p].cols.size() == 1 ? quantity_from_name(csv.names[panels[p].cols[0]]).label : unit_word(u);
+    ytitle += u.empty() ? "" : (ytitle.empty() ? "" : " ") + std::string("(") + u + ")";
+    s << "<text transform=\"translate(" << 18 << ',' << y0 + ph / 2 << ") rotate(-90)\" text-anchor=\"middle\">"
+      << escape(ytitle) << "</text>\n";
+    s << "<text x=\"" << ml + pw / 2 << "\" y=\"" << y0 + ph + 32 << "\" text-anchor=\"middle\">" << escape(xq.label)
+      << (xq.unit.empty() ? "" : " (" + xq.unit + ")") << "</text>\n";
+    for (std::size_t c = 0; c < panels[p].cols.size(); ++c) {
+      const auto& y = csv.columns[panels[p].cols[c]];
+      const char* colour = kLineColours[c % std::size(kLineColours)];
+      s << "<polyline fill=\"none\" stroke=\"" << colour << "\" stroke-width=\"1.6\" points=\"";
+      for (std::size_t i = 0; i < y.size(); ++i)
+        if (std::isfinite(x[i]) && std::isfinite(y[i])) s << px(x[i]) << ',' << py(y[i]) << ' ';
+      s << "\"/>\n";
+      const int ly = y0 + 12 + static_cast<int>(c) * 16;
+      s << "<line x1=\"" << ml + pw + 10 << "\" y1=\"" << ly - 4 << "\" x2=\"" << ml + pw + 30 << "\" y2=\"" << ly - 4
+        << "\" stroke=\"" << colour << "\" stroke-width=\"2\"/><text x=\"" << ml + pw + 34 << "\" y=\"" << ly << "\">"
+        << escape(quantity_from_name(csv.names[panels[p].cols[c]]).label) << "</text>\n";
+    }
+    s << "</g>\n";
+  }
+  s << "</svg>\n";
+  return s.str();
+}
+
+// ---------------------------------------------------------------------------------------------
+// summary.json
+
+namespace {
+
+enum GroupId { kVolumes, kReach, kPeak, kStrength, kDamage, kTime, kOther, kGroups };
+constexpr const char* kGroupTitles[kGroups] = {"Volumes and areas",
+                                               "Reach and H/L",
+                                               "Peak values",
+                                               "Strength and stiffness (measured on the sample)",
+                                               "Damage and fragmentation",
+                                               "Time",
+                                               "Run bookkeeping / other"};
+
+/// A summary.json key as a reader knows it. `unit` overrides the unit read from the key name.
+struct KeyLabel {
+  const char* key;
+  GroupId group;
+  const char* label;
+  bool headline = false;
+  const char* unit = nullptr;
+};
+
+// Keys written by sph-slope, debris-runout and dem-avalanche (their summary_json / main). A key
+// not listed here is shown under "Run bookkeeping / other", labelled from its name.
+const KeyLabel kKeys[] = {
+    // sph-slope
+    {"release.total_volume_m3", kVolumes, "failed volume handed to the run-out", true},
+    {"release.volume_on_raster_m3", kVolumes, "failed volume on the thickness raster"},
+    {"release.width_m", kVolumes, "width the section stands for"},
+    {"failed_area_m2_per_m", kVolumes, "failed area of the section (per metre width)", true},
+    {"max_runout_m", kReach, "largest run-out of the toe during the run", true},
+    {"runout_m", kReach, "run-out of the toe at the end"},
+    {"normalised_runout", kReach, "run-out / slope height"},
+    {"front_m", kReach, "front position at the end"},
+    {"tip_m", kReach, "tip position at the end"},
+    {"max_displacement_m", kPeak, "largest displacement", true},
+    {"max_plastic_strain", kPeak, "largest plastic strain"},
+    {"max_speed_m_per_s", kPeak, "peak speed", true},
+    {"final_max_speed_m_per_s", kPeak, "largest speed at the end"},
+    {"end_time_s", kTime, "simulated time"},
+    {"time_to_rest_s", kTime, "time to come to rest", true},
+    {"stopped_at_rest", kTime, "came to rest"},
+    // debris-runout
+    {"volumes_m3.release_read", kVolumes, "release volume read", true},
+    {"volumes_m3.seeded", kVolumes, "volume seeded as particles"},
+    {"volumes_m3.deposited", kVolumes, "volume stopped (deposited particles)"},
+    {"volumes_m3.mobile", kVolumes, "volume still moving at the end"},
+    {"volumes_m3.lost", kVolumes, "volume lost over the DTM edge"},
+    {"volumes_m3.deposit_raster", kVolumes, "deposit volume on the raster", true},
+    {"volumes_m3.mobile_raster", kVolumes, "moving volume on the raster"},
+    {"volumes_m3.entrained", kVolumes, "volume entrained from the bed"},
+    {"volumes_m3.injected", kVolumes, "volume injected by inflows"},
+    {"area_affected_m2", kVolumes, "area reached by the flow", true},
+    {"mobile_at_end.fraction", kVolumes, "fraction still moving at the end"},
+    {"mobile_at_end.volume_m3", kVolumes, "volume still moving at the end"},
+    {"fahrboeschung.ratio_H_over_L", kReach, "H/L (Fahrböschung: release top to toe)", true},
+    {"fahrboeschung.angle_deg", kReach, "Fahrböschung angle"},
+    {"fahrboeschung.drop_height_m", kReach, "drop height H", true},
+    {"fahrboeschung.reach_m", kReach, "horizontal reach L", true},
+    {"fahrboeschung.toe_x_m", kReach, "toe easting"},
+    {"fahrboeschung.toe_y_m", kReach, "toe northing"},
+    {"runout_length_along_path_m", kReach, "run-out length along the path"},
+    {"centre_of_mass.travel_m", kReach, "centre of mass: horizontal travel"},
+    {"centre_of_mass.drop_m", kReach, "centre of mass: drop"},
+    {"centre_of_mass.angle_deg", kReach, "centre of mass: travel angle"},
+    {"max_speed_m_s", kPeak, "peak speed", true},
+    {"max_pressure_pa", kPeak, "peak pressure ρv²", true},
+    {"mobile_at_end.max_speed_m_s", kPeak, "largest speed at the end"},
+    {"kinetic_energy_j.peak", kPeak, "peak kinetic energy"},
+    {"kinetic_energy_j.at_end", kPeak, "kinetic energy at the end"},
+    {"processes.entrainment.max_eroded_depth_m", kPeak, "deepest erosion"},
+    {"simulated_time_s", kTime, "simulated time", true},
+    {"ended_by", kTime, "the run ended by"},
+    {"release_time_s", kTime, "release time"},
+    // dem-avalanche, biaxial
+    {"mohr_coulomb.cohesion_Pa", kStrength, "cohesion c (Mohr–Coulomb fit over the tests)", true},
+    {"mohr_coulomb.friction_angle_deg", kStrength, "friction angle φ (Mohr–Coulomb fit)", true},
+    {"mohr_coulomb.failure_plane_angle_deg", kStrength, "failure plane angle 45° + φ/2"},
+    {"mohr_coulomb.valid", kStrength, "fit valid (at least two confining stresses)"},
+    {"sample.porosity", kStrength, "sample porosity"},
+    // dem-avalanche, avalanche
+    {"volume_m3", kVolumes, "rock volume", true},
+    {"source_area_m2", kVolumes, "source area of the section"},
+    {"H_over_L", kReach, "H/L (fall height over run-out)", true},
+    {"fall_height_H_m", kReach, "fall height H"},
+    {"runout_L_m", kReach, "run-out L", true},
+    {"scheidegger_1973_H_over_L", kReach, "H/L for this volume by Scheidegger (1973)"},
+    {"bond_breaks.tensile", kDamage, "bonds broken in tension"},
+    {"bond_breaks.shear", kDamage, "bonds broken in shear"},
+    {"bond_breaks.before_release", kDamage, "bonds broken before release"},
+    {"bonds_initial", kDamage, "bonds at the start"},
+    {"bonds_intact_final", kDamage, "bonds intact at the end"},
+    {"fragments_final", kDamage, "fragments at the end"},
+    {"largest_fragment_discs", kDamage, "discs in the largest fragment"},
+    {"fragments_with_2_or_more_discs", kDamage, "fragments of two discs or more"},
+    {"discontinuities.traces", kDamage, "joint traces"},
+    {"discontinuities.total_length_m", kDamage, "total joint trace length"},
+    {"discontinuities.intensity_P21_per_m", kDamage, "joint intensity P21"},
+    {"discontinuities.bonds_cut", kDamage, "bonds cut by joints"},
+    // bookkeeping, in every app
+    {"wall_time_s", kOther, "wall-clock time"},
+    {"mass_balance_error_relative", kOther, "relative mass-balance error"},
+    {"bytes_per_particle", kOther, "memory per particle", false, "bytes"},
+};
+
+/// Column labels of the tables made from arrays of objects.
+const KeyLabel kTableKeys[] = {
+    {"tests.confining_stress_Pa", kStrength, "confining stress σ3"},
+    {"tests.peak_stress_Pa", kStrength, "peak axial stress σ1"},
+    {"tests.deviator_at_peak_Pa", kStrength, "deviator at peak σ1 − σ3"},
+    {"tests.youngs_modulus_Pa", kStrength, "Young's modulus E"},
+    {"tests.poisson_ratio", kStrength, "Poisson's ratio ν"},
+    {"tests.peak_axial_strain", kStrength, "axial strain at peak"},
+    {"tests.crack_band_inclination_deg", kStrength, "crack band inclination"},
+    {"tests.tensile_breaks", kStrength, "tensile cracks"},
+    {"tests.shear_breaks", kStrength, "shear cracks"},
+};
+constexpr const char* kTableTitles[][2] = {{"tests", "Results per confining stress"},
+                                           {"materials", "Materials (derived model constants)"},
+                                           {"discontinuities.sets", "Joint sets"}};
+
+const KeyLabel* find_key(const std::string& k) {
+  for (const auto& e : kKeys)
+    if (k == e.key) return &e;
+  return nullptr;
+}
+
+std::string last_segment(const std::string& k) {
+  const auto dot = k.rfind('.');
+  return dot == std::string::npos ? k : k.substr(dot + 1);
+}
+
+std::string value_text(const json& v, const std::string& unit) {
+  if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
+  if (v.is_number()) return format_quantity(v.get<double>(), unit);
+  if (v.is_string()) return v.get<std::string>();
+  if (v.is_null()) return "n/a";
+  if (v.is_array() && v.empty()) return "none";
+  if (v.is_array() && std::all_of(v.begin(), v.end(), [](const json& e) { return e.is_number(); })) {
+    std::string s;
+    for (const auto& e : v) s += (s.empty() ? "" : ", ") + format_quantity(e.get<double>(), unit);
+    return s;
+  }
+  return v.dump();
+}
+
+/// "a.b_c_m" → "a: b c" with its unit from the name.
+std::pair<std::string, std::string> label_from_key(const std::string& key) {
+  std::string prefix, last = key;
+  if (const auto dot = key.rfind('.'); dot != std::string::npos) {
+    prefix = key.substr(0, dot);
+    last = key.substr(dot + 1);
+    std::replace(prefix.begin(), prefix.end(), '_', ' ');
+    std::replace(prefix.begin(), prefix.end(), '.', ' ');
+  }
+  const Quantity q = quantity_from_name(last);
+  return {prefix.empty() ? q.label : prefix + ": " + q.label, q.unit};
+}
+
+/// The unit of a dotted key: from its last segment, else from the nearest parent that names one
+/// ("volumes_m3.deposited" → m³, "kinetic_energy_j.peak" → J).
+std::string unit_of_key(const std::string& key) {
+  const auto seg = split(key, '.');
+  for (auto it = seg.rbegin(); it != seg.rend(); ++it)
+    if (const Quantity q = quantity_from_name(*it); !q.unit.empty()) return q.unit;
+  return "";
+}
+
+void flatten(const json& j, const std::string& prefix, Summary& out, std::vector<Row> (&groups)[kGroups]) {
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
+    if (it->is_object()) {
+      flatten(*it, key, out, groups);
+      continue;
+    }
+    if (it->is_array() && !it->empty() && it->front().is_object()) {
+      SubTable t;
+      t.title = key;
+      for (const auto& tt : kTableTitles)
+        if (key == tt[0]) t.title = tt[1];
+      t.folded = key == "materials";
+      std::vector<std::string> cols;
+      for (const auto& e : *it)
+        for (auto c = e.begin(); c != e.end(); ++c)
+          if (!c->is_structured() && std::find(cols.begin(), cols.end(), c.key()) == cols.end())
+            cols.push_back(c.key());
+      // Labelled columns first, in the label table's order.
+      std::vector<std::string> ordered;
+      for (const auto& e : kTableKeys) {
+        const std::string full = e.key;
+        if (full.rfind(key + ".", 0) == 0) {
+          const std::string c = full.substr(key.size() + 1);
+          if (std::find(cols.begin(), cols.end(), c) != cols.end()) ordered.push_back(c);
+        }
+      }
+      if (auto n = std::find(cols.begin(), cols.end(), "name"); n != cols.end())
+        ordered.insert(ordered.begin(), "name");
+      for (const auto& c : cols)
+        if (std::find(ordered.begin(), ordered.end(), c) == ordered.end()) ordered.push_back(c);
+      std::vector<std::string> units;
+      for (const auto& c : ordered) {
+        std::string label = quantity_from_name(c).label, unit = quantity_from_name(c).unit;
+        for (const auto& e : kTableKeys)
+          if (key + "." + c == e.key) label = e.label;
+        t.headers.push_back(unit.empty() ? label : label + " (" + unit + ")");
+        units.push_back(unit);
+      }
+      for (const auto& e : *it) {
+        std::vector<std::string> row;
+        for (std::size_t c = 0; c < ordered.size(); ++c)
+          row.push_back(e.contains(ordered[c]) ? value_text(e[ordered[c]], units[c]) : "");
+        t.cells.push_back(row);
+      }
+      out.tables.push_back(std::move(t));
+      continue;
+    }
+    if (it->is_array() && it->size() > 8) continue;  // long arrays are left to the files
+    const KeyLabel* kl = find_key(key);
+    auto [label, unit] = label_from_key(key);
+    unit = unit_of_key(key);
+    GroupId g = kOther;
+    if (kl) {
+      label = kl->label;
+      if (kl->unit) unit = kl->unit;
+      g = kl->group;
+    }
+    Row r{key, label, value_text(*it, unit)};
+    if (kl && kl->headline) out.headline.push_back(r);
+    groups[g].push_back(std::move(r));
+  }
+}
+
+}  // namespace
+
+Summary summarise(const json& summary) {
+  Summary s;
+  std::vector<Row> groups[kGroups];
+  flatten(summary, "", s, groups);
+  // Labelled keys in the label table's order (the headline in group order); the rest alphabetically.
+  const auto rank = [](const Row& r) {
+    const auto it = std::find_if(std::begin(kKeys), std::end(kKeys), [&](const KeyLabel& k) { return r.key == k.key; });
+    return std::pair<int, long>{it == std::end(kKeys) ? kGroups : static_cast<int>(it->group), it - std::begin(kKeys)};
+  };
+  const auto by_rank = [&](const Row& a, const Row& b) { return rank(a) < rank(b); };
+  for (int g = 0; g < kGroups; ++g) {
+    auto& rows = groups[g];
+    std::stable_sort(rows.begin(), rows.end(), by_rank);
+    if (!rows.empty()) s.groups.push_back({kGroupTitles[g], rows});
+  }
+  std::stable_sort(s.headline.begin(), s.headline.end(), by_rank);
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Input parameters from config.resolved.toml
+
+namespace {
+
+/// A config key in the user's terms. `when` = "key=value" limits it to runs where another key has
+/// that value (the friction law's own coefficients).
+struct ParamLabel {
+  const char* key;  ///< TOML path; "material[]." for each table of the [[material]] array
+  const char* label;
+  const char* unit;
+  const char* when = nullptr;
+};
+
+const ParamLabel kParams[] = {
+    // sph-slope
+    {"model.constitutive", "constitutive model", ""},
+    {"material[].density", "ρ density", "kg/m³"},
+    {"material[].young", "E Young's modulus", "Pa"},
+    {"material[].poisson", "ν Poisson's ratio", ""},
+    {"material[].cohesion", "c cohesion", "Pa"},
+    {"material[].friction", "φ friction angle", "°"},
+    {"material[].dilatancy", "ψ dilatancy angle", "°"},
+    {"section.soil_thickness", "soil cover thickness", "m"},
+    {"earthquake.type", "earthquake", ""},
+    {"earthquake.amplitude", "earthquake amplitude", "m/s²"},
+    {"earthquake.frequency", "earthquake frequency", "Hz"},
+    {"earthquake.duration", "earthquake duration", "s"},
+    // debris-runout
+    {"model.friction", "basal friction law", ""},
+    {"model.density", "ρ flow density", "kg/m³"},
+    {"model.n", "n Manning roughness", "s/m^(1/3)", "model.friction=manning"},
+    {"model.icr", "i_cr critical slope", "", "model.friction=manning"},
+    {"model.m", "m speed exponent of the yield term", "", "model.friction=manning"},
+    {"model.mu", "μ Coulomb friction coefficient", "", "model.friction=voellmy"},
+    {"model.mu", "μ Coulomb friction coefficient", "", "model.friction=coulomb"},
+    {"model.xi", "ξ Voellmy turbulence coefficient", "m/s²", "model.friction=voellmy"},
+    {"release.from", "release from", ""},
+    {"release.file", "release polygons", ""},
+    {"run.duration", "longest simulated time", "s"},
+    // dem-avalanche
+    {"test", "test", ""},
+    {"material.density", "ρ rock density", "kg/m³"},
+    {"material.youngs_modulus", "E contact Young's modulus", "Pa"},
+    {"material.friction", "μ inter-particle friction", ""},
+    {"bond.modulus", "E_b bond modulus", "Pa"},
+    {"bond.tensile_strength", "σ_t bond tensile strength (mean)", "Pa"},
+    {"bond.tensile_strength_std", "σ_t standard deviation", "Pa"},
+    {"bond.shear_strength", "τ_s bond shear strength (mean)", "Pa"},
+    {"bond.shear_strength_std", "τ_s standard deviation", "Pa"},
+    {"joints.friction", "μ_j joint friction", ""},
+    {"biaxial.confining_stresses", "σ3 confining stresses", "Pa"},
+    {"avalanche.runout_time", "simulated time after release", "s"},
+};
+
+std::string toml_value_text(const toml::node& n, const std::string& unit) {
+  if (const auto* v = n.as_floating_point()) return format_quantity(v->get(), unit);
+  if (const auto* v = n.as_integer()) return format_quantity(static_cast<double>(v->get()), unit);
+  if (const auto* v = n.as_boolean()) return v->get() ? "yes" : "no";
+  if (const auto* v = n.as_string()) return v->get().empty() ? "" : v->get();
+  if (const auto* a = n.as_array()) {
+    std::string s;
+    for (const auto& e : *a) s += (s.empty() ? "" : ", ") + toml_value_text(e, unit);
+    return s;
+  }
+  return "";
+}
+
+}  // namespace
+
+std::vector<Row> input_parameters(const fs::path& resolved_config) {
+  std::vector<Row> rows;
+  if (!fs::is_regular_file(resolved_config)) return rows;
+  toml::table t;
+  try {
+    t = toml::parse_file(resolved_config.string());
+  } catch (const toml::parse_error& e) {
+    throw InputError(std::string("config.resolved.toml does not parse: ") + std::string(e.description()),
+                     resolved_config.string());
+  }
+  const auto holds = [&](const char* when) {
+    if (!when) return true;
+    const std::string w = when;
+    const auto eq = w.find('=');
+    const auto n = t.at_path(w.substr(0, eq));
+    return n && n.value<std::string>() == w.substr(eq + 1);
+  };
+  bool materials_done = false;
+  for (const auto& p : kParams) {
+    if (!holds(p.when)) continue;
+    const std::string key = p.key;
+    if (key.rfind("material[].", 0) == 0) {
+      // Each material's parameters together, in the table's order.
+      const auto* arr = t["material"].as_array();
+      if (!arr || materials_done) continue;
+      materials_done = true;
+      for (const auto& m : *arr) {
+        const auto* mt = m.as_table();
+        if (!mt) continue;
+        const std::string name = (*mt)["name"].value_or(std::string("material"));
+        for (const auto& q : kParams) {
+          const std::string qk = q.key;
+          if (qk.rfind("material[].", 0) != 0 || !mt->contains(qk.substr(11))) continue;
+          rows.push_back({qk, name + ": " + q.label, toml_value_text(*mt->get(qk.substr(11)), q.unit)});
+        }
+      }
+      continue;
+    }
+    const auto n = t.at_path(key);
+    if (!n) continue;
+    const std::string v = toml_value_text(*n.node(), p.unit);
+    if (!v.empty()) rows.push_back({key, p.label, v});
+  }
+  return rows;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The page
+
+namespace {
+
+/// Natural order: digit runs compare as numbers ("cracks_5MPa" before "cracks_10MPa").
+bool natural_less(const std::string& a, const std::string& b) {
+  std::size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    if (std::isdigit(static_cast<unsigned char>(a[i])) && std::isdigit(static_cast<unsigned char>(b[j]))) {
+      std::size_t ie = i, je = j;
+      while (ie < a.size() && std::isdigit(static_cast<unsigned char>(a[ie]))) ++ie;
+      while (je < b.size() && std::isdigit(static_cast<unsigned char>(b[je]))) ++je;
+      const double x = std::stod(a.substr(i, ie - i)), y = std::stod(b.substr(j, je - j));
+      if (x != y) return x < y;
+      i = ie;
+      j = je;
+    } else {
+      if (a[i] != b[j]) return a[i] < b[j];
+      ++i;
+      ++j;
+    }
+  }
+  return a.size() - i < b.size() - j;
+}
+
+/// Captions of the pictures the apps write; the maps first, in this order.
+struct Caption {
+  const char* stem;  ///< file name without .png, or a prefix ending in '*'
+  const char* text;
+};
+const Caption kCaptions[] = {
+    {"max_depth", "Peak flow depth over the hillshade (the affected area, 200 m around)."},
+    {"max_speed", "Peak speed."},
+    {"max_pressure", "Peak dynamic pressure ρv² (kPa)."},
+    {"intensity", "Intensity classes (thresholds in the run's config; docs/runout.md)."},
+    {"deposit", "Final deposit thickness."},
+    {"arrival_time", "Time of first arrival of the flow."},
+    {"erosion_depth", "Depth eroded from the bed."},
+    {"final_displacement", "Displacement at the end of the run (particles in the section plane)."},
+    {"final_plastic_strain", "Accumulated plastic strain at the end of the run."},
+    {"mechanism", "Failure mechanism: displacement with the critical slip circle."},
+    {"mechanism_deformed", "Failure mechanism on the deformed configuration."},
+    {"srm_curve", "Strength reduction: displacement against the reduction factor."},
+    {"velocity_*", "Speed of the particles at this time."},
+    {"cracks_*", "Bonds and cracks at the end of the test at this confining stress."},
+    {"deposit_profile", "Deposit thickness along the profile."},
+};
+
+int caption_rank(const std::string& stem) {
+  for (std::size_t k = 0; k < std::size(kCaptions); ++k) {
+    const std::string c = kCaptions[k].stem;
+    if (c.back() == '*' ? stem.rfind(c.substr(0, c.size() - 1), 0) == 0 : stem == c) return static_cast<int>(k);
+  }
+  return static_cast<int>(std::size(kCaptions));
+}
+
+const char* kCrackLegend =
+    "<span class=key><i style=\"background:#285ac8\"></i>intact bond</span>"
+    "<span class=key><i style=\"background:#dc1e1e\"></i>tensile crack</span>"
+    "<span class=key><i style=\"background:#fa9600\"></i>shear crack</span>"
+    "<span class=key><i style=\"background:#14a03c\"></i>bond cut by a joint</span>";
+
+/// Titles of the CSV plots.
+std::string plot_title(const std::string& stem) {
+  if (stem == "series") return "Time series";
+  if (stem == "runout") return "Run-out against time";
+  if (stem.rfind("curve_", 0) == 0) return "Test record " + stem.substr(6);
+  if (stem == "deposit") return "Deposit profile";
+  if (stem == "slip_surface") return "Slip surface";
+  if (stem == "surface_final") return "Ground surface at the end";
+  return stem;
+}
+
+const char* kStyle =
+    "body{font-family:sans-serif;margin:2em;max-width:1500px;color:#222}"
+    "table{border-collapse:collapse;margin:0 2em 1em 0}td,th{border:1px solid #ccc;padding:2px 8px;font-size:90%}"
+    "th{background:#eee;text-align:left}td.v{text-align:right;white-space:nowrap}.row{display:flex;flex-wrap:wrap;"
+    "align-items:flex-start}figure{display:inline-block;margin:0.5em;vertical-align:top}"
+    "img{max-width:720px;border:1px solid #ddd}figcaption{font-size:85%;color:#444;max-width:720px}"
+    "section{border-top:2px solid #444;margin-top:2em}h3{margin-bottom:0.3em}"
+    ".key{margin-right:1em;white-space:nowrap}.key i{display:inline-block;width:0.9em;height:0.9em;margin-right:0.3em;"
+    "vertical-align:middle}#page-check{display:none;background:#fdd;padding:0.5em;border:1px solid #c00}"
+    "ul.files{columns:3;font-size:85%}";
+
+// The page checks itself on load: every image decoded, no resource or script error. The result is
+// kept in #page-check's attributes (read by the browser test, tests/report) and shown to the
+// reader when something is missing.
+const char* kCheckScript = R"(<script>
+(function () {
+  var errors = [];
+  window.addEventListener('error', function (e) {
+    var t = e.target;
+    errors.push(t && (t.src || t.href) ? 'cannot load ' + (t.src || t.href) : String(e.message));
+  }, true);
+  window.addEventListener('load', function () {
+    var imgs = document.images, decoded = 0;
+    for (var i = 0; i < imgs.length; i++) {
+      if (imgs[i].complete && imgs[i].naturalWidth > 0) decoded++;
+      else errors.push('not decoded ' + imgs[i].getAttribute('src'));
+    }
+    var d = document.getElementById('page-check');
+    d.setAttribute('data-images', imgs.length);
+    d.setAttribute('data-decoded', decoded);
+    d.setAttribute('data-errors', errors.length);
+    if (errors.length) { d.textContent = 'Not shown: ' + errors.join('; '); d.style.display = 'block'; }
+  });
+})();
+</script>
+)";
+
+void rows_table(std::ostringstream& o, const std::vector<Row>& rows) {
+  o << "<table>\n";
+  for (const auto& r : rows)
+    o << "<tr><td title=\"" << escape(r.key) << "\">" << escape(r.label) << "</td><td class=v>" << escape(r.value)
+      << "</td></tr>\n";
+  o << "</table>\n";
+}
+
+}  // namespace
+
+fs::path write_report(const fs::path& root, const std::string& title) {
+  if (!fs::is_directory(root)) throw InputError("not a directory", "", "RESULTS_DIR", root.string());
+  std::vector<fs::path> runs;
+  for (auto it = fs::recursive_directory_iterator(root); it != fs::recursive_directory_iterator(); ++it) {
+    if (it.depth() > 2) it.disable_recursion_pending();
+    if (it->is_regular_file() && it->path().filename() == "summary.json") runs.push_back(it->path().parent_path());
+  }
+  std::sort(runs.begin(), runs.end(), [](const fs::path& a, const fs::path& b) { return natural_less(a, b); });
+  if (runs.empty()) throw InputError("no run folder with a summary.json found", root.string());
+
+  // Read everything before writing anything.
+  struct Run {
+    fs::path dir;
+    std::string name;
+    Summary summary;
+    std::vector<Row> inputs;
+    std::vector<std::pair<std::string, std::string>> plots;  // SVG file name, SVG text
+    std::vector<fs::path> pngs, files;
+  };
+  std::vector<Run> all;
+  for (const auto& dir : runs) {
+    Run r;
+    r.dir = dir;
+    r.name = fs::relative(dir, root).string();
+    try {
+      r.summary = summarise(json::parse(slurp(dir / "summary.json")));
+    } catch (const json::exception& e) {
+      throw InputError(std::string("summary.json does not parse: ") + e.what(), (dir / "summary.json").string());
+    }
+    r.inputs = input_parameters(dir / "config.resolved.toml");
+    std::vector<fs::path> csvs;
+    for (const auto& e : fs::directory_iterator(dir)) {
+      if (!e.is_regular_file()) continue;
+      const auto ext = e.path().extension();
+      if (ext == ".png")
+        r.pngs.push_back(e.path());
+      else
+        r.files.push_back(e.path());
+      if (ext == ".csv") csvs.push_back(e.path());
+    }
+    const auto by_name = [](const fs::path& a, const fs::path& b) {
+      return natural_less(a.filename().string(), b.filename().string());
+    };
+    std::sort(r.files.begin(), r.files.end(), by_name);
+    std::sort(csvs.begin(), csvs.end(), by_name);
+    std::sort(r.pngs.begin(), r.pngs.end(), [&](const fs::path& a, const fs::path& b) {
+      const int ra = caption_rank(a.stem().string()), rb = caption_rank(b.stem().string());
+      return ra != rb ? ra < rb : by_name(a, b);
+    });
+    for (const auto& c : csvs) {
+      const Csv csv = read_csv(c);
+      if (!is_plottable(csv)) continue;
+      std::string svg_name = r.name + "_" + c.stem().string() + ".svg";
+      std::replace(svg_name.begin(), svg_name.end(), '/', '_');
+      r.plots.emplace_back(svg_name, svg_plot(csv, plot_title(c.stem().string()) + " (" + c.filename().string() + ")"));
+    }
+    all.push_back(std::move(r));
+  }
+
+  const fs::path files_dir = root / "report_files";
+  fs::create_directories(files_dir);
+  std::ostringstream head, body;
+  head << "<h2>Overview</h2>\n<table><tr><th>run</th><th>quantity</th><th>value</th></tr>\n";
+  for (const auto& r : all) {
+    for (const auto& row : r.summary.headline)
+      head << "<tr><td><a href=\"#" << escape(r.name) << "\">" << escape(r.name) << "</a></td><td>" << escape(row.label)
+           << "</td><td class=v>" << escape(row.value) << "</td></tr>\n";
+    body << "<section id=\"" << escape(r.name) << "\"><h2>" << escape(r.name) << "</h2>\n<div class=row>\n";
+    for (const auto& g : r.summary.groups) {
+      if (g.title == std::string(kGroupTitles[kOther])) continue;
+      body << "<div><h3>" << escape(g.title) << "</h3>\n";
+      rows_table(body, g.rows);
+      body << "</div>\n";
+    }
+    if (!r.inputs.empty()) {
+      body << "<div><h3>Input parameters</h3>\n";
+      rows_table(body, r.inputs);
+      body << "</div>\n";
+    }
+    body << "</div>\n";
+    const auto sub_table = [&](const SubTable& t) {
+      body << "<h3>" << escape(t.title) << "</h3>\n<table><tr>";
+      for (const auto& h : t.headers) body << "<th>" << escape(h) << "</th>";
+      body << "</tr>\n";
+      for (const auto& row : t.cells) {
+        body << "<tr>";
+        for (const auto& c : row) body << "<td class=v>" << escape(c) << "</td>";
+        body << "</tr>\n";
+      }
+      body << "</table>\n";
+    };
+    for (const auto& t : r.summary.tables)
+      if (!t.folded) sub_table(t);
+    for (const auto& p : r.pngs) {
+      const std::string stem = p.stem().string();
+      const int rank = caption_rank(stem);
+      std::string caption = rank < static_cast<int>(std::size(kCaptions)) ? kCaptions[rank].text : "";
+      body << "<figure><img alt=\"" << escape(stem) << "\" src=\"" << escape(fs::relative(p, root).generic_string())
+           << "\"><figcaption><b>" << escape(p.filename().string()) << "</b> " << escape(caption);
+      if (stem.rfind("cracks_", 0) == 0) body << "<br>" << kCrackLegend;
+      body << "</figcaption></figure>\n";
+    }
+    for (const auto& [name, svg] : r.plots)
+      body << "<figure><img alt=\"" << escape(name) << "\" src=\"report_files/" << escape(name) << "\"></figure>\n";
+    for (const auto& g : r.summary.groups)
+      if (g.title == std::string(kGroupTitles[kOther])) {
+        body << "<details><summary>" << escape(g.title) << "</summary>\n";
+        rows_table(body, g.rows);
+        for (const auto& t : r.summary.tables)
+          if (t.folded) sub_table(t);
+        body << "</details>\n";
+      }
+    body << "<details><summary>Files</summary><ul class=files>\n";
+    for (const auto& f : r.files)
+      body << "<li><a href=\"" << escape(fs::relative(f, root).generic_string()) << "\">"
+           << escape(f.filename().string()) << "</a></li>\n";
+    body << "</ul></details>\n</section>\n";
+  }
+  head << "</table>\n";
+
+  for (const auto& r : all)
+    for (const auto& [name, svg] : r.plots) write_text_file(files_dir / name, svg);
+  std::ostringstream html;
+  html << "<!DOCTYPE html>\n<html lang=en><head><meta charset=utf-8><title>" << escape(title) << "</title>\n<style>"
+       << kStyle << "</style>\n"
+       << kCheckScript << "</head><body>\n<div id=page-check></div>\n<h1>" << escape(title)
+       << "</h1>\n<p>Generated by geohaz " << GEOHAZ_VERSION
+       << ". The maps are quick-looks of the GeoTIFFs beside them (open those in QGIS, with the .qml styles); "
+          "ParaView opens the <code>.xmf</code> files. Hover a label to see its summary.json key.</p>\n"
+       << head.str() << body.str() << "</body></html>\n";
+  const fs::path out = root / "report.html";
+  write_text_file(out, html.str());
+  return out;
+}
+
+}  // namespace geohaz::report

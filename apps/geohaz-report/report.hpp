@@ -1,0 +1,87 @@
+#pragma once
+/// \file report.hpp
+/// The pieces of geohaz-report (docs/report.md), kept apart from its main so the tests can check
+/// them one by one: quantity names and units from column and key names, CSV reading, SVG plots,
+/// the grouped table of a summary.json, the input parameters of a resolved config, and the page.
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace geohaz::report {
+
+/// A quantity as a reader sees it: "mean speed" in "m/s", from a name such as "mean_speed_m_s".
+struct Quantity {
+  std::string label;  ///< words, e.g. "mean speed"
+  std::string unit;   ///< unit for display, e.g. "m/s", "m³", "°" ("" when dimensionless or unknown)
+};
+
+/// Split a column or key name into words and unit: the longest trailing run of "_"-separated
+/// tokens that names a unit (m, m2, m3, s, m_s or m_per_s, m_per_s2, Pa, N, N_per_m, J, J_per_m,
+/// kg, deg, per_m, Hz, …) is the unit; the rest, "_" read as spaces, is the label.
+Quantity quantity_from_name(const std::string& name);
+
+/// A value with its unit for a table: 4 significant digits, thousands grouped with thin spaces,
+/// Pa and J shown as kPa/MPa/GPa and kJ/MJ/GJ when large. Returns the text "value unit".
+std::string format_quantity(double value, const std::string& unit);
+
+/// A CSV file of numbers with a header line.
+struct Csv {
+  std::vector<std::string> names;            ///< column names from the header
+  std::vector<std::vector<double>> columns;  ///< one vector per column (NaN where not a number)
+  std::vector<bool> numeric;                 ///< whether every cell of the column is a number
+};
+/// Read a CSV (comma-separated, a header line, no quoting). InputError when it cannot be opened.
+Csv read_csv(const std::filesystem::path& path);
+
+/// Whether a CSV is worth a plot: its first column is the abscissa (time_s, or a distance x_m /
+/// s_m / distance_m for profiles), it has at least two rows, and every column is numeric (event
+/// lists with a text column, such as the acoustic-emission files, are left to the files).
+bool is_plottable(const Csv& csv);
+
+/// An SVG plot of a plottable CSV: one panel per unit of the other columns (columns sharing a unit
+/// share a panel, with a legend), axes with nice ticks and labels "quantity (unit)" from the
+/// column names. Step counters, map coordinates (…x_m, …y_m) and columns that are zero throughout
+/// are left out. `title` heads the picture. Width 760 px; the height grows with the panels.
+std::string svg_plot(const Csv& csv, const std::string& title);
+
+/// A row of a key-number table.
+struct Row {
+  std::string key;    ///< the flattened summary.json key ("fahrboeschung.ratio_H_over_L")
+  std::string label;  ///< what a reader calls it ("H/L (Fahrböschung)")
+  std::string value;  ///< the value with its unit
+};
+/// A group of rows under a heading ("Volumes and areas", …, "Run bookkeeping / other").
+struct Group {
+  std::string title;
+  std::vector<Row> rows;
+};
+/// A table of an array of objects in summary.json (one row per entry, e.g. per biaxial test).
+struct SubTable {
+  std::string title;
+  std::vector<std::string> headers;  ///< "label (unit)"
+  std::vector<std::vector<std::string>> cells;
+  bool folded = false;  ///< bookkeeping (derived model constants): shown folded, after the pictures
+};
+/// The key numbers of a summary.json, grouped by meaning. Keys of the label table get its label and
+/// group; any other key still appears, labelled from its name, in "Run bookkeeping / other" (so keys
+/// added later show up). Arrays of objects become SubTables; long number arrays are left out.
+struct Summary {
+  std::vector<Group> groups;  ///< in display order, empty groups left out
+  std::vector<SubTable> tables;
+  std::vector<Row> headline;  ///< the few numbers for the overview at the top of the page
+};
+Summary summarise(const nlohmann::json& summary);
+
+/// The input parameters of a run in the user's terms (c, φ, ψ, E, ν; n, i_cr or μ, ξ; bond
+/// strengths …) from its config.resolved.toml: rows "symbol — meaning", value with unit. Only the
+/// keys of the parameter table are shown (the whole file is linked). Empty when there is no file.
+std::vector<Row> input_parameters(const std::filesystem::path& resolved_config);
+
+/// Write RESULTS/report.html and RESULTS/report_files/*.svg from every run folder (a sub-folder,
+/// up to two levels deep, holding a summary.json). InputError when there is none or a
+/// summary.json does not parse. Returns the path of report.html.
+std::filesystem::path write_report(const std::filesystem::path& results, const std::string& title);
+
+}  // namespace geohaz::report

@@ -1,0 +1,162 @@
+// geohaz-report's pieces (apps/geohaz-report/report.hpp, docs/report.md): names and units read
+// from keys and columns, numbers formatted with units, SVG plots whose points sit where the axes
+// say, the grouping of summary.json (unknown keys kept), the input parameters in the user's terms.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "report.hpp"
+
+namespace fs = std::filesystem;
+using namespace geohaz::report;
+
+namespace {
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("geohaz_report_" + name + "_" +
+                                                  std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+void write_file(const fs::path& p, const std::string& text) {
+  std::ofstream out(p);
+  out << text;
+}
+
+const Group* find_group(const Summary& s, const std::string& title) {
+  for (const auto& g : s.groups)
+    if (g.title == title) return &g;
+  return nullptr;
+}
+
+const Row* find_row(const std::vector<Row>& rows, const std::string& key) {
+  for (const auto& r : rows)
+    if (r.key == key) return &r;
+  return nullptr;
+}
+
+}  // namespace
+
+TEST(ReportNames, UnitsAreReadFromTheEndOfColumnAndKeyNames) {
+  EXPECT_EQ(quantity_from_name("mean_speed_m_s").label, "mean speed");
+  EXPECT_EQ(quantity_from_name("mean_speed_m_s").unit, "m/s");
+  EXPECT_EQ(quantity_from_name("max_speed_m_per_s").unit, "m/s");
+  EXPECT_EQ(quantity_from_name("time_s").label, "time");
+  EXPECT_EQ(quantity_from_name("time_s").unit, "s");
+  EXPECT_EQ(quantity_from_name("force_N").unit, "N");
+  EXPECT_EQ(quantity_from_name("kinetic_energy_J_per_m").label, "kinetic energy");
+  EXPECT_EQ(quantity_from_name("kinetic_energy_J_per_m").unit, "J/m");
+  EXPECT_EQ(quantity_from_name("earthquake_acceleration_m_per_s2").unit, "m/s²");
+  EXPECT_EQ(quantity_from_name("deposited_volume_m3").unit, "m³");
+  EXPECT_EQ(quantity_from_name("max_pressure_pa").unit, "Pa");
+  EXPECT_EQ(quantity_from_name("angle_deg").unit, "°");
+  // No unit: the whole name is the label; a lone unit-like word stays a word.
+  EXPECT_EQ(quantity_from_name("ratio_H_over_L").label, "ratio H over L");
+  EXPECT_EQ(quantity_from_name("ratio_H_over_L").unit, "");
+  EXPECT_EQ(quantity_from_name("s").label, "s");
+  EXPECT_EQ(quantity_from_name("s").unit, "");
+}
+
+TEST(ReportNames, NumbersCarryFourDigitsAndEngineeringUnits) {
+  EXPECT_EQ(format_quantity(2.208e6, "Pa"), "2.208 MPa");
+  EXPECT_EQ(format_quantity(31700751174.6, "Pa"), "31.7 GPa");
+  EXPECT_EQ(format_quantity(17678.389, "m³"), "17\u202F678 m³");
+  EXPECT_EQ(format_quantity(0.5131776, ""), "0.5132");
+  EXPECT_EQ(format_quantity(27.1658, "°"), "27.17°");
+  EXPECT_EQ(format_quantity(3.0, ""), "3");
+  EXPECT_EQ(format_quantity(4.5e9, "J"), "4.5 GJ");
+  EXPECT_EQ(format_quantity(2.05e-16, ""), "2.050e-16");
+}
+
+// A force growing linearly over 10 s: the axes run 0–10 s and 0–1000 N, so the first point is at
+// the plot's lower left corner (80, 36 + 200) and the last at its upper right (80 + 480, 36).
+TEST(ReportPlots, SvgPointsSitWhereTheAxesSay) {
+  const fs::path d = temp_dir("svg");
+  write_file(d / "forces.csv", "time_s,step,force_N,front_x_m\n0,0,0,5\n5,10,500,6\n10,20,1000,7\n");
+  const Csv csv = read_csv(d / "forces.csv");
+  ASSERT_TRUE(is_plottable(csv));
+  const std::string svg = svg_plot(csv, "Barrier force");
+  EXPECT_NE(svg.find("points=\"80,236 320,136 560,36 \""), std::string::npos) << svg;
+  EXPECT_NE(svg.find(">force (N)<"), std::string::npos);
+  EXPECT_NE(svg.find(">time (s)<"), std::string::npos);
+  EXPECT_EQ(svg.find("step"), std::string::npos);     // a counter, not a quantity
+  EXPECT_EQ(svg.find("front x"), std::string::npos);  // map coordinates are left out
+  EXPECT_NE(svg.find("width=\"760\""), std::string::npos);
+  // Event lists (a text column) and tables without a time or distance column are not plotted.
+  write_file(d / "ae.csv", "time_s,x_m,mode\n0,1,tensile\n1,2,shear\n");
+  EXPECT_FALSE(is_plottable(read_csv(d / "ae.csv")));
+  write_file(d / "fragments.csv", "fragment,discs\n0,1\n1,3\n");
+  EXPECT_FALSE(is_plottable(read_csv(d / "fragments.csv")));
+  fs::remove_all(d);
+}
+
+TEST(ReportSummary, KeysAreGroupedLabelledAndUnknownKeysKept) {
+  const auto j = nlohmann::json::parse(R"({
+    "fahrboeschung": {"ratio_H_over_L": 0.5131776, "reach_m": 2802.16},
+    "max_pressure_pa": 2.208e6,
+    "volumes_m3": {"deposited": 3911.4},
+    "bytes_per_particle": 610.2,
+    "barrier_peak_force_N": 12500.0,
+    "tests": [{"name": "sigma3_5MPa", "confining_stress_Pa": 5e6, "peak_stress_Pa": 9.76e7}],
+    "long": [1,2,3,4,5,6,7,8,9,10]
+  })");
+  const Summary s = summarise(j);
+  const Group* reach = find_group(s, "Reach and H/L");
+  ASSERT_NE(reach, nullptr);
+  const Row* hl = find_row(reach->rows, "fahrboeschung.ratio_H_over_L");
+  ASSERT_NE(hl, nullptr);
+  EXPECT_EQ(hl->label, "H/L (Fahrböschung: release top to toe)");
+  EXPECT_EQ(hl->value, "0.5132");
+  const Group* volumes = find_group(s, "Volumes and areas");
+  ASSERT_NE(volumes, nullptr);
+  EXPECT_EQ(find_row(volumes->rows, "volumes_m3.deposited")->value, "3911 m³");  // the unit from the parent key
+  const Group* peak = find_group(s, "Peak values");
+  ASSERT_NE(peak, nullptr);
+  EXPECT_EQ(find_row(peak->rows, "max_pressure_pa")->value, "2.208 MPa");
+  const Group* other = find_group(s, "Run bookkeeping / other");
+  ASSERT_NE(other, nullptr);
+  const Row* added = find_row(other->rows, "barrier_peak_force_N");  // a key another branch adds
+  ASSERT_NE(added, nullptr);
+  EXPECT_EQ(added->label, "barrier peak force");
+  EXPECT_EQ(added->value, "12.5 kN");
+  EXPECT_NE(find_row(other->rows, "bytes_per_particle"), nullptr);
+  EXPECT_EQ(find_row(other->rows, "long"), nullptr);  // long arrays are left to the files
+  EXPECT_NE(find_row(s.headline, "fahrboeschung.ratio_H_over_L"), nullptr);
+  ASSERT_EQ(s.tables.size(), 1u);
+  EXPECT_EQ(s.tables[0].title, "Results per confining stress");
+  EXPECT_EQ(s.tables[0].headers[0], "name");
+  EXPECT_EQ(s.tables[0].headers[1], "confining stress σ3 (Pa)");
+  EXPECT_EQ(s.tables[0].cells[0][1], "5 MPa");
+}
+
+TEST(ReportInputs, ParametersInTheUsersTermsForTheChosenLawOnly) {
+  const fs::path d = temp_dir("inputs");
+  write_file(d / "runout.toml",
+             "[model]\nfriction = 'manning'\ndensity = 1900.0\nn = 0.06\nicr = 0.15\nmu = 0.15\nxi = 500.0\n");
+  const auto r = input_parameters(d / "runout.toml");
+  const Row* n = find_row(r, "model.n");
+  ASSERT_NE(n, nullptr);
+  EXPECT_EQ(n->label, "n Manning roughness");
+  EXPECT_EQ(n->value, "0.06 s/m^(1/3)");
+  EXPECT_NE(find_row(r, "model.icr"), nullptr);
+  EXPECT_EQ(find_row(r, "model.mu"), nullptr);  // Voellmy's coefficients do not apply to Manning
+  EXPECT_EQ(find_row(r, "model.xi"), nullptr);
+  write_file(d / "slope.toml",
+             "[[material]]\nname = 'colluvium'\ncohesion = 20000.0\nfriction = 35.0\ndilatancy = 0.0\n"
+             "young = 2e8\npoisson = 0.3\n");
+  const auto m = input_parameters(d / "slope.toml");
+  ASSERT_GE(m.size(), 5u);
+  bool c = false, phi = false;
+  for (const auto& row : m) {
+    c = c || (row.label == "colluvium: c cohesion" && row.value == "20 kPa");
+    phi = phi || (row.label == "colluvium: φ friction angle" && row.value == "35°");
+  }
+  EXPECT_TRUE(c);
+  EXPECT_TRUE(phi);
+  EXPECT_TRUE(input_parameters(d / "absent.toml").empty());
+  fs::remove_all(d);
+}

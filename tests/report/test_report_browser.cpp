@@ -1,0 +1,181 @@
+// The report page in a real browser (issue #16, docs/report.md "Tested in a browser"): a small
+// results folder (a run-out run with a map, a time series and a force CSV, a biaxial run with two
+// crack pictures) → geohaz-report → headless Chromium. The page marks itself on load (an inline
+// script counts the <img> elements that decoded and any load or script error in #page-check's
+// attributes); --dump-dom prints the DOM after load, so the test reads the marks there. Chromium's
+// own log (--enable-logging=stderr) must hold no console message. A screenshot is taken and must
+// show the page. As a control, one picture is then deleted and the page must report it.
+// Skipped (with a message) only when no chromium is installed; scripts/setup installs it.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <string>
+
+#include "geohaz/core/raster.hpp"
+#include "geohaz/core/raster_extra.hpp"
+#include "report.hpp"
+#include "run_command.hpp"
+
+namespace fs = std::filesystem;
+using geohaz::testing::run_command;
+
+namespace {
+
+void write_file(const fs::path& p, const std::string& text) {
+  std::ofstream out(p);
+  out << text;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string find_chromium() {
+  for (const char* name : {"chromium", "chromium-browser", "google-chrome"}) {
+    const auto r = run_command(std::string("command -v ") + name);
+    if (r.code == 0 && !r.output.empty()) return r.output.substr(0, r.output.find('\n'));
+  }
+  return "";
+}
+
+/// The attribute `name` of #page-check in a dumped DOM (-1 when absent).
+int page_mark(const std::string& dom, const std::string& name) {
+  const std::regex div("<div id=\"page-check\"[^>]*>");
+  std::smatch m;
+  if (!std::regex_search(dom, m, div)) return -1;
+  const std::regex attr(name + "=\"([0-9]+)\"");
+  const std::string tag = m.str();
+  std::smatch a;
+  if (!std::regex_search(tag, a, attr)) return -1;
+  return std::stoi(a[1]);
+}
+
+/// A small results folder with what the apps write.
+void make_results(const fs::path& root) {
+  const fs::path run = root / "1-runout", lab = root / "2-rock-biaxial";
+  fs::create_directories(run);
+  fs::create_directories(lab);
+  write_file(run / "summary.json", R"({"model": "debris-runout", "area_affected_m2": 138975.0,
+    "fahrboeschung": {"ratio_H_over_L": 0.5132, "reach_m": 2802.2, "drop_height_m": 1438.0},
+    "max_pressure_pa": 970929.6, "max_speed_m_s": 22.6, "simulated_time_s": 402.9,
+    "volumes_m3": {"release_read": 17700.0, "deposit_raster": 17678.4}, "barrier_peak_force_N": 1.2e5,
+    "wall_time_s": 35.9})");
+  write_file(run / "config.resolved.toml", "[model]\nfriction = 'voellmy'\nmu = 0.2\nxi = 500.0\ndensity = 2000.0\n");
+  write_file(run / "series.csv",
+             "time_s,step,front_travel_m,max_speed_m_s,mobile_volume_m3,deposited_volume_m3\n"
+             "0,0,0,0,100,0\n10,5,150,12,80,20\n20,9,260,8,30,70\n30,12,300,1,0,100\n");
+  write_file(run / "barrier_forces.csv", "time_s,force_N\n0,0\n10,1.2e5\n20,4e4\n30,0\n");
+  // A map as debris-runout draws it: a cone with a flow over one flank.
+  geohaz::Raster dem;
+  dem.nx = 120;
+  dem.ny = 90;
+  dem.geotransform = {600000.0, 5.0, 0.0, 5100000.0, 0.0, -5.0};
+  dem.data.resize(static_cast<std::size_t>(dem.nx) * dem.ny);
+  geohaz::Raster depth = dem;
+  for (int r = 0; r < dem.ny; ++r)
+    for (int c = 0; c < dem.nx; ++c) {
+      dem.at(c, r) = 1500.0 - 2.0 * std::hypot(c - 60.0, r - 45.0);
+      depth.at(c, r) = (c > 60 && c < 100 && std::abs(r - 45) < 10) ? 0.5 + 0.05 * (c - 60) : 0.0;
+    }
+  geohaz::QuicklookOptions o;
+  o.title = "peak flow depth";
+  o.unit = "m";
+  o.overlay_min = 0.01;
+  o.crop_margin_m = 100.0;
+  o.scale_bar = true;
+  o.north_arrow = true;
+  o.lines = {{{600400.0, 4999850.0 + 200.0}, {600400.0, 4999850.0 + 260.0}}};
+  geohaz::write_quicklook_png(run / "max_depth.png", dem, &depth, o);
+  // The biaxial run: two crack pictures named so that a plain sort puts 10 MPa before 5 MPa.
+  write_file(lab / "summary.json", R"({"model": "dem-avalanche", "test": "biaxial-compression",
+    "mohr_coulomb": {"cohesion_Pa": 2.14e7, "friction_angle_deg": 33.6},
+    "tests": [{"name": "sigma3_5MPa", "confining_stress_Pa": 5e6, "peak_stress_Pa": 9.76e7},
+              {"name": "sigma3_10MPa", "confining_stress_Pa": 1e7, "peak_stress_Pa": 1.146e8}]})");
+  write_file(
+      lab / "curve_sigma3_5MPa.csv",
+      "time_s,axial_strain,axial_stress_Pa,lateral_stress_Pa\n0,0,5e6,5e6\n1e-3,1e-3,5e7,5e6\n2e-3,2e-3,9e7,5e6\n");
+  for (const char* name : {"cracks_sigma3_10MPa.png", "cracks_sigma3_5MPa.png"}) {
+    geohaz::Image img(80, 120);
+    img.fill_circle(40, 60, 20, {220, 30, 30});
+    geohaz::write_png(lab / name, img);
+  }
+}
+
+}  // namespace
+
+TEST(ReportInBrowser, EveryImageDecodesWithoutErrorsAndTheScreenshotShowsThePage) {
+  const fs::path root = fs::temp_directory_path() /
+                        ("geohaz_report_browser_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+  fs::remove_all(root);
+  make_results(root / "results");
+  const fs::path results = root / "results";
+
+  const auto gen =
+      run_command(std::string("'") + GEOHAZ_REPORT_EXE + "' '" + results.string() + "' --title 'test page'");
+  ASSERT_EQ(gen.code, 0) << gen.output;
+  const std::string html = slurp(results / "report.html");
+  // Crack maps in stress order, the maps before the plots, every CSV with a time column plotted.
+  const auto p5 = html.find("cracks_sigma3_5MPa.png"), p10 = html.find("cracks_sigma3_10MPa.png");
+  ASSERT_NE(p5, std::string::npos);
+  ASSERT_NE(p10, std::string::npos);
+  EXPECT_LT(p5, p10);
+  EXPECT_TRUE(fs::exists(results / "report_files" / "1-runout_series.svg"));
+  EXPECT_TRUE(fs::exists(results / "report_files" / "1-runout_barrier_forces.svg"));
+  EXPECT_TRUE(fs::exists(results / "report_files" / "2-rock-biaxial_curve_sigma3_5MPa.svg"));
+  EXPECT_NE(html.find("μ Coulomb friction coefficient"), std::string::npos);
+  EXPECT_NE(html.find("barrier peak force"), std::string::npos);    // an unknown key still shows
+  EXPECT_EQ(html.find("http://"), html.find("http://www.w3.org"));  // no network (SVG namespace only)
+  EXPECT_EQ(html.find("https://"), std::string::npos);
+  std::size_t images = 0;
+  for (auto p = html.find("<img"); p != std::string::npos; p = html.find("<img", p + 1)) ++images;
+  EXPECT_EQ(images, 3u + 3u);  // 3 PNGs, 3 SVG plots
+
+  const std::string chromium = find_chromium();
+  if (chromium.empty()) GTEST_SKIP() << "chromium is not installed (scripts/setup installs the Debian package)";
+  // No D-Bus in CI containers: say so rather than let Chromium wait for it.
+  const std::string common = "DBUS_SESSION_BUS_ADDRESS=disabled: '" + chromium +
+                             "' --headless --no-sandbox --disable-gpu --hide-scrollbars "
+                             "--user-data-dir='" +
+                             (root / "profile").string() + "' --virtual-time-budget=10000 ";
+  const std::string url = "'file://" + (results / "report.html").string() + "'";
+
+  // One Chromium run prints the DOM after load, its log, and takes the screenshot.
+  const fs::path shot = root / "report.png";
+  const auto dom =
+      run_command(common + "--enable-logging=stderr --v=0 --window-size=1280,1600 --dump-dom --screenshot='" +
+                  shot.string() + "' " + url);
+  ASSERT_EQ(dom.code, 0) << dom.output;
+  EXPECT_EQ(page_mark(dom.output, "data-images"), static_cast<int>(images)) << dom.output;
+  EXPECT_EQ(page_mark(dom.output, "data-decoded"), static_cast<int>(images)) << dom.output;
+  EXPECT_EQ(page_mark(dom.output, "data-errors"), 0) << dom.output;
+  EXPECT_EQ(dom.output.find(":CONSOLE"), std::string::npos) << dom.output;  // nothing logged by the page
+
+  const geohaz::Image img = geohaz::read_image(shot);
+  EXPECT_EQ(img.width, 1280);
+  EXPECT_EQ(img.height, 1600);
+  // The page is drawn: dark text and the hillshade's greys, not a blank window.
+  int dark = 0, mid_grey = 0;
+  for (std::size_t i = 0; i < img.rgb.size(); i += 3) {
+    const int r = img.rgb[i], g = img.rgb[i + 1], b = img.rgb[i + 2];
+    dark += r < 60 && g < 60 && b < 60;
+    mid_grey += r == g && g == b && r > 80 && r < 200;
+  }
+  EXPECT_GT(dark, 2000);
+  EXPECT_GT(mid_grey, 2000);
+
+  // Control: a picture that is gone is reported by the page (so the marks above can fail).
+  fs::remove(results / "2-rock-biaxial" / "cracks_sigma3_10MPa.png");
+  const auto broken = run_command(common + "--dump-dom " + url);
+  ASSERT_EQ(broken.code, 0) << broken.output;
+  EXPECT_EQ(page_mark(broken.output, "data-decoded"), static_cast<int>(images) - 1);
+  EXPECT_GE(page_mark(broken.output, "data-errors"), 1);
+  EXPECT_NE(broken.output.find("cracks_sigma3_10MPa.png"), std::string::npos);
+
+  std::error_code ec;
+  fs::remove_all(root, ec);
+}
