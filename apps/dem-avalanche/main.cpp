@@ -145,22 +145,22 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   m.contact.rolling_damping =
       r.get("material.rolling_damping", 0.3, Range::closed(0.0, 1.0), {"1", "rolling viscous damping ratio eta_r"});
   // [bond]
-  ParallelBondProperties& b = m.bond;
-  b.radius_multiplier = r.get("bond.radius_multiplier", 1.0, Range::open_closed(0.0, 1.0),
+  ParallelBondProperties& b = m.bond;  // defaults: the struct's (bonds.hpp)
+  b.radius_multiplier = r.get("bond.radius_multiplier", b.radius_multiplier, Range::open_closed(0.0, 1.0),
                               {"1", "lambda: bond radius = lambda min(R_A, R_B)"});
   b.modulus =
-      r.get("bond.modulus", 20e9, Range::positive(), {"Pa", "bond modulus E_c-bar: k_n-bar = E_c-bar/(R_A+R_B)"});
-  b.stiffness_ratio = r.get("bond.stiffness_ratio", 2.5, Range::positive(), {"1", "k_n-bar/k_s-bar"});
-  b.tensile_strength =
-      r.get("bond.tensile_strength", 50e6, Range::positive(), {"Pa", "mean bond tensile strength sigma_c-bar"});
-  b.tensile_strength_std =
-      r.get("bond.tensile_strength_std", 10e6, Range::non_negative(), {"Pa", "standard deviation of sigma_c-bar"});
+      r.get("bond.modulus", b.modulus, Range::positive(), {"Pa", "bond modulus E_c-bar: k_n-bar = E_c-bar/(R_A+R_B)"});
+  b.stiffness_ratio = r.get("bond.stiffness_ratio", b.stiffness_ratio, Range::positive(), {"1", "k_n-bar/k_s-bar"});
+  b.tensile_strength = r.get("bond.tensile_strength", b.tensile_strength, Range::positive(),
+                             {"Pa", "mean bond tensile strength sigma_c-bar"});
+  b.tensile_strength_std = r.get("bond.tensile_strength_std", b.tensile_strength_std, Range::non_negative(),
+                                 {"Pa", "standard deviation of sigma_c-bar"});
   b.shear_strength =
-      r.get("bond.shear_strength", 50e6, Range::positive(), {"Pa", "mean bond shear strength tau_c-bar"});
-  b.shear_strength_std =
-      r.get("bond.shear_strength_std", 10e6, Range::non_negative(), {"Pa", "standard deviation of tau_c-bar"});
+      r.get("bond.shear_strength", b.shear_strength, Range::positive(), {"Pa", "mean bond shear strength tau_c-bar"});
+  b.shear_strength_std = r.get("bond.shear_strength_std", b.shear_strength_std, Range::non_negative(),
+                               {"Pa", "standard deviation of tau_c-bar"});
   m.bond_gap_tolerance =
-      r.get("bond.gap_tolerance", 0.1, Range::non_negative(),
+      r.get("bond.gap_tolerance", m.bond_gap_tolerance, Range::non_negative(),
             {"1", "bond triangulation edges whose gap is below this fraction of the smaller radius"});
   // [joints]
   m.joint_friction =
@@ -570,7 +570,9 @@ int main(int argc, char** argv) {
       "bonded-disc DEM (parallel bonds, Potyondy & Cundall 2004) of rock: biaxial compression "
       "and tension tests of a bonded sample, and rock avalanches of a jointed rock mass on a "
       "terrain profile.\n"
-      "Usage: dem-avalanche --config case.toml [--set key=value ...] [--out DIR] [--threads N] [--quiet]";
+      "Usage: dem-avalanche --config case.toml [--set key=value ...] [--out DIR] [--threads N] [--quiet]\n"
+      "Example: dem-avalanche --config data/dem/biaxial_compression.toml --set bond.tensile_strength=40e6 "
+      "--out biaxial-out";
   app.options_caption =
       "Options (SI units throughout: m, s, kg, Pa; discs are 1 m thick, so forces are N/m and energies J/m; "
       "angles in the config in degrees)";
@@ -580,8 +582,10 @@ int main(int argc, char** argv) {
     reader.finish();
     cfg.resolved = reader.resolved();
     // Everything is validated before the output directory is created.
-    return cfg.kind == TestKind::Avalanche ? run_avalanche_case(cfg, opts.out, opts.quiet)
-                                           : run_lab(cfg, opts.out, opts.quiet);
+    return run_in_output_dir(opts.out, "dem-avalanche", {}, [&] {
+      return cfg.kind == TestKind::Avalanche ? run_avalanche_case(cfg, opts.out, opts.quiet)
+                                             : run_lab(cfg, opts.out, opts.quiet);
+    });
   };
   return run_config_app(argc, argv, app);
 }
