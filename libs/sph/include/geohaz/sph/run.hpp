@@ -22,7 +22,7 @@ namespace geohaz::sph {
 /// Where the particles come from.
 enum class ScenarioType { Slope, Column, Biaxial, Section };
 
-/// Pile rows of seed 001 Fig. 17 (3D): one row across the width at a position along the face.
+/// Pile rows of SPH-slope paper (2020), Fig. 17 (3D): one row across the width at a position along the face.
 struct PileRows {
   bool enabled = false;
   double position =
