@@ -111,20 +111,22 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   // [[material]]
   auto mats = r.tables("material", {"", "soil materials, indexed from 0 in order (base layer first)"});
   for (auto& m : mats) {
-    MaterialParams p;
+    MaterialParams p;  // defaults from the struct (constitutive.hpp), except the friction angle below
     c.material_names.push_back(m.get_string("name", "soil", {"", "label"}));
     // Bounded to real materials: the time step scales with √(ρ/E), so a density of a few kg/m³
     // (a slip of the unit) would make a run of seconds take hours (fuzz case 116).
-    p.density = m.get("density", 1800.0, Range::closed(100.0, 30000.0),
+    p.density = m.get("density", p.density, Range::closed(100.0, 30000.0),
                       {"kg/m^3", "density rho0 (soils 1500-2300, water 1000, rock 2500-3000)"});
-    p.young = m.get("young", 1e6, Range::positive(), {"Pa", "Young's modulus E"});
-    p.poisson = m.get("poisson", 0.3, Range::closed_open(0.0, 0.5), {"1", "Poisson's ratio"});
-    p.cohesion = m.get("cohesion", 0.0, Range::non_negative(), {"Pa", "cohesion c (Drucker-Prager)"});
+    p.young = m.get("young", p.young, Range::positive(), {"Pa", "Young's modulus E"});
+    p.poisson = m.get("poisson", p.poisson, Range::closed_open(0.0, 0.5), {"1", "Poisson's ratio"});
+    p.cohesion = m.get("cohesion", p.cohesion, Range::non_negative(), {"Pa", "cohesion c (Drucker-Prager)"});
     p.friction = kDeg * m.get("friction", 30.0, Range::closed_open(0.0, 90.0), {"deg", "friction angle phi"});
-    p.dilatancy =
-        kDeg * m.get("dilatancy", 0.0, Range::closed_open(0.0, 90.0), {"deg", "dilatancy angle psi (<= phi)"});
-    p.yield_stress = m.get("yield_stress", 1e5, Range::positive(), {"Pa", "uniaxial yield stress (von Mises)"});
-    p.viscosity = m.get("viscosity", 1e-3, Range::non_negative(), {"Pa s", "dynamic viscosity (Newtonian fluid)"});
+    p.dilatancy = kDeg * m.get("dilatancy", p.dilatancy / kDeg, Range::closed_open(0.0, 90.0),
+                               {"deg", "dilatancy angle psi (<= phi)"});
+    p.yield_stress =
+        m.get("yield_stress", p.yield_stress, Range::positive(), {"Pa", "uniaxial yield stress (von Mises)"});
+    p.viscosity =
+        m.get("viscosity", p.viscosity, Range::non_negative(), {"Pa s", "dynamic viscosity (Newtonian fluid)"});
     p.residual_cohesion =
         m.get("residual_cohesion", p.cohesion, Range::non_negative(),
               {"Pa", "residual cohesion c_r <= cohesion (drucker_prager_softening; default: cohesion)"});
