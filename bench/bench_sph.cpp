@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
     auto d = g.profile();
     const double dx = 0.01 / std::cbrt(scale);
     d.width = std::max(0.15, 5.0 * dx);  // ~4e4 particles at dx = 10 mm; periodic width ≥ 4h
-    run<3>("3D DP slope (SPH-slope paper (2020))", build_profile<3>(d, dx, {m.density}, 1.2), m, steps / 2 + 1);
+    run<3>("3D DP slope (SPH-slope paper 2020)", build_profile<3>(d, dx, {m.density}, 1.2), m, steps / 2 + 1);
   }
   return 0;
 }

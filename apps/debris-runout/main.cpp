@@ -102,7 +102,7 @@ int run(int argc, char** argv) {
   po::positional_options_description pos;
   pos.add("dsm", 1);
   if (!parse_command_line(argc, argv, kApp,
-                          "depth-averaged particle debris-flow runout over a DSM (SWJTU lecture (2010), §3).\n"
+                          "depth-averaged particle debris-flow runout over a DSM (SWJTU lecture 2010, §3).\n"
                           "Usage: debris-runout DSM [--release FILE | --release-from FILE] [--config run.toml] "
                           "[--set key=value ...] [--out DIR] [--threads N] [--quiet]\n"
                           "Example: debris-runout --config data/runout/valley_small.toml --set model.n=0.08 "

@@ -102,8 +102,8 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   }
   const auto fit = r.get_choice("model.dp_fit", "auto", {"auto", "plane_strain", "compression_3d"},
                                 {"",
-                                 "Drucker-Prager constants: auto = plane_strain in 2D (Bui et al. (2010), eqs. 18-19), "
-                                 "compression_3d in 3D (SPH-slope paper (2020), eq. 21)"});
+                                 "Drucker-Prager constants: auto = plane_strain in 2D (Bui et al. 2010, eqs. 18-19), "
+                                 "compression_3d in 3D (SPH-slope paper 2020, eq. 21)"});
   const DruckerPragerFit dpfit =
       fit == "plane_strain"     ? DruckerPragerFit::PlaneStrain
       : fit == "compression_3d" ? DruckerPragerFit::Compression3D
@@ -183,9 +183,9 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   n.artificial_stress_n = r.get("numerics.artificial_stress_n", d.artificial_stress_n, Range::non_negative(),
                                 {"1", "artificial-stress exponent n (0: W(0)/W(dx))"});
   n.xsph = r.get("numerics.xsph", d.xsph, Range::closed(0.0, 1.0),
-                 {"1", "XSPH velocity-correction factor epsilon (SWJTU lecture (2010))"});
+                 {"1", "XSPH velocity-correction factor epsilon (SWJTU lecture 2010)"});
   n.damping = r.get("numerics.damping", d.damping, Range::closed_open(0.0, 1.0),
-                    {"1", "Cundall local damping zeta in the main phase (Bui et al. (2010) uses 0.2 under shaking)"});
+                    {"1", "Cundall local damping zeta in the main phase (Bui et al. 2010 uses 0.2 under shaking)"});
   n.stress_free_fraction = r.get("numerics.stress_free_fraction", d.stress_free_fraction, Range::closed_open(0.0, 1.0),
                                  {"1", "stress vanishes where the kernel-sum density < fraction rho0 (0: off)"});
   n.reorder_every = static_cast<int>(r.get_int("numerics.reorder_every", d.reorder_every, Range::closed(0, 1e6),
@@ -207,7 +207,7 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   // [earthquake]
   const auto eq =
       r.get_choice("earthquake.type", "none", {"none", "sine", "record"},
-                   {"", "earthquake acceleration applied to every particle (Bui et al. (2010), eqs. 25-26)"});
+                   {"", "earthquake acceleration applied to every particle (Bui et al. 2010, eqs. 25-26)"});
   {  // all keys are read whatever the type, so that --set earthquake.type=none works on any config
     const double A =
         r.get("earthquake.amplitude", 5.0, Range::non_negative(), {"m/s^2", "sine amplitude (500 gal = 5)"});
@@ -284,7 +284,7 @@ RunConfig read_config(ConfigReader& r, bool describe) {
                     {"m", "3D width (axis y); a 3D DSM section: the strip width, centred on the polyline"});
     c.periodic_width = r.get_bool(
         "geometry.periodic", c.scenario != ScenarioType::Section,
-        {"", "3D: periodic across the width (SPH-slope paper (2020)), else roller walls (default for a DSM section)"});
+        {"", "3D: periodic across the width (SPH-slope paper 2020), else roller walls (default for a DSM section)"});
   }
   const char* right_default = c.scenario == ScenarioType::Column ? "none" : "fixed";
   c.left_wall = wall(r, "walls.left", "fixed");

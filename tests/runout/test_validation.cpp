@@ -1,6 +1,6 @@
 // Validation runs of the debris-runout model (label `validation`, not in CI; minutes). They print
 // the figures quoted in docs/validation/runout.md and write the pictures to docs/figures/runout/.
-//  1. The lecture's scenario at its scale (SWJTU lecture (2010), §3: a debris flow travelling 4.8 km in 10 min,
+//  1. The lecture's scenario at its scale (SWJTU lecture 2010, §3: a debris flow travelling 4.8 km in 10 min,
 //     n = 0.06, i_cr = 0.15, 2.5 m DSM): the synthetic 5 km valley, 2000 × 1000 cells, ~5000
 //     particles (d0 = 5 m).
 //  2. Real terrain: the Alplehner DTM and release polygon (data/terrain/alr).

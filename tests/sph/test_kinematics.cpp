@@ -112,7 +112,7 @@ TEST(VelocityGradient, TranslationHasNoStrainRateAnywhere) {
 }
 
 // Body forces on a free block (no walls, no stress): the earthquake acceleration of Bui et al. (2010)
-// eq. 26 adds to every particle, and Cundall's local damping (Bui et al. (2010), eq. 14) reduces an
+// eq. 26 adds to every particle, and Cundall's local damping (Bui et al. 2010, eq. 14) reduces an
 // accelerating motion to a(1 − ζ).
 TEST(BodyForces, EarthquakeAndLocalDamping) {
   auto solver_with = [](double g, double zeta, EarthquakeLoading eq) {

@@ -201,7 +201,7 @@ TEST(Validation, Seed002MasaShakingTable) {
   copy_figure("seed002_masa", "velocity_t4.000.png", "seed002_masa_velocity_4s.png");
 }
 
-// Biaxial compression (SWJTU lecture (2010)): shear band inclination between Roscoe (45° + ψ/2) and Coulomb
+// Biaxial compression (SWJTU lecture 2010): shear band inclination between Roscoe (45° + ψ/2) and Coulomb
 // (45° + φ/2) angles; the band is located from the plastic strain in the final snapshot (docs).
 TEST(Validation, BiaxialCompression) {
   const double phi = 25.0, psi = 0.0;

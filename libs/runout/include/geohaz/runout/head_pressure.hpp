@@ -1,7 +1,7 @@
 #pragma once
 /// \file head_pressure.hpp
 /// The flow-head pressure of the depth-averaged debris-flow model as an inter-particle force
-/// (SWJTU lecture (2010), section 3, "pressure due to the soil-water mixture head is modeled with
+/// (SWJTU lecture 2010, section 3, "pressure due to the soil-water mixture head is modeled with
 /// inter-particle force", including the effective-length extension):
 ///
 ///     a_i = Σ_j  C · g · (V_j / d0³) · f(|d|/d0) · d/|d|,      d = x_i − x_j  (map view)
@@ -26,7 +26,7 @@
 
 namespace geohaz::runout {
 
-/// Shape function and constants of the head-pressure force (SWJTU lecture (2010), §3, continuous reading).
+/// Shape function and constants of the head-pressure force (SWJTU lecture 2010, §3, continuous reading).
 struct HeadPressureForce {
   /// Support of f in units of d0.
   static constexpr double support = 2.0;

@@ -3,9 +3,9 @@
 /// Constitutive models of the SPH slope model (stress update per particle and step).
 ///
 /// All models advance the Cauchy stress σ (3×3, tension positive) with the Jaumann rate
-/// (SPH-slope paper (2020), eq. 22 / Bui et al. (2010), eq. 21, Bui et al. 2008):
+/// (SPH-slope paper 2020, eq. 22 / Bui et al. (2010), eq. 21, Bui et al. 2008):
 ///     dσ/dt = W σ − σ W + 2G ė + K tr(ε̇) I − (plastic correction)
-/// where ε̇ = ½(L + Lᵀ), W = ½(L − Lᵀ) (SPH-slope paper (2020), eqs. 24–25), ė = ε̇ − ⅓ tr(ε̇) I,
+/// where ε̇ = ½(L + Lᵀ), W = ½(L − Lᵀ) (SPH-slope paper 2020, eqs. 24–25), ė = ε̇ − ⅓ tr(ε̇) I,
 /// K = E / (3(1 − 2ν)), G = E / (2(1 + ν)). In 2D plane strain L is embedded in 3×3 with
 /// zero out-of-plane row/column, so σ_zz evolves with (K − 2G/3) tr(ε̇) (ε_zz = 0).
 ///
@@ -19,7 +19,7 @@
 /// Density floor (`min_density`): the continuity density of a material that cannot carry mean
 /// tension beyond p_t (Drucker–Prager: the apex, p_t = k_c/(3α_φ)) is bounded below by the density
 /// of the elastic dilation at p_t, ρ_min = ρ0/(1 + p_t/K) (ρ0 for c = 0). Beyond it the particles are
-/// parting (SWJTU lecture (2010) "meeting and parting"), not dilating: the gap between them is not material
+/// parting (SWJTU lecture 2010 "meeting and parting"), not dilating: the gap between them is not material
 /// volume. Without the floor m/ρ of separating particles grows without bound (ρ → 0), their
 /// neighbours' velocity gradients and σ/ρ² blow up (column collapses at Δx = L0/30–L0/40).
 ///

@@ -6,7 +6,7 @@
 /// store, so reordering by cell, restart and output can never forget one (STYLE.md §1).
 /// Stress is always a 3×3 tensor: in 2D plane strain the out-of-plane normal stress σ_zz is
 /// non-zero (ε_zz = 0) and is needed for the invariants I1 and J2 of the yield functions.
-/// Sign convention: tension positive (Bui et al. (2010): σ' is negative in compression).
+/// Sign convention: tension positive (Bui et al. 2010: σ' is negative in compression).
 
 #include <cstdint>
 

@@ -10,18 +10,18 @@
 ///      soil particle i as its mirror image (Bui et al. 2008): full fixity v_B = 2v_wall − v_i, roller
 ///      v_i with the normal component mirrored; stress σ_B = σ_i − ρ_i d [ḡ_n I + ḡ_t ⊗ ν + ν ⊗ ḡ_t]
 ///      extrapolated along the layering normal ν (d = (x_B − x_i)·ν), shear mirrored for a roller;
-///   2. velocity_gradient: L_i = Σ_j V_j (v_j − v_i) ⊗ ∇_i W_ij (SPH-slope paper (2020), eqs. 24–25), continuity
-///      dρ_i/dt = Σ_j m_j (v_i − v_j)·∇_i W_ij (SPH-slope paper (2020), eq. 11), kernel-summation density and the
-///      XSPH term Σ_j V_j (v_j − v_i) W_ij (SWJTU lecture (2010)); each soil–soil pair evaluated once;
+///   2. velocity_gradient: L_i = Σ_j V_j (v_j − v_i) ⊗ ∇_i W_ij (SPH-slope paper 2020, eqs. 24–25), continuity
+///      dρ_i/dt = Σ_j m_j (v_i − v_j)·∇_i W_ij (SPH-slope paper 2020, eq. 11), kernel-summation density and the
+///      XSPH term Σ_j V_j (v_j − v_i) W_ij (SWJTU lecture 2010); each soil–soil pair evaluated once;
 ///   3. update_stress: density and stress update (the constitutive model, chosen once per step,
 ///      updates σ and its internal variables), stress vanishing below a summation-density threshold
-///      (SWJTU lecture (2010) "meeting and parting"), artificial stress R = −ε_as σ_a/ρ² on tensile principal
+///      (SWJTU lecture 2010 "meeting and parting"), artificial stress R = −ε_as σ_a/ρ² on tensile principal
 ///      stresses (Gray & Monaghan 2001);
-///   4. momentum (Bui et al. (2010), eq. 12 with the stress pair in its energy-consistent form):
+///   4. momentum (Bui et al. 2010, eq. 12 with the stress pair in its energy-consistent form):
 ///      a_i = Σ_j m_j ((σ_i + σ_j)/(ρ_i ρ_j) − Π_ij I + f_ij^n (R_i + R_j)) ∇_i W_ij + ḡ
 ///      with Monaghan's viscosity Π_ij (the model's wave speed), f_ij = W(r)/W(Δx),
-///      ḡ = g + a_earthquake (Bui et al. (2010), eqs. 25–26);
-///   5. integrate: body force ḡ, Cundall local damping −ζ|a_α| sign(v_α) (Bui et al. (2010), eq. 14),
+///      ḡ = g + a_earthquake (Bui et al. 2010, eqs. 25–26);
+///   5. integrate: body force ḡ, Cundall local damping −ζ|a_α| sign(v_α) (Bui et al. 2010, eq. 14),
 ///      leap-frog (kick–drift: v^{n+½} = v^{n−½} + Δt a^n, x^{n+1} = x^n + Δt (v^{n+½} + ε ΔvXSPH));
 ///   6. check_state, update_dt: Δt = min(C_cfl h/(c + |v|max), C_f √(h/|a|max), the model's own
 ///      limit, Δt_max), c the model's wave speed (constitutive.hpp: P-wave speed of a solid; a
@@ -68,7 +68,7 @@ struct NumericalSettings {
   double viscosity_beta = 0.0;        ///< Monaghan β_Π
   double artificial_stress = 0.3;     ///< ε_as (0 switches it off)
   double artificial_stress_n = 0.0;   ///< exponent n; 0 → W(0)/W(Δx)
-  double xsph = 0.0;                  ///< ε of the XSPH correction (SWJTU lecture (2010)), 0 = off
+  double xsph = 0.0;                  ///< ε of the XSPH correction (SWJTU lecture 2010), 0 = off
   double damping = 0.0;               ///< Cundall ζ in the main phase
   double stress_free_fraction = 0.0;  ///< stress vanishes where Σ m W < fraction·ρ0 (0 = off)
   int reorder_every = 20;             ///< steps between cell reorderings of the store
