@@ -24,8 +24,8 @@ void add_common_options(po::options_description& desc, CommonOptions& o, const s
     ("version", "print the version and exit")
     ("config,c", po::value<std::string>(&o.config), "scenario configuration file (TOML)")
     ("set", po::value<std::vector<std::string>>(&o.set)->composing(),
-     "override a config key (repeatable; values in SI units, TOML syntax; an element of an array of "
-     "tables as key[i].name, e.g. material[0].cohesion=5e3); see the example below")
+     "override a config key (repeatable; values in SI units, TOML syntax; a key in the i-th entry of an "
+     "array of tables as table[i].key, counted from 0); see the example above")
     ("out,o", po::value<std::string>(&o.out)->default_value(default_out),
      "output directory: new, empty, or holding an earlier run of this app (its files, listed in "
      "geohaz-manifest.txt, are removed first); any other file there stops the run (exit 2)")
