@@ -111,7 +111,6 @@ int main(int argc, char** argv) {
       pb.tensile_strength = pb.shear_strength = 50e6;
       pb.tensile_strength_std = pb.shear_strength_std = 10e6;
       install_parallel_bonds(s.discs, t.edges, pb, 0.5, 3, s.bonds);
-      s.bond_properties = pb;
       box(s, hi.x() + rmax, hi.y() + rmax);
       s.walls[0].velocity = Vec2(0, 0.2);   // bottom platen up
       s.walls[2].velocity = Vec2(0, -0.2);  // top platen down

@@ -1,7 +1,7 @@
 // Throughput of the debris-runout solver (issue 4 targets, 2-core machine):
 //  1. particle-steps per second for a 10^5-particle flow on an inclined plane, 1 and 2 threads
 //     (target ≥ 5e6 /s with 2 threads);
-//  2. wall time of the seed's case at the seed's scale: 10 simulated minutes of a ~5000-particle
+//  2. wall time of the lecture's case at the lecture's scale: 10 simulated minutes of a ~5000-particle
 //     release (d0 = 5 m, h0 = 1 m, 2 m thick over 300 m × 200 m) on the synthetic 5 km valley DSM of 2000 × 1000 cells
 //     at 2.5 m, n = 0.06, i_cr = 0.15 (target < 10 s), with the hazard maps recorded every step as the app does.
 // Prints rates; never asserts. Usage: bench_runout [particles=100000] [steps=40] [all|plane|seed|processes] [threads]
@@ -112,7 +112,7 @@ int main(int argc, char** argv) {
   }
   if (which != "all" && which != "seed") return 0;
 
-  // The seed's case.
+  // The lecture's case.
   const int seed_threads = only_threads > 0 ? only_threads : 2;
   omp_set_num_threads(seed_threads);
   const SyntheticValley v;
@@ -146,8 +146,9 @@ int main(int argc, char** argv) {
   const double wall = now() - t0, cpu_s = cpu() - c0;
   const auto row = series_row(s.particles(), s.budget(), s.time(), s.step_count());
   std::printf(
-      "seed case: %zu particles (%.0f m^3), 2000 x 1000 DSM at 2.5 m, %.0f s simulated in %lld steps: "
-      "%.2f s wall, %.2f s CPU (%d thread(s), %.3g particle-steps/s); front travelled %.0f m (seed: 4800 m in 600 s)\n",
+      "lecture case: %zu particles (%.0f m^3), 2000 x 1000 DSM at 2.5 m, %.0f s simulated in %lld steps: "
+      "%.2f s wall, %.2f s CPU (%d thread(s), %.3g particle-steps/s); front travelled %.0f m (lecture: 4800 m in 600 "
+      "s)\n",
       rep.particles, rep.volume_seeded, s.time(), static_cast<long long>(s.step_count()), wall, cpu_s, seed_threads,
       static_cast<double>(particle_steps) / wall, row.front_travel);
   // Sum of the final positions in id order: equal sums mean the same run (to compare variants).

@@ -1,5 +1,5 @@
 // Throughput of the SPH slope model: particle-steps per second for a 2D Drucker–Prager column
-// collapse (~1e5 particles) and a 3D slope (~4e4 particles, seed 001's size), on 1 and 2 threads,
+// collapse (~1e5 particles) and a 3D slope (~4e4 particles, SPH-slope paper (2020)'s size), on 1 and 2 threads,
 // and the memory per particle. Prints figures; never asserts (docs/performance.md). The state hash
 // after the steps is the same on 1 and 2 threads (results independent of the thread count).
 //   bench_sph [steps] [scale] [2d|3d|all] [threads] [skin] [structures] [correction]   (scale < 1
@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
   }
   if (selection.dim != 2) {
     m.fit = DruckerPragerFit::Compression3D;
-    SlopeGeometry g;  // seed 001 Fig. 3: 0.25 m high, 1.5H:1V, crest 0.3 m, front 0.6 m
+    SlopeGeometry g;  // SPH-slope paper (2020), Fig. 3: 0.25 m high, 1.5H:1V, crest 0.3 m, front 0.6 m
     g.height = 0.25;
     g.crest_length = 0.3;
     g.front_length = 0.6;
@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
     auto d = g.profile();
     const double dx = 0.01 / std::cbrt(scale);
     d.width = std::max(0.15, 5.0 * dx);  // ~4e4 particles at dx = 10 mm; periodic width ≥ 4h
-    run<3>("3D DP slope (seed 001)", build_profile<3>(d, dx, {m.density}, 1.2), m, steps / 2 + 1);
+    run<3>("3D DP slope (SPH-slope paper 2020)", build_profile<3>(d, dx, {m.density}, 1.2), m, steps / 2 + 1);
   }
   return 0;
 }

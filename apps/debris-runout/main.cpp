@@ -58,7 +58,11 @@ int make_synthetic(const std::string& path, double scale, double release_depth) 
   dsm.crs_wkt = kSyntheticValleyCrsWkt;
   dsm.nodata = -9999.0;
   dsm.data = v.surface().values();
-  Raster rel = dsm.like(0.0, std::nullopt);
+  dsm.description = "elevation of the synthetic valley";
+  dsm.unit = "m";
+  Raster rel = dsm.like(0.0, -9999.0);  // nodata, description and unit on every GeoTIFF (issue #16)
+  rel.description = "release thickness, vertical";
+  rel.unit = "m";
   const double L = v.length(), depth = release_depth > 0.0 ? release_depth : 2.0;
   for (int r = 0; r < g.ny; ++r)
     for (int c = 0; c < g.nx; ++c) {
@@ -98,9 +102,11 @@ int run(int argc, char** argv) {
   po::positional_options_description pos;
   pos.add("dsm", 1);
   if (!parse_command_line(argc, argv, kApp,
-                          "depth-averaged particle debris-flow runout over a DSM (seed 000 §3).\n"
+                          "depth-averaged particle debris-flow runout over a DSM (SWJTU lecture 2010, §3).\n"
                           "Usage: debris-runout DSM [--release FILE | --release-from FILE] [--config run.toml] "
-                          "[--set key=value ...] [--out DIR] [--threads N] [--quiet]",
+                          "[--set key=value ...] [--out DIR] [--threads N] [--quiet]\n"
+                          "Example: debris-runout --config data/runout/valley_small.toml --set model.n=0.08 "
+                          "--out runout-small",
                           desc, &pos))
     return kExitOk;
   if (common.help_config) {
@@ -138,8 +144,12 @@ int run(int argc, char** argv) {
   RunoutCase c = read_case(cfg);
   cfg.finish();
   c.resolved_config = cfg.resolved();
-  run_case(c, common.out, common.quiet, threads);
-  return kExitOk;
+  // The inputs read while the run goes on must not lie in the folder it cleans first.
+  std::vector<fs::path> inputs{c.dsm, c.release.file, c.release.handoff, c.processes.hydrograph, c.processes.erodible};
+  return run_in_output_dir(common.out, kApp, inputs, [&] {
+    run_case(c, common.out, common.quiet, threads);
+    return kExitOk;
+  });
 }
 
 }  // namespace

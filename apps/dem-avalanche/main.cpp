@@ -119,7 +119,7 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   // [material]
   MaterialSpec& m = c.material;
   p.density = m.density =
-      r.get("material.density", 2650.0, Range::positive(), {"kg/m^3", "disc density (discs are 1 m thick)"});
+      r.get("material.density", m.density, Range::positive(), {"kg/m^3", "disc density (discs are 1 m thick)"});
   const auto law = r.get_choice("material.contact_law", "linear", {"linear", "hertz"},
                                 {"", "contact law: linear spring + Coulomb (Cundall & Strack 1979) or Hertz-Mindlin"});
   const double Ec = r.get("material.contact_modulus", 20e9, Range::positive(),
@@ -145,26 +145,26 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   m.contact.rolling_damping =
       r.get("material.rolling_damping", 0.3, Range::closed(0.0, 1.0), {"1", "rolling viscous damping ratio eta_r"});
   // [bond]
-  ParallelBondProperties& b = m.bond;
-  b.radius_multiplier = r.get("bond.radius_multiplier", 1.0, Range::open_closed(0.0, 1.0),
+  ParallelBondProperties& b = m.bond;  // defaults: the struct's (bonds.hpp)
+  b.radius_multiplier = r.get("bond.radius_multiplier", b.radius_multiplier, Range::open_closed(0.0, 1.0),
                               {"1", "lambda: bond radius = lambda min(R_A, R_B)"});
   b.modulus =
-      r.get("bond.modulus", 20e9, Range::positive(), {"Pa", "bond modulus E_c-bar: k_n-bar = E_c-bar/(R_A+R_B)"});
-  b.stiffness_ratio = r.get("bond.stiffness_ratio", 2.5, Range::positive(), {"1", "k_n-bar/k_s-bar"});
-  b.tensile_strength =
-      r.get("bond.tensile_strength", 50e6, Range::positive(), {"Pa", "mean bond tensile strength sigma_c-bar"});
-  b.tensile_strength_std =
-      r.get("bond.tensile_strength_std", 10e6, Range::non_negative(), {"Pa", "standard deviation of sigma_c-bar"});
+      r.get("bond.modulus", b.modulus, Range::positive(), {"Pa", "bond modulus E_c-bar: k_n-bar = E_c-bar/(R_A+R_B)"});
+  b.stiffness_ratio = r.get("bond.stiffness_ratio", b.stiffness_ratio, Range::positive(), {"1", "k_n-bar/k_s-bar"});
+  b.tensile_strength = r.get("bond.tensile_strength", b.tensile_strength, Range::positive(),
+                             {"Pa", "mean bond tensile strength sigma_c-bar"});
+  b.tensile_strength_std = r.get("bond.tensile_strength_std", b.tensile_strength_std, Range::non_negative(),
+                                 {"Pa", "standard deviation of sigma_c-bar"});
   b.shear_strength =
-      r.get("bond.shear_strength", 50e6, Range::positive(), {"Pa", "mean bond shear strength tau_c-bar"});
-  b.shear_strength_std =
-      r.get("bond.shear_strength_std", 10e6, Range::non_negative(), {"Pa", "standard deviation of tau_c-bar"});
+      r.get("bond.shear_strength", b.shear_strength, Range::positive(), {"Pa", "mean bond shear strength tau_c-bar"});
+  b.shear_strength_std = r.get("bond.shear_strength_std", b.shear_strength_std, Range::non_negative(),
+                               {"Pa", "standard deviation of tau_c-bar"});
   m.bond_gap_tolerance =
-      r.get("bond.gap_tolerance", 0.1, Range::non_negative(),
+      r.get("bond.gap_tolerance", m.bond_gap_tolerance, Range::non_negative(),
             {"1", "bond triangulation edges whose gap is below this fraction of the smaller radius"});
   // [joints]
-  m.joint_friction =
-      r.get("joints.friction", 0.5, Range::non_negative(), {"1", "friction coefficient of joint contacts"});
+  m.joint_friction = r.get("joints.friction", m.joint_friction, Range::non_negative(),
+                           {"1", "friction coefficient of joint contacts"});
   for (auto& js : r.tables("joints.set", {"", "joint sets: dip, spacing, persistence, trace_length"})) {
     JointSet s;
     s.dip = js.get("dip", 45.0, Range::closed(-180, 180), {"deg", "trace angle from +x, counter-clockwise"});
@@ -196,19 +196,19 @@ RunConfig read_config(ConfigReader& r, bool describe) {
                               {"Pa", "confining stresses sigma_3 of the compression tests (one test each)"});
     l.loading_velocity =
         r.get("biaxial.loading_velocity", 0.25, Range::closed(1e-3, 100.0),
-              {"m/s",
-               "speed of each platen / grip (quasi-static tests: 0.01-1; the test lasts strain·height/speed "
-               "at a step of ~1e-7 s, so slower is impractically long)"});
-    l.max_axial_strain =
-        r.get("biaxial.max_axial_strain", 0.02, Range::open_closed(0.0, 0.5), {"1", "stop at this axial strain"});
-    l.post_peak_stop = r.get("biaxial.post_peak_stop", 0.7, Range::closed(0.0, 1.0),
+                {"m/s",
+                 "speed of each platen / grip (quasi-static tests: 0.01-1; the test lasts strain·height/speed "
+                 "at a step of ~1e-7 s, so slower is impractically long)"});
+    l.max_axial_strain = r.get("biaxial.max_axial_strain", l.max_axial_strain, Range::open_closed(0.0, 0.5),
+                               {"1", "stop at this axial strain"});
+    l.post_peak_stop = r.get("biaxial.post_peak_stop", l.post_peak_stop, Range::closed(0.0, 1.0),
                              {"1", "stop once the stress falls below this fraction of the peak"});
-    l.local_damping =
-        r.get("biaxial.local_damping", 0.7, Range::closed_open(0.0, 1.0), {"1", "Cundall local damping alpha"});
-    l.grip_fraction = r.get("biaxial.grip_fraction", 0.1, Range::open_closed(0.0, 0.3),
+    l.local_damping = r.get("biaxial.local_damping", l.local_damping, Range::closed_open(0.0, 1.0),
+                            {"1", "Cundall local damping alpha"});
+    l.grip_fraction = r.get("biaxial.grip_fraction", l.grip_fraction, Range::open_closed(0.0, 0.3),
                             {"1", "tension: gripped fraction of the height at each end"});
-    l.record_interval = static_cast<int>(
-        r.get_int("biaxial.record_interval", 50, Range::closed(1, 1e9), {"1", "steps between curve points"}));
+    l.record_interval = static_cast<int>(r.get_int("biaxial.record_interval", l.record_interval, Range::closed(1, 1e9),
+                                                   {"1", "steps between curve points"}));
     l.packing = p;
     l.material = m;
     if (!describe && p.width < 8 * p.r_max)
@@ -281,41 +281,42 @@ RunConfig read_config(ConfigReader& r, bool describe) {
                        "optional support wall (2 points) holding the mass until release", false, 2);
     if (!a.support.empty() && a.support.size() != 2)
       throw InputError("the support wall takes exactly 2 points", r.source(), "avalanche.support_x");
-    a.terrain_friction = r.get("avalanche.terrain_friction", 0.6, Range::non_negative(),
+    a.terrain_friction = r.get("avalanche.terrain_friction", a.terrain_friction, Range::non_negative(),
                                {"1", "friction coefficient of disc-terrain contacts"});
-    a.terrain_restitution = r.get("avalanche.terrain_restitution", 0.3, Range::open_closed(0.0, 1.0),
+    a.terrain_restitution = r.get("avalanche.terrain_restitution", a.terrain_restitution, Range::open_closed(0.0, 1.0),
                                   {"1", "restitution of disc-terrain contacts"});
     a.terrain_rolling_friction = r.get(
         "avalanche.terrain_rolling_friction", m.contact.rolling_friction, Range::non_negative(),
         {"1", "rolling-resistance coefficient mu_r of disc-terrain contacts (default: material.rolling_friction)"});
-    a.settle_time =
-        r.get("avalanche.settle_time", 1.0, Range::non_negative(), {"s", "settling under gravity before release"});
-    a.settle_damping =
-        r.get("avalanche.settle_damping", 0.7, Range::closed_open(0.0, 1.0), {"1", "local damping while settling"});
+    a.settle_time = r.get("avalanche.settle_time", a.settle_time, Range::non_negative(),
+                          {"s", "settling under gravity before release"});
+    a.settle_damping = r.get("avalanche.settle_damping", a.settle_damping, Range::closed_open(0.0, 1.0),
+                             {"1", "local damping while settling"});
     a.strength_factor =
-        r.get("avalanche.strength_factor", 1.0, Range::closed(0.0, 1.0),
+        r.get("avalanche.strength_factor", a.strength_factor, Range::closed(0.0, 1.0),
               {"1", "bond strengths are multiplied by this at release (weathering / weakening trigger)"});
     const auto trig =
         r.get_array("avalanche.trigger_acceleration", {0.0, 0.0}, Range{},
                     {"m/s^2", "extra acceleration [ax, az] applied during the trigger (earthquake-like push)"}, 2);
     a.trigger_acceleration = Vec2(trig[0], trig[1]);
-    a.trigger_duration =
-        r.get("avalanche.trigger_duration", 0.0, Range::non_negative(), {"s", "duration of the trigger acceleration"});
-    a.runout_time = r.get("avalanche.runout_time", AvalancheSpec{}.runout_time, Range::positive(),
+    a.trigger_duration = r.get("avalanche.trigger_duration", a.trigger_duration, Range::non_negative(),
+                               {"s", "duration of the trigger acceleration"});
+    a.runout_time = r.get("avalanche.runout_time", a.runout_time, Range::positive(),
                           {"s",
                            "longest simulated time after release; the run ends earlier once the mass is at rest "
                            "(stop_kinetic_fraction, stop_speed), and warns if it is still moving at this time"});
     a.stop_kinetic_fraction =
-        r.get("avalanche.stop_kinetic_fraction", AvalancheSpec{}.stop_kinetic_fraction, Range{0.0, 1.0, true, true},
+        r.get("avalanche.stop_kinetic_fraction", a.stop_kinetic_fraction, Range{0.0, 1.0, true, true},
               {"1",
                "at rest when the kinetic energy is below this fraction of its peak after release (and no disc "
                "is faster than stop_speed)"});
-    a.stop_speed = r.get("avalanche.stop_speed", AvalancheSpec{}.stop_speed, Range::non_negative(),
+    a.stop_speed = r.get("avalanche.stop_speed", a.stop_speed, Range::non_negative(),
                          {"m/s", "at rest when no disc is faster than this (0: kinetic-energy criterion alone)"});
-    a.runout_damping =
-        r.get("avalanche.runout_damping", 0.0, Range::closed_open(0.0, 1.0), {"1", "local damping during the run-out"});
-    a.record_interval = r.get("avalanche.record_interval", 0.1, Range::positive(), {"s", "time-series interval"});
-    a.volume_width = r.get("avalanche.volume_width", 0.0, Range::non_negative(),
+    a.runout_damping = r.get("avalanche.runout_damping", a.runout_damping, Range::closed_open(0.0, 1.0),
+                             {"1", "local damping during the run-out"});
+    a.record_interval =
+        r.get("avalanche.record_interval", a.record_interval, Range::positive(), {"s", "time-series interval"});
+    a.volume_width = r.get("avalanche.volume_width", a.volume_width, Range::non_negative(),
                            {"m", "out-of-plane width turning the 2D source area into a volume (0: source length)"});
     a.packing = p;
     a.packing.locked_in_stress = r.get("avalanche.locked_in_stress", 0.0, Range::non_negative(),
@@ -575,7 +576,9 @@ int main(int argc, char** argv) {
       "bonded-disc DEM (parallel bonds, Potyondy & Cundall 2004) of rock: biaxial compression "
       "and tension tests of a bonded sample, and rock avalanches of a jointed rock mass on a "
       "terrain profile.\n"
-      "Usage: dem-avalanche --config case.toml [--set key=value ...] [--out DIR] [--threads N] [--quiet]";
+      "Usage: dem-avalanche --config case.toml [--set key=value ...] [--out DIR] [--threads N] [--quiet]\n"
+      "Example: dem-avalanche --config data/dem/biaxial_compression.toml --set bond.tensile_strength=40e6 "
+      "--out biaxial-out";
   app.options_caption =
       "Options (SI units throughout: m, s, kg, Pa; discs are 1 m thick, so forces are N/m and energies J/m; "
       "angles in the config in degrees)";
@@ -585,8 +588,10 @@ int main(int argc, char** argv) {
     reader.finish();
     cfg.resolved = reader.resolved();
     // Everything is validated before the output directory is created.
-    return cfg.kind == TestKind::Avalanche ? run_avalanche_case(cfg, opts.out, opts.quiet)
-                                           : run_lab(cfg, opts.out, opts.quiet);
+    return run_in_output_dir(opts.out, "dem-avalanche", {}, [&] {
+      return cfg.kind == TestKind::Avalanche ? run_avalanche_case(cfg, opts.out, opts.quiet)
+                                             : run_lab(cfg, opts.out, opts.quiet);
+    });
   };
   return run_config_app(argc, argv, app);
 }

@@ -105,8 +105,8 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   }
   const auto fit = r.get_choice("model.dp_fit", "auto", {"auto", "plane_strain", "compression_3d"},
                                 {"",
-                                 "Drucker-Prager constants: auto = plane_strain in 2D (seed 002 eqs. 18-19), "
-                                 "compression_3d in 3D (seed 001 eq. 21)"});
+                                 "Drucker-Prager constants: auto = plane_strain in 2D (Bui et al. 2010, eqs. 18-19), "
+                                 "compression_3d in 3D (SPH-slope paper 2020, eq. 21)"});
   const DruckerPragerFit dpfit =
       fit == "plane_strain"     ? DruckerPragerFit::PlaneStrain
       : fit == "compression_3d" ? DruckerPragerFit::Compression3D
@@ -114,20 +114,22 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   // [[material]]
   auto mats = r.tables("material", {"", "soil materials, indexed from 0 in order (base layer first)"});
   for (auto& m : mats) {
-    MaterialParams p;
+    MaterialParams p;  // defaults from the struct (constitutive.hpp), except the friction angle below
     c.material_names.push_back(m.get_string("name", "soil", {"", "label"}));
     // Bounded to real materials: the time step scales with √(ρ/E), so a density of a few kg/m³
     // (a slip of the unit) would make a run of seconds take hours (fuzz case 116).
-    p.density = m.get("density", 1800.0, Range::closed(100.0, 30000.0),
+    p.density = m.get("density", p.density, Range::closed(100.0, 30000.0),
                       {"kg/m^3", "density rho0 (soils 1500-2300, water 1000, rock 2500-3000)"});
-    p.young = m.get("young", 1e6, Range::positive(), {"Pa", "Young's modulus E"});
-    p.poisson = m.get("poisson", 0.3, Range::closed_open(0.0, 0.5), {"1", "Poisson's ratio"});
-    p.cohesion = m.get("cohesion", 0.0, Range::non_negative(), {"Pa", "cohesion c (Drucker-Prager)"});
+    p.young = m.get("young", p.young, Range::positive(), {"Pa", "Young's modulus E"});
+    p.poisson = m.get("poisson", p.poisson, Range::closed_open(0.0, 0.5), {"1", "Poisson's ratio"});
+    p.cohesion = m.get("cohesion", p.cohesion, Range::non_negative(), {"Pa", "cohesion c (Drucker-Prager)"});
     p.friction = kDeg * m.get("friction", 30.0, Range::closed_open(0.0, 90.0), {"deg", "friction angle phi"});
-    p.dilatancy =
-        kDeg * m.get("dilatancy", 0.0, Range::closed_open(0.0, 90.0), {"deg", "dilatancy angle psi (<= phi)"});
-    p.yield_stress = m.get("yield_stress", 1e5, Range::positive(), {"Pa", "uniaxial yield stress (von Mises)"});
-    p.viscosity = m.get("viscosity", 1e-3, Range::non_negative(), {"Pa s", "dynamic viscosity (Newtonian fluid)"});
+    p.dilatancy = kDeg * m.get("dilatancy", p.dilatancy / kDeg, Range::closed_open(0.0, 90.0),
+                               {"deg", "dilatancy angle psi (<= phi)"});
+    p.yield_stress =
+        m.get("yield_stress", p.yield_stress, Range::positive(), {"Pa", "uniaxial yield stress (von Mises)"});
+    p.viscosity =
+        m.get("viscosity", p.viscosity, Range::non_negative(), {"Pa s", "dynamic viscosity (Newtonian fluid)"});
     p.residual_cohesion =
         m.get("residual_cohesion", p.cohesion, Range::non_negative(),
               {"Pa", "residual cohesion c_r <= cohesion (drucker_prager_softening; default: cohesion)"});
@@ -184,9 +186,9 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   n.artificial_stress_n = r.get("numerics.artificial_stress_n", d.artificial_stress_n, Range::non_negative(),
                                 {"1", "artificial-stress exponent n (0: W(0)/W(dx))"});
   n.xsph = r.get("numerics.xsph", d.xsph, Range::closed(0.0, 1.0),
-                 {"1", "XSPH velocity-correction factor epsilon (seed 000)"});
+                 {"1", "XSPH velocity-correction factor epsilon (SWJTU lecture 2010)"});
   n.damping = r.get("numerics.damping", d.damping, Range::closed_open(0.0, 1.0),
-                    {"1", "Cundall local damping zeta in the main phase (seed 002 uses 0.2 under shaking)"});
+                    {"1", "Cundall local damping zeta in the main phase (Bui et al. 2010 uses 0.2 under shaking)"});
   n.stress_free_fraction = r.get("numerics.stress_free_fraction", d.stress_free_fraction, Range::closed_open(0.0, 1.0),
                                  {"1", "stress vanishes where the kernel-sum density < fraction rho0 (0: off)"});
   n.reorder_every = static_cast<int>(r.get_int("numerics.reorder_every", d.reorder_every, Range::closed(0, 1e6),
@@ -215,8 +217,9 @@ RunConfig read_config(ConfigReader& r, bool describe) {
       r.get("geostatic.rest_tolerance", 0.01, Range::positive(), {"1", "at rest: max|v| < tol sqrt(g H)"});
 
   // [earthquake]
-  const auto eq = r.get_choice("earthquake.type", "none", {"none", "sine", "record"},
-                               {"", "earthquake acceleration applied to every particle (seed 002 eqs. 25-26)"});
+  const auto eq =
+      r.get_choice("earthquake.type", "none", {"none", "sine", "record"},
+                   {"", "earthquake acceleration applied to every particle (Bui et al. 2010, eqs. 25-26)"});
   {  // all keys are read whatever the type, so that --set earthquake.type=none works on any config
     const double A =
         r.get("earthquake.amplitude", 5.0, Range::non_negative(), {"m/s^2", "sine amplitude (500 gal = 5)"});
@@ -313,9 +316,9 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   if (is3d || describe) {
     c.width = r.get("geometry.width", 0.1, Range::positive(),
                     {"m", "3D width (axis y); a 3D DSM section: the strip width, centred on the polyline"});
-    c.periodic_width =
-        r.get_bool("geometry.periodic", c.scenario != ScenarioType::Section,
-                   {"", "3D: periodic across the width (seed 001), else roller walls (default for a DSM section)"});
+    c.periodic_width = r.get_bool(
+        "geometry.periodic", c.scenario != ScenarioType::Section,
+        {"", "3D: periodic across the width (SPH-slope paper 2020), else roller walls (default for a DSM section)"});
   }
   const bool block = c.scenario == ScenarioType::Block;
   const char* left_default = block ? "none" : "fixed";
@@ -405,7 +408,8 @@ int main(int argc, char** argv) {
   app.summary =
       "SPH simulation of slope failure and post-failure flow of elasto-plastic soil "
       "(2D plane strain / 3D) under gravity and earthquake shaking.\n"
-      "Usage: sph-slope --config slope.toml [--set key=value ...] [--out DIR] [--threads N] [--quiet]";
+      "Usage: sph-slope --config slope.toml [--set key=value ...] [--out DIR] [--threads N] [--quiet]\n"
+      "Example: sph-slope --config data/sph/slope_2d_granular.toml --set material[0].cohesion=5e3 --out slope-out";
   app.options_caption = "Options (all physical quantities in SI units: m, s, kg, Pa; angles in the config in degrees)";
   app.describe = [](ConfigReader& r) { (void)read_config(r, true); };
   app.run = [](ConfigReader& reader, const CommonOptions& opts) {
@@ -413,7 +417,7 @@ int main(int argc, char** argv) {
     reader.finish();
     cfg.resolved_config = reader.resolved();
     validate(cfg);  // everything checked before the output directory is created
-    return run(cfg, opts.out, opts.quiet);
+    return run_in_output_dir(opts.out, "sph-slope", {cfg.restart}, [&] { return run(cfg, opts.out, opts.quiet); });
   };
   return run_config_app(argc, argv, app);
 }

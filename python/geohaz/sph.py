@@ -9,7 +9,7 @@ from ._app import run_app
 def run(config, *, set=None, out=None, threads=0, quiet=True):
     """Run `sph-slope --config config [--set k=v ...] --out out`.
 
-    config   the TOML scenario (data/sph/*.toml); set: {"material.cohesion": 5e3} or ["key=value"].
+    config   the TOML scenario (data/sph/*.toml); set: {"material[0].cohesion": 5e3} or ["key=value"].
     out      the output folder (None: a temporary one, removed after reading).
     Returns {"summary": dict from summary.json, "tables": {csv stem: {column: array}}, "out", "stdout"}.
     Raises geohaz.InputError (exit code 2, the app's message), SimulationError (1), IoError (3).

@@ -203,22 +203,31 @@ py::dict runout_run(const std::string& config, const std::vector<std::string>& o
     // 1-2. Inputs and particles, all checked before anything is written (as run_case).
     *in = load_inputs(c);
     sim = std::make_unique<RunoutSimulation>(*in, c.params, c.output);
-    // 3. Outputs only now, when asked for.
-    if (!out.empty()) {
-      make_output_dir(out);
-      write_text_file(fs::path(out) / "config.resolved.toml", c.resolved_config);
-      if (c.output.snapshots) {
-        obs.snapshots =
-            std::make_unique<SnapshotWriter>(fs::path(out) / "snapshots.h5", "debris-runout", 2, c.resolved_config);
-        obs.snapshots->set_attribute("crs_wkt", in->dsm.crs_wkt);
-        obs.snapshots->set_attribute("release_volume", in->volume);
-        obs.snapshot_interval = c.output.snapshot_interval;
+    // 3. Outputs only now, when asked for, in a folder under the apps' --out policy (app.hpp).
+    const auto run_and_write = [&]() -> int {
+      if (!out.empty()) {
+        make_output_dir(out);
+        write_text_file(fs::path(out) / "config.resolved.toml", c.resolved_config);
+        if (c.output.snapshots) {
+          obs.snapshots =
+              std::make_unique<SnapshotWriter>(fs::path(out) / "snapshots.h5", "debris-runout", 2, c.resolved_config);
+          obs.snapshots->set_attribute("crs_wkt", in->dsm.crs_wkt);
+          obs.snapshots->set_attribute("release_volume", in->volume);
+          obs.snapshot_interval = c.output.snapshot_interval;
+        }
       }
-    }
-    if (!quiet) obs.progress = std::make_unique<ProgressReporter>("debris-runout", c.params.duration, quiet);
-    sim->run(&obs);
-    obs.snapshots.reset();  // closes the HDF5 file
-    if (!out.empty()) write_outputs(c, *sim, out, nthreads);
+      if (!quiet) obs.progress = std::make_unique<ProgressReporter>("debris-runout", c.params.duration, quiet);
+      sim->run(&obs);
+      obs.snapshots.reset();  // closes the HDF5 file
+      if (!out.empty()) write_outputs(c, *sim, out, nthreads);
+      return 0;
+    };
+    if (out.empty())
+      run_and_write();
+    else
+      run_in_output_dir(out, "debris-runout",
+                        {c.dsm, c.release.file, c.release.handoff, c.processes.hydrograph, c.processes.erodible},
+                        run_and_write);
   }
 
   const Raster& dsm = in->dsm;

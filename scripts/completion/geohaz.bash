@@ -29,8 +29,9 @@ _geohaz_complete() {
     --set)
       # Config keys, completed up to the '='.
       local keys
-      # (keys of arrays of tables, "material[].cohesion", are set as "material.cohesion")
-      keys=$("$exe" --help-config 2>/dev/null | sed -n 's/^\([a-z_][][a-z0-9_.]*\)  (.*/\1=/p' | sed 's/\[\]//g')
+      # (a key of an array of tables, "material[].cohesion", is offered for the first entry,
+      # "material[0].cohesion", the form --set takes)
+      keys=$("$exe" --help-config 2>/dev/null | sed -n 's/^\([a-z_][][a-z0-9_.]*\)  (.*/\1=/p' | sed 's/\[\]/[0]/g')
       compopt -o nospace 2>/dev/null
       mapfile -t COMPREPLY < <(compgen -W "$keys" -- "$cur")
       return ;;

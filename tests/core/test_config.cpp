@@ -179,6 +179,45 @@ TEST(Config, ResolvedConfigHoldsDefaultsAndParsesBack) {
   EXPECT_EQ(back.tables("layer", {"", ""}).size(), 2u);
 }
 
+// The resolved config writes the shortest text that reads back as the same double (issue #16):
+// 0.15, not 0.14999999999999999; every value, string, array and array of tables parses back exactly.
+TEST(Config, ResolvedNumbersAreShortestRoundTrip) {
+  auto r = ConfigReader::from_string(
+      "[run]\nname = \"a \\\"quoted\\\" name\"\n[[layer]]\nc = 0.1\n[[layer]]\nc = 2e5\n", "x.toml");
+  const double third = 1.0 / 3.0;
+  r.get("run.i_cr", 0.15, Range{}, {"", ""});
+  r.get("run.third", third, Range{}, {"", ""});
+  r.get("run.big", 1e6, Range{}, {"", ""});
+  r.get("run.whole", 3.0, Range{}, {"", ""});
+  r.get_int("run.steps", 7, Range{}, {"", ""});
+  r.get_bool("run.flag", true, {"", ""});
+  r.get_string("run.name", "", {"", ""});
+  r.get_array("run.times", {0.1, 0.2, 0.7}, Range{}, {"", ""});
+  for (auto& t : r.tables("layer", {"", ""})) t.get("c", 0.0, Range{}, {"", ""});
+  r.get("deep.er.key", 0.3, Range{}, {"", ""});
+  const std::string text = r.resolved();
+  EXPECT_NE(text.find("i_cr = 0.15\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("whole = 3.0\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("times = [0.1, 0.2, 0.7]"), std::string::npos) << text;
+  EXPECT_EQ(text.find("0.1499999"), std::string::npos) << text;
+  EXPECT_EQ(text.find("0.7000000"), std::string::npos) << text;
+  auto back = ConfigReader::from_string(text, "resolved.toml");
+  EXPECT_EQ(back.get("run.i_cr", 0.0, Range{}, {"", ""}), 0.15);  // bit-exact, not DOUBLE_EQ
+  EXPECT_EQ(back.get("run.third", 0.0, Range{}, {"", ""}), third);
+  EXPECT_EQ(back.get("run.big", 0.0, Range{}, {"", ""}), 1e6);
+  EXPECT_EQ(back.get("run.whole", 0.0, Range{}, {"", ""}), 3.0);
+  EXPECT_EQ(back.get_int("run.steps", 0, Range{}, {"", ""}), 7);
+  EXPECT_TRUE(back.get_bool("run.flag", false, {"", ""}));
+  EXPECT_EQ(back.get_string("run.name", "", {"", ""}), "a \"quoted\" name");
+  EXPECT_EQ(back.get_array("run.times", {}, Range{}, {"", ""}), (std::vector<double>{0.1, 0.2, 0.7}));
+  auto layers = back.tables("layer", {"", ""});
+  ASSERT_EQ(layers.size(), 2u);
+  EXPECT_EQ(layers[0].get("c", 0.0, Range{}, {"", ""}), 0.1);
+  EXPECT_EQ(layers[1].get("c", 0.0, Range{}, {"", ""}), 2e5);
+  EXPECT_EQ(back.get("deep.er.key", 0.0, Range{}, {"", ""}), 0.3);
+  EXPECT_NO_THROW(back.finish());
+}
+
 TEST(Config, DescribeModeBuildsTheReference) {
   auto d = ConfigReader::describe();
   read_all(d);

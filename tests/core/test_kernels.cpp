@@ -104,7 +104,7 @@ TYPED_TEST(KernelTest, GradientFirstMomentIsIdentityOnLattice) {
 }
 
 TEST(CubicSpline, NormalisationConstantsMatchTheIssueForm) {
-  // 10/(7πh²) and 1/(πh³) for the form 1 − 3q²/2 + 3q³/4 equal the seed form's W(0).
+  // 10/(7πh²) and 1/(πh³) for the form 1 − 3q²/2 + 3q³/4 equal the W(0) of the source papers' form.
   const double h = 0.5;
   EXPECT_NEAR(CubicSpline<2>::value(0.0, h), 10.0 / (7.0 * std::numbers::pi * h * h), 1e-12);
   EXPECT_NEAR(CubicSpline<3>::value(0.0, h), 1.0 / (std::numbers::pi * h * h * h), 1e-12);

@@ -7,7 +7,7 @@
 //
 // Run: H = 1 m, h0 = H/16, d0 = 1 m, t = 5 s (c t/d0 = 16), a 50 m reservoir (the rarefaction
 // from its far end does not reach the fan by then), a square lattice 4 m wide, periodic across.
-// The wet front is not asserted here: it lags Ritter's 2c t because the seed's force vanishes
+// The wet front is not asserted here: it lags Ritter's 2c t because the lecture's force vanishes
 // beyond 2 d0 (measured and explained in docs/validation/runout.md; the bound is in test_flows).
 //
 // Tolerances: the errors measured at this resolution are, for this square packing and for a

@@ -64,7 +64,7 @@ Periodicity<2> box(Vec2 lo, Vec2 hi, bool px, bool py) {
 TEST(Flows, UniformLayerAtRestStaysAtRest) {
   // Infinite (periodic) flat layer on a hexagonal lattice of spacing 0.707 d0 (depth 2.31 h0), no
   // friction: the head-pressure forces cancel by symmetry and this packing is a stable equilibrium
-  // of the seed's force, so nothing may move beyond round-off. (Not every packing is: the force
+  // of the lecture's force, so nothing may move beyond round-off. (Not every packing is: the force
   // rises with distance on 1 < |d|/d0 < 1.5, and a square lattice has no shear stiffness, so
   // round-off can drift them; any friction i_cr > 0 holds them, tested below.)
   RunoutParameters p;
@@ -145,7 +145,7 @@ TEST(Flows, SteadyUniformManningFlow) {
   double hmean = 0.0;
   for (double h : hk) hmean += h * std::cos(th) / static_cast<double>(hk.size());
   const double v_manning = std::pow(hmean, 2.0 / 3.0) * std::sqrt(std::sin(th) - icr * std::cos(th)) / n_m;
-  // 0.5 %: the packing keeps a small particle-scale fluctuation (the seed's force has no damping).
+  // 0.5 %: the packing keeps a small particle-scale fluctuation (the lecture's force has no damping).
   for (std::size_t i = 0; i < sp.size(); ++i) EXPECT_NEAR(sp[i], v, 5e-3 * v);
   EXPECT_NEAR(v, v_manning, 0.01 * v_manning);
   EXPECT_NEAR(hmean, 2.0 * std::cos(th), 0.05);
@@ -219,7 +219,7 @@ TEST(Flows, DamBreakMatchesRitterInTheRarefaction) {
   // d0 = 1 m (spacing 0.5 m). Tolerances: the kernel (support 2 m, 8 m bins) smooths the profile,
   // 0.12 c on the velocity, 15 % of h on the depth, 25 % on the rarefaction head.
   // The wet front is not resolved: a layer thinner than ≈ h0 carries almost no pressure with the
-  // seed's force (f ≈ 0 at spacing ≥ d0), so the leading particles run at 0.56·2c for h0 = h/4
+  // lecture's force (f ≈ 0 at spacing ≥ d0), so the leading particles run at 0.56·2c for h0 = h/4
   // (0.69·2c for h0 = h/16, the validation run); they can never outrun Ritter's front 2c t.
   auto db = DamBreak::make(10.0);
   auto& s = db.solver;

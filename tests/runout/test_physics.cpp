@@ -20,7 +20,7 @@ constexpr double kPi = std::numbers::pi;
 
 TEST(HeadPressure, ContinuousAtOneAndTwoAndZeroBeyond) {
   const double eps = 1e-9;
-  // The seed's transcription (+1/8) jumps by 1/4 at x = 1 and x = 2; the continuous reading
+  // The lecture's transcription (+1/8) jumps by 1/4 at x = 1 and x = 2; the continuous reading
   // must not: |f(1−ε) − f(1+ε)| = O(ε).
   EXPECT_NEAR(HeadPressureForce::shape(1.0 - eps), HeadPressureForce::shape(1.0 + eps), 1e-8);
   EXPECT_NEAR(HeadPressureForce::shape(2.0 - eps), HeadPressureForce::shape(2.0 + eps), 1e-8);

@@ -1,6 +1,6 @@
 // Validation runs of the debris-runout model (label `validation`, not in CI; minutes). They print
 // the figures quoted in docs/validation/runout.md and write the pictures to docs/figures/runout/.
-//  1. The seed's scenario at its scale (seed 000 §3: a debris flow travelling 4.8 km in 10 min,
+//  1. The lecture's scenario at its scale (SWJTU lecture 2010, §3: a debris flow travelling 4.8 km in 10 min,
 //     n = 0.06, i_cr = 0.15, 2.5 m DSM): the synthetic 5 km valley, 2000 × 1000 cells, ~5000
 //     particles (d0 = 5 m).
 //  2. Real terrain: the Alplehner DTM and release polygon (data/terrain/alr).
@@ -64,7 +64,7 @@ std::vector<std::vector<double>> read_series(const fs::path& csv, std::vector<st
   return rows;
 }
 
-// A line plot of the front's travelled distance against time, with the seed's point marked.
+// A line plot of the front's travelled distance against time, with the lecture's point marked.
 void plot_front(const fs::path& csv, const fs::path& png, double seed_t, double seed_s) {
   std::vector<std::string> h;
   const auto rows = read_series(csv, h);
@@ -100,13 +100,13 @@ TEST(RunoutValidation, SeedScenarioFiveKilometreValley) {
   const auto j = nlohmann::json::parse(in);
   const double travel = j["runout_length_along_path_m"];
   std::printf(
-      "VALIDATION seed scenario: %d particles, %.0f m^3, front travelled %.0f m in %.0f s (seed: 4800 m in "
+      "VALIDATION lecture scenario: %d particles, %.0f m^3, front travelled %.0f m in %.0f s (lecture: 4800 m in "
       "600 s), H/L = %.3f (%.1f deg), max speed %.1f m/s, wall %.1f s, steps %d\n",
       j["particles_released"].get<int>(), j["volumes_m3"]["seeded"].get<double>(), travel,
       j["simulated_time_s"].get<double>(), j["fahrboeschung"]["ratio_H_over_L"].get<double>(),
       j["fahrboeschung"]["angle_deg"].get<double>(), j["max_speed_m_s"].get<double>(), j["wall_time_s"].get<double>(),
       j["steps"].get<int>());
-  // "Travels kilometres in ten minutes": within a factor 2 of the seed's 4.8 km.
+  // "Travels kilometres in ten minutes": within a factor 2 of the lecture's 4.8 km.
   EXPECT_GT(travel, 2400.0);
   EXPECT_LT(travel, 9600.0);
   EXPECT_LT(std::abs(j["mass_balance_error_relative"].get<double>()), 1e-12);

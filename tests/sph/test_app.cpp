@@ -448,7 +448,7 @@ std::vector<double> deviators(const fs::path& p) {
   return q;
 }
 
-/// Plane-strain Drucker–Prager constants (seed 002 eqs. 18–19).
+/// Plane-strain Drucker–Prager constants (Bui et al. 2010, eqs. 18–19).
 std::pair<double, double> dp_plane_strain(double c, double phi_deg) {
   const double t = std::tan(phi_deg * 3.14159265358979323846 / 180.0), d = std::sqrt(9.0 + 12.0 * t * t);
   return {t / d, 3.0 * c / d};

@@ -26,7 +26,7 @@ double J2(const Mat3& s) {
 }
 
 TEST(DruckerPragerConstants, PlaneStrainHandValues) {
-  // φ = 30°, c = 10 kPa: tanφ = 1/√3, √(9 + 12 tan²φ) = √13 (seed 002 eqs. 18–19).
+  // φ = 30°, c = 10 kPa: tanφ = 1/√3, √(9 + 12 tan²φ) = √13 (Bui et al. 2010, eqs. 18–19).
   const auto k = drucker_prager_constants(10e3, 30 * kDeg, 0.0, DruckerPragerFit::PlaneStrain);
   EXPECT_NEAR(k.alpha_phi, (1.0 / std::sqrt(3.0)) / std::sqrt(13.0), 1e-12);
   EXPECT_NEAR(k.alpha_phi, 0.160128, 1e-6);
@@ -36,7 +36,7 @@ TEST(DruckerPragerConstants, PlaneStrainHandValues) {
 }
 
 TEST(DruckerPragerConstants, ThreeDHandValues) {
-  // φ = 30°, c = 10 kPa: sinφ = 1/2 → α = 1/(√3·2.5), k = 6c cos30°/(√3·2.5) = 12 kPa (seed 001 eq. 21).
+  // φ = 30°, c = 10 kPa: sinφ = 1/2 → α = 1/(√3·2.5), k = 6c cos30°/(√3·2.5) = 12 kPa (SPH-slope paper 2020, eq. 21).
   const auto k = drucker_prager_constants(10e3, 30 * kDeg, 30 * kDeg, DruckerPragerFit::Compression3D);
   EXPECT_NEAR(k.alpha_phi, 0.2309401, 1e-7);
   EXPECT_NEAR(k.kc, 12000.0, 1e-6);
@@ -44,7 +44,7 @@ TEST(DruckerPragerConstants, ThreeDHandValues) {
 }
 
 TEST(DruckerPragerConstants, SeedMasaSoil) {
-  // seed 002 Table 1: c = 0.78 kPa, φ = 22.56°: tanφ = 0.41544, √(9+12·0.172591) = 3.327325.
+  // Bui et al. (2010), Table 1: c = 0.78 kPa, φ = 22.56°: tanφ = 0.41544, √(9+12·0.172591) = 3.327325.
   const auto k = drucker_prager_constants(780.0, 22.56 * kDeg, 0.0, DruckerPragerFit::PlaneStrain);
   EXPECT_NEAR(k.alpha_phi, 0.124857, 1e-6);
   EXPECT_NEAR(k.kc, 703.27, 0.01);

@@ -175,8 +175,8 @@ TEST(VelocityGradient, TranslationHasNoStrainRateAnywhere) {
   }
 }
 
-// Body forces on a free block (no walls, no stress): the earthquake acceleration of seed 002
-// eq. 26 adds to every particle, and Cundall's local damping (seed 002 eq. 14) reduces an
+// Body forces on a free block (no walls, no stress): the earthquake acceleration of Bui et al. (2010)
+// eq. 26 adds to every particle, and Cundall's local damping (Bui et al. 2010, eq. 14) reduces an
 // accelerating motion to a(1 − ζ).
 TEST(BodyForces, EarthquakeAndLocalDamping) {
   auto solver_with = [](double g, double zeta, EarthquakeLoading eq) {
@@ -214,7 +214,7 @@ TEST(BodyForces, EarthquakeAndLocalDamping) {
   }
 }
 
-// Stress vanishing ("meeting and parting", seed 000): a detached particle carries no stress and
+// Stress vanishing ("meeting and parting", SWJTU lecture (2010)): a detached particle carries no stress and
 // is flagged; back in contact it rejoins the continuum.
 TEST(StressVanishing, DetachedParticleIsStressFreeAndRejoins) {
   ProfileDomain d;

@@ -20,7 +20,7 @@ TEST(EarthquakeLoading, NoneIsZero) {
 }
 
 TEST(EarthquakeLoading, SineWithRamps) {
-  // 1 Hz, 500 gal (seed 000), from t = 1 s for 4 s, 0.5 s ramps.
+  // 1 Hz, 500 gal (SWJTU lecture 2010), from t = 1 s for 4 s, 0.5 s ramps.
   const auto e = EarthquakeLoading::sine(5.0, 1.0, 1.0, 4.0, 0.5);
   EXPECT_TRUE(e.active());
   EXPECT_EQ(e.horizontal(0.5), 0.0);

@@ -128,7 +128,7 @@ TEST(ElasticWave, CompressionArrivalMatchesPWaveSpeed) {
   EXPECT_NEAR(stress_behind / (-rho * cp * v0), 1.0, 0.05);
 }
 
-// Couette start-up (seed 000 "simple shear of viscous fluid"): fluid at rest between a fixed wall
+// Couette start-up (SWJTU lecture 2010 "simple shear of viscous fluid"): fluid at rest between a fixed wall
 // (y = 0) and a wall moving at U (y = H), periodic along x. Analytical profile
 //   u(y,t) = U y/H + Σ_n 2U(−1)^n/(nπ) sin(nπy/H) exp(−n²π²νt/H²).
 // Layer-averaged velocities within 4 % of U at t = 0.1 s (profile still developing) and 0.4 s.
@@ -198,7 +198,7 @@ TEST(ViscousShear, CouetteStartUpMatchesSeries) {
   }
 }
 
-// Parting (seed 000 "meeting and parting"): a free cohesionless block without gravity, given a
+// Parting (SWJTU lecture 2010 "meeting and parting"): a free cohesionless block without gravity, given a
 // uniform expansion v = ε̇ (x − x_c), comes apart. Its particles carry no stress (nothing holds
 // them together) and their density stays at ρ0 (constitutive.hpp, `min_density`); without the floor
 // the continuity density follows ρ0/(1 + ε̇t)² (0.25ρ0 here) and m/ρ grows without bound, which is
@@ -333,7 +333,7 @@ TEST(NeighbourSkin, SameResultAsRebuildEveryStep) {
   EXPECT_LT(worst, 1e-9);
 }
 
-// Geostatic column (seed 002: gravity applied gradually): σ_v = −ρ g depth within a few per cent,
+// Geostatic column (Bui et al. 2010: gravity applied gradually): σ_v = −ρ g depth within a few per cent,
 // K0 = ν/(1−ν) for the laterally confined elastic column, particles at rest and no clumping.
 TEST(Geostatic, ElasticColumnAtRest) {
   const double W = 0.1, H = 0.4, dx = 0.01, rho = 2000.0, g = 9.81, nu = 0.3;
@@ -422,7 +422,7 @@ TEST(Geostatic, CoverOnInclinedBedrockStaysPut) {
 // base (E_b, ρ_b) under three of cover (E = 20 MPa, ρ = 1900 kg/m³), Δx = 1 m, the default Δt
 // (CFL 0.2), on flat ground or a plane inclined at `slope_deg`. After the geostatic phase it must
 // stay at rest. It did not with walls that take the Shepard average of their soil neighbours
-// (from the previous step's stress, with the seed's momentum pair σ_i/ρ_i² + σ_j/ρ_j²): an
+// (from the previous step's stress, with the paper's momentum pair σ_i/ρ_i² + σ_j/ρ_j²): an
 // oscillation of the base rows grew to > 1 m/s within seconds on flat ground, and on the 45° plane
 // also once the lag and the pair were fixed (docs/sph.md, "Boundary particles and material
 // interfaces"). Returns the largest soil speed over the first and over the last second after the

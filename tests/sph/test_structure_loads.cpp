@@ -79,7 +79,7 @@ TEST(StructureLoads, BoxScenarioNamesItsWallsAndTagsTheirParticles) {
 }
 
 // A Newtonian fluid column of height H at rest between two vertical walls (after the gravity ramp
-// under local damping, seed 002): the hydrostatic pressure ρ g (H − z) on the wall face integrates
+// under local damping, Bui et al. 2010): the hydrostatic pressure ρ g (H − z) on the wall face integrates
 // to F = ½ ρ g H² per metre of wall, acting at H/3 above the base (moment ρ g H³/6 about it).
 // Tolerance 2 % on F: the SPH wall sum has a free-surface kernel deficiency over the top h, and the
 // weakly compressible fluid (c = 20 m/s, ρgH/K = 0.5 %) lowers the centre of mass by ~0.1 %. The

@@ -118,15 +118,16 @@ TEST(Validation, ColumnCollapseRunoutScaling) {
   }
 }
 
-// Seed 001 Table 1 (2D section of the 3D model): granular vs cohesive slope, normalised run-out at
-// 1 s (seed: ~0.4 vs ~0.13). We require the cohesive slope to run out much less (< half) — the
-// seed's absolute values come from a 3D model whose run-out definition is only described in words.
+// SPH-slope paper (2020), Table 1 (2D section of the 3D model): granular vs cohesive slope, normalised run-out at
+// 1 s (paper: ~0.4 vs ~0.13). We require the cohesive slope to run out much less (< half) — the
+// paper's absolute values come from a 3D model whose run-out definition is only described in words.
 TEST(Validation, Seed001GranularVsCohesive) {
   run_case("seed001_granular", "slope_2d_granular.toml", "--set run.end_time=3 --set run.stop_at_rest=false");
   run_case("seed001_cohesive", "slope_2d_granular.toml",
            "--set run.end_time=3 --set run.stop_at_rest=false --set material[0].cohesion=10e3");
   const double g1 = runout_at("seed001_granular", 1.0), c1 = runout_at("seed001_cohesive", 1.0);
-  std::printf("seed 001 Table 1 at 1 s: granular %.3f (seed ~0.4), cohesive %.3f (seed ~0.13)\n", g1, c1);
+  std::printf("SPH-slope paper (2020), Table 1 at 1 s: granular %.3f (paper ~0.4), cohesive %.3f (paper ~0.13)\n", g1,
+              c1);
   EXPECT_GT(g1, 0.05);
   EXPECT_LT(c1, 0.5 * g1);
   copy_figure("seed001_granular", "final_displacement.png", "seed001_granular_final.png");
@@ -134,8 +135,8 @@ TEST(Validation, Seed001GranularVsCohesive) {
   copy_figure("seed001_cohesive", "final_displacement.png", "seed001_cohesive_final.png");
 }
 
-// Seed 001 Table 2: the five layered slopes run (finite run-out, no blow-up); slope-2 (loose
-// middle layer) runs out further than slope-3 (seed: ~50 % less with the dense layer at the toe).
+// SPH-slope paper (2020), Table 2: the five layered slopes run (finite run-out, no blow-up); slope-2 (loose
+// middle layer) runs out further than slope-3 (paper: ~50 % less with the dense layer at the toe).
 TEST(Validation, Seed001LayeredSlopes) {
   struct Layers {
     double c3, p3, c2, p2;
@@ -151,14 +152,14 @@ TEST(Validation, Seed001LayeredSlopes) {
     const std::string name = "seed001_layered_" + std::to_string(k + 1);
     auto s = run_case(name, "slope_layered.toml", sets.str());
     r[k] = s.value("normalised_runout", -1.0);
-    std::printf("seed 001 Table 2 slope-%d: normalised run-out %.3f at 3 s\n", k + 1, r[k]);
+    std::printf("SPH-slope paper (2020), Table 2 slope-%d: normalised run-out %.3f at 3 s\n", k + 1, r[k]);
     copy_figure(name, "final_displacement.png", name + "_final.png");
   }
   for (double v : r) EXPECT_GE(v, 0.0);
   EXPECT_GT(r[1], r[2]);
 }
 
-// Seed 001 upper cut (50 mm at 2H:1V): run-out reduced (seed: 6–8 %). The cut removes 0.6 % of the
+// SPH-slope paper (2020) upper cut (50 mm at 2H:1V): run-out reduced (paper: 6–8 %). The cut removes 0.6 % of the
 // soil; at Δx = 10 mm its effect on the front is below one front bin (no reduction measured), so
 // both runs use Δx = 5 mm (7,400 particles, ~6 min each on one thread).
 TEST(Validation, Seed001UpperCut) {
@@ -167,13 +168,13 @@ TEST(Validation, Seed001UpperCut) {
   auto cut = run_case("seed001_cut_5mm", "slope_upper_cut.toml", sets);
   const double b = base.value("normalised_runout", 0.0), c = cut.value("normalised_runout", 0.0);
   const double reduction = (b - c) / b;
-  std::printf("seed 001 upper cut (dx = 5 mm): run-out %.3f -> %.3f (%.1f %% reduction; seed 6-8 %%)\n", b, c,
-              100 * reduction);
+  std::printf("SPH-slope paper (2020) upper cut (dx = 5 mm): run-out %.3f -> %.3f (%.1f %% reduction; seed 6-8 %%)\n",
+              b, c, 100 * reduction);
   EXPECT_GT(reduction, 0.03);  // a clear effect: the front moves by several 5 mm bins
   copy_figure("seed001_cut_5mm", "final_displacement.png", "seed001_upper_cut_final.png");
 }
 
-// Seed 001 piles (3D at the seed's Δx = 10 mm: 37,080 soil particles, ~30 min per case on one
+// SPH-slope paper (2020) piles (3D at the paper's Δx = 10 mm: 37,080 soil particles, ~30 min per case on one
 // thread; the config's 20 mm default cannot tell the middle row from the upper one): a row at
 // mid-slope reduces run-out more than a row at the top.
 TEST(Validation, Seed001Piles) {
@@ -183,17 +184,17 @@ TEST(Validation, Seed001Piles) {
   auto top = run_case("seed001_piles_upper", "slope_piles_3d.toml", "--set piles.position=upper" + dx);
   const double n = none.value("normalised_runout", 0.0), m = mid.value("normalised_runout", 0.0),
                u = top.value("normalised_runout", 0.0);
-  std::printf("seed 001 piles (3D): none %.3f, middle %.3f, upper %.3f\n", n, m, u);
+  std::printf("SPH-slope paper (2020) piles (3D): none %.3f, middle %.3f, upper %.3f\n", n, m, u);
   EXPECT_LT(m, u);
   EXPECT_LE(m, n);
   copy_figure("seed001_piles_middle", "final_displacement.png", "seed001_piles_middle_final.png");
 }
 
-// Seed 002 Masa-soil shaking-table slope: the slope fails under shaking (displacements grow while
+// Bui et al. (2010) Masa-soil shaking-table slope: the slope fails under shaking (displacements grow while
 // shaking, a slip surface reaching down into the slope). Displacements over time go to the docs.
 TEST(Validation, Seed002MasaShakingTable) {
   auto s = run_case("seed002_masa", "masa_shaking_table.toml", "");
-  std::printf("seed 002 Masa: max displacement %.3f m, failed area %.4f m2/m, run-out %.3f m\n",
+  std::printf("Bui et al. (2010) Masa: max displacement %.3f m, failed area %.4f m2/m, run-out %.3f m\n",
               s.value("max_displacement_m", 0.0), s.value("failed_area_m2_per_m", 0.0), s.value("runout_m", 0.0));
   EXPECT_GT(s.value("max_displacement_m", 0.0), 0.02);
   copy_figure("seed002_masa", "final_displacement.png", "seed002_masa_final.png");
@@ -201,7 +202,7 @@ TEST(Validation, Seed002MasaShakingTable) {
   copy_figure("seed002_masa", "velocity_t4.000.png", "seed002_masa_velocity_4s.png");
 }
 
-// Biaxial compression (seed 000): shear band inclination between Roscoe (45° + ψ/2) and Coulomb
+// Biaxial compression (SWJTU lecture 2010): shear band inclination between Roscoe (45° + ψ/2) and Coulomb
 // (45° + φ/2) angles; the band is located from the plastic strain in the final snapshot (docs).
 TEST(Validation, BiaxialCompression) {
   const double phi = 25.0, psi = 0.0;
@@ -374,7 +375,7 @@ TEST(Validation, Figures) {
     }
     plot(kFigures / "column_runout_vs_aspect_ratio.png", {law, law2, model}, 0.0, 3.5, 0.0, 7.0, 0.5, 1.0);
   }
-  // Seed 001: normalised run-out vs time, granular (blue) and cohesive (red) at Δx = 10 mm; the
+  // SPH-slope paper (2020): normalised run-out vs time, granular (blue) and cohesive (red) at Δx = 10 mm; the
   // upper cut at Δx = 5 mm, without (blue) and with the cut (green).
   for (const auto& [file, runs] :
        {std::pair{"seed001_runout_vs_time.png",
@@ -391,7 +392,7 @@ TEST(Validation, Figures) {
     }
     plot(kFigures / file, cs, 0.0, 3.0, 0.0, 0.8, 0.5, 0.1);
   }
-  // Seed 002 Masa: max displacement (blue) and run-out (green) vs time, input acceleration/10 (grey).
+  // Bui et al. (2010) Masa: max displacement (blue) and run-out (green) vs time, input acceleration/10 (grey).
   {
     const auto f = kWork / "seed002_masa" / "series.csv";
     if (fs::exists(f)) {
@@ -413,8 +414,8 @@ TEST(Validation, Figures) {
     }
   }
 
-  // Seed 002 Masa: displacement history of marker particles (face centre, crest edge, crest 0.2 m
-  // behind the edge) from the 1 s snapshots, like the seed's sensors SH/SV along the slope centre.
+  // Bui et al. (2010) Masa: displacement history of marker particles (face centre, crest edge, crest 0.2 m
+  // behind the edge) from the 1 s snapshots, like the paper's sensors SH/SV along the slope centre.
   {
     const auto f = kWork / "seed002_masa" / "snapshots.h5";
     if (fs::exists(f)) {

@@ -3,27 +3,36 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <fstream>
 #include <iostream>
 #include <new>
+#include <set>
 #include <system_error>
 
 #include "geohaz/core/errors.hpp"
+#include "geohaz/core/output.hpp"
 
 namespace po = boost::program_options;
 
 namespace geohaz {
 
 void add_common_options(po::options_description& desc, CommonOptions& o, const std::string& default_out) {
+  // One option a line reads better than clang-format's chained layout.
+  // clang-format off
   desc.add_options()
     ("help,h", "print this help and exit")
     ("version", "print the version and exit")
     ("config,c", po::value<std::string>(&o.config), "scenario configuration file (TOML)")
     ("set", po::value<std::vector<std::string>>(&o.set)->composing(),
-     "override a config key, e.g. --set material.cohesion=5e3 (repeatable; values in SI units)")
-    ("out,o", po::value<std::string>(&o.out)->default_value(default_out), "output directory")
+     "override a config key (repeatable; values in SI units, TOML syntax; a key in the i-th entry of an "
+     "array of tables as table[i].key, counted from 0); see the example above")
+    ("out,o", po::value<std::string>(&o.out)->default_value(default_out),
+     "output directory: new, empty, or holding an earlier run of this app (its files, listed in "
+     "geohaz-manifest.txt, are removed first); any other file there stops the run (exit 2)")
     ("threads,j", po::value<int>(&o.threads)->default_value(0), "OpenMP threads (0: all cores)")
     ("quiet,q", po::bool_switch(&o.quiet), "no progress output")
     ("help-config", po::bool_switch(&o.help_config), "print every config key with unit, default and range, and exit");
+  // clang-format on
 }
 
 bool parse_command_line(int argc, const char* const* argv, const std::string& app, const std::string& summary,
@@ -95,6 +104,96 @@ int run_main(const std::string& app, const std::function<int()>& body) {
     std::cerr << app << ": error: " << e.what() << "\n";
     return kExitFailure;
   }
+}
+
+namespace {
+namespace fs = std::filesystem;
+
+/// Every file below `dir` (not the folders), as paths relative to it, sorted.
+std::vector<std::string> files_below(const fs::path& dir) {
+  std::vector<std::string> files;
+  for (auto it = fs::recursive_directory_iterator(dir); it != fs::recursive_directory_iterator(); ++it)
+    if (!it->is_directory()) files.push_back(fs::relative(it->path(), dir).generic_string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+struct OutputManifest {
+  std::string app;
+  std::set<std::string> files;
+};
+
+std::optional<OutputManifest> read_output_manifest(const fs::path& dir) {
+  std::ifstream in(dir / kOutputManifest);
+  if (!in) return std::nullopt;
+  OutputManifest m;
+  std::string line;
+  if (!std::getline(in, line) || line.rfind("app = ", 0) != 0) return std::nullopt;
+  m.app = line.substr(6);
+  while (std::getline(in, line))
+    if (!line.empty()) m.files.insert(line);
+  return m;
+}
+
+void clean_output_dir(const fs::path& out, const std::string& app, const std::vector<fs::path>& inputs) {
+  std::error_code ec;
+  if (!fs::exists(out, ec)) return;
+  if (!fs::is_directory(out, ec))
+    throw InputError("output path exists and is not a directory", "command line", "--out", out.string());
+  const auto files = files_below(out);
+  if (files.empty()) return;
+  const auto refuse = [&](const std::string& why) {
+    throw InputError(why + "; choose a new or empty folder, or remove what is there", "command line", "--out",
+                     out.string());
+  };
+  const auto m = read_output_manifest(out);
+  if (!m) refuse("the folder holds files that no geohaz run wrote (e.g. " + files.front() + ")");
+  if (m->app != app) refuse("the folder holds the output of " + m->app + ", not of " + app);
+  for (const auto& f : files)
+    if (f != kOutputManifest && !m->files.count(f))
+      refuse("the folder holds " + f + ", which the earlier " + app + " run there did not write");
+  const fs::path canonical_out = fs::weakly_canonical(out);
+  for (const auto& in : inputs) {
+    if (in.empty()) continue;
+    const auto rel = fs::weakly_canonical(in).lexically_relative(canonical_out);
+    if (!rel.empty() && *rel.begin() != "..")
+      refuse("the input " + in.string() + " lies in it, and this run empties the folder first");
+  }
+  for (const auto& f : files) fs::remove(out / f);  // throws filesystem_error (exit 3) if it cannot
+  // Sub-folders the earlier run made and that are empty now, deepest first.
+  std::vector<fs::path> dirs;
+  for (auto it = fs::recursive_directory_iterator(out); it != fs::recursive_directory_iterator(); ++it)
+    if (it->is_directory()) dirs.push_back(it->path());
+  std::sort(dirs.rbegin(), dirs.rend());
+  for (const auto& d : dirs)
+    if (fs::is_empty(d, ec)) fs::remove(d, ec);
+}
+
+void write_output_manifest(const fs::path& out, const std::string& app) {
+  std::error_code ec;
+  if (!fs::is_directory(out, ec)) return;
+  std::string text = "app = " + app + "\n";
+  for (const auto& f : files_below(out))
+    if (f != kOutputManifest) text += f + "\n";
+  write_text_file(out / kOutputManifest, text);
+}
+}  // namespace
+
+int run_in_output_dir(const fs::path& out, const std::string& app, const std::vector<fs::path>& inputs,
+                      const std::function<int()>& body) {
+  clean_output_dir(out, app, inputs);
+  int code = 0;
+  try {
+    code = body();
+  } catch (...) {
+    try {
+      write_output_manifest(out, app);
+    } catch (...) {  // the run's own error is the one to report
+    }
+    throw;
+  }
+  write_output_manifest(out, app);
+  return code;
 }
 
 int run_config_app(int argc, const char* const* argv, const ConfigApp& app) {

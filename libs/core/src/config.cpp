@@ -3,6 +3,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -506,9 +507,80 @@ void ConfigReader::finish() const {
   walk(state_->root, "");
 }
 
+namespace {
+/// The shortest text that reads back as the same double (std::to_chars without a precision), kept a
+/// TOML float: 0.15, not toml++'s 17-digit 0.14999999999999999 (issue #16).
+std::string toml_float(double v) {
+  char buf[64];
+  const auto res = std::to_chars(buf, buf + sizeof buf, v);
+  std::string s(buf, res.ptr);
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";  // "3" → "3.0"; inf and nan stay
+  return s;
+}
+
+std::string toml_key(const std::string& k) {
+  const bool bare = !k.empty() && std::all_of(k.begin(), k.end(),
+                                              [](unsigned char c) { return std::isalnum(c) || c == '_' || c == '-'; });
+  if (bare) return k;
+  std::ostringstream s;
+  s << toml::value<std::string>(k);
+  return s.str();
+}
+
+void write_toml_value(std::ostream& s, const toml::node& n) {
+  if (auto d = n.as_floating_point()) {
+    s << toml_float(d->get());
+  } else if (auto a = n.as_array()) {
+    s << "[";
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      if (i) s << ", ";
+      write_toml_value(s, *a->get(i));
+    }
+    s << "]";
+  } else {
+    n.visit([&](auto&& v) {
+      if constexpr (toml::is_table<decltype(v)>)
+        s << "{}";  // not produced by the reader (tables are written as sections)
+      else
+        s << v;
+    });
+  }
+}
+
+bool is_array_of_tables(const toml::node& n) {
+  auto a = n.as_array();
+  return a && !a->empty() && a->is_array_of_tables();
+}
+
+/// Write `t` under the header path `path` (empty: the root): plain keys first, then sub-tables and
+/// arrays of tables as their own sections, in toml++'s (sorted) key order.
+void write_toml_table(std::ostream& s, const toml::table& t, const std::string& path, bool array_element) {
+  bool plain = false;
+  for (const auto& [k, v] : t)
+    if (!v.is_table() && !is_array_of_tables(v)) plain = true;
+  if (!path.empty() && (plain || array_element || t.empty()))
+    s << (s.tellp() > 0 ? "\n" : "") << (array_element ? "[[" : "[") << path << (array_element ? "]]" : "]") << "\n";
+  for (const auto& [k, v] : t) {
+    if (v.is_table() || is_array_of_tables(v)) continue;
+    s << toml_key(std::string(k.str())) << " = ";
+    write_toml_value(s, v);
+    s << "\n";
+  }
+  for (const auto& [k, v] : t) {
+    const std::string sub = (path.empty() ? "" : path + ".") + toml_key(std::string(k.str()));
+    if (auto tt = v.as_table()) {
+      write_toml_table(s, *tt, sub, false);
+    } else if (is_array_of_tables(v)) {
+      for (const auto& e : *v.as_array()) write_toml_table(s, *e.as_table(), sub, true);
+    }
+  }
+}
+}  // namespace
+
 std::string ConfigReader::resolved() const {
   std::ostringstream s;
-  s << state_->resolved << "\n";
+  write_toml_table(s, state_->resolved, "", false);
+  s << "\n";
   return s.str();
 }
 

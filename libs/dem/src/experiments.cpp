@@ -142,7 +142,6 @@ void load_sample(DemSolver& s, const BondedSample& sample, const MaterialSpec& m
   s.bonds = sample.bonds;
   s.law = material.law;
   s.contact = material.contact;
-  s.bond_properties = material.bond;
   s.settings.joint_friction = material.joint_friction;
   s.set_joints(sample.joints);
 }
@@ -458,7 +457,6 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
   s.bonds = std::move(bonds);
   s.law = spec.material.law;
   s.contact = spec.material.contact;
-  s.bond_properties = spec.material.bond;
   s.settings.joint_friction = spec.material.joint_friction;
   s.settings.local_damping = spec.settle_damping;
   s.set_joints(joints);

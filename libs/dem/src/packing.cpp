@@ -248,8 +248,6 @@ double coordination_number(const DiscStore& discs) {
   const auto& x = discs.get<Position<2>>();
   const auto& R = discs.get<Radius>();
   const double rmax = *std::max_element(R.begin(), R.end());
-  CellList<2> cells;
-  cells.build(x, 2 * rmax);
   NeighbourList<2> list;
   list.build(x, 2 * rmax);
   std::size_t c = 0;

@@ -176,7 +176,9 @@ RunoutCase read_case(ConfigReader& cfg) {
   p.smoothing = cfg.get("numerics.smoothing", p.smoothing, Range::closed(0.0, 1.0),
                         {"1", "velocity smoothing ε per step (Monaghan 1994 XSPH); 0: off"});
   const std::string norm = cfg.get_choice("numerics.pressure_normalisation", "consistent", {"consistent", "seed"},
-                                          {"", "head-pressure constant: consistent (continuum −g∇h) or seed (1)"});
+                                          {"",
+                                           "head-pressure constant: consistent (continuum −g∇h) or seed (C = 1, the "
+                                           "raw coefficient of SWJTU lecture (2010), §3)"});
   p.pressure_scale = norm == "seed" ? 1.0 : HeadPressureForce::consistent_normalisation();
 
   read_processes(cfg, c);

@@ -926,17 +926,30 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
     write_handoff(out / "release.h5", handoff, c.resolved_config);
     summary["release"] = {{"file", "release.h5"}, {"points", pts.size()}, {"total_volume_m3", total}, {"width_m", W}};
     if (c.section.dsm) {
-      Raster th = c.section.dsm->like(0.0);
+      // Nodata where the DSM has none (-9999, as the debris-runout maps), a band description and
+      // unit, and a QGIS style beside it, like every GeoTIFF geohaz writes (issue #16).
+      constexpr double kNodata = -9999.0;
+      const Raster& dsm = *c.section.dsm;
+      Raster th = dsm.like(0.0, kNodata);
+      th.description = "release thickness: failed volume per cell area (sph-slope section)";
+      th.unit = "m";
+      for (std::size_t k = 0; k < th.data.size(); ++k)
+        if (dsm.is_nodata(dsm.data[k])) th.data[k] = kNodata;
       const double cell = th.cell_size_x() * th.cell_size_y();
       double binned = 0.0;
       for (std::size_t q = 0; q < pts.size(); ++q) {
         const Vec2 px = th.to_pixel(pts[q]);
         const int col = static_cast<int>(std::lround(px.x())), row = static_cast<int>(std::lround(px.y()));
-        if (col < 0 || row < 0 || col >= th.nx || row >= th.ny) continue;
+        if (col < 0 || row < 0 || col >= th.nx || row >= th.ny || th.at(col, row) == kNodata) continue;
         th.at(col, row) += vols[q] / cell;
         binned += vols[q];
       }
       write_geotiff(out / "release_thickness.tif", th);
+      double vmax = 0.0;
+      for (double v : th.data)
+        if (v != kNodata) vmax = std::max(vmax, v);
+      write_qgis_ramp_style(out / "release_thickness.qml", ColourRamp::Viridis, 0.0, vmax > 0.0 ? vmax : 1.0, "m", 0.0);
+      summary["release"]["thickness_style"] = "release_thickness.qml";
       summary["release"]["thickness_raster"] = "release_thickness.tif";
       summary["release"]["volume_on_raster_m3"] = binned;
     }

@@ -339,7 +339,7 @@ void SphSolver<Dim>::resume(const SolverState& st) {
 
 template <int Dim>
 Vec<Dim> SphSolver<Dim>::body_acceleration() const {
-  // Effective body acceleration ḡ = g + a_eq (seed 002 eq. 26); gravity along −axis Dim−1.
+  // Effective body acceleration ḡ = g + a_eq (Bui et al. 2010, eq. 26); gravity along −axis Dim−1.
   Vec<Dim> gbar = Vec<Dim>::Zero();
   gbar[Dim - 1] = -settings_.gravity * gravity_factor_;
   if (earthquake_on_ && settings_.earthquake.active()) {
@@ -627,9 +627,9 @@ void SphSolver<Dim>::update_stress(const Model& /*model*/) {
 }
 
 // 4. Momentum: a_i = Σ_j m_j [(σ_i + σ_j)/(ρ_i ρ_j) − Π_ij I + f_ij^n (R_i + R_j)] ∇W_ij + ḡ
-//    (seed 002 eq. 12 with the stress pair in the form that pairs with the velocity gradient of
+//    (Bui et al. 2010, eq. 12 with the stress pair in the form that pairs with the velocity gradient of
 //    step 2, L_i = Σ_j V_j (v_j − v_i) ⊗ ∇W_ij: together they conserve energy also where the
-//    density jumps between materials; the seed's σ_i/ρ_i² + σ_j/ρ_j² does not, and a layered
+//    density jumps between materials; the paper's σ_i/ρ_i² + σ_j/ρ_j² does not, and a layered
 //    slope then oscillates at its interfaces, docs/sph.md). Summed as a force density
 //    f_i = Σ_j V_j [σ_i + σ_j + ρ_i ρ_j (f^n (R_i + R_j) − Π_ij I)] ∇W_ij, a_i = f_i/ρ_i (ḡ: step 5).
 //    Each soil–soil pair is evaluated once, by the particle of lower index: the pair term is
@@ -852,7 +852,7 @@ void SphSolver<Dim>::structure_forces() {
     }
 }
 
-// 5. Body force ḡ, Cundall local damping (seed 002 eq. 14), leap-frog update (kick–drift, with
+// 5. Body force ḡ, Cundall local damping (Bui et al. 2010, eq. 14), leap-frog update (kick–drift, with
 //    the XSPH correction in the drift); boundary particles move with their prescribed velocity, clamped
 //    soil particles stay at rest.
 //    The step statistics (max speed, max acceleration) and the drift since the last neighbour

@@ -5,6 +5,7 @@
 /// failure; see errors.hpp), thread setup and the `--help-config` key reference.
 
 #include <boost/program_options.hpp>
+#include <filesystem>
 #include <functional>
 #include <optional>
 #include <string>
@@ -47,6 +48,22 @@ int setup_threads(int threads);
 /// IoError → 3 ("app: I/O error: ..."), std::bad_alloc and std::system_error (file system calls)
 /// → 3 ("app: system error: ..."), any other exception → 1 ("app: error: ...").
 int run_main(const std::string& app, const std::function<int()>& body);
+
+/// The file a run leaves in its --out folder listing the files it wrote there (first line
+/// "app = NAME", then one path a line, relative to the folder).
+inline constexpr const char* kOutputManifest = "geohaz-manifest.txt";
+
+/// The --out policy of every app (issue #16): a run never mixes its files with an earlier run's.
+///  - a folder that does not exist or is empty is used as it is;
+///  - a folder holding only the files that an earlier run of the same app listed in its
+///    geohaz-manifest.txt is cleaned of them first (so no stale map or snapshot survives);
+///  - anything else is refused with an InputError (exit 2) naming the folder and the first file that
+///    no earlier run of this app wrote (or the app whose output it is), and nothing is touched.
+/// An input file (`inputs`, e.g. a restart snapshot) lying in the folder is refused too, since
+/// cleaning would delete it. Call after the inputs are validated; then `body` runs, and the manifest
+/// is written afterwards, also when `body` throws (the exception goes on).
+int run_in_output_dir(const std::filesystem::path& out, const std::string& app,
+                      const std::vector<std::filesystem::path>& inputs, const std::function<int()>& body);
 
 /// What a config-driven app (`APP --config case.toml [--set ...] [--out DIR] ...`) tells main().
 struct ConfigApp {

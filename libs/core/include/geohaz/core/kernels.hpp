@@ -4,7 +4,7 @@
 /// loop has no dispatch. All kernels have support radius 2h and are normalised so that
 /// ∫ W dV = 1 in Dim dimensions.
 ///
-///  - CubicSpline (Monaghan & Lattanzio 1985), seed 001 eq. 9 / seed 002 eq. 4:
+///  - CubicSpline (Monaghan & Lattanzio 1985), SPH-slope paper (2020), eq. 9 / Bui et al. (2010), eq. 4:
 ///      W = α_d { 2/3 − q² + q³/2  (0 ≤ q < 1);  (2 − q)³/6  (1 ≤ q < 2);  0 }
 ///    with α_d = 15/(7πh²) in 2D and 3/(2πh³) in 3D for this form of the polynomial
 ///    (equivalently 10/(7πh²) and 1/(πh³) for the form  1 − 3q²/2 + 3q³/4,  (2−q)³/4).

@@ -22,13 +22,15 @@ namespace geohaz::dem {
 /// Stiffnesses follow from a bond modulus as in PFC2D (Potyondy & Cundall 2004, eq. 20):
 /// k̄_n = Ē_c/(R_A + R_B), k̄_s = k̄_n/(k̄_n/k̄_s), so the macro modulus does not depend on disc size.
 struct ParallelBondProperties {
-  double radius_multiplier = 1.0;   ///< λ̄
-  double modulus = 50e9;            ///< Ē_c (Pa)
-  double stiffness_ratio = 2.5;     ///< k̄_n/k̄_s
-  double tensile_strength = 10e6;   ///< mean σ̄_c (Pa)
-  double tensile_strength_std = 0;  ///< standard deviation of σ̄_c (Pa)
-  double shear_strength = 30e6;     ///< mean τ̄_c (Pa)
-  double shear_strength_std = 0;    ///< standard deviation of τ̄_c (Pa)
+  // The dem-avalanche config takes its defaults from here (one copy of each fact, issue #11): the
+  // bonded granite-like rock of data/dem/biaxial_compression.toml.
+  double radius_multiplier = 1.0;      ///< λ̄
+  double modulus = 20e9;               ///< Ē_c (Pa)
+  double stiffness_ratio = 2.5;        ///< k̄_n/k̄_s
+  double tensile_strength = 50e6;      ///< mean σ̄_c (Pa)
+  double tensile_strength_std = 10e6;  ///< standard deviation of σ̄_c (Pa)
+  double shear_strength = 50e6;        ///< mean τ̄_c (Pa)
+  double shear_strength_std = 10e6;    ///< standard deviation of τ̄_c (Pa)
 };
 
 /// State of a bond.

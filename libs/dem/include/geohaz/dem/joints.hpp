@@ -34,7 +34,7 @@ std::vector<JointTrace> generate_joint_traces(const std::vector<JointSet>& sets,
 /// Whether the closed segments [a, b] and [c, d] intersect (orientation tests).
 bool segments_intersect(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) noexcept;
 
-/// Summary of the discontinuities, the seed's "density and orientation of discontinuities".
+/// Summary of the discontinuities, the lecture's "density and orientation of discontinuities".
 struct DiscontinuityReport {
   std::size_t traces = 0;
   double total_length = 0;   ///< m

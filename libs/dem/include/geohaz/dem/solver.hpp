@@ -49,7 +49,6 @@ class DemSolver {
  public:
   DiscStore discs;
   BondTable bonds;
-  ParallelBondProperties bond_properties;
   ContactLaw law = LinearSpringCoulomb{};
   ContactProperties contact;
   SolverSettings settings;

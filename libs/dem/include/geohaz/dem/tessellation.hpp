@@ -4,7 +4,7 @@
 /// power (Laguerre–Voronoi) diagram, computed with CGAL (Regular_triangulation_2) — CGAL stays in
 /// tessellation.cpp. For non-overlapping discs each disc lies inside its own power cell, so the cell
 /// area gives a local porosity 1 − πR²/A_cell, and the triangulation edges are the natural
-/// neighbours that form the bond network (the seed's "physics-based tessellation").
+/// neighbours that form the bond network (the lecture's "physics-based tessellation").
 /// Cells are clipped to a rectangle; discs are mirrored across its sides so the cells of discs
 /// next to a side end exactly on it, and the cell areas sum to the rectangle's area.
 

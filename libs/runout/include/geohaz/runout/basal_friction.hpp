@@ -24,7 +24,7 @@ struct FrictionTerms {
   double drag;  ///< coefficient of |v|² (1/m)
 };
 
-/// Modified Manning law for a soil–water mixture (seed 000 §3):
+/// Modified Manning law for a soil–water mixture (SWJTU lecture 2010, §3):
 ///   τ_b = (τ_cr |v|^m + ρ g n² |v|² / R_h^{1/3}) v/|v|,   τ_cr = ρ g_n R_h i_cr,   R_h = h_n.
 /// Divided by ρ h_n: a = g_n i_cr |v|^m + g n² |v|² / h_n^{4/3}.
 /// n: Manning roughness (s/m^{1/3}), 0.02–0.1 for natural rivers, seed example 0.06;

@@ -97,7 +97,7 @@ struct HeadAcceleration {
   static constexpr const char* label = "head_acceleration";
   static constexpr const char* unit = "m/s^2";
 };
-/// Velocity correction of the neighbour smoothing (seed 000 §2, Monaghan 1994), map view (m/s).
+/// Velocity correction of the neighbour smoothing (SWJTU lecture 2010, §2, Monaghan 1994), map view (m/s).
 struct VelocityCorrection {
   using type = Vec2;
   static constexpr const char* label = "velocity_correction";

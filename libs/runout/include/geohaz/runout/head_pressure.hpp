@@ -1,7 +1,7 @@
 #pragma once
 /// \file head_pressure.hpp
 /// The flow-head pressure of the depth-averaged debris-flow model as an inter-particle force
-/// (seed 000, section 3, "pressure due to the soil-water mixture head is modeled with
+/// (SWJTU lecture 2010, section 3, "pressure due to the soil-water mixture head is modeled with
 /// inter-particle force", including the effective-length extension):
 ///
 ///     a_i = Σ_j  C · g · (V_j / d0³) · f(|d|/d0) · d/|d|,      d = x_i − x_j  (map view)
@@ -10,7 +10,7 @@
 ///     f(x) = −½ (x − 1)(x − 2)        1 ≤ x < 2     (continuous reading, see below)
 ///     f(x) = 0                        x ≥ 2
 ///
-/// For particles of the reference volume V0 = h0·d0² this is the seed's p = ρ g (h0/d0) f d/|d|
+/// For particles of the reference volume V0 = h0·d0² this is the lecture's p = ρ g (h0/d0) f d/|d|
 /// per unit mass (times C). The seed transcribes the second branch as −½[(x − 3/2)² + 1/8], which
 /// jumps at x = 1 (from 0 to −1/4) and at x = 2 (from −1/4 to 0); with −1/4 in place of +1/8 the
 /// bracket factorises into (x − 1)(x − 2): continuous at both ends, zero at x = 1 and x = 2.
@@ -19,14 +19,14 @@
 /// derivative is −f(r/d0)/d0³; its integral is ∫W_f dA = π ∫₀² x² f(x) dx = π·I with
 /// I = (2 ln 2 − 4/3) + 23/120 ≈ 0.2446. With C = 1/(π I) ≈ 1.301 the continuum limit of the force is
 /// exactly −g ∇h, the pressure term of the shallow-water equations, so waves travel at √(g h) (dam
-/// break: Ritter). C = 1 reproduces the seed's raw coefficient (waves slower by √(πI) ≈ 0.877).
+/// break: Ritter). C = 1 reproduces the lecture's raw coefficient (waves slower by √(πI) ≈ 0.877).
 
 #include <cmath>
 #include <numbers>
 
 namespace geohaz::runout {
 
-/// Shape function and constants of the head-pressure force (seed 000 §3, continuous reading).
+/// Shape function and constants of the head-pressure force (SWJTU lecture 2010, §3, continuous reading).
 struct HeadPressureForce {
   /// Support of f in units of d0.
   static constexpr double support = 2.0;

@@ -6,7 +6,7 @@
 /// cells across); the release volume V_b of a block (Σ thickness·cell area over its cells) goes to
 /// N_b = max(1, round(V_b / V0)) particles of volume V_b / N_b each, V0 = h0·d0². The particles sit
 /// on a regular sub-lattice over the bounding box of the block's release cells, so a release of
-/// thickness h is seeded at spacing ≈ d0·√(h0/h) (seed 000 §3) and the volume seeded equals the
+/// thickness h is seeded at spacing ≈ d0·√(h0/h) (SWJTU lecture 2010, §3) and the volume seeded equals the
 /// volume given, block by block, to round-off. Particle volumes therefore differ slightly from V0;
 /// the head-pressure force and the depth both weight neighbours by their actual volume.
 

@@ -1,7 +1,7 @@
 #pragma once
 /// \file synthetic_terrain.hpp
-/// A synthetic mountain valley DSM for examples, regression tests and the seed-scale validation
-/// (seed 000 §3: a debris flow travelling 4.8 km in 10 min over a 2.5 m DSM).
+/// A synthetic mountain valley DSM for examples, regression tests and the lecture-scale validation
+/// (SWJTU lecture 2010, §3: a debris flow travelling 4.8 km in 10 min over a 2.5 m DSM).
 ///
 /// The valley runs west → east. Its thalweg falls with a longitudinal gradient S(s) that is steep
 /// at the head (S_head over the first `head_length`), eases linearly to S_channel by
@@ -42,7 +42,7 @@ struct SyntheticValley {
   SyntheticValley scaled(double factor) const;
 };
 
-/// WKT of WGS 84 / UTM zone 54N (EPSG:32654), the CRS of the synthetic DSM (the seed's case is in
+/// WKT of WGS 84 / UTM zone 54N (EPSG:32654), the CRS of the synthetic DSM (the lecture's case is in
 /// northern Japan).
 extern const char* const kSyntheticValleyCrsWkt;
 

@@ -3,9 +3,9 @@
 /// Constitutive models of the SPH slope model (stress update per particle and step).
 ///
 /// All models advance the Cauchy stress σ (3×3, tension positive) with the Jaumann rate
-/// (seed 001 eq. 22 / seed 002 eq. 21, Bui et al. 2008):
+/// (SPH-slope paper 2020, eq. 22 / Bui et al. (2010), eq. 21, Bui et al. 2008):
 ///     dσ/dt = W σ − σ W + 2G ė + K tr(ε̇) I − (plastic correction)
-/// where ε̇ = ½(L + Lᵀ), W = ½(L − Lᵀ) (seed 001 eqs. 24–25), ė = ε̇ − ⅓ tr(ε̇) I,
+/// where ε̇ = ½(L + Lᵀ), W = ½(L − Lᵀ) (SPH-slope paper 2020, eqs. 24–25), ė = ε̇ − ⅓ tr(ε̇) I,
 /// K = E / (3(1 − 2ν)), G = E / (2(1 + ν)). In 2D plane strain L is embedded in 3×3 with
 /// zero out-of-plane row/column, so σ_zz evolves with (K − 2G/3) tr(ε̇) (ε_zz = 0).
 ///
@@ -13,13 +13,13 @@
 /// Int. J. Numer. Anal. Meth. Geomech. 32:1537–1570, §3):
 ///   f = α_φ I1 + √J2 − k_c ,  g = α_ψ I1 + √J2 (non-associated when ψ ≠ φ),
 ///   Δλ = f(σ_trial) / (9 α_φ α_ψ K + G),  σ = σ_trial − Δλ (3K α_ψ I + G s_trial/√J2_trial),
-/// i.e. the time-discrete form of the plastic term of seed 002 eqs. 21–22. Then Bui's two
+/// i.e. the time-discrete form of the plastic term of Bui et al. (2010), eqs. 21–22. Then Bui's two
 /// safeguards: tension cut-off (I1 > k_c/α_φ → hydrostatic shift to the apex) and scaling back
 /// (√J2 > k_c − α_φ I1 → s scaled by r = (k_c − α_φ I1)/√J2).
 /// Density floor (`min_density`): the continuity density of a material that cannot carry mean
 /// tension beyond p_t (Drucker–Prager: the apex, p_t = k_c/(3α_φ)) is bounded below by the density
 /// of the elastic dilation at p_t, ρ_min = ρ0/(1 + p_t/K) (ρ0 for c = 0). Beyond it the particles are
-/// parting (seed 000 "meeting and parting"), not dilating: the gap between them is not material
+/// parting (SWJTU lecture 2010 "meeting and parting"), not dilating: the gap between them is not material
 /// volume. Without the floor m/ρ of separating particles grows without bound (ρ → 0), their
 /// neighbours' velocity gradients and σ/ρ² blow up (column collapses at Δx = L0/30–L0/40).
 ///
@@ -65,8 +65,8 @@ namespace geohaz::sph {
 
 /// Which Drucker–Prager fit to the Mohr–Coulomb parameters (c, φ).
 enum class DruckerPragerFit {
-  PlaneStrain,   ///< seed 002 eqs. 18–19: α = tanφ/√(9+12tan²φ), k = 3c/√(9+12tan²φ)
-  Compression3D  ///< seed 001 eq. 21: α = 2sinφ/(√3(3−sinφ)), k = 6c cosφ/(√3(3−sinφ)) (outer cone)
+  PlaneStrain,  ///< Bui et al. (2010), eqs. 18–19: α = tanφ/√(9+12tan²φ), k = 3c/√(9+12tan²φ)
+  Compression3D  ///< SPH-slope paper (2020), eq. 21: α = 2sinφ/(√3(3−sinφ)), k = 6c cosφ/(√3(3−sinφ)) (outer cone)
 };
 
 /// Drucker–Prager constants α_φ, k_c (Pa) and α_ψ.
@@ -233,7 +233,7 @@ struct VonMises {
 };
 
 /// Elastic–perfectly plastic Drucker–Prager, non-associated (dilatancy ψ), Jaumann rate,
-/// seed 002 eqs. 17–22 / seed 001 eqs. 18–23, return mapping after Bui et al. (2008).
+/// Bui et al. (2010), eqs. 17–22 / SPH-slope paper (2020), eqs. 18–23, return mapping after Bui et al. (2008).
 /// Internal variable: the accumulated plastic multiplier Σ Δλ (PlasticStrain).
 struct DruckerPrager {
   static constexpr const char* name = "drucker_prager";
@@ -300,7 +300,7 @@ struct DruckerPragerSoftening {
 };
 
 /// Weakly compressible Newtonian fluid: σ = −p I + 2μ ė, p = K (ρ/ρ0 − 1) (linear equation of
-/// state with bulk modulus K = E/(3(1−2ν))). Used for the viscous simple-shear check of seed 000.
+/// state with bulk modulus K = E/(3(1−2ν))). Used for the viscous simple-shear check of SWJTU lecture (2010).
 struct NewtonianFluid {
   static constexpr const char* name = "newtonian_fluid";
   static constexpr const char* summary = "weakly compressible Newtonian fluid (viscosity; bulk modulus from E, nu)";

@@ -6,7 +6,7 @@
 /// store, so reordering by cell, restart and output can never forget one (STYLE.md §1).
 /// Stress is always a 3×3 tensor: in 2D plane strain the out-of-plane normal stress σ_zz is
 /// non-zero (ε_zz = 0) and is needed for the invariants I1 and J2 of the yield functions.
-/// Sign convention: tension positive (seed 002: σ' is negative in compression).
+/// Sign convention: tension positive (Bui et al. 2010: σ' is negative in compression).
 
 #include <cstdint>
 
@@ -91,7 +91,7 @@ struct PlasticStrain {
   static constexpr const char* label = "plastic_strain";
   static constexpr const char* unit = "1";
 };
-/// 1 when the particle is stress-free ("meeting and parting", seed 000), else 0.
+/// 1 when the particle is stress-free ("meeting and parting", SWJTU lecture (2010)), else 0.
 struct StressFree {
   using type = std::uint8_t;
   static constexpr const char* label = "stress_free";

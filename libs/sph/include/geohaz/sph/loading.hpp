@@ -1,10 +1,10 @@
 #pragma once
 /// \file loading.hpp
 /// Body-force loading of the SPH slope model: gravity applied gradually (geostatic phase) and
-/// earthquake acceleration added to every particle (seed 002 eqs. 25–26: ḡ = g + a_earthquake).
+/// earthquake acceleration added to every particle (Bui et al. 2010, eqs. 25–26: ḡ = g + a_earthquake).
 ///
 /// The earthquake acceleration is applied to every soil particle as a body acceleration, the
-/// boundary particles stay fixed: this is the box-frame reading of seed 002 ("seismic acceleration
+/// boundary particles stay fixed: this is the box-frame reading of Bui et al. (2010) ("seismic acceleration
 /// is applied directly to each SPH particle as the external load, rather than shaking from solid
 /// boundaries"). The sign convention of the record is kept as given (a sine has no preferred sign).
 
@@ -20,7 +20,7 @@ class EarthquakeLoading {
   EarthquakeLoading() = default;
 
   /// A sine a(t) = A·r(t)·sin(2πf(t − t0)) for t0 ≤ t ≤ t0 + duration, with a linear ramp r(t)
-  /// of length `ramp` at both ends (seed 000: 1 Hz, 500 gal). amplitude in m/s², frequency in Hz,
+  /// of length `ramp` at both ends (SWJTU lecture 2010: 1 Hz, 500 gal). amplitude in m/s², frequency in Hz,
   /// start, duration and ramp in s.
   static EarthquakeLoading sine(double amplitude, double frequency, double start, double duration, double ramp);
 

@@ -38,7 +38,7 @@ struct InitialVelocity {
   double length = 1.0;  ///< m: free length of the beam
 };
 
-/// Pile rows of seed 001 Fig. 17 (3D): one row across the width at a position along the face.
+/// Pile rows of SPH-slope paper (2020), Fig. 17 (3D): one row across the width at a position along the face.
 struct PileRows {
   bool enabled = false;
   double position =

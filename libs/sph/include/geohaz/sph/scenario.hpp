@@ -4,7 +4,7 @@
 /// plus layers of boundary particles (Bui et al. 2008) along the walls.
 ///
 /// Axes: axis 0 is horizontal along the section (x), axis Dim−1 vertical (z, up); in 3D axis 1
-/// is the width (y), periodic when requested (seed 001: "periodic boundary condition was applied
+/// is the width (y), periodic when requested (SPH-slope paper 2020: "periodic boundary condition was applied
 /// across the smaller side"). Every scenario is a *profile domain*: soil between the top of a
 /// bottom wall z_b and a piecewise-linear surface z_s(x), between x_left and x_right, with
 /// materials assigned by elevation (layers), optional walls at both ends and optional piles.
@@ -96,9 +96,9 @@ template <int Dim>
 Scenario<Dim> build_profile(const ProfileDomain& dom, double spacing, const std::vector<double>& densities,
                             double h_factor);
 
-/// Parametric slope (seed 001 Fig. 3): base of thickness `base_thickness`, crest of length
+/// Parametric slope (SPH-slope paper 2020, Fig. 3): base of thickness `base_thickness`, crest of length
 /// `crest_length` at height `height` above the base, face with gradient `gradient`:1 (H:V), front
-/// of length `front_length`. Optional upper cut (seed 001 Fig. 15): the face is cut back from
+/// of length `front_length`. Optional upper cut (SPH-slope paper 2020, Fig. 15): the face is cut back from
 /// depth `cut_depth` below the crest at gradient `cut_gradient`:1.
 struct SlopeGeometry {
   double height = 0.25, gradient = 1.5, crest_length = 0.3, front_length = 0.6, base_thickness = 0.05;

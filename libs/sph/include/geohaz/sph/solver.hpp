@@ -1,7 +1,8 @@
 #pragma once
 /// \file solver.hpp
 /// The SPH solver for elasto-plastic soil (2D plane strain and 3D), after Bui et al. (2008) and
-/// seeds 000–002. One step (step_impl in solver.cpp: one function per item, in this order):
+/// the three source documents (docs/references.md). One step (step_impl in solver.cpp: one function per item, in this
+/// order):
 ///   0. update_neighbours: neighbour list (rebuilt every step, or with a Verlet skin only when a
 ///      particle has moved more than half the skin; store reordered by cell every `reorder_every`
 ///      steps at a rebuild);
@@ -12,25 +13,25 @@
 ///   2. gradient_correction (only with `kernel_correction`): C_i = M_i⁻¹, M_i = Σ_j V_j ∇_i W_ij ⊗
 ///      (x_j − x_i) over all neighbours (boundary particles included), C_i = I where det M_i < 0.2^Dim
 ///      (Bonet & Lok 1999; Randles & Libersky 1996; docs/sph.md "Kernel-gradient correction");
-///      velocity_gradient: L_i = Σ_j V_j (v_j − v_i) ⊗ ∇_i W_ij (seed 001 eqs. 24–25), with the
+///      velocity_gradient: L_i = Σ_j V_j (v_j − v_i) ⊗ ∇_i W_ij (SPH-slope paper 2020, eqs. 24–25), with the
 ///      correction ∇̃_i W_ij = C_i ∇_i W_ij, i.e. L_i ← L_i C_iᵀ; continuity
-///      dρ_i/dt = Σ_j m_j (v_i − v_j)·∇_i W_ij (seed 001 eq. 11), kernel-summation density and the
-///      XSPH term Σ_j V_j (v_j − v_i) W_ij (seed 000); each soil–soil pair evaluated once;
+///      dρ_i/dt = Σ_j m_j (v_i − v_j)·∇_i W_ij (SPH-slope paper 2020, eq. 11), kernel-summation density and the
+///      XSPH term Σ_j V_j (v_j − v_i) W_ij (SWJTU lecture 2010); each soil–soil pair evaluated once;
 ///   3. update_stress: density and stress update (the constitutive model, chosen once per step,
 ///      updates σ and its internal variables), stress vanishing below a summation-density threshold
-///      (seed 000 "meeting and parting"), artificial stress R = −ε_as σ_a/ρ² on tensile principal
+///      (SWJTU lecture 2010 "meeting and parting"), artificial stress R = −ε_as σ_a/ρ² on tensile principal
 ///      stresses (Gray & Monaghan 2001);
-///   4. momentum (seed 002 eq. 12 with the stress pair in its energy-consistent form):
+///   4. momentum (Bui et al. 2010, eq. 12 with the stress pair in its energy-consistent form):
 ///      a_i = Σ_j m_j ((σ_i + σ_j)/(ρ_i ρ_j) − Π_ij I + f_ij^n (R_i + R_j)) ∇_i W_ij + ḡ
 ///      with Monaghan's viscosity Π_ij (the model's wave speed), f_ij = W(r)/W(Δx),
-///      ḡ = g + a_earthquake (seed 002 eqs. 25–26); with `kernel_correction` the stress pair is
+///      ḡ = g + a_earthquake (Bui et al. 2010, eqs. 25–26); with `kernel_correction` the stress pair is
 ///      (σ_i C_i + σ_j C_j) ∇_i W_ij / (ρ_i ρ_j) (Bonet & Lok 1999: conserves linear momentum and
 ///      pairs with the corrected L of step 2), a boundary particle taking the C_i of its soil partner;
 ///   4b. structure_forces (only when structures are tracked, track_structures): the force the soil
 ///      exerts on each structure, F_s = −Σ_{i soil, b ∈ s} V_i [V_b T_ib ∇_i W_ib + a_rep,ib ρ_i], the
 ///      reaction of step 4's soil–boundary pair terms, and its moment Σ (x_b − x_base) × F_ib;
 ///      read only, the particles move exactly as without it;
-///   5. integrate: body force ḡ, Cundall local damping −ζ|a_α| sign(v_α) (seed 002 eq. 14),
+///   5. integrate: body force ḡ, Cundall local damping −ζ|a_α| sign(v_α) (Bui et al. 2010, eq. 14),
 ///      a clamped soil particle (field Clamped) held at rest in place,
 ///      leap-frog (kick–drift: v^{n+½} = v^{n−½} + Δt a^n, x^{n+1} = x^n + Δt (v^{n+½} + ε ΔvXSPH));
 ///   6. check_state, update_dt: Δt = min(C_cfl h/(c + |v|max), C_f √(h/|a|max), the model's own
@@ -78,7 +79,7 @@ struct NumericalSettings {
   double viscosity_beta = 0.0;        ///< Monaghan β_Π
   double artificial_stress = 0.3;     ///< ε_as (0 switches it off)
   double artificial_stress_n = 0.0;   ///< exponent n; 0 → W(0)/W(Δx)
-  double xsph = 0.0;                  ///< ε of the XSPH correction (seed 000), 0 = off
+  double xsph = 0.0;                  ///< ε of the XSPH correction (SWJTU lecture 2010), 0 = off
   double damping = 0.0;               ///< Cundall ζ in the main phase
   double stress_free_fraction = 0.0;  ///< stress vanishes where Σ m W < fraction·ρ0 (0 = off)
   int reorder_every = 20;             ///< steps between cell reorderings of the store
