@@ -73,14 +73,30 @@ void check(Layout layout, bool periodic, int threads) {
   EXPECT_GT(pairs, x.size());  // the test is not vacuous
 }
 
-TEST(NeighbourList, Uniform2D) { check<2>(Layout::Uniform, false, 1); }
-TEST(NeighbourList, Uniform2DTwoThreads) { check<2>(Layout::Uniform, false, 2); }
-TEST(NeighbourList, Clustered2D) { check<2>(Layout::Clustered, false, 2); }
-TEST(NeighbourList, Periodic2D) { check<2>(Layout::Uniform, true, 2); }
-TEST(NeighbourList, Uniform3D) { check<3>(Layout::Uniform, false, 1); }
-TEST(NeighbourList, Clustered3DTwoThreads) { check<3>(Layout::Clustered, false, 2); }
-TEST(NeighbourList, Periodic3D) { check<3>(Layout::Uniform, true, 2); }
-TEST(NeighbourList, Periodic3DOneThread) { check<3>(Layout::Clustered, true, 1); }
+TEST(NeighbourList, Uniform2D) {
+  check<2>(Layout::Uniform, false, 1);
+}
+TEST(NeighbourList, Uniform2DTwoThreads) {
+  check<2>(Layout::Uniform, false, 2);
+}
+TEST(NeighbourList, Clustered2D) {
+  check<2>(Layout::Clustered, false, 2);
+}
+TEST(NeighbourList, Periodic2D) {
+  check<2>(Layout::Uniform, true, 2);
+}
+TEST(NeighbourList, Uniform3D) {
+  check<3>(Layout::Uniform, false, 1);
+}
+TEST(NeighbourList, Clustered3DTwoThreads) {
+  check<3>(Layout::Clustered, false, 2);
+}
+TEST(NeighbourList, Periodic3D) {
+  check<3>(Layout::Uniform, true, 2);
+}
+TEST(NeighbourList, Periodic3DOneThread) {
+  check<3>(Layout::Clustered, true, 1);
+}
 
 TEST(NeighbourList, ShortPeriodicAxisHasNoDuplicates) {
   // Period 2.5 × cutoff: only two cells fit; the ±1 neighbour cells coincide and must be visited once.
@@ -208,11 +224,21 @@ void check_scan(Layout layout, bool periodic, int threads) {
   EXPECT_GT(pairs, x.size());  // the test is not vacuous
 }
 
-TEST(CellPairScan, SameNeighboursInTheSameOrderAsTheList2D) { check_scan<2>(Layout::Uniform, false, 1); }
-TEST(CellPairScan, Clustered2DTwoThreads) { check_scan<2>(Layout::Clustered, false, 2); }
-TEST(CellPairScan, Periodic2D) { check_scan<2>(Layout::Uniform, true, 2); }
-TEST(CellPairScan, Clustered3D) { check_scan<3>(Layout::Clustered, false, 1); }
-TEST(CellPairScan, Periodic3D) { check_scan<3>(Layout::Uniform, true, 2); }
+TEST(CellPairScan, SameNeighboursInTheSameOrderAsTheList2D) {
+  check_scan<2>(Layout::Uniform, false, 1);
+}
+TEST(CellPairScan, Clustered2DTwoThreads) {
+  check_scan<2>(Layout::Clustered, false, 2);
+}
+TEST(CellPairScan, Periodic2D) {
+  check_scan<2>(Layout::Uniform, true, 2);
+}
+TEST(CellPairScan, Clustered3D) {
+  check_scan<3>(Layout::Clustered, false, 1);
+}
+TEST(CellPairScan, Periodic3D) {
+  check_scan<3>(Layout::Uniform, true, 2);
+}
 
 TEST(CellPairScan, ShortPeriodicAxisAndTooShortAxis) {
   // Period 2.5 × cutoff (the ±1 neighbour cells coincide) and a period below 2 × cutoff (rejected).
@@ -228,7 +254,8 @@ TEST(CellPairScan, ShortPeriodicAxisAndTooShortAxis) {
   const auto ref = brute_force<2>(x, 0.1, p);
   for (std::size_t i = 0; i < x.size(); ++i) {
     std::vector<std::uint32_t> got;
-    scan.for_each_neighbour(i, [&](std::size_t j, const Vec2&, double) { got.push_back(static_cast<std::uint32_t>(j)); });
+    scan.for_each_neighbour(i,
+                            [&](std::size_t j, const Vec2&, double) { got.push_back(static_cast<std::uint32_t>(j)); });
     EXPECT_EQ(std::set<std::uint32_t>(got.begin(), got.end()), ref[i]);
     EXPECT_EQ(got.size(), ref[i].size());
   }

@@ -10,10 +10,10 @@
 #include <random>
 #include <string>
 
+#include "child_process.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
 #include "geohaz/core/raster_extra.hpp"
-#include "child_process.hpp"
 #include "tiff_header.hpp"
 
 namespace fs = std::filesystem;

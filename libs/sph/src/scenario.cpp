@@ -105,8 +105,7 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
   Builder<Dim> B;
   B.dx = dx;
   auto material_at = [&](double x, double y, double z) {
-    if (dom.surface_layer_depth > 0.0 && z > zs_at(x, y) - dom.surface_layer_depth)
-      return dom.surface_material;
+    if (dom.surface_layer_depth > 0.0 && z > zs_at(x, y) - dom.surface_layer_depth) return dom.surface_material;
     if (dom.layer_materials.empty()) return 0;
     std::size_t k = 0;
     while (k < dom.layer_tops.size() && z >= dom.layer_tops[k]) ++k;
@@ -200,8 +199,9 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
         const int nzw = static_cast<int>(std::lround((dom.bedrock_depth + 3 * dx) / dx));
         for (int l = 0; l < layers; ++l)
           for (int k = 0; k < nzw; ++k)
-            B.add(make(side == 0 ? xe - (l + 0.5) * dx : xe + (l + 0.5) * dx, y, ze - dom.bedrock_depth + (k + 0.5) * dx),
-                  wall_kind(w), material_floor, wall_rho, ex);
+            B.add(
+                make(side == 0 ? xe - (l + 0.5) * dx : xe + (l + 0.5) * dx, y, ze - dom.bedrock_depth + (k + 0.5) * dx),
+                wall_kind(w), material_floor, wall_rho, ex);
       }
       continue;
     }
@@ -234,7 +234,8 @@ Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vect
             const double x = xb0 + (i + 0.5) * dx;
             const double z0 = zs_at(x, y_edge) - dom.bedrock_depth - layers * dx;
             const double yw = side == 0 ? -(l + 0.5) * dx : y_max + (l + 0.5) * dx;
-            for (int k = 0; k < nzw; ++k) B.add(make(x, yw, z0 + (k + 0.5) * dx), Kind::RollerWall, material_floor, wall_rho, ey);
+            for (int k = 0; k < nzw; ++k)
+              B.add(make(x, yw, z0 + (k + 0.5) * dx), Kind::RollerWall, material_floor, wall_rho, ey);
           }
       }
     } else if (!dom.periodic_width) {

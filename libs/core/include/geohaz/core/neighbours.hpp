@@ -68,7 +68,7 @@ constexpr int ipow(int b, int e) noexcept {
 /// Cell-linked list: particles binned into cubic cells of edge ≥ cell_size, sorted by cell.
 template <int Dim>
 class CellList {
-public:
+ public:
   /// Slot ranges [first, last) of sorted() to scan for the neighbours of a particle in `cell`,
   /// R cells deep, and how many of them. Along axis 0 neighbouring cells are contiguous in the
   /// linear index, so each combination of the other axes is one range (two when a periodic axis
@@ -145,7 +145,7 @@ public:
   std::array<int, Dim> cell_coords(std::uint32_t c) const noexcept;
   const Periodicity<Dim>& periodicity() const noexcept { return periodic_; }
 
-private:
+ private:
   Periodicity<Dim> periodic_;
   Vec<Dim> origin_ = Vec<Dim>::Zero();
   Vec<Dim> edge_ = Vec<Dim>::Ones();
@@ -157,7 +157,7 @@ private:
 /// Full neighbour list in CSR form, built from a CellList.
 template <int Dim>
 class NeighbourList {
-public:
+ public:
   /// Cells per cut-off length: the grid has cells of edge cutoff/kReach, scanned kReach cells deep.
   static constexpr int kReach = 2;
 
@@ -204,13 +204,13 @@ public:
     }
   }
 
-private:
+ private:
   CellList<Dim> cells_;
   double cutoff_ = 0.0;
   bool periodic_any_ = false;
   std::vector<std::uint32_t> offsets_, indices_;
   std::vector<std::vector<std::uint32_t>> thread_buffers_;  // reused between builds
-  std::vector<Vec<Dim>> sorted_x_;                         // positions in cell order, reused
+  std::vector<Vec<Dim>> sorted_x_;                          // positions in cell order, reused
 };
 
 /// Pairs closer than a cut-off found on the fly from a cell list, without storing a list.
@@ -230,7 +230,7 @@ private:
 
 template <int Dim>
 class CellPairScan {
-public:
+ public:
   /// Cells per cut-off length, as in NeighbourList (cells of edge cutoff/kReach scanned kReach deep).
   static constexpr int kReach = NeighbourList<Dim>::kReach;
 
@@ -280,7 +280,7 @@ public:
       visit(std::false_type{});
   }
 
-private:
+ private:
   CellList<Dim> cells_;
   double cutoff_ = 0.0;
   bool periodic_any_ = false;
