@@ -17,7 +17,9 @@
 using namespace geohaz;
 
 namespace {
-double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+double now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
 
 struct Density {
   using type = double;
@@ -81,10 +83,11 @@ void run(std::size_t n, int threads) {
   t_build /= reps;
   t_loop /= reps;
   const double pairs = static_cast<double>(nl.pair_count());
-  std::printf("%dD n=%8zu threads=%d  neighbours/particle=%5.1f  rebuild %.4f s  pair loops %.4f s  "
-              "rebuild share %4.1f%%  pairs/s %.3g  particle-steps/s %.3g\n",
-              Dim, n, threads, pairs / n, t_build, t_loop, 100.0 * t_build / (t_build + t_loop),
-              2.0 * pairs / t_loop, n / (t_build + t_loop));
+  std::printf(
+      "%dD n=%8zu threads=%d  neighbours/particle=%5.1f  rebuild %.4f s  pair loops %.4f s  "
+      "rebuild share %4.1f%%  pairs/s %.3g  particle-steps/s %.3g\n",
+      Dim, n, threads, pairs / n, t_build, t_loop, 100.0 * t_build / (t_build + t_loop), 2.0 * pairs / t_loop,
+      n / (t_build + t_loop));
 }
 }  // namespace
 

@@ -196,9 +196,9 @@ RunConfig read_config(ConfigReader& r, bool describe) {
                               {"Pa", "confining stresses sigma_3 of the compression tests (one test each)"});
     l.loading_velocity =
         r.get("biaxial.loading_velocity", 0.25, Range::closed(1e-3, 100.0),
-                {"m/s",
-                 "speed of each platen / grip (quasi-static tests: 0.01-1; the test lasts strain·height/speed "
-                 "at a step of ~1e-7 s, so slower is impractically long)"});
+              {"m/s",
+               "speed of each platen / grip (quasi-static tests: 0.01-1; the test lasts strain·height/speed "
+               "at a step of ~1e-7 s, so slower is impractically long)"});
     l.max_axial_strain = r.get("biaxial.max_axial_strain", l.max_axial_strain, Range::open_closed(0.0, 0.5),
                                {"1", "stop at this axial strain"});
     l.post_peak_stop = r.get("biaxial.post_peak_stop", l.post_peak_stop, Range::closed(0.0, 1.0),

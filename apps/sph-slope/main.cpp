@@ -217,9 +217,8 @@ RunConfig read_config(ConfigReader& r, bool describe) {
       r.get("geostatic.rest_tolerance", 0.01, Range::positive(), {"1", "at rest: max|v| < tol sqrt(g H)"});
 
   // [earthquake]
-  const auto eq =
-      r.get_choice("earthquake.type", "none", {"none", "sine", "record"},
-                   {"", "earthquake acceleration applied to every particle (Bui et al. 2010, eqs. 25-26)"});
+  const auto eq = r.get_choice("earthquake.type", "none", {"none", "sine", "record"},
+                               {"", "earthquake acceleration applied to every particle (Bui et al. 2010, eqs. 25-26)"});
   {  // all keys are read whatever the type, so that --set earthquake.type=none works on any config
     const double A =
         r.get("earthquake.amplitude", 5.0, Range::non_negative(), {"m/s^2", "sine amplitude (500 gal = 5)"});

@@ -76,7 +76,6 @@ TEST(Chain, SectionFailureRunsOutWithTheSameVolume) {
   fs::remove_all(out);
 }
 
-
 // The 3D variant: a 6 m wide strip of the same hillside centred on a 50 m polyline, with roller
 // side walls following the terrain; each failed particle is handed over at its own map position
 // with its own volume Δx³. The soil is weakened (φ = 20°, c = 1 kPa) because the 3D

@@ -1,17 +1,15 @@
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <new>
 
 #include "geohaz/core/app.hpp"
 #include "geohaz/core/config.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/resources.hpp"
-
-#include <omp.h>
-
-#include <limits>
-#include <new>
 
 namespace geohaz {
 namespace {
@@ -157,9 +155,9 @@ TEST(Config, ChoiceListsTheAllowedValues) {
 TEST(Config, OverridesReplaceAndCreateKeys) {
   auto r = ConfigReader::from_string(kToml, "slope.toml");
   r.apply_override("material.density=2100");
-  r.apply_override("material.model = elastic");   // bare word → string
-  r.apply_override("run.duration=2.5");           // new table
-  r.apply_override("layer[1].c=3e3");             // element of an array of tables
+  r.apply_override("material.model = elastic");  // bare word → string
+  r.apply_override("run.duration=2.5");          // new table
+  r.apply_override("layer[1].c=3e3");            // element of an array of tables
   EXPECT_DOUBLE_EQ(r.get("material.density", 0.0, Range::positive(), {"", ""}), 2100.0);
   EXPECT_EQ(r.get_string("material.model", "", {"", ""}), "elastic");
   EXPECT_DOUBLE_EQ(r.get("run.duration", 0.0, Range::positive(), {"s", ""}), 2.5);
@@ -262,7 +260,6 @@ TEST(InputError, MessageCarriesContext) {
   EXPECT_EQ(e.reason(), "must be positive");
 }
 
-
 // ---- issue #12: what the fuzzer found in the config reader, the command line and run_main ----
 
 /// The message of the InputError `f` throws ("" when it throws none).
@@ -279,9 +276,11 @@ std::string input_error_of(F&& f) {
 TEST(App, IoAndSystemFailuresExitWithThree) {
   EXPECT_EQ(run_main("t", []() -> int { throw IoError("No space left on device", "out/a.tif"); }), kExitIoError);
   EXPECT_EQ(run_main("t", []() -> int { throw std::bad_alloc(); }), kExitIoError);
-  EXPECT_EQ(run_main("t", []() -> int {
-              throw std::filesystem::filesystem_error("rename", std::make_error_code(std::errc::no_space_on_device));
-            }),
+  EXPECT_EQ(run_main("t",
+                     []() -> int {
+                       throw std::filesystem::filesystem_error("rename",
+                                                               std::make_error_code(std::errc::no_space_on_device));
+                     }),
             kExitIoError);
   EXPECT_EQ(kExitIoError, 3);
 }
@@ -310,8 +309,9 @@ TEST(Config, InfinityIsOutsideEveryRange) {
     EXPECT_THROW(ConfigReader::from_string(text).get("t", 1.0, Range::non_negative(), {"s", ""}), InputError) << text;
     EXPECT_THROW(ConfigReader::from_string(text).get("t", 1.0, Range{}, {"s", ""}), InputError) << text;
   }
-  const std::string msg = input_error_of(
-      [] { ConfigReader::from_string("[run]\nend_time = inf").get("run.end_time", 1.0, Range::positive(), {"s", ""}); });
+  const std::string msg = input_error_of([] {
+    ConfigReader::from_string("[run]\nend_time = inf").get("run.end_time", 1.0, Range::positive(), {"s", ""});
+  });
   EXPECT_NE(msg.find("not a finite number"), std::string::npos) << msg;
   EXPECT_THROW(ConfigReader::from_string("a = [1.0, inf]").get_array("a", {}, Range{}, {"m", ""}), InputError);
 }
@@ -344,7 +344,9 @@ TEST(Config, SetErrorsNameTheCommandLine) {
   EXPECT_NE(unknown.find("run.typo"), std::string::npos) << unknown;
   // A value from the file still names the file.
   auto r3 = ConfigReader::from_string("[run]\nend_time = -1.0\n", "case.toml");
-  EXPECT_NE(input_error_of([&] { r3.get("run.end_time", 1.0, Range::positive(), {"s", ""}); }).find("case.toml"),
+  EXPECT_NE(input_error_of([&] {
+              r3.get("run.end_time", 1.0, Range::positive(), {"s", ""});
+            }).find("case.toml"),
             std::string::npos);
 }
 

@@ -5,10 +5,10 @@
 #include <filesystem>
 #include <fstream>
 
+#include "child_process.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
 #include "geohaz/core/progress.hpp"
-#include "child_process.hpp"
 
 namespace fs = std::filesystem;
 
@@ -92,7 +92,6 @@ TEST(Progress, DurationFormat) {
   EXPECT_EQ(format_duration(3720), "1h02m");
   EXPECT_EQ(format_duration(-1), "--");
 }
-
 
 // A full disk (simulated by a 1 kB file size limit in a child process): the write fails with an
 // IoError naming the file, and neither the file nor its ".partial" is left behind.

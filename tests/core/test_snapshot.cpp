@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
+#include "child_process.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/particles.hpp"
 #include "geohaz/core/snapshot.hpp"
 #include "geohaz/core/vec.hpp"
-#include "child_process.hpp"
 
 namespace geohaz {
 namespace {
@@ -546,7 +546,6 @@ TEST(Snapshot, ReadableWhileWriterInAnotherProcessIsAlive) {
   EXPECT_EQ(count, 1u);
   EXPECT_EQ(density, make_store(4, 0).get<Density>());
 }
-
 
 // A full disk mid-run (a 300 kB file size limit in a child process; each big snapshot needs about
 // 1.3 MB): the writer refuses the snapshot that does not fit with an IoError before touching the

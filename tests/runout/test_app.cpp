@@ -54,7 +54,8 @@ fs::path tiny_dsm() {
     if (fs::exists(dsm) && fs::exists(rel)) return dsm;
     const fs::path own = work_dir() / ("make_" + std::to_string(::getpid()));
     fs::create_directories(own);
-    const auto r = run("--make-synthetic-dsm " + (own / "tiny.tif").string() + " --synthetic-scale 0.1 --release-depth 3");
+    const auto r =
+        run("--make-synthetic-dsm " + (own / "tiny.tif").string() + " --synthetic-scale 0.1 --release-depth 3");
     EXPECT_EQ(r.code, 0) << r.output;
     fs::rename(own / "tiny_release.tif", rel);
     fs::rename(own / "tiny.tif", dsm);

@@ -60,14 +60,15 @@ bool parse_command_line(int argc, const char* const* argv, const std::string& ap
 }
 
 ConfigReader load_config(const CommonOptions& opts) {
-  ConfigReader r = opts.config.empty() ? ConfigReader::from_string("", "<no config file>")
-                                       : ConfigReader::from_file(opts.config);
+  ConfigReader r =
+      opts.config.empty() ? ConfigReader::from_string("", "<no config file>") : ConfigReader::from_file(opts.config);
   for (const auto& s : opts.set) r.apply_override(s);
   return r;
 }
 
 int setup_threads(int threads) {
-  if (threads < 0) throw InputError("must be ≥ 0 (0 uses all cores)", "command line", "--threads", std::to_string(threads));
+  if (threads < 0)
+    throw InputError("must be ≥ 0 (0 uses all cores)", "command line", "--threads", std::to_string(threads));
   // More threads than the machine has only slow a run down, and tens of thousands make the OpenMP
   // runtime crash or run out of memory while starting them (issue #12), so they are capped.
   const int hardware = std::max(1, omp_get_num_procs());

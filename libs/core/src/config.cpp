@@ -137,9 +137,9 @@ void insert_path(toml::table& root, std::string_view path, const toml::node& val
                            std::string(path) + ".<key>=value",
                        {}, std::string(path));
     if (value.is_table())
-      throw InputError("a table cannot be set with --set: set its keys one at a time, e.g. " + std::string(path) +
-                           ".<key>=value",
-                       {}, std::string(path));
+      throw InputError(
+          "a table cannot be set with --set: set its keys one at a time, e.g. " + std::string(path) + ".<key>=value",
+          {}, std::string(path));
   }
   value.visit([&](auto&& v) { t->insert_or_assign(last, v); });
 }
@@ -459,7 +459,9 @@ std::vector<ConfigReader> ConfigReader::tables(std::string_view key, KeyDoc doc)
   return out;
 }
 
-ConfigReader ConfigReader::section(std::string_view key) const { return ConfigReader(state_, full_key(key)); }
+ConfigReader ConfigReader::section(std::string_view key) const {
+  return ConfigReader(state_, full_key(key));
+}
 
 std::string ConfigReader::full_key(std::string_view key) const {
   return prefix_.empty() ? std::string(key) : prefix_ + "." + std::string(key);
@@ -584,7 +586,9 @@ std::string ConfigReader::resolved() const {
   return s.str();
 }
 
-std::vector<KeyReference> ConfigReader::reference() const { return state_->refs; }
+std::vector<KeyReference> ConfigReader::reference() const {
+  return state_->refs;
+}
 
 std::string ConfigReader::format_reference(const std::vector<KeyReference>& refs) {
   std::ostringstream s;
@@ -598,8 +602,12 @@ std::string ConfigReader::format_reference(const std::vector<KeyReference>& refs
   return s.str();
 }
 
-const std::string& ConfigReader::source() const { return state_->source; }
-std::filesystem::path ConfigReader::base_dir() const { return state_->base; }
+const std::string& ConfigReader::source() const {
+  return state_->source;
+}
+std::filesystem::path ConfigReader::base_dir() const {
+  return state_->base;
+}
 
 std::string Range::str() const {
   if (std::isinf(min) && std::isinf(max)) return "any";

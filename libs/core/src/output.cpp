@@ -12,7 +12,8 @@ AtomicTextFile::AtomicTextFile(std::filesystem::path final_path)
     : final_(std::move(final_path)), tmp_(final_.string() + ".partial") {
   errno = 0;
   out_.open(tmp_);
-  if (!out_) throw IoError(std::string("cannot create the file: ") + std::strerror(errno ? errno : EIO), final_.string());
+  if (!out_)
+    throw IoError(std::string("cannot create the file: ") + std::strerror(errno ? errno : EIO), final_.string());
   out_.precision(10);
 }
 

@@ -43,7 +43,8 @@ std::string ProgressReporter::format(double t, std::int64_t step, std::size_t n)
   const double rate = wall > 0 ? steps / wall : 0.0;
   const double eta = frac > 0 ? wall * (1.0 - frac) / frac : NAN;
   char buf[256];
-  std::snprintf(buf, sizeof buf, "%s: t = %.4g / %.4g s (%5.1f%%)  step %lld  %.3g steps/s  %.3g particle-steps/s  ETA %s",
+  std::snprintf(buf, sizeof buf,
+                "%s: t = %.4g / %.4g s (%5.1f%%)  step %lld  %.3g steps/s  %.3g particle-steps/s  ETA %s",
                 label_.c_str(), t, end_time_, 100.0 * frac, static_cast<long long>(step), rate,
                 rate * static_cast<double>(n), format_duration(eta).c_str());
   return buf;

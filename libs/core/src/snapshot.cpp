@@ -556,8 +556,8 @@ void SnapshotWriter::write(double time, std::int64_t step, std::span<const Field
     double bytes = 16.0 * 1024.0;  // group, attributes, B-tree and heap growth
     for (const FieldView& f : fields) {
       const std::size_t elem = f.type == ScalarType::Float64 || f.type == ScalarType::Int64 ? 8
-                               : f.type == ScalarType::Int32                              ? 4
-                                                                                         : 1;
+                               : f.type == ScalarType::Int32                                ? 4
+                                                                                            : 1;
       bytes += static_cast<double>(f.count) * f.rows * f.cols * static_cast<double>(elem) + 1024.0;
     }
     bytes += 4.0 * static_cast<double>(lines.size() + (m.vertex_indices.count(n) ? 0 : n));

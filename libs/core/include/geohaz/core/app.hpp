@@ -17,12 +17,12 @@ namespace geohaz {
 
 /// Options every app takes.
 struct CommonOptions {
-  std::string config;                ///< --config FILE ("" if none)
-  std::vector<std::string> set;      ///< --set key=value ...
-  std::string out;                   ///< --out DIR
-  int threads = 0;                   ///< --threads N (0: all cores)
-  bool quiet = false;                ///< --quiet
-  bool help_config = false;          ///< --help-config
+  std::string config;            ///< --config FILE ("" if none)
+  std::vector<std::string> set;  ///< --set key=value ...
+  std::string out;               ///< --out DIR
+  int threads = 0;               ///< --threads N (0: all cores)
+  bool quiet = false;            ///< --quiet
+  bool help_config = false;      ///< --help-config
 };
 
 /// Add --config, --set, --out, --threads, --quiet, --help, --version, --help-config.

@@ -52,7 +52,7 @@ struct KeyReference {
 };
 
 class ConfigReader {
-public:
+ public:
   /// Read a TOML file. Missing or unparsable file → InputError naming the file (and line).
   static ConfigReader from_file(const std::filesystem::path& path);
   /// Parse TOML text; `source` names it in messages.
@@ -113,7 +113,7 @@ public:
   ConfigReader& operator=(ConfigReader&&) noexcept;
   ~ConfigReader();
 
-private:
+ private:
   struct State;
   ConfigReader(std::shared_ptr<State> state, std::string prefix);
   /// The dotted path of `key` below this reader's prefix.

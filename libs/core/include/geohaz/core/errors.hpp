@@ -17,7 +17,7 @@ namespace geohaz {
 
 /// Bad input: names the file, the key and the offending value when they are known.
 class InputError : public std::runtime_error {
-public:
+ public:
   /// \param what  what is wrong and what is allowed (e.g. "must be in [0, 90] degrees").
   /// \param file  the input file ("" when it came from the command line).
   /// \param key   the config key or option name ("" when not applicable).
@@ -30,13 +30,13 @@ public:
   /// The bare reason, without the file/key/value prefix that what() carries.
   const std::string& reason() const noexcept { return reason_; }
 
-private:
+ private:
   std::string reason_, file_, key_, value_;
 };
 
 /// A simulation that cannot go on. what() carries the diagnosis.
 class SimulationError : public std::runtime_error {
-public:
+ public:
   using std::runtime_error::runtime_error;
 };
 
@@ -44,21 +44,21 @@ public:
 /// on device"). Thrown by the output writers (AtomicTextFile, write_geotiff, the PNG writers,
 /// SnapshotWriter); a writer throwing it has removed its temporary file.
 class IoError : public std::runtime_error {
-public:
+ public:
   /// \param what what failed and why (the system's reason when known).
   /// \param file the output file.
   IoError(const std::string& what, std::string file);
   const std::string& file() const noexcept { return file_; }
 
-private:
+ private:
   std::string file_;
 };
 
 /// Exit codes shared by all apps (README, docs/reliability.md, every app's --help).
-inline constexpr int kExitOk = 0;           ///< done
-inline constexpr int kExitFailure = 1;      ///< the simulation failed (blow-up, diagnosis), or a bug
-inline constexpr int kExitInputError = 2;   ///< bad input; nothing written
-inline constexpr int kExitIoError = 3;      ///< an I/O or system failure; outputs so far kept readable
+inline constexpr int kExitOk = 0;          ///< done
+inline constexpr int kExitFailure = 1;     ///< the simulation failed (blow-up, diagnosis), or a bug
+inline constexpr int kExitInputError = 2;  ///< bad input; nothing written
+inline constexpr int kExitIoError = 3;     ///< an I/O or system failure; outputs so far kept readable
 
 /// The exit-code paragraph of every app's --help.
 inline constexpr const char* kExitCodesHelp =

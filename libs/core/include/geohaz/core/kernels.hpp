@@ -26,20 +26,29 @@ struct CubicSpline {
   static constexpr const char* name = "cubic_spline";
 
   static constexpr double sigma(double h) noexcept {
-    if constexpr (Dim == 1) return 1.0 / h;
-    else if constexpr (Dim == 2) return 15.0 / (7.0 * std::numbers::pi * h * h);
-    else return 3.0 / (2.0 * std::numbers::pi * h * h * h);
+    if constexpr (Dim == 1)
+      return 1.0 / h;
+    else if constexpr (Dim == 2)
+      return 15.0 / (7.0 * std::numbers::pi * h * h);
+    else
+      return 3.0 / (2.0 * std::numbers::pi * h * h * h);
   }
   /// Dimensionless shape w(q) and its derivative dw/dq: W = σ_d w(r/h), dW/dr = σ_d w'(r/h)/h.
   /// Pair loops that precompute σ_d and 1/h call these directly (no division per pair).
   static double shape(double q) noexcept {
     if (q < 1.0) return 2.0 / 3.0 - q * q + 0.5 * q * q * q;
-    if (q < 2.0) { const double t = 2.0 - q; return t * t * t / 6.0; }
+    if (q < 2.0) {
+      const double t = 2.0 - q;
+      return t * t * t / 6.0;
+    }
     return 0.0;
   }
   static double shape_derivative(double q) noexcept {
     if (q < 1.0) return -2.0 * q + 1.5 * q * q;
-    if (q < 2.0) { const double t = 2.0 - q; return -0.5 * t * t; }
+    if (q < 2.0) {
+      const double t = 2.0 - q;
+      return -0.5 * t * t;
+    }
     return 0.0;
   }
   /// W(r, h)
@@ -61,8 +70,10 @@ struct WendlandC2 {
   static constexpr const char* name = "wendland_c2";
 
   static constexpr double sigma(double h) noexcept {
-    if constexpr (Dim == 2) return 7.0 / (4.0 * std::numbers::pi * h * h);
-    else return 21.0 / (16.0 * std::numbers::pi * h * h * h);
+    if constexpr (Dim == 2)
+      return 7.0 / (4.0 * std::numbers::pi * h * h);
+    else
+      return 21.0 / (16.0 * std::numbers::pi * h * h * h);
   }
   /// Dimensionless shape w(q) = (1 − q/2)⁴(2q + 1) and dw/dq = −5q(1 − q/2)³ (see CubicSpline).
   static double shape(double q) noexcept {

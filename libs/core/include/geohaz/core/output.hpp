@@ -14,7 +14,7 @@ namespace geohaz {
 /// commit (an exception), it removes its temporary file. IoError when the temporary file cannot
 /// be created.
 class AtomicTextFile {
-public:
+ public:
   explicit AtomicTextFile(std::filesystem::path final_path);
   ~AtomicTextFile();
   AtomicTextFile(const AtomicTextFile&) = delete;
@@ -31,7 +31,7 @@ public:
   void commit();
   const std::filesystem::path& path() const noexcept { return final_; }
 
-private:
+ private:
   std::filesystem::path final_, tmp_;
   std::ofstream out_;
   bool committed_ = false;

@@ -13,7 +13,7 @@
 namespace geohaz {
 
 class ProgressReporter {
-public:
+ public:
   /// \param label      short name printed at the start of the line ("sph-slope").
   /// \param end_time   simulated time at which the run ends (s).
   /// \param quiet      print nothing.
@@ -33,7 +33,7 @@ public:
   /// The line last formatted (for tests).
   const std::string& last_line() const { return last_; }
 
-private:
+ private:
   std::string format(double sim_time, std::int64_t step, std::size_t particles) const;
   std::string label_;
   double end_time_;

@@ -30,11 +30,16 @@ enum class ScalarType { Float64, Int64, Int32, UInt8 };
 
 template <class S>
 constexpr ScalarType scalar_type_of() {
-  if constexpr (std::is_same_v<S, double>) return ScalarType::Float64;
-  else if constexpr (std::is_same_v<S, std::int64_t>) return ScalarType::Int64;
-  else if constexpr (std::is_same_v<S, std::int32_t>) return ScalarType::Int32;
-  else if constexpr (std::is_same_v<S, std::uint8_t>) return ScalarType::UInt8;
-  else static_assert(sizeof(S) == 0, "unsupported field scalar type");
+  if constexpr (std::is_same_v<S, double>)
+    return ScalarType::Float64;
+  else if constexpr (std::is_same_v<S, std::int64_t>)
+    return ScalarType::Int64;
+  else if constexpr (std::is_same_v<S, std::int32_t>)
+    return ScalarType::Int32;
+  else if constexpr (std::is_same_v<S, std::uint8_t>)
+    return ScalarType::UInt8;
+  else
+    static_assert(sizeof(S) == 0, "unsupported field scalar type");
 }
 
 /// A view of one field for writing: n particles × (rows × cols) scalars, contiguous.
@@ -48,13 +53,12 @@ struct FieldView {
 };
 
 class SnapshotWriter {
-public:
+ public:
   /// Create (truncate) `h5_path` and its XDMF companion (same name, .xmf). IoError when it cannot.
   /// \param model     "sph-slope", "debris-runout", "dem-avalanche".
   /// \param dimension 2 or 3 (geometry of the "position" field).
   /// \param resolved_config TOML text stored as an attribute.
-  SnapshotWriter(const std::filesystem::path& h5_path, std::string model, int dimension,
-                 std::string resolved_config);
+  SnapshotWriter(const std::filesystem::path& h5_path, std::string model, int dimension, std::string resolved_config);
   ~SnapshotWriter();
   SnapshotWriter(const SnapshotWriter&) = delete;
   SnapshotWriter& operator=(const SnapshotWriter&) = delete;
@@ -78,8 +82,8 @@ public:
     store.for_each_field([&](auto tag, const auto& v) {
       using Tag = decltype(tag);
       using Tr = FieldTraits<typename Tag::type>;
-      views.push_back({Tag::label, Tag::unit, scalar_type_of<typename Tr::scalar>(), v.data(), v.size(), Tr::rows,
-                       Tr::cols});
+      views.push_back(
+          {Tag::label, Tag::unit, scalar_type_of<typename Tr::scalar>(), v.data(), v.size(), Tr::rows, Tr::cols});
     });
     write(time, step, views, lines);
   }
@@ -88,7 +92,7 @@ public:
   const std::filesystem::path& path() const noexcept;
   const std::filesystem::path& xdmf_path() const noexcept;
 
-private:
+ private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
@@ -104,7 +108,7 @@ struct FieldData {
 };
 
 class SnapshotReader {
-public:
+ public:
   /// Open a file written by SnapshotWriter; InputError if it is missing or not a geohaz snapshot file.
   explicit SnapshotReader(const std::filesystem::path& h5_path);
   ~SnapshotReader();
@@ -125,7 +129,7 @@ public:
   std::string model() const { return attribute("model"); }
   int dimension() const;
 
-private:
+ private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
