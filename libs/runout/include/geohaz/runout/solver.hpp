@@ -298,7 +298,7 @@ class RunoutSolver {
     const bool periodic = periodic_.any();
     const auto pass = [&](auto periodic_tag) {
       constexpr bool kPeriodic = decltype(periodic_tag)::value;
-#pragma omp parallel for schedule(static) if (static_cast<std::int64_t>(n) >= kParallelMin)
+#pragma omp parallel for schedule(static) if (static_cast <std::int64_t>(n) >= kParallelMin)
       for (std::int64_t bb = 0; bb < nblocks; ++bb) {
         const auto b = static_cast<std::size_t>(bb);
         PairSums* mine = blocks.buffer(reactions_.data(), b);  // mine[s]: the reactions to slot s
@@ -359,7 +359,7 @@ class RunoutSolver {
     // Every particle: its own sums, then the reactions of the blocks that reach it, in block order.
     const PairSums* all = reactions_.data();
     double signal = 0.0;
-#pragma omp parallel for reduction(max : signal) schedule(static) if (static_cast<std::int64_t>(n) >= kParallelMin)
+#pragma omp parallel for reduction(max : signal) schedule(static) if (static_cast <std::int64_t>(n) >= kParallelMin)
     for (std::int64_t bb = 0; bb < nblocks; ++bb) {
       const auto b = static_cast<std::size_t>(bb);
       const std::size_t c0 = blocks.first_block_reaching(b);
@@ -837,8 +837,8 @@ class RunoutSolver {
   RunoutParameters p_;
   Periodicity<2> periodic_;
   RunoutStore store_;
-  NeighbourList<2> list_;  // with a skin (numerics.skin > 0)
-  CellPairScan<2> scan_;   // without (the default)
+  NeighbourList<2> list_;            // with a skin (numerics.skin > 0)
+  CellPairScan<2> scan_;             // without (the default)
   std::vector<PairSums> own_;        // half_pair_terms: each slot's own sums
   std::vector<PairSums> reactions_;  // half_pair_terms: the blocks' reaction buffers
   VolumeBudget budget_;

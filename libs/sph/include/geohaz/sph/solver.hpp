@@ -227,7 +227,7 @@ class SphSolver {
   template <class Kernel, bool Corrected>
   void momentum();  // 4
   template <class Kernel, bool Corrected>
-  void structure_forces();  // 4b (tracked structures only)
+  void structure_forces();               // 4b (tracked structures only)
   void integrate(const Vec<Dim>& gbar);  // 5
   void check_state() const;              // 6
   void update_dt();                      // 6
