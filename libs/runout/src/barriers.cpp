@@ -17,7 +17,9 @@ namespace geohaz::runout {
 
 namespace {
 
-double cross(const Vec2& a, const Vec2& b) noexcept { return a.x() * b.y() - a.y() * b.x(); }
+double cross(const Vec2& a, const Vec2& b) noexcept {
+  return a.x() * b.y() - a.y() * b.x();
+}
 
 std::string num(double v) {
   std::ostringstream o;
@@ -155,7 +157,8 @@ BarrierSet::BarrierSet(std::vector<Barrier> barriers, WallLaw law, double d0)
   hi_ = -lo_;
   for (const Barrier& b : barriers_) {
     std::vector<double> s{0.0};
-    for (std::size_t k = 1; k < b.vertices.size(); ++k) s.push_back(s.back() + (b.vertices[k] - b.vertices[k - 1]).norm());
+    for (std::size_t k = 1; k < b.vertices.size(); ++k)
+      s.push_back(s.back() + (b.vertices[k] - b.vertices[k - 1]).norm());
     for (const Vec2& v : b.vertices) {
       lo_ = lo_.cwiseMin(v);
       hi_ = hi_.cwiseMax(v);
@@ -186,8 +189,8 @@ bool BarrierSet::crossing(const Vec2& x0, const Vec2& x1, BarrierCrossing& c) co
       if (o0 == 0.0 || (o0 > 0.0 && o1 > 0.0) || (o0 < 0.0 && o1 < 0.0)) continue;
       const double den = cross(d, e);
       if (den == 0.0) continue;
-      const double t = cross(a - x0, e) / den;     // along the step
-      const double u = cross(a - x0, d) / den;     // along the segment
+      const double t = cross(a - x0, e) / den;  // along the step
+      const double u = cross(a - x0, d) / den;  // along the segment
       if (u < -1e-12 || u > 1.0 + 1e-12 || t < 0.0 || t > 1.0 || t >= best) continue;
       best = t;
       c.barrier = static_cast<int>(b);
@@ -233,7 +236,8 @@ bool BarrierSet::passes(std::int64_t id, std::size_t b) const noexcept {
   const double p = barriers_[b].permeability;
   if (!(p > 0.0)) return false;
   // splitmix64 of (id, b): a uniform number in [0, 1) per particle and barrier.
-  std::uint64_t z = static_cast<std::uint64_t>(id) * 0x9E3779B97F4A7C15ull + (static_cast<std::uint64_t>(b) + 1) * 0xD1B54A32D192ED03ull;
+  std::uint64_t z = static_cast<std::uint64_t>(id) * 0x9E3779B97F4A7C15ull +
+                    (static_cast<std::uint64_t>(b) + 1) * 0xD1B54A32D192ED03ull;
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
   z ^= z >> 31;
@@ -298,8 +302,8 @@ std::vector<Barrier> load_barriers(const BarrierSpec& s, const Raster& dsm, cons
           msg << std::fixed;
           msg.precision(1);
           msg << feature << ": the barrier line leaves the DSM (or crosses nodata) at (" << p.x() << ", " << p.y()
-              << "); the DSM extent is " << g.x0 << " … " << g.x0 + g.nx * g.dx << " × " << g.y0 - g.ny * g.dy
-              << " … " << g.y0 << " (check the CRS of both files)";
+              << "); the DSM extent is " << g.x0 << " … " << g.x0 + g.nx * g.dx << " × " << g.y0 - g.ny * g.dy << " … "
+              << g.y0 << " (check the CRS of both files)";
           std::ostringstream val;
           val << std::fixed;
           val.precision(1);

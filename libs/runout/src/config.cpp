@@ -128,12 +128,14 @@ void read_processes(ConfigReader& cfg, RunoutCase& c) {
 
 /// Barriers across the flow (docs/runout.md, "Barriers").
 void read_barriers(ConfigReader& cfg, BarrierSpec& b) {
-  b.file = resolve(cfg, cfg.get_string("barriers.file", "",
-                                       {"", "barrier lines (Shapefile/GeoJSON/GPKG): check dams, walls, slit or net barriers"}));
+  b.file = resolve(
+      cfg, cfg.get_string("barriers.file", "",
+                          {"", "barrier lines (Shapefile/GeoJSON/GPKG): check dams, walls, slit or net barriers"}));
   b.height_attribute = cfg.get_string("barriers.height_attribute", b.height_attribute,
                                       {"", "line attribute holding the crest height above the terrain (m)"});
-  b.height = cfg.get("barriers.height", b.height, Range::closed(0.0, 100.0),
-                     {"m", "crest height above the terrain where the attribute is absent or null; 0: attribute required"});
+  b.height =
+      cfg.get("barriers.height", b.height, Range::closed(0.0, 100.0),
+              {"m", "crest height above the terrain where the attribute is absent or null; 0: attribute required"});
   b.permeability_attribute =
       cfg.get_string("barriers.permeability_attribute", b.permeability_attribute,
                      {"", "line attribute holding the open fraction of a slit or net barrier (1)"});

@@ -36,40 +36,40 @@ namespace geohaz::runout {
 
 /// One barrier as given (map coordinates of the DSM's CRS, SI units).
 struct Barrier {
-  std::string name;               ///< "barrier_<feature>" (file feature id) or set by the caller
-  std::int64_t feature = -1;      ///< feature id in the file (messages)
-  std::vector<Vec2> vertices;     ///< the line, ≥ 2 vertices (m)
-  double height = 0.0;            ///< crest height above the terrain under the line (m)
-  double permeability = 0.0;      ///< fraction of the arriving particles that pass (1), [0, 1)
-  bool upstream_left = true;      ///< the flow comes from the left of the directed line a → b
+  std::string name;            ///< "barrier_<feature>" (file feature id) or set by the caller
+  std::int64_t feature = -1;   ///< feature id in the file (messages)
+  std::vector<Vec2> vertices;  ///< the line, ≥ 2 vertices (m)
+  double height = 0.0;         ///< crest height above the terrain under the line (m)
+  double permeability = 0.0;   ///< fraction of the arriving particles that pass (1), [0, 1)
+  bool upstream_left = true;   ///< the flow comes from the left of the directed line a → b
   double length() const noexcept;
 };
 
 /// How particles meet the walls (the same for every barrier of a run).
 struct WallLaw {
-  double restitution = 0.0;    ///< e: normal speed after the impact over before (1), [0, 1]
-  double friction = 0.0;       ///< μ_w: Coulomb friction along the wall on the normal impulse (1)
+  double restitution = 0.0;           ///< e: normal speed after the impact over before (1), [0, 1]
+  double friction = 0.0;              ///< μ_w: Coulomb friction along the wall on the normal impulse (1)
   double retention_distance = 100.0;  ///< retained = upstream volume at the end within this distance (m)
 };
 
 /// The nearest wall point of a particle within the kernel reach 2 d0 (not at a line's free end).
 struct WallProximity {
   int barrier = -1;
-  double distance = 0.0;       ///< m
-  Vec2 point = Vec2::Zero();   ///< nearest point on the line (m)
-  Vec2 away = Vec2::Zero();    ///< unit normal from the wall towards the particle
-  double arclength = 0.0;      ///< distance along the line from its first vertex (m)
+  double distance = 0.0;      ///< m
+  Vec2 point = Vec2::Zero();  ///< nearest point on the line (m)
+  Vec2 away = Vec2::Zero();   ///< unit normal from the wall towards the particle
+  double arclength = 0.0;     ///< distance along the line from its first vertex (m)
 };
 
 /// Where a particle's step first crosses a barrier.
 struct BarrierCrossing {
   int barrier = -1;
   std::size_t segment = 0;
-  double t = 0.0;            ///< fraction of the step x0 → x1 at the crossing
-  Vec2 point = Vec2::Zero();  ///< crossing point (m)
+  double t = 0.0;              ///< fraction of the step x0 → x1 at the crossing
+  Vec2 point = Vec2::Zero();   ///< crossing point (m)
   Vec2 normal = Vec2::Zero();  ///< unit normal of the segment pointing from x0's side to x1's side
-  double arclength = 0.0;    ///< distance along the barrier line from its first vertex (m)
-  bool from_upstream = true;  ///< x0 lies on the barrier's upstream side
+  double arclength = 0.0;      ///< distance along the barrier line from its first vertex (m)
+  bool from_upstream = true;   ///< x0 lies on the barrier's upstream side
 };
 
 /// The barriers of a run, prepared for the particle loop: segment list, bounding box, bins along
@@ -131,7 +131,7 @@ class BarrierSet {
   std::vector<Barrier> barriers_;
   WallLaw law_;
   std::vector<double> bin_length_;
-  std::vector<std::size_t> bin0_;  // size() + 1 entries
+  std::vector<std::size_t> bin0_;               // size() + 1 entries
   std::vector<std::vector<double>> arclength_;  // per barrier, at each vertex
   Vec2 lo_ = Vec2::Zero(), hi_ = Vec2::Zero();
   double reach_ = 0.0;  // 2 d0
@@ -140,11 +140,11 @@ class BarrierSet {
 /// What the walls have taken so far, per barrier (the solver adds to it in store order, so it is
 /// the same for any thread count).
 struct BarrierTally {
-  std::vector<double> impulse;          ///< Σ ρ V (1 + e) v_n since the start (N·s)
-  std::vector<double> passed;           ///< net volume crossed from the upstream side (m³)
-  std::vector<double> contacts;         ///< particles held, counted since the start
-  std::vector<double> window_depth;     ///< largest depth at the wall h_w (within d0) since the last window reset (m)
-  std::vector<std::uint8_t> touched;    ///< per bin: touched since the last window reset
+  std::vector<double> impulse;        ///< Σ ρ V (1 + e) v_n since the start (N·s)
+  std::vector<double> passed;         ///< net volume crossed from the upstream side (m³)
+  std::vector<double> contacts;       ///< particles held, counted since the start
+  std::vector<double> window_depth;   ///< largest depth at the wall h_w (within d0) since the last window reset (m)
+  std::vector<std::uint8_t> touched;  ///< per bin: touched since the last window reset
 };
 
 }  // namespace geohaz::runout

@@ -74,12 +74,12 @@ SpatialProcesses load_processes(const ProcessSpec& s, const RunoutParameters& p,
 
 /// Where the barriers come from (docs/runout.md, "Barriers"); empty file: none.
 struct BarrierSpec {
-  std::string file;                                  ///< lines (Shapefile, GeoJSON, GPKG, …)
-  std::string height_attribute = "height";           ///< attribute of the crest height above the terrain (m)
-  double height = 0.0;                               ///< crest height where the attribute is absent or null (m)
+  std::string file;                                     ///< lines (Shapefile, GeoJSON, GPKG, …)
+  std::string height_attribute = "height";              ///< attribute of the crest height above the terrain (m)
+  double height = 0.0;                                  ///< crest height where the attribute is absent or null (m)
   std::string permeability_attribute = "permeability";  ///< attribute of the open fraction (1)
-  double permeability = 0.0;                         ///< open fraction where the attribute is absent or null (1)
-  WallLaw law;                                       ///< restitution, wall friction, retention distance
+  double permeability = 0.0;                            ///< open fraction where the attribute is absent or null (1)
+  WallLaw law;                                          ///< restitution, wall friction, retention distance
 };
 
 /// Read the barrier lines of `s` in the DSM's CRS and check them (InputError naming the file, the
@@ -104,12 +104,12 @@ struct BarrierRow {
 struct BarrierResult {
   std::string name;
   double height = 0.0, permeability = 0.0, length = 0.0;  ///< m, 1, m
-  double peak_force = 0.0;        ///< N
-  double peak_force_per_m = 0.0;  ///< N/m
-  double peak_pressure = 0.0;     ///< Pa
-  double retained = 0.0;          ///< volume on the upstream side within the retention distance (m³)
-  double overtopped = 0.0;        ///< net volume that crossed (m³)
-  double impulse = 0.0;           ///< total normal impulse (N·s)
+  double peak_force = 0.0;                                ///< N
+  double peak_force_per_m = 0.0;                          ///< N/m
+  double peak_pressure = 0.0;                             ///< Pa
+  double retained = 0.0;    ///< volume on the upstream side within the retention distance (m³)
+  double overtopped = 0.0;  ///< net volume that crossed (m³)
+  double impulse = 0.0;     ///< total normal impulse (N·s)
 };
 
 /// What to write besides the maps and the summary.

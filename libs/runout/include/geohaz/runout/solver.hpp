@@ -852,15 +852,15 @@ class RunoutSolver {
   std::vector<double> emitted_;           // per inflow (m³)
   BarrierSet barriers_;
   BarrierTally tally_;
-  std::vector<int> wall_barrier_;          // per particle, this step: the barrier met (−1: none)
-  std::vector<std::size_t> wall_bin_;      // its bin
-  std::vector<double> wall_value_;         // V (1+e) v_n when held; ± V when crossing
-  std::vector<double> wall_depth_;         // depth at the wall h_w (m)
-  std::vector<std::uint8_t> wall_cross_;   // 1 when it crossed
-  std::vector<int> push_barrier_;          // per particle, this step: the barrier pushing it (−1: none)
-  std::vector<double> push_value_;         // its impulse per unit density (m⁴/s)
-  std::vector<std::size_t> push_bin_;      // the bin of the nearest wall point
-  std::vector<double> push_depth_;         // h_w within d0 of the wall (m), else 0
+  std::vector<int> wall_barrier_;         // per particle, this step: the barrier met (−1: none)
+  std::vector<std::size_t> wall_bin_;     // its bin
+  std::vector<double> wall_value_;        // V (1+e) v_n when held; ± V when crossing
+  std::vector<double> wall_depth_;        // depth at the wall h_w (m)
+  std::vector<std::uint8_t> wall_cross_;  // 1 when it crossed
+  std::vector<int> push_barrier_;         // per particle, this step: the barrier pushing it (−1: none)
+  std::vector<double> push_value_;        // its impulse per unit density (m⁴/s)
+  std::vector<std::size_t> push_bin_;     // the bin of the nearest wall point
+  std::vector<double> push_depth_;        // h_w within d0 of the wall (m), else 0
   std::vector<std::int64_t> slot_;        // per inflow: particles emitted
   std::int64_t next_id_ = 0;
   bool list_valid_ = false;
