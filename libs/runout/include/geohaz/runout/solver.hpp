@@ -585,6 +585,7 @@ class RunoutSolver {
       // d. Barriers: held at the wall unless the flow surface is above the crest or the particle
       //    passes an open barrier.
       BarrierCrossing hit;
+      bool held = false;
       if (walls && barriers_.first_crossing(x[i], x_new, hit)) {
         any_wall = 1;
         const auto b = static_cast<std::size_t>(hit.barrier);
@@ -619,9 +620,10 @@ class RunoutSolver {
           if (barriers_.first_crossing(xc, x_new, again)) x_new = xc;  // a corner: the next step resolves it
           const double vzn = gz.dot(v_new);
           s = std::sqrt(v_new.squaredNorm() + vzn * vzn);
+          held = true;
         }
       }
-      const double moved = (x_new - x[i]).norm();
+      const double moved = held ? (x_new - x[i]).norm() : dt * v_new.norm();
       if (periodic) x_new = periodic_.wrap(x_new);
       SurfaceSample smp;
       if (!surface_.sample(x_new, smp)) {
