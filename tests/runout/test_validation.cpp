@@ -361,7 +361,8 @@ TEST(RunoutValidation, AlpineTerrainVoellmyAgainstCom1DFA) {
     EXPECT_NEAR(m.area_ha / kCom1dfaAreaHa, 1.0, 0.30) << "d0 " << d0;
     EXPECT_NEAR(vmax / kCom1dfaPeakSpeed, 1.0, 0.30) << "d0 " << d0;
     if (d0 == 5.0) {
-      fs::copy_file(out / "max_depth.png", figures() / "alr_voellmy_max_depth.png", fs::copy_options::overwrite_existing);
+      fs::copy_file(out / "max_depth.png", figures() / "alr_voellmy_max_depth.png",
+                    fs::copy_options::overwrite_existing);
     }
   }
 }
