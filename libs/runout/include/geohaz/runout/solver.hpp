@@ -21,7 +21,9 @@
 ///  4. per particle:
 ///     a. lateral mixing (an artificial viscosity, Sampl & Zwinger 2004 as in AvaFrame com1DFA),
 ///        implicit: v ← (v + kΔt ṽ)/(1 + kΔt), k = C_mix |ṽ − v|_s √(h_n/V);
-///     b. driving acceleration along the bed: a = −g cos²θ p + P F_i;
+///     b. driving acceleration along the bed: a = −g cos²θ p + P F_i; within 2 d0 of a barrier
+///        whose crest is above the flow surface, plus the push of the mirror layer the wall stands
+///        for, P C g cos θ h_w M(s/d0)/d0 away from it (barriers.hpp), which the wall takes;
 ///     c. basal friction applied implicitly on the surface speed S = |(v, p·v)| with the bed-normal
 ///        stress of g_n = cos θ (g + vᵀHv)⁺ (gravity plus the centripetal acceleration of the bed
 ///        curvature along the velocity, H the Hessian of z; zero when the particle would leave the
