@@ -272,7 +272,8 @@ std::vector<Barrier> load_barriers(const BarrierSpec& s, const Raster& dsm, cons
     if ((k > 0 && lines[k - 1].feature == l.feature) || (k + 1 < lines.size() && lines[k + 1].feature == l.feature)) {
       std::size_t part = 0;
       for (std::size_t m = 0; m < k; ++m) part += lines[m].feature == l.feature ? 1 : 0;
-      b.name += "_" + std::to_string(part);
+      b.name += '_';
+      b.name += std::to_string(part);
     }
     b.vertices = l.vertices;
     b.height = std::isfinite(l.attribute) ? l.attribute : s.height;
