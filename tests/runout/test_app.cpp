@@ -536,3 +536,100 @@ TEST(DebrisRunoutApp, ErodibleRasterOnAnotherGridIsResampled) {
         EXPECT_EQ(ero.at(c, rr), 0.0) << c << ", " << rr;
       }
 }
+
+namespace {
+
+/// A GeoJSON layer (EPSG:32654) of features of one geometry type (`type`: "LineString", "Point",
+/// …) with the given coordinates JSON and properties each.
+void write_features(const fs::path& path, const std::string& type,
+                    const std::vector<std::pair<std::string, std::string>>& features) {
+  std::ofstream f(path);
+  f << R"({"type":"FeatureCollection","crs":{"type":"name","properties":{"name":"urn:ogc:def:crs:EPSG::32654"}},)"
+    << R"("features":[)";
+  for (std::size_t k = 0; k < features.size(); ++k)
+    f << (k ? "," : "") << R"({"type":"Feature","properties":{)" << features[k].second << R"(},"geometry":{"type":")"
+      << type << R"(","coordinates":)" << features[k].first << "}}";
+  f << "]}";
+}
+
+}  // namespace
+
+// A 2 m check dam across the tiny valley's channel: the run writes its force series and the
+// barriers block of summary.json; the retained and overtopped volumes do not exceed the release, and
+// the flow's volume budget still closes.
+TEST(DebrisRunoutApp, BarrierAcrossTheChannelWritesItsForceSeries) {
+  const fs::path dsm = tiny_dsm(), d = work_dir();
+  write_features(d / "dam.geojson", "LineString", {{"[[480250,4309800],[480250,4309950]]", R"("height":2)"}});
+  const fs::path out = d / "barrier_out";
+  fs::remove_all(out);
+  const auto r = run(dsm.string() + " --release " + (d / "tiny_release.tif").string() +
+                     " --d0 2.5 --h0 0.75 --duration 60 --out " + out.string() + " --quiet --threads 1" +
+                     " --set barriers.file=" + (d / "dam.geojson").string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_TRUE(fs::exists(out / "barriers" / "barrier_0.csv"));
+  std::ifstream csv(out / "barriers" / "barrier_0.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_EQ(header.rfind("time_s,force_N,force_per_m_N_m,", 0), 0u) << header;
+  std::ifstream in(out / "summary.json");
+  const auto j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["barriers"].size(), 1u);
+  const auto& b = j["barriers"][0];
+  EXPECT_EQ(b["name"], "barrier_0");
+  EXPECT_DOUBLE_EQ(b["crest_height_m"].get<double>(), 2.0);
+  EXPECT_NEAR(b["length_m"].get<double>(), 150.0, 1e-9);
+  EXPECT_EQ(b["vertices_xy_m"].size(), 2u);
+  const double read = j["volumes_m3"]["release_read"];
+  const double retained = b["retained_volume_m3"], over = b["overtopped_volume_m3"];
+  EXPECT_GT(b["peak_force_n"].get<double>(), 0.0);  // the flow reached it
+  EXPECT_GT(retained, 0.0);
+  EXPECT_LE(retained + over, read * (1.0 + 1e-9));
+  const auto& v = j["volumes_m3"];
+  EXPECT_NEAR(v["deposited"].get<double>() + v["mobile"].get<double>() + v["lost"].get<double>(), read, 1e-9 * read);
+}
+
+// A barrier line leaving the DSM, a negative or missing crest height, a permeability of 1, a file of
+// points or of polygons: exit 2 naming the file, the feature and the value; nothing written.
+TEST(DebrisRunoutApp, BadBarrierInputsExitTwoAndWriteNothing) {
+  const fs::path dsm = tiny_dsm(), d = work_dir();
+  const std::string rel = " --release " + (d / "tiny_release.tif").string();
+  write_features(d / "dam_outside.geojson", "LineString", {{"[[480250,4309800],[480250,4319950]]", R"("height":2)"}});
+  write_features(d / "dam_negative.geojson", "LineString",
+                 {{"[[480250,4309800],[480250,4309950]]", R"("height":2)"},
+                  {"[[480300,4309800],[480300,4309950]]", R"("height":-1)"}});
+  write_features(d / "dam_noheight.geojson", "LineString", {{"[[480250,4309800],[480250,4309950]]", R"("name":"a")"}});
+  write_features(d / "dam_open.geojson", "LineString",
+                 {{"[[480250,4309800],[480250,4309950]]", R"("height":2,"permeability":1)"}});
+  write_features(d / "dam_points.geojson", "Point", {{"[480250,4309800]", R"("height":2)"}});
+  write_boxes(d / "dam_polygons.geojson", {{{480250, 480260, 4309800, 4309950}, R"("height":2)"}});
+  struct Case {
+    std::string file;
+    std::vector<std::string> expect;
+  };
+  const std::vector<Case> cases = {
+      {"dam_outside.geojson", {"feature 0", "leaves the DSM", "480250.0, 4"}},
+      {"dam_negative.geojson", {"feature 1", "(0, 100]", "-1"}},
+      {"dam_noheight.geojson", {"barriers.height"}},
+      {"dam_open.geojson", {"feature 0", "[0, 1)", "permeability"}},
+      {"dam_points.geojson", {"feature 0", "Point", "not a line"}},
+      {"dam_polygons.geojson", {"feature 0", "Polygon", "not a line"}},
+  };
+  const fs::path out = d / "bad_barrier_out";
+  for (const auto& c : cases) {
+    fs::remove_all(out);
+    const auto r = run(dsm.string() + rel + " --set barriers.file=" + (d / c.file).string() + " --out " + out.string() +
+                       " --quiet");
+    EXPECT_EQ(r.code, 2) << c.file << "\n" << r.output;
+    for (const auto& e : c.expect)
+      EXPECT_NE(r.output.find(e), std::string::npos) << c.file << ": " << e << "\n" << r.output;
+    EXPECT_NE(r.output.find(c.file), std::string::npos) << r.output;
+    EXPECT_FALSE(dir_has_files(out)) << c.file;
+  }
+  // A negative default height is refused by the config's range.
+  fs::remove_all(out);
+  const auto r = run(dsm.string() + rel + " --set barriers.file=" + (d / "dam_noheight.geojson").string() +
+                     " --set barriers.height=-2 --out " + out.string() + " --quiet");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("barriers.height"), std::string::npos) << r.output;
+  EXPECT_FALSE(dir_has_files(out));
+}

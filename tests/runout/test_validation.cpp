@@ -85,7 +85,61 @@ void plot_front(const fs::path& csv, const fs::path& png, double seed_t, double 
   write_png(png, img);
 }
 
+/// Force per metre (blue, left axis 0–fmax) and overtopped volume (red, right axis 0–vmax) against
+/// time from a barrier's CSV (docs/runout.md, "Barriers").
+void plot_barrier(const fs::path& csv, const fs::path& png) {
+  std::vector<std::string> h;
+  const auto rows = read_series(csv, h);
+  const auto col = [&](const char* name) { return std::find(h.begin(), h.end(), name) - h.begin(); };
+  const auto ct = col("time_s"), cf = col("force_per_m_N_m"), cv = col("overtopped_volume_m3");
+  double tmax = 0.0, fmax = 0.0, vmax = 0.0;
+  for (const auto& r : rows) {
+    tmax = std::max(tmax, r[ct]);
+    fmax = std::max(fmax, r[cf]);
+    vmax = std::max(vmax, r[cv]);
+  }
+  fmax = std::max(fmax * 1.1, 1.0);
+  vmax = std::max(vmax * 1.1, 1.0);
+  const int W = 640, H = 400, m = 50;
+  Image img(W, H);
+  const auto px = [&](double t) { return m + (W - 2 * m) * t / tmax; };
+  const auto py = [&](double f, double top) { return H - m - (H - 2 * m) * f / top; };
+  img.line(px(0), py(0, 1), px(tmax), py(0, 1), {0, 0, 0});
+  img.line(px(0), py(0, 1), px(0), py(1, 1), {0, 0, 0});
+  img.line(px(tmax), py(0, 1), px(tmax), py(1, 1), {0, 0, 0});
+  for (double t = 0; t <= tmax; t += 30) img.line(px(t), py(0, 1), px(t), py(0, 1) + 5, {0, 0, 0});
+  for (std::size_t k = 1; k < rows.size(); ++k) {
+    img.line(px(rows[k - 1][ct]), py(rows[k - 1][cf], fmax), px(rows[k][ct]), py(rows[k][cf], fmax), {30, 90, 200});
+    img.line(px(rows[k - 1][ct]), py(rows[k - 1][cv], vmax), px(rows[k][ct]), py(rows[k][cv], vmax), {220, 40, 40});
+  }
+  write_png(png, img);
+}
+
 }  // namespace
+
+// The check dam of data/runout/alr_check_dam.toml (docs/runout.md, "Barriers"): the force history
+// figure and the volumes: retained + overtopped within the release.
+TEST(RunoutValidation, AlplehnerCheckDam) {
+  const fs::path cfg = fs::path(GEOHAZ_SOURCE_DIR) / "data" / "runout" / "alr_check_dam.toml";
+  if (!fs::exists(fs::path(GEOHAZ_SOURCE_DIR) / "data" / "terrain" / "alr" / "avaAlr.tif"))
+    GTEST_SKIP() << "data/terrain/alr not present";
+  const fs::path out = work_dir() / "alr_dam_out";
+  fs::remove_all(out);
+  ASSERT_EQ(run("--config " + cfg.string() + " --out " + out.string()), 0);
+  std::ifstream in(out / "summary.json");
+  const auto j = nlohmann::json::parse(in);
+  const auto& b = j["barriers"][0];
+  const double read = j["volumes_m3"]["release_read"];
+  std::printf(
+      "VALIDATION alr check dam: retained %.0f m^3, overtopped %.0f m^3 of %.0f m^3; peak force %.3g N, %.3g N/m, "
+      "peak pressure %.3g Pa; run-out %.0f m\n",
+      b["retained_volume_m3"].get<double>(), b["overtopped_volume_m3"].get<double>(), read,
+      b["peak_force_n"].get<double>(), b["peak_force_per_m_n_m"].get<double>(), b["peak_pressure_pa"].get<double>(),
+      j["runout_length_along_path_m"].get<double>());
+  EXPECT_LE(b["retained_volume_m3"].get<double>() + b["overtopped_volume_m3"].get<double>(), read * (1.0 + 1e-9));
+  EXPECT_GT(b["retained_volume_m3"].get<double>(), 0.0);
+  plot_barrier(out / "barriers" / (b["name"].get<std::string>() + ".csv"), figures() / "alr_check_dam_force.png");
+}
 
 TEST(RunoutValidation, SeedScenarioFiveKilometreValley) {
   const fs::path dsm = work_dir() / "valley.tif";

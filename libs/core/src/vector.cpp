@@ -125,9 +125,10 @@ struct VectorLayer {
   }
 };
 
-void add_line(const OGRLineString* line, double attribute, std::vector<Polyline>& out) {
+void add_line(const OGRLineString* line, double attribute, std::int64_t feature, std::vector<Polyline>& out) {
   if (!line || line->getNumPoints() < 2) return;
   Polyline p;
+  p.feature = feature;
   for (int i = 0; i < line->getNumPoints(); ++i) p.vertices.emplace_back(line->getX(i), line->getY(i));
   p.attribute = attribute;
   out.push_back(std::move(p));
@@ -212,9 +213,9 @@ std::vector<Polyline> read_lines(const std::filesystem::path& path, const std::s
                        file);
     const double value = v.value(*feature);
     if (type == wkbLineString) {
-      add_line(g->toLineString(), value, out);
+      add_line(g->toLineString(), value, feature->GetFID(), out);
     } else {
-      for (const OGRLineString* part : *g->toMultiLineString()) add_line(part, value, out);
+      for (const OGRLineString* part : *g->toMultiLineString()) add_line(part, value, feature->GetFID(), out);
     }
   }
   if (out.empty()) throw InputError("no line in the first layer ('" + std::string(v.layer->GetName()) + "')", file);

@@ -126,6 +126,30 @@ void read_processes(ConfigReader& cfg, RunoutCase& c) {
                      "inflow.points");
 }
 
+/// Barriers across the flow (docs/runout.md, "Barriers").
+void read_barriers(ConfigReader& cfg, BarrierSpec& b) {
+  b.file = resolve(
+      cfg, cfg.get_string("barriers.file", "",
+                          {"", "barrier lines (Shapefile/GeoJSON/GPKG): check dams, walls, slit or net barriers"}));
+  b.height_attribute = cfg.get_string("barriers.height_attribute", b.height_attribute,
+                                      {"", "line attribute holding the crest height above the terrain (m)"});
+  b.height =
+      cfg.get("barriers.height", b.height, Range::closed(0.0, 100.0),
+              {"m", "crest height above the terrain where the attribute is absent or null; 0: attribute required"});
+  b.permeability_attribute =
+      cfg.get_string("barriers.permeability_attribute", b.permeability_attribute,
+                     {"", "line attribute holding the open fraction of a slit or net barrier (1)"});
+  b.permeability = cfg.get("barriers.permeability", b.permeability, Range::closed_open(0.0, 1.0),
+                           {"1", "fraction of the arriving particles an open barrier lets through; 0: closed wall"});
+  b.law.restitution = cfg.get("barriers.restitution", b.law.restitution, Range::closed(0.0, 1.0),
+                              {"1", "restitution e: normal speed after hitting the wall over before (0: stopped)"});
+  b.law.friction = cfg.get("barriers.wall_friction", b.law.friction, Range::closed(0.0, 2.0),
+                           {"1", "Coulomb friction μ_w along the wall on the normal impulse"});
+  b.law.retention_distance =
+      cfg.get("barriers.retention_distance", b.law.retention_distance, Range::open_closed(0.0, 1e5),
+              {"m", "retained volume = volume upstream of the line within this distance at the end"});
+}
+
 }  // namespace
 
 RunoutCase read_case(ConfigReader& cfg) {
@@ -182,6 +206,7 @@ RunoutCase read_case(ConfigReader& cfg) {
   p.pressure_scale = norm == "seed" ? 1.0 : HeadPressureForce::consistent_normalisation();
 
   read_processes(cfg, c);
+  read_barriers(cfg, c.barriers);
 
   auto& o = c.output;
   o.series_interval = cfg.get("output.series_interval", o.series_interval, Range::open_closed(0.0, 1e6),

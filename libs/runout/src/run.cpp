@@ -273,6 +273,36 @@ const char* to_string(RunEnd e) noexcept {
   return "?";
 }
 
+namespace {
+
+/// Where the flow comes from, for the upstream side of the barriers: the volume-weighted centre of
+/// the release, or the first inflow's line.
+Vec2 flow_source(const RunoutInputs& in) {
+  const GridGeometry& g = in.grid();
+  double w = 0.0;
+  Vec2 c = Vec2::Zero();
+  for (int r = 0; r < g.ny; ++r)
+    for (int col = 0; col < g.nx; ++col) {
+      const double t = in.thickness.empty() ? 0.0 : in.thickness[g.index(col, r)];
+      if (t > 0.0) {
+        c += t * g.centre(col, r);
+        w += t;
+      }
+    }
+  if (w > 0.0) return c / w;
+  if (!in.processes.inflows.empty()) return 0.5 * (in.processes.inflows.front().a + in.processes.inflows.front().b);
+  return c;
+}
+
+void load_barriers_into(const RunoutCase& c, RunoutInputs& in) {
+  if (c.barriers.file.empty()) return;
+  in.barriers = load_barriers(c.barriers, in.dsm, in.surface, flow_source(in));
+  in.wall_law = c.barriers.law;
+  in.barrier_source = c.barriers.file;
+}
+
+}  // namespace
+
 RunoutInputs load_inputs(const RunoutCase& c) {
   if (c.dsm.empty()) throw InputError("no DSM given (positional argument or terrain.dsm)", "command line");
   if (!c.release.file.empty() && !c.release.handoff.empty())
@@ -294,9 +324,11 @@ RunoutInputs load_inputs(const RunoutCase& c) {
     in.volume = 0.0;
     in.source = c.processes.hydrograph;
     in.description = "inflow hydrograph " + c.processes.hydrograph;
+    load_barriers_into(c, in);
     return in;
   }
   read_release(c.release, in.dsm, in);
+  load_barriers_into(c, in);
   return in;
 }
 
@@ -324,6 +356,9 @@ RunoutSimulation::RunoutSimulation(const RunoutInputs& in, RunoutParameters para
                        in.source);
   }
   solver_.set_processes(in.processes);
+  if (!in.barriers.empty()) solver_.set_barriers(BarrierSet(in.barriers, in.wall_law, p.d0));
+  barrier_series_.assign(in.barriers.size(), std::vector<BarrierRow>(1));
+  last_impulse_.assign(in.barriers.size(), 0.0);
   solver_.initialise();
   const double rel_err = in.volume > 0.0 ? std::abs(seeded_.volume_seeded - in.volume) / in.volume : 0.0;
   if (rel_err > 1e-9)
@@ -352,12 +387,65 @@ void RunoutSimulation::run(RunObserver* observer) {
     const bool last = solver_.finished();
     if (solver_.time() >= next_series_ - 1e-9 || last) {
       series_.push_back(series_row(store, solver_.budget(), solver_.time(), solver_.step_count()));
+      record_barrier_rows();
       while (next_series_ <= solver_.time() + 1e-9) next_series_ += output_.series_interval;
     }
     if (observer) observer->stepped(*this);
   }
   if (observer) observer->finished(*this);
   wall_time_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+}
+
+void RunoutSimulation::record_barrier_rows() {
+  if (barrier_series_.empty()) return;
+  const BarrierSet& set = solver_.barriers();
+  const BarrierTally& t = solver_.barrier_tally();
+  const double now = solver_.time(), span = now - last_row_time_;
+  for (std::size_t b = 0; b < set.size(); ++b) {
+    BarrierRow r;
+    r.time = now;
+    r.force = span > 0.0 ? (t.impulse[b] - last_impulse_[b]) / span : 0.0;
+    std::size_t wet = 0;
+    for (std::size_t k = set.first_bin(b); k < set.first_bin(b + 1); ++k) wet += t.touched[k];
+    r.wetted_length = static_cast<double>(wet) * set.bin_length(b);
+    r.force_per_m = r.wetted_length > 0.0 ? r.force / r.wetted_length : 0.0;
+    r.depth = t.window_depth[b];
+    r.pressure = r.depth > 0.0 ? r.force_per_m / r.depth : 0.0;
+    r.passed = t.passed[b];
+    barrier_series_[b].push_back(r);
+    last_impulse_[b] = t.impulse[b];
+  }
+  last_row_time_ = now;
+  solver_.reset_barrier_window();
+}
+
+std::vector<BarrierResult> RunoutSimulation::barrier_results() const {
+  std::vector<BarrierResult> out;
+  const BarrierSet& set = solver_.barriers();
+  const auto& store = solver_.particles();
+  const auto& x = store.get<Position<2>>();
+  const auto& vol = store.get<Volume>();
+  for (std::size_t b = 0; b < set.size(); ++b) {
+    BarrierResult r;
+    const Barrier& bar = set[b];
+    r.name = bar.name;
+    r.height = bar.height;
+    r.permeability = bar.permeability;
+    r.length = bar.length();
+    for (const BarrierRow& row : barrier_series_[b]) {
+      r.peak_force = std::max(r.peak_force, row.force);
+      r.peak_force_per_m = std::max(r.peak_force_per_m, row.force_per_m);
+      r.peak_pressure = std::max(r.peak_pressure, row.pressure);
+    }
+    for (std::size_t i = 0; i < store.size(); ++i) {
+      bool up = false;
+      if (set.distance(b, x[i], up) <= set.law().retention_distance && up) r.retained += vol[i];
+    }
+    r.overtopped = solver_.barrier_tally().passed[b];
+    r.impulse = solver_.barrier_tally().impulse[b];
+    out.push_back(r);
+  }
+  return out;
 }
 
 std::vector<double> RunoutSimulation::deposit() const {
@@ -504,6 +592,33 @@ std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int t
                     {"speed_m_s", q.speed},      {"direction_xy", {q.direction.x(), q.direction.y()}}};
   }
   j["processes"] = jp;
+  // Barriers: the figures of each and its line in map coordinates (the maps draw them).
+  nlohmann::json jb = nlohmann::json::array();
+  const std::vector<BarrierResult> bres = sim.barrier_results();
+  for (std::size_t b = 0; b < bres.size(); ++b) {
+    const BarrierResult& r = bres[b];
+    nlohmann::json verts = nlohmann::json::array();
+    for (const Vec2& v : sim.inputs().barriers[b].vertices) verts.push_back({v.x(), v.y()});
+    jb.push_back({{"name", r.name},
+                  {"file", sim.inputs().barrier_source},
+                  {"crest_height_m", r.height},
+                  {"permeability", r.permeability},
+                  {"length_m", r.length},
+                  {"peak_force_n", r.peak_force},
+                  {"peak_force_per_m_n_m", r.peak_force_per_m},
+                  {"peak_pressure_pa", r.peak_pressure},
+                  {"retained_volume_m3", r.retained},
+                  {"overtopped_volume_m3", r.overtopped},
+                  {"impulse_n_s", r.impulse},
+                  {"vertices_xy_m", verts},
+                  {"series", "barriers/" + r.name + ".csv"}});
+  }
+  j["barriers"] = jb;
+  if (!bres.empty())
+    j["barrier_law"] = {{"restitution", sim.inputs().wall_law.restitution},
+                        {"wall_friction", sim.inputs().wall_law.friction},
+                        {"retention_distance_m", sim.inputs().wall_law.retention_distance},
+                        {"force_window_s", c.output.series_interval}};
   return j.dump(2);
 }
 
@@ -618,6 +733,19 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
           << r.volumes.mobile << ',' << r.volumes.deposited << ',' << r.volumes.lost << ',' << r.volumes.balance_error()
           << ',' << r.volumes.entrained << ',' << r.volumes.injected << '\n';
     csv.commit();
+  }
+
+  if (!sim.barrier_series().empty()) {
+    fs::create_directories(out / "barriers");
+    for (std::size_t b = 0; b < sim.barrier_series().size(); ++b) {
+      AtomicTextFile csv(out / "barriers" / (sim.inputs().barriers[b].name + ".csv"));
+      csv << "time_s,force_N,force_per_m_N_m,wetted_length_m,depth_at_wall_m,pressure_Pa,overtopped_volume_m3\n";
+      csv.stream() << std::setprecision(10);
+      for (const BarrierRow& r : sim.barrier_series()[b])
+        csv << r.time << ',' << r.force << ',' << r.force_per_m << ',' << r.wetted_length << ',' << r.depth << ','
+            << r.pressure << ',' << r.passed << '\n';
+      csv.commit();
+    }
   }
 
   write_text_file(out / "summary.json", summary_json(c, sim, threads) + "\n");

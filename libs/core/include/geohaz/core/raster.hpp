@@ -119,6 +119,7 @@ std::vector<std::string> vector_field_names(const std::filesystem::path& path);
 struct Polyline {
   std::vector<Vec2> vertices;
   double attribute = std::numeric_limits<double>::quiet_NaN();
+  std::int64_t feature = -1;  ///< OGR feature id it came from (for messages; parts share it)
 };
 
 /// Read all lines (LineString, MultiLineString parts; curves linearised) of the first layer of an

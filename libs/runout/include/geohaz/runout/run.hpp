@@ -72,6 +72,46 @@ struct ProcessSpec {
 SpatialProcesses load_processes(const ProcessSpec& s, const RunoutParameters& p, const Raster& dsm,
                                 const GridSurface& surface);
 
+/// Where the barriers come from (docs/runout.md, "Barriers"); empty file: none.
+struct BarrierSpec {
+  std::string file;                                     ///< lines (Shapefile, GeoJSON, GPKG, …)
+  std::string height_attribute = "height";              ///< attribute of the crest height above the terrain (m)
+  double height = 0.0;                                  ///< crest height where the attribute is absent or null (m)
+  std::string permeability_attribute = "permeability";  ///< attribute of the open fraction (1)
+  double permeability = 0.0;                            ///< open fraction where the attribute is absent or null (1)
+  WallLaw law;                                          ///< restitution, wall friction, retention distance
+};
+
+/// Read the barrier lines of `s` in the DSM's CRS and check them (InputError naming the file, the
+/// feature and the value: a line leaving the DSM, a height outside (0, 100] m, a permeability
+/// outside [0, 1), a feature that is not a line). The side of each line holding `upstream_point`
+/// (the release) is its upstream side.
+std::vector<Barrier> load_barriers(const BarrierSpec& s, const Raster& dsm, const GridSurface& surface,
+                                   const Vec2& upstream_point);
+
+/// One row of a barrier's time series: the means over the window since the previous row.
+struct BarrierRow {
+  double time = 0.0;           ///< end of the window (s)
+  double force = 0.0;          ///< normal force, impulse taken over the window / its duration (N)
+  double wetted_length = 0.0;  ///< length of the bins touched in the window (m)
+  double force_per_m = 0.0;    ///< force / wetted length (N/m)
+  double depth = 0.0;          ///< largest depth at the wall h_w in the window (m)
+  double pressure = 0.0;       ///< force_per_m / depth (Pa)
+  double passed = 0.0;         ///< net volume crossed from the upstream side so far (m³)
+};
+
+/// The figures of one barrier at the end of a run.
+struct BarrierResult {
+  std::string name;
+  double height = 0.0, permeability = 0.0, length = 0.0;  ///< m, 1, m
+  double peak_force = 0.0;                                ///< N
+  double peak_force_per_m = 0.0;                          ///< N/m
+  double peak_pressure = 0.0;                             ///< Pa
+  double retained = 0.0;    ///< volume on the upstream side within the retention distance (m³)
+  double overtopped = 0.0;  ///< net volume that crossed (m³)
+  double impulse = 0.0;     ///< total normal impulse (N·s)
+};
+
 /// What to write besides the maps and the summary.
 struct OutputSettings {
   double series_interval = 1.0;     ///< s between rows of series.csv
@@ -86,6 +126,7 @@ struct RunoutCase {
   std::string dsm;  ///< terrain raster (projected CRS, metres)
   ReleaseSpec release;
   ProcessSpec processes;
+  BarrierSpec barriers;
   RunoutParameters params;
   OutputSettings output;
   std::string resolved_config;  ///< TOML text of the resolved configuration (written beside the outputs)
@@ -108,6 +149,10 @@ struct RunoutInputs {
   std::string source;             ///< the release file (for messages)
   bool from_handoff = false;      ///< the release came as points with volumes
   SpatialProcesses processes;     ///< friction zones, forest, erodible layer, inflows
+  /// Barrier lines in the DSM's CRS with their crest heights (the maps draw them) and the wall law.
+  std::vector<Barrier> barriers;
+  WallLaw wall_law;
+  std::string barrier_source;  ///< the barrier file ("" for none)
 
   const GridGeometry& grid() const noexcept { return surface.geometry(); }
 };
@@ -177,6 +222,10 @@ class RunoutSimulation {
   const OutputSettings& output() const noexcept { return output_; }
   const HazardMaps& maps() const noexcept { return maps_; }
   const std::vector<SeriesRow>& series() const noexcept { return series_; }
+  /// Per barrier, its time series (a row with every row of series()).
+  const std::vector<std::vector<BarrierRow>>& barrier_series() const noexcept { return barrier_series_; }
+  /// Per barrier, its figures now.
+  std::vector<BarrierResult> barrier_results() const;
   const SeedReport& seeded() const noexcept { return seeded_; }
   const RunoutInputs& inputs() const noexcept { return in_; }
   /// Final deposit thickness on the DSM grid (m, vertical). When the run ended at its duration with
@@ -198,6 +247,10 @@ class RunoutSimulation {
   HazardMaps maps_;
   ReleaseTop top_;
   std::vector<SeriesRow> series_;
+  std::vector<std::vector<BarrierRow>> barrier_series_;
+  std::vector<double> last_impulse_;
+  double last_row_time_ = 0.0;
+  void record_barrier_rows();
   double next_series_ = 0.0;
   double wall_time_ = 0.0;
 };

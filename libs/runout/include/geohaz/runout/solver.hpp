@@ -23,19 +23,26 @@
 ///  4. per particle:
 ///     a. lateral mixing (an artificial viscosity, Sampl & Zwinger 2004 as in AvaFrame com1DFA),
 ///        implicit: v ← (v + kΔt ṽ)/(1 + kΔt), k = C_mix |ṽ − v|_s √(h_n/V);
-///     b. driving acceleration along the bed: a = −g cos²θ p + P F_i;
+///     b. driving acceleration along the bed: a = −g cos²θ p + P F_i; within 2 d0 of a barrier
+///        whose crest is above the flow surface, plus the push of the mirror layer the wall stands
+///        for, P C g cos θ h_w M(s/d0)/d0 away from it (barriers.hpp), which the wall takes;
 ///     c. basal friction applied implicitly on the surface speed S = |(v, p·v)| with the bed-normal
 ///        stress of g_n = cos θ (g + vᵀHv)⁺ (gravity plus the centripetal acceleration of the bed
 ///        curvature along the velocity, H the Hessian of z; zero when the particle would leave the
 ///        bed) and the depth h_n = h cos θ (basal_friction.hpp): it may stop a particle, never
 ///        reverse it; position x += Δt v (symplectic Euler);
-///     d. the bed constraint: the velocity is turned into the tangent plane at the new position
+///     d. barriers (barriers.hpp, set_barriers): a step that would cross a barrier below its crest
+///        ends at the wall with the velocity reflected, v_n' = −e v_n, the tangential speed reduced
+///        by μ_w (1 + e) v_n, the rest of the step taken with v'; the wall takes ρ V (1 + e) v_n.
+///        A particle whose flow surface is above the crest, or that passes an open barrier, crosses;
+///     e. the bed constraint: the velocity is turned into the tangent plane at the new position
 ///        keeping its magnitude S (the normal reaction does no work), as AvaFrame com1DFA
 ///        reprojects it;
 ///     With spatial processes (processes.hpp, set_processes) the friction coefficients are those of
 ///     the particle's cell, forest drag k_f S² joins the law's drag, and a particle in an erodible
 ///     cell records the volume it asks to entrain;
-///  5. entrainment granted in store order, capped by the layer, the mass joining at rest;
+///  5. entrainment granted in store order, capped by the layer, the mass joining at rest; the wall
+///     impulses and crossed volumes added to the barrier tally in store order;
 ///     particles whose new position is off the terrain (raster edge, nodata) are removed and their
 ///     volume is added to the lost volume; inflow hydrographs inject the particles now due;
 ///  6. the volume budget and the kinetic energy Σ ½ ρ V S²; the run ends at the duration, when
@@ -43,7 +50,7 @@
 ///     stop_energy_fraction of its peak (AvaFrame com1DFA / RAMMS practice) — not before the
 ///     inflows have delivered their volume.
 /// All per-particle loops are parallel over i with no order-dependent reduction (only maxima and
-/// "any" flags); entrainment and injection are serial in store order; so 1 and N threads give
+/// "any" flags); entrainment, injection and the barrier tally are serial in store order; so 1 and N threads give
 /// bit-identical results.
 
 #include <omp.h>
@@ -59,6 +66,7 @@
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/kernels.hpp"
 #include "geohaz/core/neighbours.hpp"
+#include "geohaz/runout/barriers.hpp"
 #include "geohaz/runout/basal_friction.hpp"
 #include "geohaz/runout/fields.hpp"
 #include "geohaz/runout/head_pressure.hpp"
@@ -150,6 +158,26 @@ class RunoutSolver {
     return false;
   }
 
+  /// Barriers across the flow (barriers.hpp; docs/runout.md, "Barriers"). Set before initialise().
+  void set_barriers(BarrierSet b) {
+    barriers_ = std::move(b);
+    const std::size_t nb = barriers_.size();
+    tally_.impulse.assign(nb, 0.0);
+    tally_.passed.assign(nb, 0.0);
+    tally_.contacts.assign(nb, 0.0);
+    tally_.window_depth.assign(nb, 0.0);
+    tally_.touched.assign(barriers_.bins(), 0);
+  }
+  const BarrierSet& barriers() const noexcept { return barriers_; }
+  /// What the walls have taken so far (impulses, crossed volumes, the bins touched and the depth at
+  /// the wall since the last reset_barrier_window()).
+  const BarrierTally& barrier_tally() const noexcept { return tally_; }
+  /// Start a new window for the wetted bins and the depth at the wall (the outputs call it per row).
+  void reset_barrier_window() {
+    std::fill(tally_.touched.begin(), tally_.touched.end(), std::uint8_t{0});
+    std::fill(tally_.window_depth.begin(), tally_.window_depth.end(), 0.0);
+  }
+
   /// Call once the particles (position, velocity, volume, id) are in the store: samples the
   /// terrain, records start elevations and the initial volume, computes depths. Throws
   /// std::invalid_argument when a particle is off the terrain or has a non-positive volume.
@@ -203,6 +231,7 @@ class RunoutSolver {
     const IntegrateFlags flags = std::visit([&](const auto& law) { return integrate(law, dt); }, p_.friction);
     if (flags.non_finite) throw_non_finite();
     if (flags.entraining) entrain();
+    if (flags.walls) tally_walls();
     if (flags.leaving) remove_leaving();
     dt_ = dt;
     time_ += dt;
@@ -579,6 +608,7 @@ class RunoutSolver {
     bool leaving = false;     ///< a particle left the terrain
     bool non_finite = false;  ///< a position or velocity is not finite
     bool entraining = false;  ///< a particle asks to erode the bed (demand_)
+    bool walls = false;       ///< a particle met a barrier (wall_barrier_)
   };
 
   template <class Law>
@@ -612,9 +642,22 @@ class RunoutSolver {
       demand_.assign(store_.size(), 0.0);
       demand_cell_.resize(store_.size());
     }
-    int any_leaving = 0, any_non_finite = 0, any_entraining = 0;
-#pragma omp parallel for reduction(max                                            \
-                                   : any_leaving, any_non_finite, any_entraining) \
+    const bool walls = !barriers_.empty();
+    if (walls) {
+      wall_barrier_.assign(store_.size(), -1);
+      wall_value_.resize(store_.size());
+      wall_depth_.resize(store_.size());
+      wall_bin_.resize(store_.size());
+      wall_cross_.resize(store_.size());
+      push_barrier_.assign(store_.size(), -1);
+      push_value_.resize(store_.size());
+      push_bin_.resize(store_.size());
+      push_depth_.resize(store_.size());
+    }
+    const auto& ids = store_.get<ParticleId>();
+    int any_leaving = 0, any_non_finite = 0, any_entraining = 0, any_wall = 0;
+#pragma omp parallel for reduction(max                                                      \
+                                   : any_leaving, any_non_finite, any_entraining, any_wall) \
     schedule(static) if (n >= kParallelMin)
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
@@ -632,7 +675,13 @@ class RunoutSolver {
         vi = (vi + kdt * vmean[i]) / (1.0 + kdt);
       }
       // b. Gravity along the bed and the head pressure: a = −g cos²θ p + a_p.
-      const Vec2 a = (-g * cos_theta * cos_theta) * gz + ap[i];
+      Vec2 a = (-g * cos_theta * cos_theta) * gz + ap[i];
+      //    Near a barrier whose crest is above the flow surface: the push of the mirror layer the
+      //    wall stands for, C g cos θ h_w M(s/d0)/d0 away from it (barriers.hpp); the wall takes it.
+      if (walls && barriers_.near(x[i])) {
+        wall_push(i, dt, a);
+        if (push_barrier_[i] >= 0) any_wall = 1;
+      }
       const Vec2 v_star = vi + dt * a;
       // c. Basal friction on the surface speed with the bed-normal stress ρ g_n h_n,
       //    g_n = cos θ (g + vᵀHv)⁺: gravity plus the centripetal acceleration of the bed curvature
@@ -648,7 +697,7 @@ class RunoutSolver {
       FrictionTerms t = local.terms(g, std::max(g + kv, 0.0) * cos_theta, h_n, s_star);
       const double basal_drag = t.drag;
       if (forest && cell != SpatialProcesses::npos && proc_.forest_drag[cell] > 0.0) t.drag += proc_.forest_drag[cell];
-      const double s = speed_after_friction(s_star, dt, t);
+      double s = speed_after_friction(s_star, dt, t);
       //    Erosion the particle asks for over the step (granted in entrain(), capped by the layer).
       if (erode && s > 0.0 && cell != SpatialProcesses::npos && proc_.erodible_depth[cell] > 0.0) {
         double want = 0.0;
@@ -666,8 +715,49 @@ class RunoutSolver {
         }
       }
       Vec2 v_new = s > 0.0 ? Vec2(v_star * (s / s_star)) : Vec2::Zero();
-      const double moved = dt * v_new.norm();
       Vec2 x_new = x[i] + dt * v_new;
+      // d. Barriers: held at the wall unless the flow surface is above the crest or the particle
+      //    passes an open barrier.
+      BarrierCrossing hit;
+      bool held = false;
+      if (walls && barriers_.first_crossing(x[i], x_new, hit)) {
+        any_wall = 1;
+        const auto b = static_cast<std::size_t>(hit.barrier);
+        const Barrier& bar = barriers_[b];
+        // Depth at the wall: the kernel sum misses the part of the support beyond the wall.
+        const double h_wall =
+            h[i] / BarrierSet::kernel_fraction(barriers_.distance_to_segment(b, hit.segment, x[i]) / p_.d0);
+        SurfaceSample at;
+        const double z_crest = (surface_.sample(hit.point, at) ? at.z : z[i]) + bar.height;
+        const bool over = z[i] + h_wall / cos_theta > z_crest;
+        wall_barrier_[i] = hit.barrier;
+        wall_bin_[i] = barriers_.bin_of(hit);
+        wall_depth_[i] = h_wall;
+        wall_cross_[i] = over || barriers_.passes(ids[i], b) ? 1 : 0;
+        if (wall_cross_[i]) {
+          wall_value_[i] = hit.from_upstream ? vol[i] : -vol[i];  // crosses: signed volume
+        } else {
+          const WallLaw& wl = barriers_.law();
+          const Vec2 nrm = hit.normal;
+          const double vn = std::max(v_new.dot(nrm), 0.0);
+          Vec2 vt = v_new - v_new.dot(nrm) * nrm;
+          const double vt_norm = vt.norm(), dvn = (1.0 + wl.restitution) * vn;
+          if (vt_norm > 0.0) vt *= std::max(0.0, 1.0 - wl.friction * dvn / vt_norm);
+          v_new = vt - wl.restitution * vn * nrm;
+          wall_value_[i] = vol[i] * dvn;  // held: the impulse per unit density (m⁴/s)
+          // Stop at the wall (a hair before it), then the rest of the step with v'.
+          const double backoff = 1e-6 * p_.d0;
+          const double to_wall = hit.t * (x_new - x[i]).dot(nrm);
+          const Vec2 xc = to_wall > 2.0 * backoff ? Vec2(x[i] + hit.t * (x_new - x[i]) - backoff * nrm) : x[i];
+          x_new = xc + ((1.0 - hit.t) * dt) * v_new;
+          BarrierCrossing again;
+          if (barriers_.first_crossing(xc, x_new, again)) x_new = xc;  // a corner: the next step resolves it
+          const double vzn = gz.dot(v_new);
+          s = std::sqrt(v_new.squaredNorm() + vzn * vzn);
+          held = true;
+        }
+      }
+      const double moved = held ? (x_new - x[i]).norm() : dt * v_new.norm();
       if (periodic) x_new = periodic_.wrap(x_new);
       SurfaceSample smp;
       if (!surface_.sample(x_new, smp)) {
@@ -677,7 +767,7 @@ class RunoutSolver {
         if (!(x[i].allFinite() && v_new.allFinite())) any_non_finite = 1;
         continue;
       }
-      // d. The bed constraint: the velocity, tangent to the bed at the old position, is turned into
+      // e. The bed constraint: the velocity, tangent to the bed at the old position, is turned into
       //    the tangent plane at the new one keeping its magnitude S (the normal reaction does no
       //    work; AvaFrame com1DFA's reprojection). In map view, with p' the new gradient:
       //        v' ∝ v + p' ((p − p')·v)/(1 + |p'|²),   scaled so that |(v', p'·v')| = S.
@@ -701,7 +791,58 @@ class RunoutSolver {
       moving[i] = s > 0.0 ? 1 : 0;
       if (!(x_new.allFinite() && v_new.allFinite())) any_non_finite = 1;
     }
-    return {any_leaving != 0, any_non_finite != 0, any_entraining != 0};
+    return {any_leaving != 0, any_non_finite != 0, any_entraining != 0, any_wall != 0};
+  }
+
+  /// The mirror push of the nearest barrier on particle i (added to its acceleration a), recorded
+  /// for the tally. None when the flow surface is above the crest or the particle passes the
+  /// barrier (open barriers), or beyond 2 d0 of the wall.
+  void wall_push(std::size_t i, double dt, Vec2& a) {
+    WallProximity w;
+    if (!barriers_.nearest_wall(store_.get<Position<2>>()[i], w)) return;
+    const auto b = static_cast<std::size_t>(w.barrier);
+    if (barriers_.passes(store_.get<ParticleId>()[i], b)) return;
+    const double sd = w.distance / p_.d0;
+    const double push_shape = BarrierSet::mirror_push(sd);
+    if (!(push_shape > 0.0)) return;
+    const double cos_theta = store_.get<BedCos>()[i], zi = store_.get<Elevation>()[i];
+    const double h_wall = store_.get<FlowDepth>()[i] / BarrierSet::kernel_fraction(sd);
+    SurfaceSample at;
+    const double z_crest = (surface_.sample(w.point, at) ? at.z : zi) + barriers_[b].height;
+    if (zi + h_wall / cos_theta > z_crest) return;  // overtopping: the wall does not hold it
+    const double push = p_.pressure_scale * p_.gravity * cos_theta * h_wall * push_shape / p_.d0;
+    const Vec2 gz = store_.get<SurfaceGradient>()[i];
+    const Vec2 f = push * w.away;
+    a += f - (gz.dot(f) / (1.0 + gz.squaredNorm())) * gz;  // P f: held on the bed
+    push_barrier_[i] = w.barrier;
+    push_value_[i] = store_.get<Volume>()[i] * push * dt;  // impulse per unit density (m⁴/s)
+    push_bin_[i] = barriers_.bin_at(b, w.arclength);
+    push_depth_[i] = w.distance <= p_.d0 ? h_wall : 0.0;
+  }
+
+  /// Add the wall events of the step to the barrier tally, in store order (deterministic). A held
+  /// particle gave the wall ρ V (1 + e) v_n; a crossing one moved its volume across (signed: + from
+  /// the upstream side).
+  void tally_walls() {
+    for (std::size_t i = 0; i < store_.size(); ++i) {
+      if (const int pb = push_barrier_[i]; pb >= 0) {
+        const auto k = static_cast<std::size_t>(pb);
+        tally_.impulse[k] += push_value_[i] * p_.density;
+        tally_.touched[push_bin_[i]] = 1;
+        tally_.window_depth[k] = std::max(tally_.window_depth[k], push_depth_[i]);
+      }
+      const int b = wall_barrier_[i];
+      if (b < 0) continue;
+      const auto k = static_cast<std::size_t>(b);
+      tally_.touched[wall_bin_[i]] = 1;
+      tally_.window_depth[k] = std::max(tally_.window_depth[k], wall_depth_[i]);
+      if (!wall_cross_[i]) {
+        tally_.impulse[k] += wall_value_[i] * p_.density;
+        tally_.contacts[k] += 1.0;
+      } else {
+        tally_.passed[k] += wall_value_[i];
+      }
+    }
   }
 
   /// Grant the erosion asked for in integrate(), in store order (deterministic), capped by the depth
@@ -847,6 +988,17 @@ class RunoutSolver {
   std::vector<double> demand_;            // per particle, this step (m³)
   std::vector<std::size_t> demand_cell_;  // the cell it erodes
   std::vector<double> emitted_;           // per inflow (m³)
+  BarrierSet barriers_;
+  BarrierTally tally_;
+  std::vector<int> wall_barrier_;         // per particle, this step: the barrier met (−1: none)
+  std::vector<std::size_t> wall_bin_;     // its bin
+  std::vector<double> wall_value_;        // V (1+e) v_n when held; ± V when crossing
+  std::vector<double> wall_depth_;        // depth at the wall h_w (m)
+  std::vector<std::uint8_t> wall_cross_;  // 1 when it crossed
+  std::vector<int> push_barrier_;         // per particle, this step: the barrier pushing it (−1: none)
+  std::vector<double> push_value_;        // its impulse per unit density (m⁴/s)
+  std::vector<std::size_t> push_bin_;     // the bin of the nearest wall point
+  std::vector<double> push_depth_;        // h_w within d0 of the wall (m), else 0
   std::vector<std::int64_t> slot_;        // per inflow: particles emitted
   std::int64_t next_id_ = 0;
   bool list_valid_ = false;
