@@ -689,7 +689,8 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
     write_qgis_class_style(out / "intensity.qml", cls);
   }
   // Quick-look maps for the report (docs/report.md): cropped to the affected area with a 200 m
-  // margin, over the hillshade, with scale bar, north arrow and a legend with units.
+  // margin, over the hillshade, with scale bar, north arrow, a legend with units and the barrier
+  // lines.
   const auto map_png = [&](const char* name, const Raster& r, ColourRamp ramp, const char* title, const char* unit,
                            double overlay_min, const std::vector<StyleClass>& classes = {}) {
     QuicklookOptions o;
@@ -701,6 +702,7 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
     o.crop_margin_m = 200.0;
     o.scale_bar = true;
     o.north_arrow = true;
+    for (const Barrier& b : sim.inputs().barriers) o.lines.push_back(b.vertices);  // barrier lines
     write_quicklook_png(out / (std::string(name) + ".png"), dsm, &r, o);
   };
   const auto& solver = sim.solver();
