@@ -59,10 +59,10 @@ int make_synthetic(const std::string& path, double scale, double release_depth) 
   dsm.nodata = -9999.0;
   dsm.data = v.surface().values();
   dsm.description = "elevation of the synthetic valley";
-  dsm.unit = "m";
+  dsm.unit = std::string(1, 'm');       // not = "m": GCC 12 -Wrestrict false positive in the inlined assign
   Raster rel = dsm.like(0.0, -9999.0);  // nodata, description and unit on every GeoTIFF (issue #16)
   rel.description = "release thickness, vertical";
-  rel.unit = "m";
+  rel.unit = dsm.unit;
   const double L = v.length(), depth = release_depth > 0.0 ? release_depth : 2.0;
   for (int r = 0; r < g.ny; ++r)
     for (int c = 0; c < g.nx; ++c) {

@@ -473,11 +473,6 @@ const KeyLabel* find_key(const std::string& k) {
   return nullptr;
 }
 
-std::string last_segment(const std::string& k) {
-  const auto dot = k.rfind('.');
-  return dot == std::string::npos ? k : k.substr(dot + 1);
-}
-
 std::string value_text(const json& v, const std::string& unit) {
   if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
   if (v.is_number()) return format_quantity(v.get<double>(), unit);
