@@ -176,6 +176,14 @@ TEST_F(Reliability, ValuesThatWouldRunForHoursAreBadInput) {
         "biaxial.loading_velocity=1e-9", "--out", (dir_ / "o").string(), "--quiet"},
        "biaxial.loading_velocity"},
       {sph_column(dir_ / "o") + std::vector<std::string>{"--set", "material[0].density=1.8"}, "density"},
+      // Fuzz cases 151 and 255 (seed 20261201 after the data of 2026-12-02): element-test
+      // specimens 2000 and 117 times as high as wide (1.25 million SPH particles; a disc column).
+      {{SPH_SLOPE_EXE, "--config", (kData / "sph/biaxial.toml").string(), "--set", "biaxial.height=100", "--out",
+        (dir_ / "o").string(), "--quiet"},
+       "biaxial.height"},
+      {{DEM_AVALANCHE_EXE, "--config", (kData / "dem/biaxial_compression.toml").string(), "--set", "sample.height=3.5",
+        "--out", (dir_ / "o").string(), "--quiet"},
+       "sample.height"},
   };
   for (const auto& [argv, key] : cases) {
     ChildLimits lim;
