@@ -10,7 +10,6 @@
 
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <string>
 
 #include "geohaz/core/raster.hpp"
@@ -43,16 +42,22 @@ std::string find_chromium() {
   return "";
 }
 
-/// The attribute `name` of #page-check in a dumped DOM (-1 when absent).
+/// The attribute `name` of #page-check in a dumped DOM (-1 when absent). Plain string search:
+/// std::regex trips GCC 12's -Wmaybe-uninitialized in the sanitizer build (-Werror in CI).
 int page_mark(const std::string& dom, const std::string& name) {
-  const std::regex div("<div id=\"page-check\"[^>]*>");
-  std::smatch m;
-  if (!std::regex_search(dom, m, div)) return -1;
-  const std::regex attr(name + "=\"([0-9]+)\"");
-  const std::string tag = m.str();
-  std::smatch a;
-  if (!std::regex_search(tag, a, attr)) return -1;
-  return std::stoi(a[1]);
+  const auto open = dom.find("<div id=\"page-check\"");
+  if (open == std::string::npos) return -1;
+  const auto close = dom.find('>', open);
+  if (close == std::string::npos) return -1;
+  const std::string tag = dom.substr(open, close - open);
+  const std::string key = " " + name + "=\"";
+  const auto at = tag.find(key);
+  if (at == std::string::npos) return -1;
+  const auto first = at + key.size(), last = tag.find('"', first);
+  if (last == std::string::npos || last == first) return -1;
+  const std::string digits = tag.substr(first, last - first);
+  if (digits.find_first_not_of("0123456789") != std::string::npos) return -1;
+  return std::stoi(digits);
 }
 
 /// A small results folder with what the apps write.
