@@ -33,7 +33,7 @@ void write_snapshot(SnapshotWriter& w, const DemSolver& s) {
   w.write(s.time(), s.step_count(), fields, lines);
 }
 
-void write_curve_csv(const std::filesystem::path& path, const std::vector<CurvePoint>& curve) {
+std::string curve_csv(const std::vector<CurvePoint>& curve) {
   std::ostringstream o;
   o << std::setprecision(9);
   o << "time_s,axial_strain,lateral_strain,volumetric_strain,axial_stress_Pa,lateral_stress_Pa,ae_count,ae_energy_J_"
@@ -43,20 +43,28 @@ void write_curve_csv(const std::filesystem::path& path, const std::vector<CurveP
     o << p.time << ',' << p.axial_strain << ',' << p.lateral_strain << ',' << p.volumetric_strain << ','
       << p.axial_stress << ',' << p.lateral_stress << ',' << p.ae_count << ',' << p.ae_energy << ',' << p.broken_total
       << '\n';
-  write_text_file(path, o.str());
+  return o.str();
 }
 
-void write_ae_csv(const std::filesystem::path& path, const std::vector<AcousticEvent>& events) {
+void write_curve_csv(const std::filesystem::path& path, const std::vector<CurvePoint>& curve) {
+  write_text_file(path, curve_csv(curve));
+}
+
+std::string ae_csv(const std::vector<AcousticEvent>& events) {
   std::ostringstream o;
   o << std::setprecision(9);
   o << "time_s,x_m,y_m,mode,energy_J_per_m,bond\n";
   for (const auto& e : events)
     o << e.time << ',' << e.position.x() << ',' << e.position.y() << ','
       << (e.mode == FailureMode::Tensile ? "tensile" : "shear") << ',' << e.energy << ',' << e.bond << '\n';
-  write_text_file(path, o.str());
+  return o.str();
 }
 
-void write_avalanche_csv(const std::filesystem::path& path, const std::vector<AvalanchePoint>& series) {
+void write_ae_csv(const std::filesystem::path& path, const std::vector<AcousticEvent>& events) {
+  write_text_file(path, ae_csv(events));
+}
+
+std::string avalanche_csv(const std::vector<AvalanchePoint>& series) {
   std::ostringstream o;
   o << std::setprecision(9);
   o << "time_s,front_m,front_velocity_m_per_s,kinetic_energy_J_per_m,fragments,largest_fragment_discs,ae_count,"
@@ -65,14 +73,22 @@ void write_avalanche_csv(const std::filesystem::path& path, const std::vector<Av
     o << p.time << ',' << p.front << ',' << p.front_velocity << ',' << p.kinetic_energy << ',' << p.fragments << ','
       << p.largest_fragment << ',' << p.ae_count << ',' << p.ae_energy << ',' << p.max_speed << ',' << p.moving_fraction
       << '\n';
-  write_text_file(path, o.str());
+  return o.str();
 }
 
-void write_deposit_csv(const std::filesystem::path& path, const std::vector<std::pair<double, double>>& deposit) {
+void write_avalanche_csv(const std::filesystem::path& path, const std::vector<AvalanchePoint>& series) {
+  write_text_file(path, avalanche_csv(series));
+}
+
+std::string deposit_csv(const std::vector<std::pair<double, double>>& deposit) {
   std::ostringstream o;
   o << std::setprecision(9) << "x_m,thickness_m\n";
   for (const auto& [x, h] : deposit) o << x << ',' << h << '\n';
-  write_text_file(path, o.str());
+  return o.str();
+}
+
+void write_deposit_csv(const std::filesystem::path& path, const std::vector<std::pair<double, double>>& deposit) {
+  write_text_file(path, deposit_csv(deposit));
 }
 
 namespace {

@@ -5,6 +5,8 @@
 /// cells), CSV curves and the AE catalogue, quick-look PNGs. One-shot files are written atomically.
 
 #include <filesystem>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "geohaz/core/snapshot.hpp"
@@ -15,6 +17,13 @@ namespace geohaz::dem {
 
 /// Append one snapshot of the solver's state.
 void write_snapshot(SnapshotWriter& w, const DemSolver& s);
+
+/// The CSV tables as text (header line, then one row per entry, 9 significant digits); the
+/// write_*_csv functions below write exactly this text.
+std::string curve_csv(const std::vector<CurvePoint>& curve);
+std::string ae_csv(const std::vector<AcousticEvent>& events);
+std::string avalanche_csv(const std::vector<AvalanchePoint>& series);
+std::string deposit_csv(const std::vector<std::pair<double, double>>& deposit);
 
 /// Stress–strain record: time, strains, stresses (Pa), AE count and energy per increment.
 void write_curve_csv(const std::filesystem::path& path, const std::vector<CurvePoint>& curve);
