@@ -416,20 +416,24 @@ void check_avalanche_spec(const AvalancheSpec& spec) {
   }
 }
 
-AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const RunObserver& observe) {
-  check_avalanche_spec(spec);
-  AvalancheResult res;
-  Vec2 lo = spec.source[0], hi = spec.source[0];
-  for (const auto& p : spec.source) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
+namespace {
+
+/// The rock mass of an avalanche: discs packed in the source polygon's bounding box `lo`–`hi`,
+/// kept inside the polygon and clear of the terrain, bonded along the tessellation, cut by the
+/// joints.
+struct RockMass {
+  DiscStore discs;
+  BondTable bonds;
+  std::vector<JointPair> joints;
+};
+
+RockMass cut_rock_mass(const AvalancheSpec& spec, const Vec2& lo, const Vec2& hi, AvalancheResult& res) {
   PackingSpec pk = spec.packing;
   pk.width = hi.x() - lo.x();
   pk.height = hi.y() - lo.y();
   PackedSample box = pack_discs_in_box(pk, spec.material.law);
-  // Keep the discs inside the polygon and clear of the terrain.
-  DiscStore kept;
+  RockMass mass;
+  DiscStore& kept = mass.discs;
   {
     const auto& x = box.discs.get<Position<2>>();
     const auto& r = box.discs.get<Radius>();
@@ -445,24 +449,26 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
     throw InputError("the source polygon holds fewer than 2 discs above the terrain: enlarge it or use smaller radii",
                      "", "avalanche.source");
   const Tessellation t = tessellate(kept.get<Position<2>>(), kept.get<Radius>(), lo, hi);
-  BondTable bonds;
-  install_parallel_bonds(kept, t.edges, spec.material.bond, spec.material.bond_gap_tolerance, pk.seed, bonds);
+  install_parallel_bonds(kept, t.edges, spec.material.bond, spec.material.bond_gap_tolerance, pk.seed, mass.bonds);
   std::vector<JointTrace> traces = generate_joint_traces(spec.material.joint_sets, lo, hi, pk.seed);
   traces.insert(traces.end(), spec.material.traces.begin(), spec.material.traces.end());
   res.area = polygon_area(spec.source);
-  const auto joints = cut_bonds_by_traces(kept, bonds, traces, &res.discontinuities, res.area);
-  res.joints_cut = joints.size();
+  mass.joints = cut_bonds_by_traces(kept, mass.bonds, traces, &res.discontinuities, res.area);
+  res.joints_cut = mass.joints.size();
+  return mass;
+}
 
-  s.discs = std::move(kept);
-  s.bonds = std::move(bonds);
+/// Load the rock mass into the solver with the terrain (tall end walls so nothing leaves the
+/// section, `tall` m high) and the optional support wall, damped for settling.
+void load_avalanche(DemSolver& s, RockMass mass, const AvalancheSpec& spec, double tall) {
+  s.discs = std::move(mass.discs);
+  s.bonds = std::move(mass.bonds);
   s.law = spec.material.law;
   s.contact = spec.material.contact;
   s.settings.joint_friction = spec.material.joint_friction;
   s.settings.local_damping = spec.settle_damping;
-  s.set_joints(joints);
-  // Terrain with tall end walls so nothing leaves the section.
+  s.set_joints(mass.joints);
   std::vector<Vec2> ter = spec.terrain;
-  const double tall = 10.0 * (hi - lo).norm() + 100.0;
   ter.insert(ter.begin(), ter.front() + Vec2(0, tall));
   ter.push_back(ter.back() + Vec2(0, tall));
   s.terrain = TerrainSegments{};
@@ -478,67 +484,65 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
     s.walls.push_back(w);
   }
   s.initialise();
-  res.discs = s.discs.size();
-  res.bonds = s.bonds.intact_count();
+}
 
-  // Settling.
-  while (s.time() < spec.settle_time) {
-    s.step();
-    if (observe && s.step_count() % 200 == 0) observe(s, "settling");
-  }
-  {
-    const auto& x = s.discs.get<Position<2>>();
-    const auto& r = s.discs.get<Radius>();
-    res.crown_z = -1e300;
-    for (std::size_t i = 0; i < s.discs.size(); ++i)
-      if (x[i].y() + r[i] > res.crown_z) {
-        res.crown_z = x[i].y() + r[i];
-        res.crown_x = x[i].x();
-      }
-  }
-  // Centre of mass and each disc's start position (by id) at release.
-  auto centre_of_mass = [&]() {
-    const auto& x = s.discs.get<Position<2>>();
-    const auto& m = s.discs.get<Mass>();
-    Vec2 c = Vec2::Zero();
-    double mt = 0;
-    for (std::size_t i = 0; i < s.discs.size(); ++i) {
-      c += m[i] * x[i];
-      mt += m[i];
-    }
-    return Vec2(c / mt);
-  };
-  res.com_start = centre_of_mass();
-  std::vector<double> start_x(s.discs.size());
+/// The crown: the highest disc top after settling (x, z).
+void find_crown(const DemSolver& s, AvalancheResult& res) {
+  const auto& x = s.discs.get<Position<2>>();
+  const auto& r = s.discs.get<Radius>();
+  res.crown_z = -1e300;
   for (std::size_t i = 0; i < s.discs.size(); ++i)
-    start_x[static_cast<std::size_t>(s.discs.get<ParticleId>()[i])] = s.discs.get<Position<2>>()[i].x();
-  // Release.
+    if (x[i].y() + r[i] > res.crown_z) {
+      res.crown_z = x[i].y() + r[i];
+      res.crown_x = x[i].x();
+    }
+}
+
+Vec2 centre_of_mass(const DemSolver& s) {
+  const auto& x = s.discs.get<Position<2>>();
+  const auto& m = s.discs.get<Mass>();
+  Vec2 c = Vec2::Zero();
+  double mt = 0;
+  for (std::size_t i = 0; i < s.discs.size(); ++i) {
+    c += m[i] * x[i];
+    mt += m[i];
+  }
+  return Vec2(c / mt);
+}
+
+/// Release: the support removed, the bond strengths weakened, the run-out damping.
+void release(DemSolver& s, const AvalancheSpec& spec) {
   for (auto& w : s.walls) w.active = false;
   for (std::size_t b = 0; b < s.bonds.size(); ++b) {
     s.bonds.tensile_strength[b] *= spec.strength_factor;
     s.bonds.shear_strength[b] *= spec.strength_factor;
   }
   s.settings.local_damping = spec.runout_damping;
+}
+
+/// Fastest disc (m/s) and the mass fraction faster than `stop_speed`.
+void motion(const DemSolver& s, double stop_speed, double& vmax, double& moving) {
+  const auto& v = s.discs.get<Velocity<2>>();
+  const auto& m = s.discs.get<Mass>();
+  double v2 = 0, mm = 0, mt = 0;
+  for (std::size_t i = 0; i < s.discs.size(); ++i) {
+    const double q = v[i].squaredNorm();
+    v2 = std::max(v2, q);
+    mt += m[i];
+    if (q > stop_speed * stop_speed) mm += m[i];
+  }
+  vmax = std::sqrt(v2);
+  moving = mt > 0 ? mm / mt : 0.0;
+}
+
+/// Step from the release until the mass is at rest or runout_time has passed, recording the
+/// time series every record_interval (the trigger acceleration during trigger_duration).
+void run_out(DemSolver& s, const AvalancheSpec& spec, const RunObserver& observe, AvalancheResult& res) {
   const Vec2 g0 = s.settings.gravity;
   const double t_release = s.time();
-  const std::size_t events_before = s.events.size();
   std::size_t last_events = s.events.size();
   double next_record = t_release;
   double prev_front = mass_quantile_x(s, 0.99), prev_t = t_release;
-  // Fastest disc and the mass fraction faster than the stop speed.
-  auto motion = [&](double& vmax, double& moving) {
-    const auto& v = s.discs.get<Velocity<2>>();
-    const auto& m = s.discs.get<Mass>();
-    double v2 = 0, mm = 0, mt = 0;
-    for (std::size_t i = 0; i < s.discs.size(); ++i) {
-      const double q = v[i].squaredNorm();
-      v2 = std::max(v2, q);
-      mt += m[i];
-      if (q > spec.stop_speed * spec.stop_speed) mm += m[i];
-    }
-    vmax = std::sqrt(v2);
-    moving = mt > 0 ? mm / mt : 0.0;
-  };
   while (true) {
     const double tr = s.time() - t_release;
     s.settings.gravity = tr < spec.trigger_duration ? Vec2(g0 + spec.trigger_acceleration) : g0;
@@ -550,7 +554,7 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
       prev_front = p.front;
       prev_t = s.time();
       p.kinetic_energy = s.kinetic_energy();
-      motion(p.max_speed, p.moving_fraction);
+      motion(s, spec.stop_speed, p.max_speed, p.moving_fraction);
       res.peak_kinetic_energy = std::max(res.peak_kinetic_energy, p.kinetic_energy);
       const auto sizes = label_fragments(s);
       p.fragments = sizes.size();
@@ -574,67 +578,72 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
   }
   s.settings.gravity = g0;
   res.duration = s.time() - t_release;
-  motion(res.max_speed_at_end, res.moving_fraction_at_end);
-  // Run-out measures: toe = 99 % mass quantile of x at the end, on the terrain.
+}
+
+/// Deposit profile: thickness above the terrain in bins of 2 R_max.
+std::vector<std::pair<double, double>> deposit_profile(const DemSolver& s) {
+  std::vector<std::pair<double, double>> deposit;
+  const auto& x = s.discs.get<Position<2>>();
+  const auto& r = s.discs.get<Radius>();
+  const double rmax = *std::max_element(r.begin(), r.end());
+  double xmin = 1e300, xmax = -1e300;
+  for (const auto& p : x) {
+    xmin = std::min(xmin, p.x());
+    xmax = std::max(xmax, p.x());
+  }
+  const double bw = 2 * rmax;
+  const std::size_t nb = static_cast<std::size_t>((xmax - xmin) / bw) + 1;
+  std::vector<double> top(nb, -1e300);
+  for (std::size_t i = 0; i < s.discs.size(); ++i) {
+    const auto b = static_cast<std::size_t>((x[i].x() - xmin) / bw);
+    top[b] = std::max(top[b], x[i].y() + r[i]);
+  }
+  for (std::size_t b = 0; b < nb; ++b) {
+    const double xc = xmin + (b + 0.5) * bw;
+    const double zt = s.terrain.elevation(xc);
+    deposit.emplace_back(xc, top[b] > -1e299 && std::isfinite(zt) ? std::max(0.0, top[b] - zt) : 0.0);
+  }
+  return deposit;
+}
+
+/// Each fragment's size, mass, centre of mass and travel from its discs' x at release (`start_x`,
+/// by disc id); the Fragment field labelled by label_fragments, ids in `res.fragment_sizes`' order.
+std::vector<FragmentSummary> fragment_summaries(const DemSolver& s, std::size_t count,
+                                                const std::vector<double>& start_x) {
+  const auto& x = s.discs.get<Position<2>>();
+  const auto& m = s.discs.get<Mass>();
+  const auto& fr = s.discs.get<Fragment>();
+  const auto& id = s.discs.get<ParticleId>();
+  std::vector<FragmentSummary> fragments(count, FragmentSummary{});
+  std::vector<double> x0(fragments.size(), 0.0);
+  for (std::size_t i = 0; i < s.discs.size(); ++i) {
+    FragmentSummary& f = fragments[static_cast<std::size_t>(fr[i])];
+    ++f.discs;
+    f.mass += m[i];
+    f.x += m[i] * x[i].x();
+    f.z += m[i] * x[i].y();
+    x0[static_cast<std::size_t>(fr[i])] += m[i] * start_x[static_cast<std::size_t>(id[i])];
+  }
+  for (std::size_t k = 0; k < fragments.size(); ++k) {
+    FragmentSummary& f = fragments[k];
+    f.x /= f.mass;
+    f.z /= f.mass;
+    f.travel = f.x - x0[k] / f.mass;
+  }
+  return fragments;
+}
+
+/// Run-out measures of the final state: toe = 99 % mass quantile of x, on the terrain; the other
+/// quantiles; the volume and Scheidegger's H/L; the centre of mass's travel angle.
+void measure_runout(const DemSolver& s, const AvalancheSpec& spec, double source_length, AvalancheResult& res) {
   res.toe_x = mass_quantile_x(s, 0.99);
   res.toe_z = s.terrain.elevation(res.toe_x);
   res.fall_height = res.crown_z - res.toe_z;
   res.runout = res.toe_x - res.crown_x;
   res.h_over_l = res.runout > 0 ? res.fall_height / res.runout : 0.0;
-  const double width = spec.volume_width > 0 ? spec.volume_width : (hi.x() - lo.x());
+  const double width = spec.volume_width > 0 ? spec.volume_width : source_length;
   res.volume = res.area * width;
   res.scheidegger_h_over_l = scheidegger_h_over_l(res.volume);
-  // Deposit profile: thickness above the terrain in bins of 2 R_max.
-  {
-    const auto& x = s.discs.get<Position<2>>();
-    const auto& r = s.discs.get<Radius>();
-    const double rmax = *std::max_element(r.begin(), r.end());
-    double xmin = 1e300, xmax = -1e300;
-    for (const auto& p : x) {
-      xmin = std::min(xmin, p.x());
-      xmax = std::max(xmax, p.x());
-    }
-    const double bw = 2 * rmax;
-    const std::size_t nb = static_cast<std::size_t>((xmax - xmin) / bw) + 1;
-    std::vector<double> top(nb, -1e300);
-    for (std::size_t i = 0; i < s.discs.size(); ++i) {
-      const auto b = static_cast<std::size_t>((x[i].x() - xmin) / bw);
-      top[b] = std::max(top[b], x[i].y() + r[i]);
-    }
-    for (std::size_t b = 0; b < nb; ++b) {
-      const double xc = xmin + (b + 0.5) * bw;
-      const double zt = s.terrain.elevation(xc);
-      res.deposit.emplace_back(xc, top[b] > -1e299 && std::isfinite(zt) ? std::max(0.0, top[b] - zt) : 0.0);
-    }
-  }
-  res.fragment_sizes = label_fragments(s);
-  {
-    const auto& x = s.discs.get<Position<2>>();
-    const auto& m = s.discs.get<Mass>();
-    const auto& fr = s.discs.get<Fragment>();
-    const auto& id = s.discs.get<ParticleId>();
-    res.fragments.assign(res.fragment_sizes.size(), FragmentSummary{});
-    std::vector<double> x0(res.fragments.size(), 0.0);
-    for (std::size_t i = 0; i < s.discs.size(); ++i) {
-      FragmentSummary& f = res.fragments[static_cast<std::size_t>(fr[i])];
-      ++f.discs;
-      f.mass += m[i];
-      f.x += m[i] * x[i].x();
-      f.z += m[i] * x[i].y();
-      x0[static_cast<std::size_t>(fr[i])] += m[i] * start_x[static_cast<std::size_t>(id[i])];
-    }
-    for (std::size_t k = 0; k < res.fragments.size(); ++k) {
-      FragmentSummary& f = res.fragments[k];
-      f.x /= f.mass;
-      f.z /= f.mass;
-      f.travel = f.x - x0[k] / f.mass;
-    }
-  }
-  res.com_end = centre_of_mass();
-  {
-    const double dl = res.com_end.x() - res.com_start.x();
-    res.com_h_over_l = dl > 0 ? (res.com_start.y() - res.com_end.y()) / dl : 0.0;
-  }
   for (double f : {0.5, 0.9, 0.95, 0.99, 1.0}) {
     RunoutQuantile q;
     q.fraction = f;
@@ -644,6 +653,48 @@ AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const Run
     q.fall_height = res.crown_z - q.z;
     q.h_over_l = q.runout > 0 ? q.fall_height / q.runout : 0.0;
     res.quantiles.push_back(q);
+  }
+}
+
+}  // namespace
+
+AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const RunObserver& observe) {
+  check_avalanche_spec(spec);
+  AvalancheResult res;
+  Vec2 lo = spec.source[0], hi = spec.source[0];
+  for (const auto& p : spec.source) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  // 1. The rock mass cut from a packed box, in the solver on the terrain.
+  load_avalanche(s, cut_rock_mass(spec, lo, hi, res), spec, 10.0 * (hi - lo).norm() + 100.0);
+  res.discs = s.discs.size();
+  res.bonds = s.bonds.intact_count();
+  // 2. Settling under gravity with damping and the support in place.
+  while (s.time() < spec.settle_time) {
+    s.step();
+    if (observe && s.step_count() % 200 == 0) observe(s, "settling");
+  }
+  find_crown(s, res);
+  res.com_start = centre_of_mass(s);
+  std::vector<double> start_x(s.discs.size());  // each disc's x at release, by id
+  for (std::size_t i = 0; i < s.discs.size(); ++i)
+    start_x[static_cast<std::size_t>(s.discs.get<ParticleId>()[i])] = s.discs.get<Position<2>>()[i].x();
+  // 3. Release and run-out.
+  release(s, spec);
+  const double t_release = s.time();
+  const std::size_t events_before = s.events.size();
+  run_out(s, spec, observe, res);
+  // 4. The deposit, the fragments and the run-out measures of the final state.
+  motion(s, spec.stop_speed, res.max_speed_at_end, res.moving_fraction_at_end);
+  measure_runout(s, spec, hi.x() - lo.x(), res);
+  res.deposit = deposit_profile(s);
+  res.fragment_sizes = label_fragments(s);
+  res.fragments = fragment_summaries(s, res.fragment_sizes.size(), start_x);
+  res.com_end = centre_of_mass(s);
+  {
+    const double dl = res.com_end.x() - res.com_start.x();
+    res.com_h_over_l = dl > 0 ? (res.com_start.y() - res.com_end.y()) / dl : 0.0;
   }
   res.events = s.events;  // settling breaks included (time < release time)
   res.release_time = t_release;
