@@ -296,6 +296,8 @@ std::string ensemble_help_config() {
 
 }  // namespace
 
+void register_dem(py::module_& m);  // python/src/dem.cpp: geohaz.dem in-process
+
 PYBIND11_MODULE(_geohaz, m) {
   m.doc() = "geohaz: compiled core of the Python package (use the geohaz package, not this module)";
   m.attr("__version__") = GEOHAZ_VERSION;
@@ -328,4 +330,5 @@ PYBIND11_MODULE(_geohaz, m) {
   m.def("ensemble_run", &ensemble_run, py::arg("config"), py::arg("overrides"), py::arg("out"), py::arg("threads"),
         py::arg("quiet"));
   m.def("ensemble_help_config", &ensemble_help_config);
+  register_dem(m);
 }
