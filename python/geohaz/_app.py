@@ -1,7 +1,7 @@
-"""Running an app (sph-slope, dem-avalanche) in a child process, its exit codes as exceptions.
+"""Running an app (sph-slope) in a child process, its exit codes as exceptions.
 
-Their config readers live in the apps' mains (apps/sph-slope/main.cpp, apps/dem-avalanche/main.cpp),
-so from Python they run as the apps do; debris-runout runs in-process (geohaz.runout).
+Its config reader lives in the app's main (apps/sph-slope/main.cpp), so from Python it runs as the
+app does; debris-runout and dem-avalanche run in-process (geohaz.runout, geohaz.dem).
 """
 import csv
 import json
