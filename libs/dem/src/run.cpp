@@ -9,6 +9,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
 #include "geohaz/core/progress.hpp"
 #include "geohaz/core/snapshot.hpp"
@@ -286,7 +287,7 @@ namespace {
 
 void write_lab_pictures(const DemSimulation& sim, const fs::path& out) {
   const bool tension = sim.config().kind == TestKind::Tension;
-  if (sim.config().write_tessellation) {
+  if (sim.config().write_tessellation && sim.sample().packed.discs.size() > 0) {
     const auto& packed = sim.sample().packed;
     const auto& x = packed.discs.get<Position<2>>();
     const auto t = tessellate(x, packed.discs.get<Radius>(), Vec2(0, 0), Vec2(packed.width, packed.height));
@@ -368,12 +369,21 @@ class OutputObserver : public DemObserver {
 
 }  // namespace
 
-void write_outputs(const DemSimulation& sim, const fs::path& out) {
+namespace {
+
+/// Everything but the summary: the tables and pictures (lab: of the tests finished so far).
+void write_tables_and_pictures(const DemSimulation& sim, const fs::path& out) {
   for (const auto& [stem, text] : csv_tables(sim)) write_text_file(out / (stem + ".csv"), text);
   if (sim.is_lab())
     write_lab_pictures(sim, out);
   else
     write_avalanche_pictures(sim, out);
+}
+
+}  // namespace
+
+void write_outputs(const DemSimulation& sim, const fs::path& out) {
+  write_tables_and_pictures(sim, out);
   write_text_file(out / "summary.json", summary_json(sim));
 }
 
@@ -383,7 +393,14 @@ void run_case(DemSimulation& sim, const fs::path& out, bool quiet, DemObserver* 
   if (!quiet && sim.is_lab()) std::cerr << kModel << ": building the bonded sample\n";
   OutputObserver files(out, quiet);
   DemObservers observers({&files, extra});
-  sim.run(&observers);
+  try {
+    sim.run(&observers);
+  } catch (const SimulationError&) {
+    // As the app always did: the lab tests finished before the blow-up keep their tables and
+    // pictures (and the sample its tessellation); no summary. An avalanche keeps its snapshots.
+    if (sim.is_lab()) write_tables_and_pictures(sim, out);
+    throw;
+  }
   write_outputs(sim, out);
   for (const auto& w : run_warnings(sim)) std::cerr << kModel << ": warning: " << w << "\n";
   if (!quiet && !sim.is_lab()) {

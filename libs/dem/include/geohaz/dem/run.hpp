@@ -117,7 +117,8 @@ void write_outputs(const DemSimulation& sim, const std::filesystem::path& out);
 
 /// The whole `dem-avalanche` run of a checked config: create `out`, write config.resolved.toml,
 /// run with snapshots (snapshots[_<test>].h5) and progress on stderr (unless quiet; the warnings
-/// always), call `extra` too (may be null), and write the outputs.
+/// always), call `extra` too (may be null), and write the outputs. On a SimulationError the lab
+/// tests finished so far still get their tables and pictures (no summary), then it goes on.
 void run_case(DemSimulation& sim, const std::filesystem::path& out, bool quiet, DemObserver* extra = nullptr);
 
 }  // namespace geohaz::dem
