@@ -2,10 +2,13 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <numeric>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/dem/tessellation.hpp"
@@ -146,6 +149,120 @@ void load_sample(DemSolver& s, const BondedSample& sample, const MaterialSpec& m
   s.set_joints(sample.joints);
 }
 
+namespace {
+
+/// Biaxial compression set-up: frictionless platens and side walls (the sides removed when
+/// unconfined), then consolidation by servo walls to σ_3 on all four sides. Returns the loaded
+/// sample's width and height (unconfined: the width of the discs' envelope).
+std::pair<double, double> consolidate(DemSolver& s, const LabTestSpec& spec, const BondedSample& sample,
+                                      const RunObserver& observe) {
+  s.walls = sample.packed.walls;  // bottom, right, top, left; frictionless platens and sides
+  for (auto& w : s.walls) w.friction = 0.0;
+  const bool confined = spec.confining_stress > 0;
+  if (!confined) s.walls[1].active = s.walls[3].active = false;
+  s.initialise();
+  // Consolidation to the isotropic (or lateral-only) stress σ_3.
+  if (confined) {
+    for (auto& w : s.walls) {
+      w.control = WallControl::Servo;
+      w.target_stress = spec.confining_stress;
+      w.servo_gain = 0.05;
+      w.max_speed = 5e-5 * sample.packed.discs.get<Radius>()[0] / s.time_step();
+    }
+    std::array<double, 4> acc{};
+    int nacc = 0;
+    for (int k = 1; k <= 20000; ++k) {
+      const double Wc = s.walls[1].a.x() - s.walls[3].a.x(), Hc = s.walls[2].a.y() - s.walls[0].a.y();
+      for (int q = 0; q < 4; ++q) s.walls[q].loaded_length = (q % 2 == 0) ? Wc : Hc;
+      s.step();
+      for (int q = 0; q < 4; ++q) acc[q] += s.walls[q].normal_stress(s.walls[q].loaded_length);
+      ++nacc;
+      if (k % 250 == 0) {
+        bool ok = true;
+        for (int q = 0; q < 4; ++q) {
+          const double mean = acc[q] / nacc;
+          ok = ok && std::abs(mean - spec.confining_stress) < 0.05 * spec.confining_stress;
+          s.walls[q].target_stress =
+              std::max(0.1 * spec.confining_stress, s.walls[q].target_stress + 0.7 * (spec.confining_stress - mean));
+        }
+        acc = {};
+        nacc = 0;
+        if (observe) observe(s, "consolidation");
+        if (ok) break;
+      }
+    }
+  }
+  // Loading: platens strain-controlled, lateral walls servo on σ_3.
+  for (int q : {0, 2}) {
+    s.walls[q].control = WallControl::Velocity;
+    s.walls[q].velocity = s.walls[q].servo_normal * spec.loading_velocity;
+  }
+  const double Hl = s.walls[2].a.y() - s.walls[0].a.y();
+  const double Wl = confined ? s.walls[1].a.x() - s.walls[3].a.x() : mean_envelope_width(s.discs, s.walls[0].a.y(), Hl);
+  return {Wl, Hl};
+}
+
+/// Direct tension set-up: the discs within grip_fraction × H of each end move as two kinematic
+/// grips at ∓v. Returns the gap between the grips (m).
+double grip(DemSolver& s, const LabTestSpec& spec, double H0) {
+  s.walls.clear();
+  const auto& x = s.discs.get<Position<2>>();
+  auto& kin = s.discs.get<Kinematic>();
+  auto& vel = s.discs.get<Velocity<2>>();
+  const double v = spec.loading_velocity;
+  const double g = spec.grip_fraction * H0;
+  double top_in = H0, bottom_in = 0;
+  for (std::size_t i = 0; i < s.discs.size(); ++i) {
+    if (x[i].y() < g) {
+      kin[i] = 1;
+      vel[i] = Vec2(0, -v);
+      bottom_in = std::max(bottom_in, x[i].y());
+    } else if (x[i].y() > H0 - g) {
+      kin[i] = 2;
+      vel[i] = Vec2(0, v);
+      top_in = std::min(top_in, x[i].y());
+    }
+  }
+  s.initialise();
+  return top_in - bottom_in;
+}
+
+/// Peak, deviator, E and ν (between 10 % and 50 % of the peak deviator), break counts and the
+/// crack band's inclination from the recorded curve and the AE catalogue.
+void derive_lab_numbers(const DemSolver& s, const LabTestSpec& spec, bool tension, LabTestResult& res) {
+  std::size_t ipk = 0;
+  for (std::size_t k = 0; k < res.curve.size(); ++k)
+    if (res.curve[k].axial_stress > res.curve[ipk].axial_stress) ipk = k;
+  if (!res.curve.empty()) {
+    res.peak_stress = res.curve[ipk].axial_stress;
+    res.peak_strain = res.curve[ipk].axial_strain;
+    res.confining_stress = tension ? 0.0 : res.curve[ipk].lateral_stress;
+    const double s3 = tension ? 0.0 : spec.confining_stress;
+    res.deviator_at_peak = res.peak_stress - s3;
+    std::vector<double> ea, q, el;
+    const double dev_pk = res.peak_stress - s3;
+    for (std::size_t k = 0; k <= ipk; ++k) {
+      const double dq = res.curve[k].axial_stress - s3;
+      if (dq >= 0.1 * dev_pk && dq <= 0.5 * dev_pk) {
+        ea.push_back(res.curve[k].axial_strain);
+        q.push_back(dq);
+        el.push_back(res.curve[k].lateral_strain);
+      }
+    }
+    res.youngs_modulus = ls_slope(ea, q);
+    res.poisson_ratio = tension ? 0.0 : -ls_slope(ea, el);
+  }
+  res.events = s.events;
+  std::vector<Vec2> cracks;
+  for (const auto& e : s.events) {
+    (e.mode == FailureMode::Tensile ? res.tensile_breaks : res.shear_breaks) += 1;
+    cracks.push_back(e.position);
+  }
+  res.crack_plane_angle = principal_inclination(cracks);
+}
+
+}  // namespace
+
 LabTestResult run_lab_test(const LabTestSpec& spec, const BondedSample& sample, DemSolver& s,
                            const RunObserver& observe) {
   load_sample(s, sample, spec.material);
@@ -160,73 +277,12 @@ LabTestResult run_lab_test(const LabTestSpec& spec, const BondedSample& sample, 
   res.height = H0;
   const double v = spec.loading_velocity;
   const bool tension = spec.test == LabTest::BiaxialTension;
-  const auto& x = s.discs.get<Position<2>>();
 
   double Wl = W0, Hl = H0, grip_gap = H0;
-  if (!tension) {
-    s.walls = sample.packed.walls;  // bottom, right, top, left; frictionless platens and sides
-    for (auto& w : s.walls) w.friction = 0.0;
-    const bool confined = spec.confining_stress > 0;
-    if (!confined) s.walls[1].active = s.walls[3].active = false;
-    s.initialise();
-    // Consolidation to the isotropic (or lateral-only) stress σ_3.
-    if (confined) {
-      for (auto& w : s.walls) {
-        w.control = WallControl::Servo;
-        w.target_stress = spec.confining_stress;
-        w.servo_gain = 0.05;
-        w.max_speed = 5e-5 * sample.packed.discs.get<Radius>()[0] / s.time_step();
-      }
-      std::array<double, 4> acc{};
-      int nacc = 0;
-      for (int k = 1; k <= 20000; ++k) {
-        const double Wc = s.walls[1].a.x() - s.walls[3].a.x(), Hc = s.walls[2].a.y() - s.walls[0].a.y();
-        for (int q = 0; q < 4; ++q) s.walls[q].loaded_length = (q % 2 == 0) ? Wc : Hc;
-        s.step();
-        for (int q = 0; q < 4; ++q) acc[q] += s.walls[q].normal_stress(s.walls[q].loaded_length);
-        ++nacc;
-        if (k % 250 == 0) {
-          bool ok = true;
-          for (int q = 0; q < 4; ++q) {
-            const double mean = acc[q] / nacc;
-            ok = ok && std::abs(mean - spec.confining_stress) < 0.05 * spec.confining_stress;
-            s.walls[q].target_stress =
-                std::max(0.1 * spec.confining_stress, s.walls[q].target_stress + 0.7 * (spec.confining_stress - mean));
-          }
-          acc = {};
-          nacc = 0;
-          if (observe) observe(s, "consolidation");
-          if (ok) break;
-        }
-      }
-    }
-    // Loading: platens strain-controlled, lateral walls servo on σ_3.
-    for (int q : {0, 2}) {
-      s.walls[q].control = WallControl::Velocity;
-      s.walls[q].velocity = s.walls[q].servo_normal * v;
-    }
-    Hl = s.walls[2].a.y() - s.walls[0].a.y();
-    Wl = confined ? s.walls[1].a.x() - s.walls[3].a.x() : mean_envelope_width(s.discs, s.walls[0].a.y(), Hl);
-  } else {
-    s.walls.clear();
-    auto& kin = s.discs.get<Kinematic>();
-    auto& vel = s.discs.get<Velocity<2>>();
-    const double g = spec.grip_fraction * H0;
-    double top_in = H0, bottom_in = 0;
-    for (std::size_t i = 0; i < s.discs.size(); ++i) {
-      if (x[i].y() < g) {
-        kin[i] = 1;
-        vel[i] = Vec2(0, -v);
-        bottom_in = std::max(bottom_in, x[i].y());
-      } else if (x[i].y() > H0 - g) {
-        kin[i] = 2;
-        vel[i] = Vec2(0, v);
-        top_in = std::min(top_in, x[i].y());
-      }
-    }
-    grip_gap = top_in - bottom_in;
-    s.initialise();
-  }
+  if (!tension)
+    std::tie(Wl, Hl) = consolidate(s, spec, sample, observe);
+  else
+    grip_gap = grip(s, spec, H0);
 
   const double W_start = Wl, H_start = Hl;
   const double t0 = s.time();
@@ -293,36 +349,7 @@ LabTestResult run_lab_test(const LabTestSpec& spec, const BondedSample& sample, 
     if (p.axial_strain >= spec.max_axial_strain) break;
     if (peak > 0 && p.axial_stress < spec.post_peak_stop * peak && p.axial_strain > 1.05 * peak_strain) break;
   }
-  // Derived numbers.
-  std::size_t ipk = 0;
-  for (std::size_t k = 0; k < res.curve.size(); ++k)
-    if (res.curve[k].axial_stress > res.curve[ipk].axial_stress) ipk = k;
-  if (!res.curve.empty()) {
-    res.peak_stress = res.curve[ipk].axial_stress;
-    res.peak_strain = res.curve[ipk].axial_strain;
-    res.confining_stress = tension ? 0.0 : res.curve[ipk].lateral_stress;
-    const double s3 = tension ? 0.0 : spec.confining_stress;
-    res.deviator_at_peak = res.peak_stress - s3;
-    std::vector<double> ea, q, el;
-    const double dev_pk = res.peak_stress - s3;
-    for (std::size_t k = 0; k <= ipk; ++k) {
-      const double dq = res.curve[k].axial_stress - s3;
-      if (dq >= 0.1 * dev_pk && dq <= 0.5 * dev_pk) {
-        ea.push_back(res.curve[k].axial_strain);
-        q.push_back(dq);
-        el.push_back(res.curve[k].lateral_strain);
-      }
-    }
-    res.youngs_modulus = ls_slope(ea, q);
-    res.poisson_ratio = tension ? 0.0 : -ls_slope(ea, el);
-  }
-  res.events = s.events;
-  std::vector<Vec2> cracks;
-  for (const auto& e : s.events) {
-    (e.mode == FailureMode::Tensile ? res.tensile_breaks : res.shear_breaks) += 1;
-    cracks.push_back(e.position);
-  }
-  res.crack_plane_angle = principal_inclination(cracks);
+  derive_lab_numbers(s, spec, tension, res);
   return res;
 }
 
