@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
     reader.finish();
     cfg.resolved_config = reader.resolved();
     validate(cfg);  // everything checked before the output directory is created
-    return run_in_output_dir(opts.out, "sph-slope", {cfg.restart}, [&] { return run(cfg, opts.out, opts.quiet); });
+    return run_in_output_dir(opts.out, "sph-slope", {cfg.restart}, [&] { return run_case(cfg, opts.out, opts.quiet); });
   };
   return run_config_app(argc, argv, app);
 }
