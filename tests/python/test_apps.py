@@ -1,4 +1,5 @@
-"""geohaz.sph and geohaz.dem: the apps run from Python, their exit codes as exceptions."""
+"""geohaz.dem: the app run from Python, its exit codes as exceptions (geohaz.sph runs in-process:
+test_sph.py)."""
 import pytest
 
 import geohaz
@@ -6,7 +7,6 @@ from conftest import app, app_error
 
 
 @pytest.mark.parametrize("module, name, case, bad", [
-    (geohaz.sph, "sph-slope", "sph/biaxial.toml", {"run.end_time": -1.0}),
     (geohaz.dem, "dem-avalanche", "dem/biaxial_tension.toml", {"sample.porosity": 0.9}),
     (geohaz.dem, "dem-avalanche", "dem/biaxial_tension.toml", {"no.such_key": 1}),
 ])
