@@ -21,7 +21,7 @@ def run(config, *, set=None, out=None, progress=None, progress_every=1, quiet=Tr
                     then "started", "running" (every `progress_every` main-phase steps), "finished";
                     with time (s of the phase), end_time (s), step and particles.
     quiet           False prints the app's messages and progress lines on stderr.
-    threads         OpenMP threads (0: all cores, as the app's --threads).
+    threads         OpenMP threads (0: keep the current setting, OMP_NUM_THREADS or all cores).
     particles       False leaves the particle fields out of the result.
 
     Returns a dict: "summary" (the figures of summary.json, from the same builder), "tables" ({CSV
