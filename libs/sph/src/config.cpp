@@ -28,11 +28,8 @@ WallType wall(ConfigReader& r, const char* key, const char* def) {
   return s == "fixed" ? WallType::Fixed : (s == "roller" ? WallType::Roller : WallType::None);
 }
 
-}  // namespace
-
-RunConfig read_config(ConfigReader& r, bool describe) {
-  RunConfig c;
-  c.config_source = r.source();
+/// [run] and [strength_reduction]: dimension, scenario, analysis, times, restart.
+void read_run(ConfigReader& r, RunConfig& c) {
   // [run]
   c.dimension = static_cast<int>(r.get_int("run.dimension", 2, Range::closed(2, 3), {"1", "2 (plane strain) or 3"}));
   const auto sc = r.get_choice("run.scenario", "slope", {"slope", "column", "biaxial", "section", "block"},
@@ -91,7 +88,10 @@ RunConfig read_config(ConfigReader& r, bool describe) {
                                      "skips the geostatic phase"});
   if (!restart.empty())
     c.restart = std::filesystem::path(restart).is_absolute() ? std::filesystem::path(restart) : r.base_dir() / restart;
+}
 
+/// [model] and [[material]].
+void read_model_and_materials(ConfigReader& r, RunConfig& c) {
   // [model]
   {  // the choices and their sentences come from the one name table (constitutive.hpp)
     std::vector<std::string> names;
@@ -154,7 +154,10 @@ RunConfig read_config(ConfigReader& r, bool describe) {
                        std::to_string(p.dilatancy / kDeg));
     c.materials.push_back(p);
   }
+}
 
+/// [numerics]: defaults from NumericalSettings (solver.hpp).
+void read_numerics(ConfigReader& r, RunConfig& c) {
   // [numerics]
   auto& n = c.numerics;
   const NumericalSettings d;  // the defaults (solver.hpp)
@@ -207,7 +210,11 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   }
   n.neighbour_skin = r.get("numerics.neighbour_skin", d.neighbour_skin, Range::closed(0.0, 1.0),
                            {"1", "Verlet skin in units of h (0: rebuild the neighbour list every step)"});
+}
 
+/// [geostatic] and [earthquake] (an accelerogram file is read here).
+void read_geostatic_and_earthquake(ConfigReader& r, RunConfig& c) {
+  auto& n = c.numerics;
   // [geostatic]
   c.geostatic = r.get_bool("geostatic.enabled", true, {"", "apply gravity gradually before the main phase"});
   c.geostatic_duration = r.get("geostatic.duration", 0.0, Range::non_negative(), {"s", "0: 20 H / c_p"});
@@ -239,7 +246,10 @@ RunConfig read_config(ConfigReader& r, bool describe) {
       n.earthquake = EarthquakeLoading::read_csv(p);
     }
   }
+}
 
+/// [output].
+void read_output(ConfigReader& r, RunConfig& c) {
   // [output]
   c.failed_threshold = r.get("output.failed_threshold", 0.01, Range::positive(),
                              {"m", "displacement above which soil counts as failed (failed mass, slip surface)"});
@@ -272,7 +282,11 @@ RunConfig read_config(ConfigReader& r, bool describe) {
       a = e + 1;
     }
   }
+}
 
+/// Geometry of the chosen scenario (every scenario's keys in describe mode): [slope], [piles],
+/// [column], [biaxial], [geometry].
+void read_geometry(ConfigReader& r, RunConfig& c, bool describe) {
   // Geometry of the chosen scenario.
   const bool is3d = c.dimension == 3;
   if (c.scenario == ScenarioType::Slope || describe) {
@@ -326,6 +340,10 @@ RunConfig read_config(ConfigReader& r, bool describe) {
         "geometry.periodic", c.scenario != ScenarioType::Section,
         {"", "3D: periodic across the width (SPH-slope paper 2020), else roller walls (default for a DSM section)"});
   }
+}
+
+/// [walls], [block], [clamp] and [initial_velocity].
+void read_walls_clamp_and_initial_velocity(ConfigReader& r, RunConfig& c, bool describe) {
   const bool block = c.scenario == ScenarioType::Block;
   const char* left_default = block ? "none" : "fixed";
   const char* right_default = c.scenario == ScenarioType::Column || block ? "none" : "fixed";
@@ -356,6 +374,11 @@ RunConfig read_config(ConfigReader& r, bool describe) {
     iv.root = r.get("initial_velocity.root", 0.0, {}, {"m", "cantilever_mode: x of the clamped end"});
     iv.length = r.get("initial_velocity.length", 1.0, Range::positive(), {"m", "cantilever_mode: free length"});
   }
+}
+
+/// [section]: the DSM is read and the profile extracted here (not in describe mode).
+void read_section(ConfigReader& r, RunConfig& c, bool describe) {
+  const auto& n = c.numerics;
   if (c.scenario == ScenarioType::Section || describe) {
     const auto dsm = r.get_string("section.dsm", "", {"", "DSM raster (GeoTIFF, projected CRS)"});
     const auto poly = r.get_array("section.polyline", {}, {}, {"m", "x0, y0, x1, y1, ... in the DSM CRS"});
@@ -403,6 +426,22 @@ RunConfig read_config(ConfigReader& r, bool describe) {
       c.section.terrain = std::make_shared<const Terrain>(*raster);
     }
   }
+}
+
+}  // namespace
+
+RunConfig read_config(ConfigReader& r, bool describe) {
+  RunConfig c;
+  c.config_source = r.source();
+  // The order of the calls is the order of the keys in --help-config and config.resolved.toml.
+  read_run(r, c);
+  read_model_and_materials(r, c);
+  read_numerics(r, c);
+  read_geostatic_and_earthquake(r, c);
+  read_output(r, c);
+  read_geometry(r, c, describe);
+  read_walls_clamp_and_initial_velocity(r, c, describe);
+  read_section(r, c, describe);
   return c;
 }
 
