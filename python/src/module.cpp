@@ -1,8 +1,8 @@
 // The compiled part of the Python package `geohaz` (python/geohaz/): the exceptions and an
-// in-process debris-runout run. The Python side (python/geohaz/runout.py) turns keyword arguments
-// into the same config overrides as the app's flags; this file reads the config with the model's
-// own key declarations (runout::read_case), runs through libs/runout/run.hpp, and hands the maps,
-// particles, series and summary back as NumPy arrays and dicts.
+// in-process debris-runout run (the in-process sph-slope run is in sph.cpp). The Python side (python/geohaz/runout.py)
+// turns keyword arguments into the same config overrides as the app's flags; this file reads the config with the
+// model's own key declarations (runout::read_case), runs through libs/runout/run.hpp, and hands the maps, particles,
+// series and summary back as NumPy arrays and dicts.
 //
 // The GIL is released for the whole run; it is taken back only to call a progress callback (when
 // one is given) and, every few hundred steps, to let Ctrl-C interrupt the run.
@@ -35,6 +35,11 @@ namespace py = pybind11;
 namespace fs = std::filesystem;
 using namespace geohaz;
 using namespace geohaz::runout;
+
+namespace geohaz::python {
+/// The sph-slope functions (python/src/sph.cpp).
+void add_sph(py::module_& m);
+}  // namespace geohaz::python
 
 namespace {
 
@@ -330,5 +335,6 @@ PYBIND11_MODULE(_geohaz, m) {
   m.def("ensemble_run", &ensemble_run, py::arg("config"), py::arg("overrides"), py::arg("out"), py::arg("threads"),
         py::arg("quiet"));
   m.def("ensemble_help_config", &ensemble_help_config);
+  geohaz::python::add_sph(m);
   register_dem(m);
 }

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
+#include <string_view>
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/handoff.hpp"
@@ -499,16 +500,18 @@ class StructureReport {
     // Units per unit thickness in plane strain (the 2D model is per metre out of the plane).
     const char* f = Dim == 2 ? "_N_per_m" : "_N";
     const char* m = Dim == 2 ? "_Nm_per_m" : "_Nm";
-    csv_ << "time_s";
+    auto& col = rows_.columns;
+    col.emplace_back("time_s");
     for (const std::size_t k : shown_) {
       const std::string& n = table_[k].name;
-      if constexpr (Dim == 2)
-        csv_ << ',' << n << "_Fx" << f << ',' << n << "_Fz" << f << ',' << n << "_My" << m;
-      else
-        csv_ << ',' << n << "_Fx" << f << ',' << n << "_Fy" << f << ',' << n << "_Fz" << f << ',' << n << "_Mx" << m
-             << ',' << n << "_My" << m << ',' << n << "_Mz" << m;
+      if constexpr (Dim == 2) {
+        for (const char* a : {"_Fx", "_Fz"}) col.push_back(n + a + f);
+        col.push_back(n + "_My" + m);
+      } else {
+        for (const char* a : {"_Fx", "_Fy", "_Fz"}) col.push_back(n + a + f);
+        for (const char* a : {"_Mx", "_My", "_Mz"}) col.push_back(n + a + m);
+      }
     }
-    csv_ << '\n';
   }
   bool empty() const noexcept { return shown_.empty(); }
   /// Every step: the peaks (resultant |F|, normal force F·n, moment |M|) and their times.
@@ -527,20 +530,21 @@ class StructureReport {
   /// state at rest after the geostatic phase, before any main-phase step).
   void record(double t, const std::vector<StructureLoad<Dim>>& loads) {
     observe(t, loads);
-    csv_ << csv_number(t);
+    std::vector<double> row{t};
     for (std::size_t q = 0; q < shown_.size(); ++q) {
       const auto& l = loads[shown_[q]];
-      for (int d = 0; d < Dim; ++d) csv_ << ',' << csv_number(l.force[d]);
+      for (int d = 0; d < Dim; ++d) row.push_back(l.force[d]);
       if constexpr (Dim == 2)
-        csv_ << ',' << csv_number(l.moment[1]);
+        row.push_back(l.moment[1]);
       else
-        csv_ << ',' << csv_number(l.moment[0]) << ',' << csv_number(l.moment[1]) << ',' << csv_number(l.moment[2]);
+        row.insert(row.end(), {l.moment[0], l.moment[1], l.moment[2]});
       normal_[q].push_back(l.force.dot(table_[shown_[q]].normal));
     }
-    csv_ << '\n';
+    rows_.rows.push_back(std::move(row));
     times_.push_back(t);
   }
-  std::string csv() const { return csv_.str(); }
+  /// The rows of structure_forces.csv.
+  const Table& table() const noexcept { return rows_; }
   /// The `structures` block of summary.json.
   nlohmann::json summary() const {
     const std::string f = Dim == 2 ? "_N_per_m" : "_N", m = Dim == 2 ? "_Nm_per_m" : "_Nm";
@@ -595,373 +599,10 @@ class StructureReport {
   std::vector<Structure<Dim>> table_;
   std::vector<std::size_t> shown_;
   std::vector<Peak> peaks_;
-  std::ostringstream csv_;
+  Table rows_;
   std::vector<double> times_;
   std::vector<std::vector<double>> normal_;  // F·n per reported structure, per row
 };
-
-template <int Dim>
-int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
-  auto wall0 = std::chrono::steady_clock::now();
-  Built<Dim> b = build<Dim>(c);
-  const auto settings = settings_for<Dim>(c, b.sc);
-  const std::size_t soil_count = b.sc.soil_count, boundary_count = b.sc.boundary_count;
-  const double href = b.sc.reference_height;
-  SphSolver<Dim> solver(std::move(b.sc.store), c.materials, c.model, settings);
-  // Loads on the structures, tracked from the geostatic phase on: the first row is the state at rest.
-  StructureReport<Dim> structures(b.sc.structures, reported_structures(c, b.sc.structures));
-  if (!structures.empty()) {
-    std::vector<Vec<Dim>> bases;
-    for (const auto& s : b.sc.structures) bases.push_back(s.base);
-    solver.track_structures(std::move(bases));
-  }
-  bool have_loads = false;  // the loads of a step exist (not before the first step of a restart)
-  const auto& mats = solver.materials();
-  std::vector<double> rho0;
-  for (const auto& m : mats) rho0.push_back(m.density);
-  const double cmax = solver.max_wave_speed();
-  if (!quiet) {
-    std::fprintf(stderr, "sph-slope: %dD %s, %zu soil + %zu boundary particles, h = %.4g m, model %s\n", Dim,
-                 scenario_name(c.scenario), soil_count, boundary_count, solver.smoothing_length(),
-                 solver.model_name().c_str());
-    for (std::size_t k = 0; k < mats.size(); ++k)
-      std::fprintf(stderr, "  material %zu (%s): c_p = %.4g m/s, DP fit %s, %s %s\n", k,
-                   k < c.material_names.size() ? c.material_names[k].c_str() : "", mats[k].p_wave_speed,
-                   mats[k].fit == DruckerPragerFit::PlaneStrain ? "plane_strain" : "compression_3d",
-                   solver.model_name().c_str(), model_parameters(c.model, mats[k]).dump().c_str());
-  }
-
-  make_output_dir(out);
-  write_text_file(out / "config.resolved.toml", c.resolved_config);
-  SnapshotWriter snaps(out / "snapshots.h5", "sph-slope", Dim, c.resolved_config);
-  snaps.set_attribute("scenario", scenario_name(c.scenario));
-  snaps.set_attribute("units", "SI: m, s, kg, Pa");
-  if (c.scenario == ScenarioType::Section && !c.section.crs_wkt.empty())
-    snaps.set_attribute("crs_wkt", c.section.crs_wkt);
-
-  nlohmann::json summary;
-  summary["scenario"] = scenario_name(c.scenario);
-  summary["dimension"] = Dim;
-  summary["model"] = solver.model_name();
-  summary["config"] = c.config_source;
-  summary["soil_particles"] = soil_count;
-  summary["boundary_particles"] = boundary_count;
-  summary["spacing_m"] = c.numerics.spacing;
-  summary["smoothing_length_m"] = solver.smoothing_length();
-  for (std::size_t k = 0; k < mats.size(); ++k) {
-    nlohmann::json e = {{"name", k < c.material_names.size() ? c.material_names[k] : ""},
-                        {"p_wave_speed_m_per_s", mats[k].p_wave_speed},
-                        {"dp_fit", mats[k].fit == DruckerPragerFit::PlaneStrain ? "plane_strain" : "compression_3d"}};
-    e.update(model_parameters(c.model, mats[k]));
-    summary["materials"].push_back(e);
-  }
-
-  // Geostatic phase or restart.
-  std::int64_t step_offset = 0;
-  if (!c.restart.empty()) {
-    const Restart rs = load_restart<Dim>(c.restart, solver.store());
-    // With the solver state the run continues exactly as the one that wrote the file; without it
-    // (files of older versions) from the snapshot's particles, with Δt from the wave speed and a
-    // fresh neighbour list: the same physics, another round-off.
-    if (rs.state)
-      solver.resume(*rs.state);
-    else
-      solver.set_time(rs.time);
-    step_offset = rs.state ? 0 : rs.step;
-    summary["restart"] = {
-        {"file", c.restart.string()}, {"time_s", rs.time}, {"step", rs.step}, {"exact", rs.state.has_value()}};
-  } else if (c.geostatic && c.scenario != ScenarioType::Biaxial) {
-    const double dur = c.geostatic_duration > 0.0 ? c.geostatic_duration : 20.0 * href / cmax;
-    ProgressReporter prog("sph-slope geostatic", dur, quiet);
-    std::int64_t k = 0;
-    const auto rep = solver.apply_gravity_gradually(dur, c.geostatic_damping, c.geostatic_elastic, [&] {
-      if (++k % 50 == 0) prog.update(solver.time(), k, solver.store().size());
-    });
-    prog.finish(dur, rep.steps, solver.store().size());
-    have_loads = rep.steps > 0;
-    const double tol = c.rest_tolerance * std::sqrt(c.numerics.gravity * href);
-    const bool at_rest = rep.max_speed < tol;
-    summary["geostatic"] = {{"duration_s", dur},
-                            {"steps", rep.steps},
-                            {"max_speed_m_per_s", rep.max_speed},
-                            {"rest_tolerance_m_per_s", tol},
-                            {"at_rest", at_rest}};
-    if (!quiet)
-      std::fprintf(stderr, "sph-slope: geostatic phase %.4g s (%lld steps): max speed %.3g m/s -> %s\n", dur,
-                   static_cast<long long>(rep.steps), rep.max_speed,
-                   at_rest ? "at rest" : "NOT at rest (see summary.json)");
-  }
-  if (c.scenario == ScenarioType::Biaxial) {
-    // Platens move towards each other (compression) or apart (tension) at ε̇ H / 2 each.
-    auto& S = solver.store();
-    const double vp = 0.5 * c.biaxial_strain_rate * c.biaxial.height;
-    for (std::size_t i = 0; i < S.size(); ++i) {
-      if (S.template get<ParticleKind>()[i] == kSoil) continue;
-      const bool top = S.template get<Position<Dim>>()[i][Dim - 1] > 0.5 * c.biaxial.height;
-      S.template get<Velocity<Dim>>()[i].setZero();
-      S.template get<Velocity<Dim>>()[i][Dim - 1] = top ? -vp : vp;
-    }
-  }
-
-  if (c.restart.empty()) set_initial_velocity<Dim>(c, solver.store());
-  // With clamped regions: the free end's particles (initial x within Δx/2 of the largest soil x,
-  // not clamped), whose mean vertical displacement is the series' tip_displacement_m.
-  std::vector<std::uint8_t> free_end;
-  if (!c.clamp_boxes.empty()) {
-    const auto& S = solver.store();
-    const auto& x = S.template get<Position<Dim>>();
-    const auto& u = S.template get<Displacement<Dim>>();
-    const auto& id = S.template get<ParticleId>();
-    double xmax = -1e300;
-    std::int64_t idmax = 0;
-    for (std::size_t i = 0; i < S.size(); ++i) {
-      idmax = std::max(idmax, id[i]);
-      if (S.template get<ParticleKind>()[i] == kSoil) xmax = std::max(xmax, x[i][0] - u[i][0]);
-    }
-    free_end.assign(static_cast<std::size_t>(idmax) + 1, 0);
-    for (std::size_t i = 0; i < S.size(); ++i)
-      if (S.template get<ParticleKind>()[i] == kSoil && !S.template get<Clamped>()[i] &&
-          x[i][0] - u[i][0] >= xmax - 0.5 * c.numerics.spacing)
-        free_end[static_cast<std::size_t>(id[i])] = 1;
-  }
-  auto tip_displacement = [&] {
-    const auto& S = solver.store();
-    const auto& id = S.template get<ParticleId>();
-    double sum = 0.0;
-    int count = 0;
-    for (std::size_t i = 0; i < S.size(); ++i)
-      if (free_end[static_cast<std::size_t>(id[i])]) {
-        sum += S.template get<Displacement<Dim>>()[i][Dim - 1];
-        ++count;
-      }
-    return sum / std::max(count, 1);
-  };
-
-  // Main phase.
-  write_snapshot<Dim>(snaps, solver, step_offset);
-  std::ostringstream series;
-  series << "time_s,front_m,tip_m,runout_m,normalised_runout,max_speed_m_per_s,mean_speed_m_per_s,kinetic_energy_J,"
-            "plastic_fraction,max_displacement_m,earthquake_acceleration_m_per_s2"
-         << (free_end.empty() ? "" : ",tip_displacement_m") << '\n';
-  std::ostringstream biax;
-  biax << "time_s,axial_strain,sigma_axial_Pa,sigma_lateral_Pa,deviator_Pa\n";
-  auto png_times = c.velocity_png_times;
-  std::sort(png_times.begin(), png_times.end());
-  std::size_t next_png = 0;
-  double next_out = solver.time(), next_snap = solver.time() + c.snapshot_interval;
-  double max_speed_run = 0.0, max_runout = 0.0, last_moving = solver.time();
-  const double t_start = solver.time();
-  ProgressReporter prog("sph-slope", c.end_time, quiet);
-  auto record = [&] {
-    const auto r = series_row(solver.store(), b.frame);
-    double runout = r.runout, nrun = r.normalised_runout;
-    if (c.scenario == ScenarioType::Section) {
-      runout = 0.0;
-      for (const auto& u : solver.store().template get<Displacement<Dim>>()) runout = std::max(runout, std::abs(u[0]));
-      nrun = runout / b.frame.base_length;
-    }
-    max_runout = std::max(max_runout, runout);
-    if (have_loads && !structures.empty()) structures.record(solver.time(), solver.structure_loads());
-    series << csv_number(solver.time()) << ',' << csv_number(r.front) << ',' << csv_number(r.tip) << ','
-           << csv_number(runout) << ',' << csv_number(nrun) << ',' << csv_number(r.max_speed) << ','
-           << csv_number(r.mean_speed) << ',' << csv_number(r.kinetic_energy) << ',' << csv_number(r.plastic_fraction)
-           << ',' << csv_number(r.max_displacement) << ',' << csv_number(settings.earthquake.horizontal(solver.time()));
-    if (!free_end.empty()) series << ',' << csv_number(tip_displacement());
-    series << '\n';
-    if (c.scenario == ScenarioType::Biaxial) {
-      const auto& S = solver.store();
-      double sa = 0, sl = 0;
-      int n = 0;
-      for (std::size_t i = 0; i < S.size(); ++i)
-        if (S.template get<ParticleKind>()[i] == kSoil) {
-          sa += S.template get<Stress>()[i](Dim - 1, Dim - 1);
-          sl += S.template get<Stress>()[i](0, 0);
-          ++n;
-        }
-      sa /= std::max(n, 1);
-      sl /= std::max(n, 1);
-      biax << csv_number(solver.time()) << ',' << csv_number(c.biaxial_strain_rate * solver.time()) << ','
-           << csv_number(sa) << ',' << csv_number(sl) << ',' << csv_number(sa - sl) << '\n';
-    }
-    return r;
-  };
-  auto speed_field = [&] {
-    std::vector<double> v(solver.store().size());
-    for (std::size_t i = 0; i < v.size(); ++i) v[i] = solver.store().template get<Velocity<Dim>>()[i].norm();
-    return v;
-  };
-  bool stopped_at_rest = false;
-  try {
-    while (solver.time() < c.end_time - 1e-12) {
-      if (solver.time() >= next_out - 1e-12) {
-        record();
-        next_out += c.output_interval;
-      }
-      while (next_png < png_times.size() && solver.time() >= png_times[next_png] - 1e-12) {
-        auto v = speed_field();
-        const double vm = *std::max_element(v.begin(), v.end());
-        std::ostringstream name;
-        name << "velocity_t" << std::fixed << std::setprecision(3) << png_times[next_png] << ".png";
-        draw_particles<Dim>(out / name.str(), solver.store(), v, vm, c.numerics.spacing, "speed (m/s)");
-        ++next_png;
-      }
-      solver.step();
-      have_loads = true;
-      if (!structures.empty()) structures.observe(solver.time(), solver.structure_loads());
-      const double vmax = solver.last_stats().max_speed;
-      max_speed_run = std::max(max_speed_run, vmax);
-      if (vmax > c.rest_speed) last_moving = solver.time();
-      prog.update(solver.time(), solver.step_count(), solver.store().size());
-      if (c.snapshot_interval > 0.0 && solver.time() >= next_snap - 1e-12) {
-        write_snapshot<Dim>(snaps, solver, step_offset + solver.step_count());
-        next_snap += c.snapshot_interval;
-      }
-      if (c.stop_at_rest && solver.time() - t_start > std::max(0.05, 0.1 * c.end_time) && vmax < c.rest_speed &&
-          solver.time() > settings.earthquake.end_time()) {
-        stopped_at_rest = true;
-        break;
-      }
-    }
-  } catch (const SimulationError&) {
-    write_text_file(out / "series.csv", series.str());
-    if (!structures.empty()) write_text_file(out / "structure_forces.csv", structures.csv());
-    throw;
-  }
-  prog.finish(solver.time(), solver.step_count(), solver.store().size());
-  const auto last = record();
-  write_snapshot<Dim>(snaps, solver, step_offset + solver.step_count());
-  write_text_file(out / "series.csv", series.str());
-  if (!structures.empty()) {
-    write_text_file(out / "structure_forces.csv", structures.csv());
-    structures.plot(out / "structure_forces.png");
-    summary["structures"] = structures.summary();
-  }
-  if (c.scenario == ScenarioType::Biaxial) write_text_file(out / "stress_strain.csv", biax.str());
-
-  // Free surface and slip surface.
-  {
-    std::ostringstream os;
-    os << "x_m,z_m\n";
-    for (const auto& p : free_surface(solver.store(), c.numerics.spacing))
-      os << csv_number(p[0]) << ',' << csv_number(p[1]) << '\n';
-    write_text_file(out / "surface_final.csv", os.str());
-    std::ostringstream ss;
-    ss << "x_m,z_m\n";
-    for (const auto& p : slip_surface(solver.store(), c.numerics.spacing, c.failed_threshold))
-      ss << csv_number(p[0]) << ',' << csv_number(p[1]) << '\n';
-    write_text_file(out / "slip_surface.csv", ss.str());
-  }
-  // Quick-look of the final state coloured by displacement.
-  double umax = 0.0;
-  {
-    std::vector<double> u(solver.store().size());
-    for (std::size_t i = 0; i < u.size(); ++i) {
-      u[i] = solver.store().template get<Displacement<Dim>>()[i].norm();
-      if (solver.store().template get<ParticleKind>()[i] == kSoil) umax = std::max(umax, u[i]);
-    }
-    draw_particles<Dim>(out / "final_displacement.png", solver.store(), u, umax, c.numerics.spacing,
-                        "displacement (m)");
-    const auto& ep = solver.store().template get<PlasticStrain>();
-    const double epmax = ep.empty() ? 0.0 : *std::max_element(ep.begin(), ep.end());
-    draw_particles<Dim>(out / "final_plastic_strain.png", solver.store(), ep, epmax, c.numerics.spacing,
-                        "accumulated plastic strain (1)");
-    summary["max_plastic_strain"] = epmax;
-  }
-  const auto fm = failed_mass(solver.store(), rho0, c.failed_threshold);
-  summary["end_time_s"] = solver.time();
-  summary["steps"] = solver.step_count();
-  summary["stopped_at_rest"] = stopped_at_rest;
-  summary["runout_m"] = c.scenario == ScenarioType::Section ? max_runout : last.runout;
-  summary["normalised_runout"] =
-      c.scenario == ScenarioType::Section ? max_runout / b.frame.base_length : last.normalised_runout;
-  summary["front_m"] = last.front;
-  summary["tip_m"] = last.tip;
-  summary["max_runout_m"] = max_runout;
-  summary["max_speed_m_per_s"] = max_speed_run;
-  summary["final_max_speed_m_per_s"] = last.max_speed;
-  summary["max_displacement_m"] = umax;
-  summary["failed_threshold_m"] = c.failed_threshold;
-  summary["front_thickness_m"] =
-      b.frame.front_thickness > 0.0 ? b.frame.front_thickness : b.frame.front_min_layers * b.frame.spacing;
-  summary["failed_particles"] = fm.count;
-  if (Dim == 2)
-    summary["failed_area_m2_per_m"] = fm.volume;
-  else
-    summary["failed_volume_m3"] = fm.volume;
-  summary["time_to_rest_s"] =
-      last.max_speed < c.rest_speed ? nlohmann::json(last_moving - t_start) : nlohmann::json(nullptr);
-  summary["rest_speed_m_per_s"] = c.rest_speed;
-  summary["bytes_per_particle"] = solver.bytes_per_particle();
-
-  // Failed mass for debris-runout (docs/handoff.md): only when the section is georeferenced.
-  // 2D: each plane-strain particle of area A becomes k = W/Δx map points spread across the width W,
-  // each of volume A·W/k. 3D: each particle is one map point (its position on the strip) carrying
-  // its own volume m/ρ0.
-  if (c.scenario == ScenarioType::Section && c.write_release) {
-    const auto& P = c.section.profile;
-    const auto& S = solver.store();
-    std::vector<Vec2> pts;
-    std::vector<double> vols;
-    double total = 0.0;
-    const double W = Dim == 2 ? c.section.release_width : strip_width(c);
-    const int k = Dim == 2 ? std::max(1, static_cast<int>(std::lround(W / c.numerics.spacing))) : 1;
-    for (std::size_t i = 0; i < S.size(); ++i) {
-      if (S.template get<ParticleKind>()[i] != kSoil) continue;
-      if (S.template get<Displacement<Dim>>()[i].norm() <= c.failed_threshold) continue;
-      const Vec<Dim>& x = S.template get<Position<Dim>>()[i];
-      const double vol = S.template get<Mass>()[i] / rho0[static_cast<std::size_t>(S.template get<MaterialId>()[i])] *
-                         (Dim == 2 ? W / k : 1.0) * c.bulking_factor;
-      for (int q = 0; q < k; ++q) {
-        const double t = Dim == 2 ? -0.5 * W + (q + 0.5) * W / k : x[1] - 0.5 * W;
-        pts.push_back(section_map_point(P, x[0], t));
-        vols.push_back(vol);
-        total += vol;
-      }
-    }
-    std::ostringstream src;
-    src << c.config_source << "; " << Dim << "D section; displacement > " << c.failed_threshold << " m; width " << W
-        << " m";
-    const Handoff handoff{
-        pts, vols, c.section.crs_wkt, src.str(), c.bulking_factor, solver.time(), solver.step_count()};
-    write_handoff(out / "release.h5", handoff, c.resolved_config);
-    summary["release"] = {{"file", "release.h5"}, {"points", pts.size()}, {"total_volume_m3", total}, {"width_m", W}};
-    if (c.section.dsm) {
-      // Nodata where the DSM has none (-9999, as the debris-runout maps), a band description and
-      // unit, and a QGIS style beside it, like every GeoTIFF geohaz writes (issue #16).
-      constexpr double kNodata = -9999.0;
-      const Raster& dsm = *c.section.dsm;
-      Raster th = dsm.like(0.0, kNodata);
-      th.description = "release thickness: failed volume per cell area (sph-slope section)";
-      th.unit = "m";
-      for (std::size_t k = 0; k < th.data.size(); ++k)
-        if (dsm.is_nodata(dsm.data[k])) th.data[k] = kNodata;
-      const double cell = th.cell_size_x() * th.cell_size_y();
-      double binned = 0.0;
-      for (std::size_t q = 0; q < pts.size(); ++q) {
-        const Vec2 px = th.to_pixel(pts[q]);
-        const int col = static_cast<int>(std::lround(px.x())), row = static_cast<int>(std::lround(px.y()));
-        if (col < 0 || row < 0 || col >= th.nx || row >= th.ny || th.at(col, row) == kNodata) continue;
-        th.at(col, row) += vols[q] / cell;
-        binned += vols[q];
-      }
-      write_geotiff(out / "release_thickness.tif", th);
-      double vmax = 0.0;
-      for (double v : th.data)
-        if (v != kNodata) vmax = std::max(vmax, v);
-      write_qgis_ramp_style(out / "release_thickness.qml", ColourRamp::Viridis, 0.0, vmax > 0.0 ? vmax : 1.0, "m", 0.0);
-      summary["release"]["thickness_style"] = "release_thickness.qml";
-      summary["release"]["thickness_raster"] = "release_thickness.tif";
-      summary["release"]["volume_on_raster_m3"] = binned;
-    }
-  }
-  summary["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  write_text_file(out / "summary.json", summary.dump(2) + "\n");
-  if (!quiet)
-    std::fprintf(stderr, "sph-slope: t = %.4g s, run-out %.4g m (normalised %.4g), failed %s %.4g, outputs in %s\n",
-                 solver.time(), summary["runout_m"].get<double>(), summary["normalised_runout"].get<double>(),
-                 Dim == 2 ? "area (m^2/m)" : "volume (m^3)", fm.volume, out.string().c_str());
-  return 0;
-}
 
 /// Every material with c/F, atan(tan φ/F) and atan(tan ψ/F) (strength reduction).
 std::vector<MaterialParams> reduced_strength(const std::vector<MaterialParams>& mats, double F) {
@@ -1013,210 +654,896 @@ BishopResult bishop_of(const RunConfig& c) {
   return bishop_critical_circle(SlopeSection::from_profile(d, soils));
 }
 
-/// Factor of safety by strength reduction (docs/sph.md, "Factor of safety by strength reduction").
+/// The table of a list of (x, z) points ("x_m,z_m": a surface or a circle).
+Table xz_table(const std::vector<std::array<double, 2>>& points) {
+  Table t{{"x_m", "z_m"}, {}, {}};
+  for (const auto& p : points) t.rows.push_back({p[0], p[1]});
+  return t;
+}
+
+/// The fields of a store as flat arrays (ParticleFields).
 template <int Dim>
-int run_strength_reduction(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
-  const auto wall0 = std::chrono::steady_clock::now();
-  Built<Dim> b = build<Dim>(c);
-  auto settings = settings_for<Dim>(c, b.sc);
-  settings.earthquake = EarthquakeLoading{};  // gravity only
-  settings.damping = c.srm.damping;
-  const double href = b.sc.reference_height;
-  SphSolver<Dim> geo(std::move(b.sc.store), c.materials, c.model, settings);
-  const double cmax = geo.max_wave_speed();
-  make_output_dir(out);
-  write_text_file(out / "config.resolved.toml", c.resolved_config);
-  nlohmann::json summary;
-  summary["analysis"] = "strength_reduction";
-  summary["scenario"] = scenario_name(c.scenario);
-  summary["dimension"] = Dim;
-  summary["model"] = geo.model_name();
-  summary["config"] = c.config_source;
-  summary["soil_particles"] = b.sc.soil_count;
-  summary["spacing_m"] = c.numerics.spacing;
+ParticleFields fields_of(const SphStore<Dim>& s) {
+  ParticleFields f;
+  f.dimension = Dim;
+  f.count = s.size();
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    for (int d = 0; d < Dim; ++d) {
+      f.position.push_back(s.template get<Position<Dim>>()[i][d]);
+      f.velocity.push_back(s.template get<Velocity<Dim>>()[i][d]);
+      f.displacement.push_back(s.template get<Displacement<Dim>>()[i][d]);
+    }
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) f.stress.push_back(s.template get<Stress>()[i](a, b));
+  }
+  f.plastic_strain = s.template get<PlasticStrain>();
+  f.density = s.template get<Density>();
+  f.mass = s.template get<Mass>();
+  f.material_id = s.template get<MaterialId>();
+  f.kind = s.template get<ParticleKind>();
+  f.id = s.template get<ParticleId>();
+  return f;
+}
 
-  // The geostatic state every trial starts from.
-  if (!c.restart.empty()) {
-    const Restart rs = load_restart<Dim>(c.restart, geo.store());
-    for (auto& v : geo.store().template get<Velocity<Dim>>()) v.setZero();
-    for (auto& u : geo.store().template get<Displacement<Dim>>()) u.setZero();
-    summary["restart"] = {{"file", c.restart.string()}, {"time_s", rs.time}};
+/// The summary's description of the run's particles and materials (both analyses).
+template <int Dim>
+nlohmann::json summary_header(const RunConfig& c, const SphSolver<Dim>& solver, std::size_t soil_count) {
+  nlohmann::json s;
+  s["scenario"] = scenario_name(c.scenario);
+  s["dimension"] = Dim;
+  s["model"] = solver.model_name();
+  s["config"] = c.config_source;
+  s["soil_particles"] = soil_count;
+  s["spacing_m"] = c.numerics.spacing;
+  return s;
+}
+
+}  // namespace
+
+/// What a simulation is, whatever its dimension and analysis: the dynamic run or the strength
+/// reduction, in 2D or 3D. Called once per phase or output, never per particle.
+class SimulationModel {
+ public:
+  virtual ~SimulationModel() = default;
+  virtual void run(const SphSimulation& self, RunObserver* obs) = 0;
+  virtual double time() const = 0;
+  virtual std::int64_t step_count() const = 0;
+  virtual std::size_t particle_count() const = 0;
+  virtual bool main_phase_started() const = 0;
+  virtual nlohmann::json summary() const = 0;
+  virtual std::vector<NamedTable> tables() const = 0;
+  virtual ParticleFields particles() const = 0;
+  /// The state a snapshot shows now (SphRunFiles: at the start, at snapshot times, at the end).
+  virtual void write_snapshot(SnapshotWriter& w) const = 0;
+  /// Quick-look PNGs whose time has come (before a main-phase step).
+  virtual void draw_due_pngs(const std::filesystem::path& out) = 0;
+  /// Every output of a finished run into `out`; a line on stderr unless quiet.
+  virtual void write_outputs(const std::filesystem::path& out) const = 0;
+  /// After a SimulationError in the main phase: the series so far.
+  virtual void write_partial(const std::filesystem::path& out) const = 0;
+};
+
+struct SphSimulation::Impl {
+  std::unique_ptr<SimulationModel> model;
+};
+
+namespace {
+
+/// The failed mass handed to debris-runout (docs/handoff.md) and, on the DSM grid, its thickness.
+struct ReleaseOutput {
+  Handoff handoff;
+  double total = 0.0, width = 0.0;  ///< m³, m
+  std::optional<Raster> thickness;  ///< release_thickness.tif (when the DSM is known)
+  double binned = 0.0, max_thickness = 0.0;
+};
+
+/// A run in time: the geostatic phase (or a restart), then the main phase with its series,
+/// structure loads, quick-looks and the summary's figures (docs/sph.md).
+template <int Dim>
+class DynamicRun final : public SimulationModel {
+ public:
+  DynamicRun(const RunConfig& c, bool quiet);
+  void run(const SphSimulation& self, RunObserver* obs) override;
+  double time() const override { return solver_.time(); }
+  std::int64_t step_count() const override { return solver_.step_count(); }
+  std::size_t particle_count() const override { return solver_.store().size(); }
+  bool main_phase_started() const override { return main_started_; }
+  nlohmann::json summary() const override { return summary_with(release()); }
+  std::vector<NamedTable> tables() const override;
+  ParticleFields particles() const override { return fields_of(solver_.store()); }
+  void write_snapshot(SnapshotWriter& w) const override {
+    sph::write_snapshot<Dim>(w, solver_, step_offset_ + solver_.step_count());
+  }
+  void draw_due_pngs(const std::filesystem::path& out) override;
+  void write_outputs(const std::filesystem::path& out) const override;
+  void write_partial(const std::filesystem::path& out) const override;
+
+ private:
+  void print_header() const;
+  void load_restart_state();
+  void geostatic_phase(const SphSimulation& self, RunObserver* obs);
+  void move_platens();
+  void mark_free_end();
+  double tip_displacement() const;
+  void start_main_phase();
+  void main_phase(const SphSimulation& self, RunObserver* obs);
+  SeriesRow record();
+  void record_biaxial();
+  void write_pictures(const std::filesystem::path& out) const;
+  ReleaseOutput release() const;
+  void write_release(const std::filesystem::path& out, const ReleaseOutput& r) const;
+  nlohmann::json summary_with(const ReleaseOutput& r) const;
+
+  const RunConfig& c_;
+  bool quiet_;
+  std::chrono::steady_clock::time_point wall0_;
+  Built<Dim> b_;
+  SolverSettings<Dim> settings_;
+  std::size_t soil_count_, boundary_count_;
+  double href_;
+  SphSolver<Dim> solver_;
+  StructureReport<Dim> structures_;
+  std::vector<double> rho0_;
+  bool have_loads_ = false;  // the loads of a step exist (not before the first step of a restart)
+  std::int64_t step_offset_ = 0;
+  nlohmann::json phase_summary_ = nlohmann::json::object();  // "restart" or "geostatic"
+  // With clamped regions: the free end's particles by id (tip_displacement_m).
+  std::vector<std::uint8_t> free_end_;
+  bool main_started_ = false, finished_ = false, stopped_at_rest_ = false;
+  Table series_, biaxial_;
+  std::vector<double> png_times_;
+  std::size_t next_png_ = 0;
+  double next_out_ = 0.0, max_speed_run_ = 0.0, max_runout_ = 0.0, last_moving_ = 0.0, t_start_ = 0.0;
+  SeriesRow last_;
+};
+
+template <int Dim>
+DynamicRun<Dim>::DynamicRun(const RunConfig& c, bool quiet)
+    : c_(c),
+      quiet_(quiet),
+      wall0_(std::chrono::steady_clock::now()),
+      b_(build<Dim>(c)),
+      settings_(settings_for<Dim>(c, b_.sc)),
+      soil_count_(b_.sc.soil_count),
+      boundary_count_(b_.sc.boundary_count),
+      href_(b_.sc.reference_height),
+      solver_(std::move(b_.sc.store), c.materials, c.model, settings_),
+      // Loads on the structures, tracked from the geostatic phase on: the first row is the state at rest.
+      structures_(b_.sc.structures, reported_structures(c, b_.sc.structures)) {
+  if (!structures_.empty()) {
+    std::vector<Vec<Dim>> bases;
+    for (const auto& s : b_.sc.structures) bases.push_back(s.base);
+    solver_.track_structures(std::move(bases));
+  }
+  for (const auto& m : solver_.materials()) rho0_.push_back(m.density);
+  if (!quiet_) print_header();
+}
+
+template <int Dim>
+void DynamicRun<Dim>::print_header() const {
+  const auto& mats = solver_.materials();
+  std::fprintf(stderr, "sph-slope: %dD %s, %zu soil + %zu boundary particles, h = %.4g m, model %s\n", Dim,
+               scenario_name(c_.scenario), soil_count_, boundary_count_, solver_.smoothing_length(),
+               solver_.model_name().c_str());
+  for (std::size_t k = 0; k < mats.size(); ++k)
+    std::fprintf(stderr, "  material %zu (%s): c_p = %.4g m/s, DP fit %s, %s %s\n", k,
+                 k < c_.material_names.size() ? c_.material_names[k].c_str() : "", mats[k].p_wave_speed,
+                 mats[k].fit == DruckerPragerFit::PlaneStrain ? "plane_strain" : "compression_3d",
+                 solver_.model_name().c_str(), model_parameters(c_.model, mats[k]).dump().c_str());
+}
+
+template <int Dim>
+void DynamicRun<Dim>::run(const SphSimulation& self, RunObserver* obs) {
+  if (!c_.restart.empty())
+    load_restart_state();
+  else if (c_.geostatic && c_.scenario != ScenarioType::Biaxial)
+    geostatic_phase(self, obs);
+  if (c_.scenario == ScenarioType::Biaxial) move_platens();
+  if (c_.restart.empty()) set_initial_velocity<Dim>(c_, solver_.store());
+  mark_free_end();
+  start_main_phase();
+  if (obs) obs->started(self);
+  main_phase(self, obs);
+}
+
+template <int Dim>
+void DynamicRun<Dim>::load_restart_state() {
+  const Restart rs = load_restart<Dim>(c_.restart, solver_.store());
+  // With the solver state the run continues exactly as the one that wrote the file; without it
+  // (files of older versions) from the snapshot's particles, with Δt from the wave speed and a
+  // fresh neighbour list: the same physics, another round-off.
+  if (rs.state)
+    solver_.resume(*rs.state);
+  else
+    solver_.set_time(rs.time);
+  step_offset_ = rs.state ? 0 : rs.step;
+  phase_summary_["restart"] = {
+      {"file", c_.restart.string()}, {"time_s", rs.time}, {"step", rs.step}, {"exact", rs.state.has_value()}};
+}
+
+template <int Dim>
+void DynamicRun<Dim>::geostatic_phase(const SphSimulation& self, RunObserver* obs) {
+  const double dur = c_.geostatic_duration > 0.0 ? c_.geostatic_duration : 20.0 * href_ / solver_.max_wave_speed();
+  RunProgress p{"geostatic", 0.0, dur, 0, solver_.store().size(), 0.0, false};
+  if (obs) obs->progress(self, p);
+  std::int64_t k = 0;
+  const auto rep = solver_.apply_gravity_gradually(dur, c_.geostatic_damping, c_.geostatic_elastic, [&] {
+    if (++k % 50 == 0 && obs) {
+      p.time = solver_.time();
+      p.steps = k;
+      obs->progress(self, p);
+    }
+  });
+  p.time = dur;
+  p.steps = rep.steps;
+  p.done = true;
+  if (obs) obs->progress(self, p);
+  have_loads_ = rep.steps > 0;
+  const double tol = c_.rest_tolerance * std::sqrt(c_.numerics.gravity * href_);
+  const bool at_rest = rep.max_speed < tol;
+  phase_summary_["geostatic"] = {{"duration_s", dur},
+                                 {"steps", rep.steps},
+                                 {"max_speed_m_per_s", rep.max_speed},
+                                 {"rest_tolerance_m_per_s", tol},
+                                 {"at_rest", at_rest}};
+  if (!quiet_)
+    std::fprintf(stderr, "sph-slope: geostatic phase %.4g s (%lld steps): max speed %.3g m/s -> %s\n", dur,
+                 static_cast<long long>(rep.steps), rep.max_speed,
+                 at_rest ? "at rest" : "NOT at rest (see summary.json)");
+}
+
+/// Biaxial test: the platens move towards each other (compression) or apart (tension) at ε̇ H / 2 each.
+template <int Dim>
+void DynamicRun<Dim>::move_platens() {
+  auto& S = solver_.store();
+  const double vp = 0.5 * c_.biaxial_strain_rate * c_.biaxial.height;
+  for (std::size_t i = 0; i < S.size(); ++i) {
+    if (S.template get<ParticleKind>()[i] == kSoil) continue;
+    const bool top = S.template get<Position<Dim>>()[i][Dim - 1] > 0.5 * c_.biaxial.height;
+    S.template get<Velocity<Dim>>()[i].setZero();
+    S.template get<Velocity<Dim>>()[i][Dim - 1] = top ? -vp : vp;
+  }
+}
+
+/// With clamped regions: the free end's particles (initial x within Δx/2 of the largest soil x,
+/// not clamped), whose mean vertical displacement is the series' tip_displacement_m.
+template <int Dim>
+void DynamicRun<Dim>::mark_free_end() {
+  if (c_.clamp_boxes.empty()) return;
+  const auto& S = solver_.store();
+  const auto& x = S.template get<Position<Dim>>();
+  const auto& u = S.template get<Displacement<Dim>>();
+  const auto& id = S.template get<ParticleId>();
+  double xmax = -1e300;
+  std::int64_t idmax = 0;
+  for (std::size_t i = 0; i < S.size(); ++i) {
+    idmax = std::max(idmax, id[i]);
+    if (S.template get<ParticleKind>()[i] == kSoil) xmax = std::max(xmax, x[i][0] - u[i][0]);
+  }
+  free_end_.assign(static_cast<std::size_t>(idmax) + 1, 0);
+  for (std::size_t i = 0; i < S.size(); ++i)
+    if (S.template get<ParticleKind>()[i] == kSoil && !S.template get<Clamped>()[i] &&
+        x[i][0] - u[i][0] >= xmax - 0.5 * c_.numerics.spacing)
+      free_end_[static_cast<std::size_t>(id[i])] = 1;
+}
+
+template <int Dim>
+double DynamicRun<Dim>::tip_displacement() const {
+  const auto& S = solver_.store();
+  const auto& id = S.template get<ParticleId>();
+  double sum = 0.0;
+  int count = 0;
+  for (std::size_t i = 0; i < S.size(); ++i)
+    if (free_end_[static_cast<std::size_t>(id[i])]) {
+      sum += S.template get<Displacement<Dim>>()[i][Dim - 1];
+      ++count;
+    }
+  return sum / std::max(count, 1);
+}
+
+template <int Dim>
+void DynamicRun<Dim>::start_main_phase() {
+  series_.columns = {"time_s",
+                     "front_m",
+                     "tip_m",
+                     "runout_m",
+                     "normalised_runout",
+                     "max_speed_m_per_s",
+                     "mean_speed_m_per_s",
+                     "kinetic_energy_J",
+                     "plastic_fraction",
+                     "max_displacement_m",
+                     "earthquake_acceleration_m_per_s2"};
+  if (!free_end_.empty()) series_.columns.emplace_back("tip_displacement_m");
+  biaxial_.columns = {"time_s", "axial_strain", "sigma_axial_Pa", "sigma_lateral_Pa", "deviator_Pa"};
+  png_times_ = c_.velocity_png_times;
+  std::sort(png_times_.begin(), png_times_.end());
+  next_out_ = solver_.time();
+  last_moving_ = t_start_ = solver_.time();
+  main_started_ = true;
+}
+
+template <int Dim>
+void DynamicRun<Dim>::main_phase(const SphSimulation& self, RunObserver* obs) {
+  while (solver_.time() < c_.end_time - 1e-12) {
+    if (solver_.time() >= next_out_ - 1e-12) {
+      record();
+      next_out_ += c_.output_interval;
+    }
+    if (obs) obs->before_step(self);
+    solver_.step();
+    have_loads_ = true;
+    if (!structures_.empty()) structures_.observe(solver_.time(), solver_.structure_loads());
+    const double vmax = solver_.last_stats().max_speed;
+    max_speed_run_ = std::max(max_speed_run_, vmax);
+    if (vmax > c_.rest_speed) last_moving_ = solver_.time();
+    if (obs) obs->stepped(self);
+    if (c_.stop_at_rest && solver_.time() - t_start_ > std::max(0.05, 0.1 * c_.end_time) && vmax < c_.rest_speed &&
+        solver_.time() > settings_.earthquake.end_time()) {
+      stopped_at_rest_ = true;
+      break;
+    }
+  }
+  last_ = record();
+  finished_ = true;
+  if (obs) obs->finished(self);
+}
+
+/// A row of the series (and of the structure loads, and of the biaxial curve).
+template <int Dim>
+SeriesRow DynamicRun<Dim>::record() {
+  const auto r = series_row(solver_.store(), b_.frame);
+  double runout = r.runout, nrun = r.normalised_runout;
+  if (c_.scenario == ScenarioType::Section) {
+    runout = 0.0;
+    for (const auto& u : solver_.store().template get<Displacement<Dim>>()) runout = std::max(runout, std::abs(u[0]));
+    nrun = runout / b_.frame.base_length;
+  }
+  max_runout_ = std::max(max_runout_, runout);
+  if (have_loads_ && !structures_.empty()) structures_.record(solver_.time(), solver_.structure_loads());
+  std::vector<double> row{solver_.time(),
+                          r.front,
+                          r.tip,
+                          runout,
+                          nrun,
+                          r.max_speed,
+                          r.mean_speed,
+                          r.kinetic_energy,
+                          r.plastic_fraction,
+                          r.max_displacement,
+                          settings_.earthquake.horizontal(solver_.time())};
+  if (!free_end_.empty()) row.push_back(tip_displacement());
+  series_.rows.push_back(std::move(row));
+  if (c_.scenario == ScenarioType::Biaxial) record_biaxial();
+  return r;
+}
+
+/// The mean axial and lateral stress of the specimen.
+template <int Dim>
+void DynamicRun<Dim>::record_biaxial() {
+  const auto& S = solver_.store();
+  double sa = 0, sl = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < S.size(); ++i)
+    if (S.template get<ParticleKind>()[i] == kSoil) {
+      sa += S.template get<Stress>()[i](Dim - 1, Dim - 1);
+      sl += S.template get<Stress>()[i](0, 0);
+      ++n;
+    }
+  sa /= std::max(n, 1);
+  sl /= std::max(n, 1);
+  biaxial_.rows.push_back({solver_.time(), c_.biaxial_strain_rate * solver_.time(), sa, sl, sa - sl});
+}
+
+template <int Dim>
+void DynamicRun<Dim>::draw_due_pngs(const std::filesystem::path& out) {
+  while (next_png_ < png_times_.size() && solver_.time() >= png_times_[next_png_] - 1e-12) {
+    std::vector<double> v(solver_.store().size());
+    for (std::size_t i = 0; i < v.size(); ++i) v[i] = solver_.store().template get<Velocity<Dim>>()[i].norm();
+    const double vm = *std::max_element(v.begin(), v.end());
+    std::ostringstream name;
+    name << "velocity_t" << std::fixed << std::setprecision(3) << png_times_[next_png_] << ".png";
+    draw_particles<Dim>(out / name.str(), solver_.store(), v, vm, c_.numerics.spacing, "speed (m/s)");
+    ++next_png_;
+  }
+}
+
+template <int Dim>
+std::vector<NamedTable> DynamicRun<Dim>::tables() const {
+  std::vector<NamedTable> t{{"series", series_}};
+  if (!structures_.empty()) t.push_back({"structure_forces", structures_.table()});
+  if (c_.scenario == ScenarioType::Biaxial) t.push_back({"stress_strain", biaxial_});
+  t.push_back({"surface_final", xz_table(free_surface(solver_.store(), c_.numerics.spacing))});
+  t.push_back({"slip_surface", xz_table(slip_surface(solver_.store(), c_.numerics.spacing, c_.failed_threshold))});
+  return t;
+}
+
+template <int Dim>
+void DynamicRun<Dim>::write_partial(const std::filesystem::path& out) const {
+  write_text_file(out / "series.csv", series_.csv());
+  if (!structures_.empty()) write_text_file(out / "structure_forces.csv", structures_.table().csv());
+}
+
+template <int Dim>
+void DynamicRun<Dim>::write_outputs(const std::filesystem::path& out) const {
+  for (const auto& [name, table] : tables()) write_text_file(out / (name + ".csv"), table.csv());
+  if (!structures_.empty()) structures_.plot(out / "structure_forces.png");
+  write_pictures(out);
+  const ReleaseOutput rel = release();
+  write_release(out, rel);
+  const nlohmann::json summary = summary_with(rel);
+  write_text_file(out / "summary.json", summary.dump(2) + "\n");
+  if (!quiet_) {
+    const auto fm = failed_mass(solver_.store(), rho0_, c_.failed_threshold);
+    std::fprintf(stderr, "sph-slope: t = %.4g s, run-out %.4g m (normalised %.4g), failed %s %.4g, outputs in %s\n",
+                 solver_.time(), summary["runout_m"].get<double>(), summary["normalised_runout"].get<double>(),
+                 Dim == 2 ? "area (m^2/m)" : "volume (m^3)", fm.volume, out.string().c_str());
+  }
+}
+
+/// Quick-looks of the final state coloured by displacement and by plastic strain.
+template <int Dim>
+void DynamicRun<Dim>::write_pictures(const std::filesystem::path& out) const {
+  const auto& S = solver_.store();
+  std::vector<double> u(S.size());
+  double umax = 0.0;
+  for (std::size_t i = 0; i < u.size(); ++i) {
+    u[i] = S.template get<Displacement<Dim>>()[i].norm();
+    if (S.template get<ParticleKind>()[i] == kSoil) umax = std::max(umax, u[i]);
+  }
+  draw_particles<Dim>(out / "final_displacement.png", S, u, umax, c_.numerics.spacing, "displacement (m)");
+  const auto& ep = S.template get<PlasticStrain>();
+  const double epmax = ep.empty() ? 0.0 : *std::max_element(ep.begin(), ep.end());
+  draw_particles<Dim>(out / "final_plastic_strain.png", S, ep, epmax, c_.numerics.spacing,
+                      "accumulated plastic strain (1)");
+}
+
+/// Failed mass for debris-runout (docs/handoff.md): only when the section is georeferenced.
+/// 2D: each plane-strain particle of area A becomes k = W/Δx map points spread across the width W,
+/// each of volume A·W/k. 3D: each particle is one map point (its position on the strip) carrying
+/// its own volume m/ρ0.
+template <int Dim>
+ReleaseOutput DynamicRun<Dim>::release() const {
+  ReleaseOutput r;
+  if (c_.scenario != ScenarioType::Section || !c_.write_release) return r;
+  const auto& P = c_.section.profile;
+  const auto& S = solver_.store();
+  std::vector<Vec2> pts;
+  std::vector<double> vols;
+  const double W = Dim == 2 ? c_.section.release_width : strip_width(c_);
+  const int k = Dim == 2 ? std::max(1, static_cast<int>(std::lround(W / c_.numerics.spacing))) : 1;
+  for (std::size_t i = 0; i < S.size(); ++i) {
+    if (S.template get<ParticleKind>()[i] != kSoil) continue;
+    if (S.template get<Displacement<Dim>>()[i].norm() <= c_.failed_threshold) continue;
+    const Vec<Dim>& x = S.template get<Position<Dim>>()[i];
+    const double vol = S.template get<Mass>()[i] / rho0_[static_cast<std::size_t>(S.template get<MaterialId>()[i])] *
+                       (Dim == 2 ? W / k : 1.0) * c_.bulking_factor;
+    for (int q = 0; q < k; ++q) {
+      const double t = Dim == 2 ? -0.5 * W + (q + 0.5) * W / k : x[1] - 0.5 * W;
+      pts.push_back(section_map_point(P, x[0], t));
+      vols.push_back(vol);
+      r.total += vol;
+    }
+  }
+  r.width = W;
+  std::ostringstream src;
+  src << c_.config_source << "; " << Dim << "D section; displacement > " << c_.failed_threshold << " m; width " << W
+      << " m";
+  r.handoff =
+      Handoff{pts, vols, c_.section.crs_wkt, src.str(), c_.bulking_factor, solver_.time(), solver_.step_count()};
+  if (c_.section.dsm) {
+    // Nodata where the DSM has none (-9999, as the debris-runout maps), a band description and
+    // unit, and a QGIS style beside it, like every GeoTIFF geohaz writes (issue #16).
+    constexpr double kNodata = -9999.0;
+    const Raster& dsm = *c_.section.dsm;
+    Raster th = dsm.like(0.0, kNodata);
+    th.description = "release thickness: failed volume per cell area (sph-slope section)";
+    th.unit = "m";
+    for (std::size_t q = 0; q < th.data.size(); ++q)
+      if (dsm.is_nodata(dsm.data[q])) th.data[q] = kNodata;
+    const double cell = th.cell_size_x() * th.cell_size_y();
+    for (std::size_t q = 0; q < pts.size(); ++q) {
+      const Vec2 px = th.to_pixel(pts[q]);
+      const int col = static_cast<int>(std::lround(px.x())), row = static_cast<int>(std::lround(px.y()));
+      if (col < 0 || row < 0 || col >= th.nx || row >= th.ny || th.at(col, row) == kNodata) continue;
+      th.at(col, row) += vols[q] / cell;
+      r.binned += vols[q];
+    }
+    for (double v : th.data)
+      if (v != kNodata) r.max_thickness = std::max(r.max_thickness, v);
+    r.thickness = std::move(th);
+  }
+  return r;
+}
+
+template <int Dim>
+void DynamicRun<Dim>::write_release(const std::filesystem::path& out, const ReleaseOutput& r) const {
+  if (c_.scenario != ScenarioType::Section || !c_.write_release) return;
+  write_handoff(out / "release.h5", r.handoff, c_.resolved_config);
+  if (!r.thickness) return;
+  write_geotiff(out / "release_thickness.tif", *r.thickness);
+  write_qgis_ramp_style(out / "release_thickness.qml", ColourRamp::Viridis, 0.0,
+                        r.max_thickness > 0.0 ? r.max_thickness : 1.0, "m", 0.0);
+}
+
+template <int Dim>
+nlohmann::json DynamicRun<Dim>::summary_with(const ReleaseOutput& rel) const {
+  const auto& S = solver_.store();
+  const auto& mats = solver_.materials();
+  nlohmann::json s = summary_header<Dim>(c_, solver_, soil_count_);
+  s["boundary_particles"] = boundary_count_;
+  s["smoothing_length_m"] = solver_.smoothing_length();
+  for (std::size_t k = 0; k < mats.size(); ++k) {
+    nlohmann::json e = {{"name", k < c_.material_names.size() ? c_.material_names[k] : ""},
+                        {"p_wave_speed_m_per_s", mats[k].p_wave_speed},
+                        {"dp_fit", mats[k].fit == DruckerPragerFit::PlaneStrain ? "plane_strain" : "compression_3d"}};
+    e.update(model_parameters(c_.model, mats[k]));
+    s["materials"].push_back(e);
+  }
+  s.update(phase_summary_);
+  if (!structures_.empty()) s["structures"] = structures_.summary();
+  double umax = 0.0;
+  for (std::size_t i = 0; i < S.size(); ++i)
+    if (S.template get<ParticleKind>()[i] == kSoil)
+      umax = std::max(umax, S.template get<Displacement<Dim>>()[i].norm());
+  const auto& ep = S.template get<PlasticStrain>();
+  s["max_plastic_strain"] = ep.empty() ? 0.0 : *std::max_element(ep.begin(), ep.end());
+  const bool section = c_.scenario == ScenarioType::Section;
+  s["end_time_s"] = solver_.time();
+  s["steps"] = solver_.step_count();
+  s["stopped_at_rest"] = stopped_at_rest_;
+  s["runout_m"] = section ? max_runout_ : last_.runout;
+  s["normalised_runout"] = section ? max_runout_ / b_.frame.base_length : last_.normalised_runout;
+  s["front_m"] = last_.front;
+  s["tip_m"] = last_.tip;
+  s["max_runout_m"] = max_runout_;
+  s["max_speed_m_per_s"] = max_speed_run_;
+  s["final_max_speed_m_per_s"] = last_.max_speed;
+  s["max_displacement_m"] = umax;
+  s["failed_threshold_m"] = c_.failed_threshold;
+  s["front_thickness_m"] =
+      b_.frame.front_thickness > 0.0 ? b_.frame.front_thickness : b_.frame.front_min_layers * b_.frame.spacing;
+  const auto fm = failed_mass(S, rho0_, c_.failed_threshold);
+  s["failed_particles"] = fm.count;
+  s[Dim == 2 ? "failed_area_m2_per_m" : "failed_volume_m3"] = fm.volume;
+  s["time_to_rest_s"] = last_.max_speed < c_.rest_speed ? nlohmann::json(last_moving_ - t_start_) : nlohmann::json();
+  s["rest_speed_m_per_s"] = c_.rest_speed;
+  s["bytes_per_particle"] = solver_.bytes_per_particle();
+  if (section && c_.write_release) {
+    s["release"] = {{"file", "release.h5"},
+                    {"points", rel.handoff.points.size()},
+                    {"total_volume_m3", rel.total},
+                    {"width_m", rel.width}};
+    if (rel.thickness) {
+      s["release"]["thickness_style"] = "release_thickness.qml";
+      s["release"]["thickness_raster"] = "release_thickness.tif";
+      s["release"]["volume_on_raster_m3"] = rel.binned;
+    }
+  }
+  s["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
+  return s;
+}
+
+/// The settings of the geostatic phase and the trials of a strength reduction: gravity only, the
+/// trials' damping.
+template <int Dim>
+SolverSettings<Dim> trial_settings(const RunConfig& c, const Scenario<Dim>& sc) {
+  auto s = settings_for<Dim>(c, sc);
+  s.earthquake = EarthquakeLoading{};
+  s.damping = c.srm.damping;
+  return s;
+}
+
+/// Factor of safety by strength reduction (docs/sph.md, "Factor of safety by strength reduction"):
+/// the geostatic state (or a restart), trials bisecting F, the Bishop circle beside it.
+template <int Dim>
+class StrengthReductionRun final : public SimulationModel {
+ public:
+  StrengthReductionRun(const RunConfig& c, bool quiet);
+  void run(const SphSimulation& self, RunObserver* obs) override;
+  double time() const override { return 0.0; }
+  std::int64_t step_count() const override { return trial_steps_; }
+  std::size_t particle_count() const override { return geo_.store().size(); }
+  bool main_phase_started() const override { return false; }
+  nlohmann::json summary() const override;
+  std::vector<NamedTable> tables() const override;
+  ParticleFields particles() const override { return mechanism_ ? fields_of(*mechanism_) : ParticleFields{}; }
+  /// Before the trials the geostatic state (snapshot 0), after them the failed trial at the
+  /// critical factor (snapshot 1).
+  void write_snapshot(SnapshotWriter& w) const override {
+    if (!finished_)
+      write_fields<Dim>(w, *initial_, 0.0, 0);
+    else if (mechanism_)
+      write_fields<Dim>(w, *mechanism_, trial_duration_, 1);
+  }
+  void draw_due_pngs(const std::filesystem::path&) override {}
+  void write_outputs(const std::filesystem::path& out) const override;
+  void write_partial(const std::filesystem::path&) const override {}
+
+ private:
+  void geostatic_state(const SphSimulation& self, RunObserver* obs);
+  bool trial(double F, const SphSimulation& self, RunObserver* obs);
+  void bracket(const SphSimulation& self, RunObserver* obs);
+  void bishop_check();
+  Table curve() const;
+  void plot_curve(const std::filesystem::path& path) const;
+  void write_mechanism(const std::filesystem::path& out) const;
+
+  const RunConfig& c_;
+  bool quiet_;
+  std::chrono::steady_clock::time_point wall0_;
+  Built<Dim> b_;
+  SolverSettings<Dim> settings_;
+  double href_;
+  SphSolver<Dim> geo_;
+  double cmax_;                                              // largest P-wave speed (m/s)
+  nlohmann::json phase_summary_ = nlohmann::json::object();  // "restart" or "geostatic"
+  std::optional<SphStore<Dim>> initial_;                     // the geostatic state every trial starts from
+  double trial_duration_ = 0.0;                              // T, s
+  double u_ref_ = -1.0;  // largest displacement of the f_min trial (the stable reference), m
+  std::vector<SrmTrial> trials_;
+  std::int64_t trial_steps_ = 0;
+  std::optional<SphStore<Dim>> mechanism_;  // the store of the failed trial at the upper end of the bracket
+  double lo_ = 0.0, hi_ = 0.0;
+  std::string outcome_ = "bracketed";
+  BishopResult bishop_;
+  std::string bishop_note_;
+  std::vector<std::array<double, 2>> circle_;
+  bool finished_ = false;
+};
+
+template <int Dim>
+StrengthReductionRun<Dim>::StrengthReductionRun(const RunConfig& c, bool quiet)
+    : c_(c),
+      quiet_(quiet),
+      wall0_(std::chrono::steady_clock::now()),
+      b_(build<Dim>(c)),
+      settings_(trial_settings<Dim>(c, b_.sc)),
+      href_(b_.sc.reference_height),
+      geo_(std::move(b_.sc.store), c.materials, c.model, settings_),
+      cmax_(geo_.max_wave_speed()) {}
+
+template <int Dim>
+void StrengthReductionRun<Dim>::run(const SphSimulation& self, RunObserver* obs) {
+  geostatic_state(self, obs);
+  trial_duration_ = c_.srm.trial_duration > 0.0 ? c_.srm.trial_duration : 30.0 * href_ / cmax_;
+  if (obs) obs->started(self);
+  bracket(self, obs);
+  bishop_check();
+  finished_ = true;
+  if (obs) obs->finished(self);
+}
+
+template <int Dim>
+void StrengthReductionRun<Dim>::geostatic_state(const SphSimulation& self, RunObserver* obs) {
+  if (!c_.restart.empty()) {
+    const Restart rs = load_restart<Dim>(c_.restart, geo_.store());
+    for (auto& v : geo_.store().template get<Velocity<Dim>>()) v.setZero();
+    for (auto& u : geo_.store().template get<Displacement<Dim>>()) u.setZero();
+    phase_summary_["restart"] = {{"file", c_.restart.string()}, {"time_s", rs.time}};
   } else {
-    const double dur = c.geostatic_duration > 0.0 ? c.geostatic_duration : 20.0 * href / cmax;
-    ProgressReporter prog("sph-slope geostatic", dur, quiet);
-    const auto rep = geo.apply_gravity_gradually(dur, c.geostatic_damping, c.geostatic_elastic);
-    prog.finish(dur, rep.steps, geo.store().size());
-    summary["geostatic"] = {{"duration_s", dur}, {"steps", rep.steps}, {"max_speed_m_per_s", rep.max_speed}};
-  }
-  const SphStore<Dim> initial = geo.store();
-  SnapshotWriter snaps(out / "snapshots.h5", "sph-slope", Dim, c.resolved_config);
-  snaps.set_attribute("scenario", scenario_name(c.scenario));
-  snaps.set_attribute("units", "SI: m, s, kg, Pa");
-  snaps.set_attribute("contents", "snapshot 0: geostatic state; snapshot 1: the failed trial at the critical factor");
-  write_fields<Dim>(snaps, initial, 0.0, 0);
-
-  const double T = c.srm.trial_duration > 0.0 ? c.srm.trial_duration : 30.0 * href / cmax;
-  double u_ref = -1.0;  // largest displacement of the f_min trial (the stable reference), m
-  std::vector<SrmTrial> trials;
-  std::optional<SphStore<Dim>> mechanism;  // the store of the failed trial at the upper end of the bracket
-  auto trial = [&](double F) {
-    SrmTrial t;
-    t.factor = F;
-    SphSolver<Dim> s(initial, reduced_strength(c.materials, F), c.model, settings);
-    double u75 = -1.0;
-    try {
-      while (s.time() < T) {
-        s.step();
-        if (u75 < 0.0 && s.time() >= 0.75 * T) u75 = max_soil_displacement(s.store());
+    const double dur = c_.geostatic_duration > 0.0 ? c_.geostatic_duration : 20.0 * href_ / cmax_;
+    RunProgress p{"geostatic", 0.0, dur, 0, geo_.store().size(), 0.0, false};
+    if (obs) obs->progress(self, p);
+    std::int64_t k = 0;
+    const auto rep = geo_.apply_gravity_gradually(dur, c_.geostatic_damping, c_.geostatic_elastic, [&] {
+      if (++k % 50 == 0 && obs) {
+        p.time = geo_.time();
+        p.steps = k;
+        obs->progress(self, p);
       }
-      t.displacement = max_soil_displacement(s.store());
-      t.growth = t.displacement - std::max(u75, 0.0);
-      // Failure: the displacement has not converged, or (once the stable reference exists) it lies
-      // beyond the knee of the F–displacement curve. SPH follows a failing mass to a new equilibrium
-      // after it has slid, so a trial just above the critical F may have stopped again by T.
-      t.failed = t.growth > c.srm.growth_ratio * t.displacement ||
-                 (u_ref >= 0.0 && t.displacement > c.srm.knee_ratio * std::max(u_ref, 1e-3 * c.numerics.spacing));
-    } catch (const SimulationError& e) {
-      t.failed = t.blew_up = true;
-      t.displacement = max_soil_displacement(s.store());
-      if (!quiet) std::fprintf(stderr, "sph-slope: trial F = %.4g stopped (%s): counted as failed\n", F, e.what());
-    }
-    t.steps = s.step_count();
-    if (!quiet)
-      std::fprintf(stderr, "sph-slope: trial F = %.4f: max displacement %.4g m, last-quarter growth %.3g m -> %s\n", F,
-                   t.displacement, t.growth, t.failed ? "fails" : "stable");
-    trials.push_back(t);
-    if (t.failed) mechanism = s.store();
-    return t.failed;
-  };
-  double lo = c.srm.f_min, hi = c.srm.f_max;
-  std::string outcome = "bracketed";
-  const bool low_fails = trial(lo);
-  u_ref = trials.back().displacement;
-  if (low_fails)
-    outcome = "below_f_min";
-  else if (!trial(hi))
-    outcome = "above_f_max";
-  else {
-    auto best_failed = mechanism;
-    while (hi - lo > c.srm.tolerance * (1.0 + 1e-9)) {
-      const double mid = 0.5 * (lo + hi);
-      if (trial(mid)) {
-        hi = mid;
-        best_failed = mechanism;
-      } else {
-        lo = mid;
-      }
-    }
-    mechanism = best_failed;
+    });
+    p.time = dur;
+    p.steps = rep.steps;
+    p.done = true;
+    if (obs) obs->progress(self, p);
+    phase_summary_["geostatic"] = {{"duration_s", dur}, {"steps", rep.steps}, {"max_speed_m_per_s", rep.max_speed}};
   }
+  initial_ = geo_.store();
+}
 
-  // Outputs: trials, F–displacement curve (CSV + PNG), mechanism, Bishop beside it.
-  {
-    std::ostringstream os;
-    os << "trial,factor,max_displacement_m,growth_last_quarter_m,failed,steps\n";
-    for (std::size_t k = 0; k < trials.size(); ++k)
-      os << k << ',' << csv_number(trials[k].factor) << ',' << csv_number(trials[k].displacement) << ','
-         << csv_number(trials[k].growth) << ',' << (trials[k].failed ? 1 : 0) << ',' << trials[k].steps << '\n';
-    write_text_file(out / "srm_trials.csv", os.str());
-  }
-  auto sorted = trials;
-  std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.factor < b.factor; });
-  {
-    std::ostringstream os;
-    os << "factor,max_displacement_m,failed\n";
-    for (const auto& t : sorted)
-      os << csv_number(t.factor) << ',' << csv_number(t.displacement) << ',' << (t.failed ? 1 : 0) << '\n';
-    write_text_file(out / "srm_curve.csv", os.str());
-    // Plot: F on x (f_min … f_max), displacement on y (log10, 4 decades below the largest), stable
-    // trials blue, failed red, the bracket as two grey verticals.
-    const int W = 800, H = 500, m = 40;
-    Image img(W, H);
-    double umax = 0.0;
-    for (const auto& t : sorted) umax = std::max(umax, t.displacement);
-    const double ly1 = std::log10(std::max(umax, 1e-12)), ly0 = ly1 - 4.0;
-    auto px = [&](double F) { return m + (F - c.srm.f_min) / (c.srm.f_max - c.srm.f_min) * (W - 2 * m); };
-    auto py = [&](double u) {
-      const double l = std::clamp(std::log10(std::max(u, 1e-300)), ly0, ly1);
-      return H - m - (l - ly0) / (ly1 - ly0) * (H - 2 * m);
-    };
-    img.line(m, H - m, W - m, H - m, {0, 0, 0});
-    img.line(m, m, m, H - m, {0, 0, 0});
-    for (int d = 0; d <= 4; ++d)
-      img.line(m - 5, py(umax * std::pow(10.0, -d)), m, py(umax * std::pow(10.0, -d)), {0, 0, 0});
-    img.line(px(lo), m, px(lo), H - m, {170, 170, 170});
-    img.line(px(hi), m, px(hi), H - m, {170, 170, 170});
-    for (std::size_t k = 1; k < sorted.size(); ++k)
-      img.line(px(sorted[k - 1].factor), py(sorted[k - 1].displacement), px(sorted[k].factor),
-               py(sorted[k].displacement), {90, 90, 90});
-    for (const auto& t : sorted)
-      img.fill_circle(px(t.factor), py(t.displacement), 5.0,
-                      t.failed ? std::array<std::uint8_t, 3>{210, 40, 40} : std::array<std::uint8_t, 3>{40, 80, 210});
-    write_png(out / "srm_curve.png", img);
-  }
-  BishopResult bishop;
+/// One trial with every strength divided by F; true when it fails.
+template <int Dim>
+bool StrengthReductionRun<Dim>::trial(double F, const SphSimulation& self, RunObserver* obs) {
+  const double T = trial_duration_;
+  SrmTrial t;
+  t.factor = F;
+  SphSolver<Dim> s(*initial_, reduced_strength(c_.materials, F), c_.model, settings_);
+  RunProgress p{"trial", 0.0, T, 0, s.store().size(), F, false};
+  double u75 = -1.0;
   try {
-    bishop = bishop_of(c);
+    while (s.time() < T) {
+      s.step();
+      if (u75 < 0.0 && s.time() >= 0.75 * T) u75 = max_soil_displacement(s.store());
+      if (obs && s.step_count() % 50 == 0) {
+        p.time = s.time();
+        p.steps = s.step_count();
+        obs->progress(self, p);
+      }
+    }
+    t.displacement = max_soil_displacement(s.store());
+    t.growth = t.displacement - std::max(u75, 0.0);
+    // Failure: the displacement has not converged, or (once the stable reference exists) it lies
+    // beyond the knee of the F–displacement curve. SPH follows a failing mass to a new equilibrium
+    // after it has slid, so a trial just above the critical F may have stopped again by T.
+    t.failed = t.growth > c_.srm.growth_ratio * t.displacement ||
+               (u_ref_ >= 0.0 && t.displacement > c_.srm.knee_ratio * std::max(u_ref_, 1e-3 * c_.numerics.spacing));
+  } catch (const SimulationError& e) {
+    t.failed = t.blew_up = true;
+    t.displacement = max_soil_displacement(s.store());
+    if (!quiet_) std::fprintf(stderr, "sph-slope: trial F = %.4g stopped (%s): counted as failed\n", F, e.what());
+  }
+  t.steps = s.step_count();
+  trial_steps_ += t.steps;
+  if (obs) {
+    p.time = s.time();
+    p.steps = t.steps;
+    p.done = true;
+    obs->progress(self, p);
+  }
+  if (!quiet_)
+    std::fprintf(stderr, "sph-slope: trial F = %.4f: max displacement %.4g m, last-quarter growth %.3g m -> %s\n", F,
+                 t.displacement, t.growth, t.failed ? "fails" : "stable");
+  trials_.push_back(t);
+  if (t.failed) mechanism_ = s.store();
+  return t.failed;
+}
+
+/// f_min, f_max, then bisection until the bracket is narrower than the tolerance.
+template <int Dim>
+void StrengthReductionRun<Dim>::bracket(const SphSimulation& self, RunObserver* obs) {
+  lo_ = c_.srm.f_min;
+  hi_ = c_.srm.f_max;
+  const bool low_fails = trial(lo_, self, obs);
+  u_ref_ = trials_.back().displacement;
+  if (low_fails) {
+    outcome_ = "below_f_min";
+  } else if (!trial(hi_, self, obs)) {
+    outcome_ = "above_f_max";
+  } else {
+    auto best_failed = mechanism_;
+    while (hi_ - lo_ > c_.srm.tolerance * (1.0 + 1e-9)) {
+      const double mid = 0.5 * (lo_ + hi_);
+      if (trial(mid, self, obs)) {
+        hi_ = mid;
+        best_failed = mechanism_;
+      } else {
+        lo_ = mid;
+      }
+    }
+    mechanism_ = best_failed;
+  }
+}
+
+template <int Dim>
+void StrengthReductionRun<Dim>::bishop_check() {
+  try {
+    bishop_ = bishop_of(c_);
   } catch (const InputError& e) {
-    summary["bishop_note"] = e.reason();
+    bishop_note_ = e.reason();
   }
-  std::vector<std::array<double, 2>> circle;
-  if (bishop.admissible()) {
-    const auto& C = bishop.circle;
-    for (int k = 0; k <= 100; ++k) {
-      const double x = bishop.x_entry + (bishop.x_exit - bishop.x_entry) * k / 100.0;
-      circle.push_back({x, C.zc - std::sqrt(std::max(0.0, C.radius * C.radius - (x - C.xc) * (x - C.xc)))});
-    }
-    summary["bishop"] = {{"factor", bishop.factor}, {"centre_x_m", C.xc},          {"centre_z_m", C.zc},
-                         {"radius_m", C.radius},    {"entry_x_m", bishop.x_entry}, {"exit_x_m", bishop.x_exit}};
-    std::ostringstream os;
-    os << "x_m,z_m\n";
-    for (const auto& p : circle) os << csv_number(p[0]) << ',' << csv_number(p[1]) << '\n';
-    write_text_file(out / "bishop_circle.csv", os.str());
+  if (!bishop_.admissible()) return;
+  const auto& C = bishop_.circle;
+  for (int k = 0; k <= 100; ++k) {
+    const double x = bishop_.x_entry + (bishop_.x_exit - bishop_.x_entry) * k / 100.0;
+    circle_.push_back({x, C.zc - std::sqrt(std::max(0.0, C.radius * C.radius - (x - C.xc) * (x - C.xc)))});
   }
-  if (mechanism) {
-    write_fields<Dim>(snaps, *mechanism, T, 1);
-    std::vector<double> u(mechanism->size());
-    double umax = 0.0;
-    SphStore<Dim> reference = *mechanism;  // drawn where the particles started, with the Bishop circle
-    for (std::size_t i = 0; i < u.size(); ++i) {
-      u[i] = mechanism->template get<Displacement<Dim>>()[i].norm();
-      reference.template get<Position<Dim>>()[i] -= mechanism->template get<Displacement<Dim>>()[i];
-      if (mechanism->template get<ParticleKind>()[i] == kSoil) umax = std::max(umax, u[i]);
-    }
-    draw_particles<Dim>(out / "mechanism.png", reference, u, umax, c.numerics.spacing, "displacement (m)", circle);
-    draw_particles<Dim>(out / "mechanism_deformed.png", *mechanism, u, umax, c.numerics.spacing, "displacement (m)",
-                        circle);
+}
+
+/// The F–displacement curve: the trials sorted by F.
+template <int Dim>
+Table StrengthReductionRun<Dim>::curve() const {
+  auto sorted = trials_;
+  std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.factor < b.factor; });
+  Table t{{"factor", "max_displacement_m", "failed"}, {}, {false, false, true}};
+  for (const auto& s : sorted) t.rows.push_back({s.factor, s.displacement, s.failed ? 1.0 : 0.0});
+  return t;
+}
+
+template <int Dim>
+std::vector<NamedTable> StrengthReductionRun<Dim>::tables() const {
+  Table tr{{"trial", "factor", "max_displacement_m", "growth_last_quarter_m", "failed", "steps"},
+           {},
+           {true, false, false, false, true, true}};
+  for (std::size_t k = 0; k < trials_.size(); ++k)
+    tr.rows.push_back({static_cast<double>(k), trials_[k].factor, trials_[k].displacement, trials_[k].growth,
+                       trials_[k].failed ? 1.0 : 0.0, static_cast<double>(trials_[k].steps)});
+  std::vector<NamedTable> t{{"srm_trials", tr}, {"srm_curve", curve()}};
+  if (bishop_.admissible()) t.push_back({"bishop_circle", xz_table(circle_)});
+  if (mechanism_) {
     // The slip surface of the mechanism: the lower edge of the soil displaced by more than a tenth
     // of the largest displacement.
-    std::ostringstream ss;
-    ss << "x_m,z_m\n";
-    for (const auto& p : slip_surface(*mechanism, c.numerics.spacing, 0.1 * umax))
-      ss << csv_number(p[0]) << ',' << csv_number(p[1]) << '\n';
-    write_text_file(out / "slip_surface.csv", ss.str());
+    t.push_back({"slip_surface",
+                 xz_table(slip_surface(*mechanism_, c_.numerics.spacing, 0.1 * max_soil_displacement(*mechanism_)))});
   }
-  summary["outcome"] = outcome;
-  summary["factor_of_safety"] = outcome == "bracketed" ? nlohmann::json(lo) : nlohmann::json(nullptr);
-  summary["bracket"] = {lo, hi};
-  summary["tolerance"] = c.srm.tolerance;
-  summary["trial_duration_s"] = T;
-  summary["trial_damping"] = c.srm.damping;
-  summary["growth_ratio"] = c.srm.growth_ratio;
-  summary["knee_ratio"] = c.srm.knee_ratio;
-  summary["reference_displacement_m"] = u_ref;
-  summary["trials"] = trials.size();
-  summary["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  write_text_file(out / "summary.json", summary.dump(2) + "\n");
-  if (!quiet) {
-    if (outcome == "bracketed")
-      std::fprintf(stderr, "sph-slope: factor of safety (strength reduction) %.4g, failed at %.4g", lo, hi);
+  return t;
+}
+
+/// Plot: F on x (f_min … f_max), displacement on y (log10, 4 decades below the largest), stable
+/// trials blue, failed red, the bracket as two grey verticals.
+template <int Dim>
+void StrengthReductionRun<Dim>::plot_curve(const std::filesystem::path& path) const {
+  const Table t = curve();
+  const int W = 800, H = 500, m = 40;
+  Image img(W, H);
+  double umax = 0.0;
+  for (const auto& r : t.rows) umax = std::max(umax, r[1]);
+  const double ly1 = std::log10(std::max(umax, 1e-12)), ly0 = ly1 - 4.0;
+  auto px = [&](double F) { return m + (F - c_.srm.f_min) / (c_.srm.f_max - c_.srm.f_min) * (W - 2 * m); };
+  auto py = [&](double u) {
+    const double l = std::clamp(std::log10(std::max(u, 1e-300)), ly0, ly1);
+    return H - m - (l - ly0) / (ly1 - ly0) * (H - 2 * m);
+  };
+  img.line(m, H - m, W - m, H - m, {0, 0, 0});
+  img.line(m, m, m, H - m, {0, 0, 0});
+  for (int d = 0; d <= 4; ++d)
+    img.line(m - 5, py(umax * std::pow(10.0, -d)), m, py(umax * std::pow(10.0, -d)), {0, 0, 0});
+  img.line(px(lo_), m, px(lo_), H - m, {170, 170, 170});
+  img.line(px(hi_), m, px(hi_), H - m, {170, 170, 170});
+  for (std::size_t k = 1; k < t.rows.size(); ++k)
+    img.line(px(t.rows[k - 1][0]), py(t.rows[k - 1][1]), px(t.rows[k][0]), py(t.rows[k][1]), {90, 90, 90});
+  for (const auto& r : t.rows)
+    img.fill_circle(px(r[0]), py(r[1]), 5.0,
+                    r[2] != 0.0 ? std::array<std::uint8_t, 3>{210, 40, 40} : std::array<std::uint8_t, 3>{40, 80, 210});
+  write_png(path, img);
+}
+
+/// The mechanism drawn where the particles started (with the Bishop circle) and deformed.
+template <int Dim>
+void StrengthReductionRun<Dim>::write_mechanism(const std::filesystem::path& out) const {
+  std::vector<double> u(mechanism_->size());
+  double umax = 0.0;
+  SphStore<Dim> reference = *mechanism_;
+  for (std::size_t i = 0; i < u.size(); ++i) {
+    u[i] = mechanism_->template get<Displacement<Dim>>()[i].norm();
+    reference.template get<Position<Dim>>()[i] -= mechanism_->template get<Displacement<Dim>>()[i];
+    if (mechanism_->template get<ParticleKind>()[i] == kSoil) umax = std::max(umax, u[i]);
+  }
+  draw_particles<Dim>(out / "mechanism.png", reference, u, umax, c_.numerics.spacing, "displacement (m)", circle_);
+  draw_particles<Dim>(out / "mechanism_deformed.png", *mechanism_, u, umax, c_.numerics.spacing, "displacement (m)",
+                      circle_);
+}
+
+template <int Dim>
+void StrengthReductionRun<Dim>::write_outputs(const std::filesystem::path& out) const {
+  for (const auto& [name, table] : tables()) write_text_file(out / (name + ".csv"), table.csv());
+  plot_curve(out / "srm_curve.png");
+  if (mechanism_) write_mechanism(out);
+  write_text_file(out / "summary.json", summary().dump(2) + "\n");
+  if (!quiet_) {
+    if (outcome_ == "bracketed")
+      std::fprintf(stderr, "sph-slope: factor of safety (strength reduction) %.4g, failed at %.4g", lo_, hi_);
     else
       std::fprintf(stderr, "sph-slope: factor of safety %s the range [%.4g, %.4g]",
-                   outcome == "below_f_min" ? "below" : "above", c.srm.f_min, c.srm.f_max);
-    if (bishop.admissible()) std::fprintf(stderr, "; Bishop %.4g", bishop.factor);
+                   outcome_ == "below_f_min" ? "below" : "above", c_.srm.f_min, c_.srm.f_max);
+    if (bishop_.admissible()) std::fprintf(stderr, "; Bishop %.4g", bishop_.factor);
     std::fprintf(stderr, "; outputs in %s\n", out.string().c_str());
   }
-  return 0;
+}
+
+template <int Dim>
+nlohmann::json StrengthReductionRun<Dim>::summary() const {
+  nlohmann::json s = summary_header<Dim>(c_, geo_, b_.sc.soil_count);
+  s["analysis"] = "strength_reduction";
+  s.update(phase_summary_);
+  if (!bishop_note_.empty()) s["bishop_note"] = bishop_note_;
+  if (bishop_.admissible()) {
+    const auto& C = bishop_.circle;
+    s["bishop"] = {{"factor", bishop_.factor}, {"centre_x_m", C.xc},           {"centre_z_m", C.zc},
+                   {"radius_m", C.radius},     {"entry_x_m", bishop_.x_entry}, {"exit_x_m", bishop_.x_exit}};
+  }
+  s["outcome"] = outcome_;
+  s["factor_of_safety"] = outcome_ == "bracketed" ? nlohmann::json(lo_) : nlohmann::json();
+  s["bracket"] = {lo_, hi_};
+  s["tolerance"] = c_.srm.tolerance;
+  s["trial_duration_s"] = trial_duration_;
+  s["trial_damping"] = c_.srm.damping;
+  s["growth_ratio"] = c_.srm.growth_ratio;
+  s["knee_ratio"] = c_.srm.knee_ratio;
+  s["reference_displacement_m"] = u_ref_;
+  s["trials"] = trials_.size();
+  s["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
+  return s;
 }
 
 /// Input checks that need the numerics and the geometry together, done before the dry-run build
@@ -1358,10 +1685,146 @@ void validate(const RunConfig& c) {
     throw InputError("restart file does not exist", c.config_source, "run.restart", c.restart.string());
 }
 
-int run(const RunConfig& cfg, const std::filesystem::path& out, bool quiet) {
-  if (cfg.analysis == Analysis::StrengthReduction)
-    return cfg.dimension == 2 ? run_strength_reduction<2>(cfg, out, quiet) : run_strength_reduction<3>(cfg, out, quiet);
-  return cfg.dimension == 2 ? run_dim<2>(cfg, out, quiet) : run_dim<3>(cfg, out, quiet);
+std::string Table::csv() const {
+  std::ostringstream os;
+  for (std::size_t k = 0; k < columns.size(); ++k) os << (k ? "," : "") << columns[k];
+  os << '\n';
+  for (const auto& row : rows) {
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      if (k) os << ',';
+      if (k < integer.size() && integer[k])
+        os << static_cast<long long>(row[k]);
+      else
+        os << csv_number(row[k]);
+    }
+    os << '\n';
+  }
+  return os.str();
+}
+
+SphSimulation::SphSimulation(const RunConfig& cfg, bool quiet) : cfg_(cfg), impl_(std::make_unique<Impl>()) {
+  const bool srm = cfg.analysis == Analysis::StrengthReduction;
+  if (cfg.dimension == 2)
+    impl_->model = srm ? std::unique_ptr<SimulationModel>(std::make_unique<StrengthReductionRun<2>>(cfg, quiet))
+                       : std::make_unique<DynamicRun<2>>(cfg, quiet);
+  else
+    impl_->model = srm ? std::unique_ptr<SimulationModel>(std::make_unique<StrengthReductionRun<3>>(cfg, quiet))
+                       : std::make_unique<DynamicRun<3>>(cfg, quiet);
+}
+
+SphSimulation::~SphSimulation() = default;
+
+void SphSimulation::run(RunObserver* observer) {
+  impl_->model->run(*this, observer);
+}
+double SphSimulation::time() const {
+  return impl_->model->time();
+}
+std::int64_t SphSimulation::step_count() const {
+  return impl_->model->step_count();
+}
+std::size_t SphSimulation::particle_count() const {
+  return impl_->model->particle_count();
+}
+bool SphSimulation::main_phase_started() const {
+  return impl_->model->main_phase_started();
+}
+std::string SphSimulation::summary_json() const {
+  return impl_->model->summary().dump(2) + "\n";
+}
+std::vector<NamedTable> SphSimulation::tables() const {
+  return impl_->model->tables();
+}
+ParticleFields SphSimulation::particles() const {
+  return impl_->model->particles();
+}
+
+/// The files of a run made during it (the output folder, the resolved config, the snapshots and
+/// the velocity PNGs) and the progress lines on stderr; passes every event on to `next`.
+class SphRunFiles final : public RunObserver {
+ public:
+  SphRunFiles(const SphSimulation& sim, std::filesystem::path out, bool quiet, RunObserver* next)
+      : model_(*sim.impl_->model), cfg_(sim.config()), out_(std::move(out)), quiet_(quiet), next_(next) {
+    if (out_.empty()) return;
+    make_output_dir(out_);
+    write_text_file(out_ / "config.resolved.toml", cfg_.resolved_config);
+    snaps_ = std::make_unique<SnapshotWriter>(out_ / "snapshots.h5", "sph-slope", cfg_.dimension, cfg_.resolved_config);
+    snaps_->set_attribute("scenario", scenario_name(cfg_.scenario));
+    snaps_->set_attribute("units", "SI: m, s, kg, Pa");
+    if (cfg_.analysis == Analysis::StrengthReduction)
+      snaps_->set_attribute("contents",
+                            "snapshot 0: geostatic state; snapshot 1: the failed trial at the critical factor");
+    else if (cfg_.scenario == ScenarioType::Section && !cfg_.section.crs_wkt.empty())
+      snaps_->set_attribute("crs_wkt", cfg_.section.crs_wkt);
+  }
+  void progress(const SphSimulation& sim, const RunProgress& p) override {
+    if (std::string_view(p.phase) == "geostatic") {
+      if (!geostatic_) geostatic_.emplace("sph-slope geostatic", p.end_time, quiet_);
+      if (p.done)
+        geostatic_->finish(p.time, p.steps, p.particles);
+      else if (p.steps > 0)
+        geostatic_->update(p.time, p.steps, p.particles);
+    }
+    if (next_) next_->progress(sim, p);
+  }
+  void started(const SphSimulation& sim) override {
+    if (snaps_) model_.write_snapshot(*snaps_);
+    next_snap_ = sim.time() + cfg_.snapshot_interval;
+    if (cfg_.analysis == Analysis::Dynamic) main_.emplace("sph-slope", cfg_.end_time, quiet_);
+    if (next_) next_->started(sim);
+  }
+  void before_step(const SphSimulation& sim) override {
+    if (!out_.empty()) model_.draw_due_pngs(out_);
+    if (next_) next_->before_step(sim);
+  }
+  void stepped(const SphSimulation& sim) override {
+    if (main_) main_->update(sim.time(), sim.step_count(), sim.particle_count());
+    if (snaps_ && cfg_.snapshot_interval > 0.0 && sim.time() >= next_snap_ - 1e-12) {
+      model_.write_snapshot(*snaps_);
+      next_snap_ += cfg_.snapshot_interval;
+    }
+    if (next_) next_->stepped(sim);
+  }
+  void finished(const SphSimulation& sim) override {
+    if (main_) main_->finish(sim.time(), sim.step_count(), sim.particle_count());
+    if (snaps_) model_.write_snapshot(*snaps_);
+    if (next_) next_->finished(sim);
+  }
+  /// Close the snapshot file.
+  void close() { snaps_.reset(); }
+  SimulationModel& model() { return model_; }
+
+ private:
+  SimulationModel& model_;
+  const RunConfig& cfg_;
+  std::filesystem::path out_;
+  bool quiet_;
+  RunObserver* next_;
+  std::unique_ptr<SnapshotWriter> snaps_;
+  std::optional<ProgressReporter> geostatic_, main_;
+  double next_snap_ = 0.0;
+};
+
+void write_outputs(const SphSimulation& sim, const std::filesystem::path& out) {
+  sim.impl_->model->write_outputs(out);
+}
+
+void run_with_outputs(SphSimulation& sim, const std::filesystem::path& out, bool quiet, RunObserver* observer) {
+  SphRunFiles files(sim, out, quiet, observer);
+  try {
+    sim.run(&files);
+  } catch (const SimulationError&) {
+    if (!out.empty() && sim.main_phase_started()) files.model().write_partial(out);
+    throw;
+  }
+  files.close();
+  if (!out.empty()) write_outputs(sim, out);
+}
+
+int run_case(const RunConfig& cfg, const std::filesystem::path& out, bool quiet) {
+  SphSimulation sim(cfg, quiet);
+  run_with_outputs(sim, out, quiet);
+  return 0;
 }
 
 }  // namespace geohaz::sph

@@ -1,11 +1,22 @@
 #pragma once
 /// \file run.hpp
-/// A complete sph-slope run from a typed configuration: build the scenario, apply gravity
-/// gradually (geostatic phase), run the main phase with optional earthquake loading, and write the
-/// outputs (snapshots, time series, free surface, slip surface, summary, quick-look PNGs, failed-mass
-/// release file for debris-runout per docs/handoff.md). The app fills RunConfig from TOML; this
-/// library never sees the config reader.
+/// A complete sph-slope run, callable from C++ without a subprocess (the app and the Python module
+/// both go through it). The shape is that of debris-runout (libs/runout/run.hpp):
+///
+///  1. `read_config(ConfigReader&, describe)` (config.hpp): every key into a typed RunConfig (the
+///     DSM of a section and an accelerogram are read there). `validate(cfg)`: the checks across
+///     keys and a dry-run build of the particles. Both throw InputError (file, key, value) and
+///     write nothing.
+///  2. `SphSimulation sim(cfg)`: builds the scenario and the solver; `sim.run(observer)` runs the
+///     geostatic phase (or loads the restart), then the main phase in time, or the strength
+///     reduction trials; the observer sees the phases and every main-phase step (progress,
+///     snapshots, quick-look PNGs). SimulationError on a blow-up, with the state so far kept.
+///  3. `write_outputs(sim, out)`: the series, surfaces, pictures, release file and summary.json.
+///
+/// `run_case(cfg, out, quiet)` chains them the way `sph-slope` does (the output folder, the
+/// resolved config and the snapshots during the run, progress on stderr, then the outputs).
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -149,8 +160,123 @@ Vec2 section_map_point(const std::vector<ProfilePoint>& profile, double s, doubl
 /// the particles (dry run). Throws InputError naming the key. Called before any output is created.
 void validate(const RunConfig& cfg);
 
-/// Run and write everything into `out` (created). Returns the process exit code (0).
-/// SimulationError propagates after the time series so far has been written.
-int run(const RunConfig& cfg, const std::filesystem::path& out, bool quiet);
+/// A table of a run (the columns of one CSV file), numbers only.
+struct Table {
+  std::vector<std::string> columns;
+  std::vector<std::vector<double>> rows;  ///< one value per column
+  /// Columns written as integers (a count, a flag); the others with 9 significant digits.
+  std::vector<bool> integer;
+  /// The CSV text: the header, then one line per row (what the app writes).
+  std::string csv() const;
+};
+
+/// A named table: `name` is the stem of its CSV file ("series", "structure_forces", ...).
+struct NamedTable {
+  std::string name;
+  Table table;
+};
+
+/// The particle fields of a run's final state (of the mechanism, for a strength reduction), every
+/// particle (soil and boundary), row-major arrays.
+struct ParticleFields {
+  int dimension = 2;
+  std::size_t count = 0;
+  std::vector<double> position;           ///< m, count × dimension
+  std::vector<double> velocity;           ///< m/s, count × dimension
+  std::vector<double> displacement;       ///< m, count × dimension
+  std::vector<double> stress;             ///< Pa, count × 3 × 3 (tension positive)
+  std::vector<double> plastic_strain;     ///< 1, accumulated plastic strain
+  std::vector<double> density;            ///< kg/m³
+  std::vector<double> mass;               ///< kg (per metre out of the plane in 2D)
+  std::vector<std::int32_t> material_id;  ///< index into the [[material]] list
+  std::vector<std::uint8_t> kind;         ///< Kind (fields.hpp): 0 soil, else a boundary
+  std::vector<std::int64_t> id;           ///< particle id, stable through reorderings
+};
+
+/// Where a run is when the observer is told about it.
+struct RunProgress {
+  const char* phase = "";     ///< "geostatic", "main" or "trial" (strength reduction)
+  double time = 0.0;          ///< simulated time of the phase (s)
+  double end_time = 0.0;      ///< simulated time at which the phase ends (s)
+  std::int64_t steps = 0;     ///< steps of the phase so far
+  std::size_t particles = 0;  ///< particles in the store
+  double factor = 0.0;        ///< trial: the strength reduction factor F
+  bool done = false;          ///< the phase (or trial) has ended: its last call
+};
+
+class SphSimulation;
+
+/// Sees a run as it goes (progress, snapshots, pictures). Default: nothing. A callback may throw to
+/// stop the run; the exception goes on through SphSimulation::run.
+class RunObserver {
+ public:
+  virtual ~RunObserver() = default;
+  /// Every 50 steps of the geostatic phase or of a strength-reduction trial, and at its end.
+  virtual void progress(const SphSimulation&, const RunProgress&) {}
+  /// The main phase (or, for a strength reduction, the first trial) is about to start from the
+  /// state after the geostatic phase or the restart.
+  virtual void started(const SphSimulation&) {}
+  /// Main phase: before each step, on the state the step starts from.
+  virtual void before_step(const SphSimulation&) {}
+  /// Main phase: after each step.
+  virtual void stepped(const SphSimulation&) {}
+  /// After the last step (the final row of the series is recorded).
+  virtual void finished(const SphSimulation&) {}
+};
+
+class SphRunFiles;
+
+/// One run: the scenario's particles, the solver, the time series and the figures of the summary.
+class SphSimulation {
+ public:
+  /// Build the scenario and the solver of `cfg` (checked by validate() first); unless `quiet`,
+  /// print the particle counts and the materials on stderr. Keeps a reference to `cfg`: it must
+  /// outlive the simulation.
+  explicit SphSimulation(const RunConfig& cfg, bool quiet = true);
+  ~SphSimulation();
+  SphSimulation(const SphSimulation&) = delete;
+  SphSimulation& operator=(const SphSimulation&) = delete;
+
+  /// Run to the end (end_time or at rest; or the whole strength-reduction bracketing).
+  /// SimulationError on a blow-up: the series so far stays readable through tables().
+  void run(RunObserver* observer = nullptr);
+
+  const RunConfig& config() const noexcept { return cfg_; }
+  double time() const;              ///< simulated time of the main phase (s)
+  std::int64_t step_count() const;  ///< steps of the main phase
+  std::size_t particle_count() const;
+  /// The main phase has started (a SimulationError after this point leaves a series to write).
+  bool main_phase_started() const;
+
+  /// The text of summary.json (the app and the Python module read the same numbers).
+  std::string summary_json() const;
+  /// The CSV tables of the run so far, by file stem (series, structure_forces, stress_strain,
+  /// surface_final, slip_surface; srm_trials, srm_curve, bishop_circle for a strength reduction).
+  std::vector<NamedTable> tables() const;
+  /// The particle fields now (the failure mechanism for a strength reduction; empty if none).
+  ParticleFields particles() const;
+
+ private:
+  friend class SphRunFiles;
+  friend void write_outputs(const SphSimulation& sim, const std::filesystem::path& out);
+  struct Impl;
+  const RunConfig& cfg_;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Write the outputs of a finished `sim` into the existing directory `out`: the CSV tables, the
+/// quick-look PNGs, release.h5 (+ release_thickness.tif) for a section and summary.json.
+void write_outputs(const SphSimulation& sim, const std::filesystem::path& out);
+
+/// Run `sim` the way the app does: when `out` is not empty, create it, write the resolved config
+/// and the snapshots (and velocity PNGs) during the run, the outputs after it (and, on a
+/// SimulationError in the main phase, the series so far); progress on stderr unless `quiet`.
+/// `observer` (optional) sees the run too.
+void run_with_outputs(SphSimulation& sim, const std::filesystem::path& out, bool quiet,
+                      RunObserver* observer = nullptr);
+
+/// The whole `sph-slope` run of a validated config: build, run with outputs into `out` (created).
+/// Returns the process exit code (0).
+int run_case(const RunConfig& cfg, const std::filesystem::path& out, bool quiet);
 
 }  // namespace geohaz::sph
