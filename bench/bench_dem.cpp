@@ -11,6 +11,7 @@
 //     short, the wall time a run to rest would take at that rate.
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -110,7 +111,7 @@ int avalanche(std::size_t n, double runout_s, int threads) {
   const auto t0 = clock::now();
   auto t_setup = t0, t_release = t0;
   bool settling = false, released = false;
-  std::int64_t steps_at_release = 0;
+  std::int64_t steps_at_release = 0, rebuilds_at_release = 0;
   std::clock_t c_release = 0;
   DemSolver s;
   const auto r = run_avalanche(a, s, [&](const DemSolver& sv, const std::string& phase) {
@@ -123,6 +124,7 @@ int avalanche(std::size_t n, double runout_s, int threads) {
       t_release = clock::now();
       c_release = std::clock();
       steps_at_release = sv.step_count();
+      rebuilds_at_release = sv.rebuild_count();
     }
   });
   const auto t1 = clock::now();
@@ -142,6 +144,10 @@ int avalanche(std::size_t n, double runout_s, int threads) {
       r.duration, static_cast<long long>(steps), s.time_step(), run_wall, rate,
       static_cast<double>(r.discs) * static_cast<double>(steps) / run_cpu,
       r.at_rest ? "at rest" : "cut short (still moving)");
+  std::printf("  neighbour-list rebuilds in the run-out: %lld (one per %.1f steps)\n",
+              static_cast<long long>(s.rebuild_count() - rebuilds_at_release),
+              static_cast<double>(steps) /
+                  static_cast<double>(std::max<std::int64_t>(1, s.rebuild_count() - rebuilds_at_release)));
   std::printf("  L = %.0f m, H = %.0f m, H/L = %.3f at 99 %% of the mass, %zu fragments\n", r.runout, r.fall_height,
               r.h_over_l, r.fragment_sizes.size());
   if (!r.at_rest && r.duration > 0) {
