@@ -434,3 +434,26 @@ TEST(DemContact, FrictionAndRollingSubModelClampsAtItsLimits) {
   EXPECT_DOUBLE_EQ(elastic.roll, -kr * w * dt);
   EXPECT_DOUBLE_EQ(elastic.roll_damping, -0.3 * 2.0 * std::sqrt(4.0 * kr) * w);
 }
+
+TEST(DemContact, DiscRestsOnTerrainWhileTheSlopeIsBelowItsRollingResistance) {
+  // docs/validation/dem.md equates a disc's terrain rolling resistance with an n-gon's tipping
+  // angle through this threshold: on a slope θ (friction μ = 0.9 > tan θ, so no sliding) the
+  // contact friction m g sin θ turns the disc against the limit μ_r R m g cos θ, so it rests while
+  // tan θ ≤ μ_r and rolls above. μ_r = tan 30° (a hexagon); 27° rests (the rolling spring's
+  // elastic creep is below 1 mm), 33° rolls (⅔ g (sin θ − μ_r cos θ) t²/2 ≈ 0.2 m in 1 s).
+  const double R = 0.5, g = 9.81, kn = 1e9, mu_r = std::tan(kPi / 6);
+  auto travel = [&](double theta_deg) {
+    const double th = theta_deg * kPi / 180;
+    DemSolver s;
+    s.settings.gravity = Vec2(g * std::sin(th), -g * std::cos(th));  // the slope is the x axis
+    s.law = LinearSpringCoulomb{kn, 0.4 * kn};
+    s.contact.restitution = 0.3;
+    add_disc(s.discs, Vec2(0, R - 2650 * kPi * R * R * g * std::cos(th) / kn), R, 2650);
+    s.terrain.add_polyline({Vec2(-10, 0), Vec2(100, 0)}, 0.9, 0.3, mu_r);
+    s.initialise();
+    s.run_until(1.0);
+    return s.discs.get<Position<2>>()[0].x();
+  };
+  EXPECT_LT(std::abs(travel(27.0)), 1e-3);
+  EXPECT_GT(travel(33.0), 0.1);
+}
