@@ -3,16 +3,25 @@
 //  2. an N-disc bonded sample (parallel bonds on the regular-triangulation edges) compressed
 //     between platens.
 // Usage: bench_dem [N=100000] [steps=300] [threads=0: both 1 and 2]. Prints rates; never asserts.
+//  3. `bench_dem avalanche [N=100000] [runout_s=300] [threads=2]`: a rock avalanche of about N
+//     bonded, jointed discs (the material of data/dem/avalanche.toml) on a 3 km profile (35°
+//     slope 1 km high onto a 1.57 km floor), run with the library's run_avalanche to rest or for
+//     runout_s seconds after release; prints the wall time of the set-up (packing, tessellation,
+//     bonds), of the settling and of the run-out, the run-out rate and, when the run was cut
+//     short, the wall time a run to rest would take at that rate.
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
 #include <random>
+#include <string>
 #include <utility>
 
+#include "geohaz/dem/experiments.hpp"
 #include "geohaz/dem/packing.hpp"
 #include "geohaz/dem/solver.hpp"
 #include "geohaz/dem/tessellation.hpp"
@@ -61,9 +70,100 @@ std::pair<double, double> rate(DemSolver& s, int steps) {
   return {ps / dt, ps / cpu};
 }
 
+/// The avalanche case (usage above).
+int avalanche(std::size_t n, double runout_s, int threads) {
+  omp_set_num_threads(threads);
+  AvalancheSpec a;
+  // Material, radii and release of data/dem/avalanche.toml.
+  a.packing.r_min = 0.6;
+  a.packing.r_max = 1.0;
+  a.packing.porosity = 0.18;
+  a.packing.locked_in_stress = 0;
+  a.packing.seed = 3;
+  a.packing.expansion_steps = 2000;
+  a.packing.max_relax_steps = 6000;
+  a.material.law = LinearSpringCoulomb{4e8, 4e8 / 2.5};
+  a.material.contact.friction = 0.5;
+  a.material.contact.rolling_friction = 0.1;
+  a.material.contact.restitution = 0.3;
+  a.material.bond.modulus = 2e8;
+  a.material.bond.tensile_strength = a.material.bond.shear_strength = 2e6;
+  a.material.bond.tensile_strength_std = a.material.bond.shear_strength_std = 0.4e6;
+  a.material.joint_friction = 0.4;
+  a.material.joint_sets = {JointSet{35, 5, 0.7, 8}, JointSet{-60, 8, 0.5, 6}};
+  a.settle_time = 1.0;
+  a.strength_factor = 0.5;
+  a.record_interval = 0.5;
+  a.terrain_friction = 0.5;
+  a.terrain_restitution = 0.3;
+  a.runout_time = runout_s;
+  // 3 km profile: 35° slope from (0, 1000) to (1428, 0), floor to x = 3000 m.
+  const double t = std::tan(35.0 * std::acos(-1.0) / 180.0), top = 1000.0;
+  a.terrain = {Vec2(0, top), Vec2(top / t, 0), Vec2(3000, 0)};
+  // Source: a parallelogram on the slope, as long (horizontally) as it is thick (vertically), of
+  // area ≈ N × (mean disc area)/(1 − porosity) (mean R² of R uniform in [0.6, 1] is 0.653 m²).
+  const double per_disc = std::acos(-1.0) * 0.653 / (1.0 - a.packing.porosity);
+  const double side = std::sqrt(static_cast<double>(n) * per_disc);
+  const double x0 = 60.0, z0 = top - x0 * t + 2.0;
+  a.source = {Vec2(x0, z0), Vec2(x0 + side, z0 - side * t), Vec2(x0 + side, z0 - side * t + side), Vec2(x0, z0 + side)};
+  a.support = {Vec2(x0 + side + 0.5, z0 - side * t - 10), Vec2(x0 + side + 0.5, z0 - side * t + side + 10)};
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  auto t_setup = t0, t_release = t0;
+  bool settling = false, released = false;
+  std::int64_t steps_at_release = 0, rebuilds_at_release = 0;
+  std::clock_t c_release = 0;
+  DemSolver s;
+  const auto r = run_avalanche(a, s, [&](const DemSolver& sv, const std::string& phase) {
+    if (!settling) {
+      settling = true;
+      t_setup = clock::now();
+    }
+    if (phase == "runout" && !released) {
+      released = true;
+      t_release = clock::now();
+      c_release = std::clock();
+      steps_at_release = sv.step_count();
+      rebuilds_at_release = sv.rebuild_count();
+    }
+  });
+  const auto t1 = clock::now();
+  const double run_cpu = static_cast<double>(std::clock() - c_release) / CLOCKS_PER_SEC;
+  auto secs = [](auto d) { return std::chrono::duration<double>(d).count(); };
+  const double run_wall = secs(t1 - t_release);
+  const auto steps = s.step_count() - steps_at_release;
+  const double rate = static_cast<double>(r.discs) * static_cast<double>(steps) / run_wall;
+  std::printf("bench_dem avalanche: %zu discs, %zu bonds, %d thread(s); 3 km profile, source side %.0f m\n", r.discs,
+              r.bonds, threads, side);
+  std::printf("  set-up (packing, tessellation, bonds, joints) + first settling steps: %.1f s wall\n",
+              secs(t_setup - t0));
+  std::printf("  settling %.1f s simulated: %.1f s wall\n", a.settle_time, secs(t_release - t_setup));
+  std::printf(
+      "  run-out %.1f s simulated, %lld steps (dt = %.3g s): %.1f s wall, %.3g particle-steps/s (%.3g per "
+      "CPU-second); %s\n",
+      r.duration, static_cast<long long>(steps), s.time_step(), run_wall, rate,
+      static_cast<double>(r.discs) * static_cast<double>(steps) / run_cpu,
+      r.at_rest ? "at rest" : "cut short (still moving)");
+  std::printf("  neighbour-list rebuilds in the run-out: %lld (one per %.1f steps)\n",
+              static_cast<long long>(s.rebuild_count() - rebuilds_at_release),
+              static_cast<double>(steps) /
+                  static_cast<double>(std::max<std::int64_t>(1, s.rebuild_count() - rebuilds_at_release)));
+  std::printf("  L = %.0f m, H = %.0f m, H/L = %.3f at 99 %% of the mass, %zu fragments\n", r.runout, r.fall_height,
+              r.h_over_l, r.fragment_sizes.size());
+  if (!r.at_rest && r.duration > 0) {
+    // At this rate, a run to rest of T seconds takes T/duration times as long.
+    for (double T : {60.0, 120.0, 200.0})
+      std::printf("  a run-out of %.0f s at this rate: %.0f s wall\n", T, run_wall * T / r.duration);
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc > 1 && std::string(argv[1]) == "avalanche")
+    return avalanche(argc > 2 ? std::strtoull(argv[2], nullptr, 10) : 100000, argc > 3 ? std::atof(argv[3]) : 300.0,
+                     argc > 4 ? std::atoi(argv[4]) : 2);
   const std::size_t n = argc > 1 ? std::strtoull(argv[1], nullptr, 10) : 100000;
   const int steps = argc > 2 ? std::atoi(argv[2]) : 300;
   const int only_threads = argc > 3 ? std::atoi(argv[3]) : 0;  // 0: 1 and 2 threads

@@ -373,3 +373,87 @@ TEST(DemContact, DiscRollingOnTerrainDeceleratesWithTheTerrainRollingResistance)
   const double a = (v1 - s.discs.get<Velocity<2>>()[0].x()) / (s.time() - t1);
   EXPECT_NEAR(a, 2.0 / 3.0 * mu_r * g, 0.02 * 2.0 / 3.0 * mu_r * g);
 }
+
+TEST(DemContact, EveryLawStoresTheWorkOfItsNormalForce) {
+  // normal_energy(F_el(δ), δ) must equal ∫₀^δ F_el dδ' for every alternative of ContactLaw (a law
+  // added with the wrong energy fails here). Simpson's rule with 2000 intervals on δ^{3/2}:
+  // relative error < 1e-6 (the integrand's derivative is singular only at 0).
+  for (std::size_t k = 0; k < contact_law_names.size(); ++k) {
+    const ContactLaw law = *contact_law_from_name(contact_law_names[k]);
+    std::visit(
+        [&](const auto& l) {
+          const double reff = 0.01, slice = 0.04, delta = 1e-4;
+          auto f = [&](double d) { return l.evaluate(d, 1.0, reff, slice, 0.0).fn_elastic; };
+          const int n = 2000;
+          const double h = delta / n;
+          double s = f(0.0) + f(delta);
+          for (int i = 1; i < n; ++i) s += (i % 2 ? 4.0 : 2.0) * f(i * h);
+          const double work = s * h / 3.0;
+          EXPECT_NEAR(l.normal_energy(f(delta), delta), work, 1e-6 * work) << contact_law_names[k];
+        },
+        law);
+  }
+}
+
+TEST(DemContact, ContactLawNameTableRoundTrips) {
+  // The config names are those of the docs and the examples; each name gives its own alternative.
+  EXPECT_EQ(contact_law_names.size(), std::variant_size_v<ContactLaw>);
+  EXPECT_EQ(contact_law_names[0], "linear");
+  EXPECT_EQ(contact_law_names[1], "hertz");
+  for (std::size_t k = 0; k < contact_law_names.size(); ++k) {
+    const auto law = contact_law_from_name(contact_law_names[k]);
+    ASSERT_TRUE(law.has_value());
+    EXPECT_EQ(law->index(), k);
+    EXPECT_EQ(contact_law_name(*law), contact_law_names[k]);
+    EXPECT_FALSE(contact_law_summaries[k].empty());
+  }
+  EXPECT_FALSE(contact_law_from_name("hooke").has_value());
+}
+
+TEST(DemContact, FrictionAndRollingSubModelClampsAtItsLimits) {
+  // Coulomb: a tangential spring pushed past μF_n stays at μF_n with the sign of the slip;
+  // rolling: the moment stops at μ_r R* F_n, and the viscous rolling damping acts only below it.
+  const double kt = 1e6, kn = 2e6, fn = 100.0, reff = 0.1, dt = 1e-3;
+  const auto slip =
+      CoulombFrictionRolling::update(0.0, 0.0, kt, kn, 1.0, fn, reff, 0.0, 0.5, 0.0, 0.3, dt, [] { return 1.0; });
+  EXPECT_DOUBLE_EQ(slip.shear, -50.0);  // −k_t v_t Δt = −1000 → −μF_n
+  EXPECT_EQ(slip.roll, 0.0);
+  EXPECT_EQ(slip.kr, 0.0);
+  const auto stuck =
+      CoulombFrictionRolling::update(0.0, 0.0, kt, kn, 1e-5, fn, reff, 0.0, 0.5, 0.0, 0.3, dt, [] { return 1.0; });
+  EXPECT_DOUBLE_EQ(stuck.shear, -kt * 1e-5 * dt);
+  const double mu_r = 0.2, kr = rolling_stiffness(mu_r, kn, reff);
+  const auto rolling =
+      CoulombFrictionRolling::update(0.0, 0.0, kt, kn, 0.0, fn, reff, 10.0, 0.5, mu_r, 0.3, dt, [] { return 1.0; });
+  EXPECT_DOUBLE_EQ(rolling.roll, -mu_r * reff * fn);  // k_r ω Δt = 1800 N·m/m ≫ μ_r R* F_n = 2
+  EXPECT_EQ(rolling.roll_damping, 0.0);
+  EXPECT_DOUBLE_EQ(rolling.kr, kr);
+  const double w = 1e-6;
+  const auto elastic =
+      CoulombFrictionRolling::update(0.0, 0.0, kt, kn, 0.0, fn, reff, w, 0.5, mu_r, 0.3, dt, [] { return 4.0; });
+  EXPECT_DOUBLE_EQ(elastic.roll, -kr * w * dt);
+  EXPECT_DOUBLE_EQ(elastic.roll_damping, -0.3 * 2.0 * std::sqrt(4.0 * kr) * w);
+}
+
+TEST(DemContact, DiscRestsOnTerrainWhileTheSlopeIsBelowItsRollingResistance) {
+  // docs/validation/dem.md equates a disc's terrain rolling resistance with an n-gon's tipping
+  // angle through this threshold: on a slope θ (friction μ = 0.9 > tan θ, so no sliding) the
+  // contact friction m g sin θ turns the disc against the limit μ_r R m g cos θ, so it rests while
+  // tan θ ≤ μ_r and rolls above. μ_r = tan 30° (a hexagon); 27° rests (the rolling spring's
+  // elastic creep is below 1 mm), 33° rolls (⅔ g (sin θ − μ_r cos θ) t²/2 ≈ 0.2 m in 1 s).
+  const double R = 0.5, g = 9.81, kn = 1e9, mu_r = std::tan(kPi / 6);
+  auto travel = [&](double theta_deg) {
+    const double th = theta_deg * kPi / 180;
+    DemSolver s;
+    s.settings.gravity = Vec2(g * std::sin(th), -g * std::cos(th));  // the slope is the x axis
+    s.law = LinearSpringCoulomb{kn, 0.4 * kn};
+    s.contact.restitution = 0.3;
+    add_disc(s.discs, Vec2(0, R - 2650 * kPi * R * R * g * std::cos(th) / kn), R, 2650);
+    s.terrain.add_polyline({Vec2(-10, 0), Vec2(100, 0)}, 0.9, 0.3, mu_r);
+    s.initialise();
+    s.run_until(1.0);
+    return s.discs.get<Position<2>>()[0].x();
+  };
+  EXPECT_LT(std::abs(travel(27.0)), 1e-3);
+  EXPECT_GT(travel(33.0), 0.1);
+}

@@ -446,16 +446,19 @@ TEST(DemApp, BadInputExitsWithCode2AndWritesNothing) {
                     " --set 'avalanche.source_z=[100.0, 80.0, 90.0, 110.0]' --out " + out.string()),
             2);
   EXPECT_FALSE(fs::exists(out));
-  // Stop fraction, restitution and rolling resistance out of range: the message names the key.
+  // Stop fraction and speed, restitution, rolling resistance and its damping out of range: the message
+  // names the key and the allowed range.
   for (const char* set :
        {"avalanche.stop_kinetic_fraction=1.0", "avalanche.stop_kinetic_fraction=0", "avalanche.terrain_restitution=1.5",
-        "avalanche.terrain_restitution=0", "material.restitution=0", "material.rolling_friction=-0.1",
-        "avalanche.terrain_rolling_friction=-0.2"}) {
+        "avalanche.terrain_restitution=0", "material.restitution=0", "material.restitution=1.5",
+        "material.rolling_friction=-0.1", "avalanche.terrain_rolling_friction=-0.2",
+        "avalanche.stop_kinetic_fraction=-0.5", "avalanche.stop_speed=-1", "material.rolling_damping=1.5"}) {
     const auto r = geohaz::testing::run_command(kApp.string() + " --config " + (kData / "avalanche.toml").string() +
                                                 " --set " + set + " --out " + out.string());
     EXPECT_EQ(r.code, 2) << set;
     const std::string key(set, std::string(set).find('='));
     EXPECT_NE(r.output.find(key), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("allowed"), std::string::npos) << r.output;  // the message states the range
     EXPECT_FALSE(fs::exists(out));
   }
   // Missing config file and help/version.

@@ -197,6 +197,34 @@ nlohmann::json quantile_json(const AvalancheResult& r) {
 
 }  // namespace
 
+namespace {
+
+/// The single block of SingleBlockTravelAngle: a bonded 4 m block (R 0.3–0.5 m, bonds 200 MPa,
+/// no joints) held on a 40° slope 100 m high that runs onto a 1 km floor.
+AvalancheSpec single_block(std::uint64_t seed, double mu_r) {
+  AvalancheSpec a = example_avalanche();
+  a.packing.seed = seed;
+  a.packing.r_min = 0.3;
+  a.packing.r_max = 0.5;
+  a.material.contact.rolling_friction = mu_r;
+  a.material.joint_sets.clear();
+  a.material.bond.tensile_strength = a.material.bond.shear_strength = 200e6;
+  a.material.bond.tensile_strength_std = a.material.bond.shear_strength_std = 0;
+  a.strength_factor = 1.0;
+  const double t = std::tan(40 * std::numbers::pi / 180), H0 = 100;
+  a.terrain = {Vec2(0, H0), Vec2(H0 / t, 0), Vec2(H0 / t + 1000, 0)};
+  const Vec2 o(10, H0 - 10 * t);  // on the slope
+  const Vec2 along = Vec2(1, -t).normalized(), up = Vec2(t, 1).normalized();
+  const double b = 4.0;
+  a.source = {o + 0.2 * up, o + b * along + 0.2 * up, o + b * along + (b + 0.2) * up, o + (b + 0.2) * up};
+  const Vec2 s0 = o + b * along + 0.7 * along;
+  a.support = {s0 - 2 * up, s0 + (b + 3) * up};
+  a.settle_time = 0.5;
+  return a;
+}
+
+}  // namespace
+
 TEST(DemValidation, SingleBlockTravelAngle) {
   // One bonded block (≈ 4 m × 4 m, bonds 100× stronger than the example's, so it stays whole)
   // released on a 40° slope 100 m high onto a flat floor. Rockfall practice: single blocks stop
@@ -209,24 +237,7 @@ TEST(DemValidation, SingleBlockTravelAngle) {
   nlohmann::json j = nlohmann::json::array();
   for (double mu_r : {0.1, 0.3})
     for (std::uint64_t seed : {1, 2, 3}) {
-      AvalancheSpec a = example_avalanche();
-      a.packing.seed = seed;
-      a.packing.r_min = 0.3;
-      a.packing.r_max = 0.5;
-      a.material.contact.rolling_friction = mu_r;
-      a.material.joint_sets.clear();
-      a.material.bond.tensile_strength = a.material.bond.shear_strength = 200e6;
-      a.material.bond.tensile_strength_std = a.material.bond.shear_strength_std = 0;
-      a.strength_factor = 1.0;
-      const double t = std::tan(40 * std::numbers::pi / 180), H0 = 100;
-      a.terrain = {Vec2(0, H0), Vec2(H0 / t, 0), Vec2(H0 / t + 1000, 0)};
-      const Vec2 o(10, H0 - 10 * t);  // on the slope
-      const Vec2 along = Vec2(1, -t).normalized(), up = Vec2(t, 1).normalized();
-      const double b = 4.0;
-      a.source = {o + 0.2 * up, o + b * along + 0.2 * up, o + b * along + (b + 0.2) * up, o + (b + 0.2) * up};
-      const Vec2 s0 = o + b * along + 0.7 * along;
-      a.support = {s0 - 2 * up, s0 + (b + 3) * up};
-      a.settle_time = 0.5;
+      const AvalancheSpec a = single_block(seed, mu_r);
       DemSolver s;
       const auto r = run_avalanche(a, s);
       const RunoutQuantile& far = r.quantiles.back();
@@ -255,6 +266,45 @@ TEST(DemValidation, SingleBlockTravelAngle) {
       EXPECT_LT(angle, 60.0);
     }
   std::ofstream(out_dir() / "single_block.json") << j.dump(2) << "\n";
+}
+
+TEST(DemValidation, SingleBlockTravelAngleWithFragmentShapeTerrainRolling) {
+  // Sensitivity, not a fit: the disc–terrain rolling resistance set to that of an angular
+  // fragment of n faces, the discs among themselves keep the example's μ_r = 0.1. A disc with
+  // rolling resistance μ_r (Ai et al. 2011, model C, R* = R on terrain) rests on a slope θ while
+  // tan θ ≤ μ_r (friction m g sin θ at the contact against the limit μ_r R m g cos θ) and, rolling,
+  // loses μ_r N per metre (energy line atan μ_r); a regular n-gon rests on a face while θ ≤ π/n
+  // (the centroid stays above the downhill corner). Equal thresholds: μ_r = tan(π/n), i.e.
+  // 1.0 (n = 4), 0.58 (n = 6), 0.41 (n = 8). Reported in docs/validation/dem.md.
+  nlohmann::json j = nlohmann::json::array();
+  for (int faces : {4, 6, 8})
+    for (std::uint64_t seed : {1, 2, 3}) {
+      AvalancheSpec a = single_block(seed, 0.1);
+      a.terrain_rolling_friction = std::tan(std::numbers::pi / faces);
+      DemSolver s;
+      const auto r = run_avalanche(a, s);
+      const RunoutQuantile& far = r.quantiles.back();
+      const double angle = std::atan(far.h_over_l) * 180 / std::numbers::pi;
+      const double angle_com = std::atan(r.com_h_over_l) * 180 / std::numbers::pi;
+      std::printf(
+          "single block, terrain mu_r = tan(pi/%d) = %.2f, seed %d: %zu discs, %zu fragments, at rest %d after %.1f "
+          "s; farthest point L = %.1f m, Fahrboeschung %.1f deg; centre of mass %.1f deg\n",
+          faces, a.terrain_rolling_friction, static_cast<int>(seed), r.discs, r.fragment_sizes.size(), r.at_rest,
+          r.duration, far.runout, angle, angle_com);
+      j.push_back({{"faces", faces},
+                   {"terrain_rolling_friction", a.terrain_rolling_friction},
+                   {"seed", seed},
+                   {"discs", r.discs},
+                   {"fragments", r.fragment_sizes.size()},
+                   {"at_rest", r.at_rest},
+                   {"L_farthest", far.runout},
+                   {"fahrboeschung_deg", angle},
+                   {"com_travel_angle_deg", angle_com}});
+      EXPECT_TRUE(r.at_rest);
+      EXPECT_GT(angle, 5.0);
+      EXPECT_LT(angle, 60.0);
+    }
+  std::ofstream(out_dir() / "single_block_fragment_shape.json") << j.dump(2) << "\n";
 }
 
 TEST(DemValidation, AvalancheHoverLVersusVolume) {

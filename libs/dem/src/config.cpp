@@ -16,6 +16,11 @@ namespace geohaz::dem {
 
 namespace {
 
+template <class... F>
+struct Overloaded : F... {
+  using F::operator()...;
+};
+
 std::vector<Vec2> points(ConfigReader& r, const char* kx, const char* kz, const char* what, bool required,
                          std::size_t min_points) {
   std::vector<double> x, z;
@@ -90,8 +95,15 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   MaterialSpec& m = c.material;
   p.density = m.density =
       r.get("material.density", m.density, Range::positive(), {"kg/m^3", "disc density (discs are 1 m thick)"});
-  const auto law = r.get_choice("material.contact_law", "linear", {"linear", "hertz"},
-                                {"", "contact law: linear spring + Coulomb (Cundall & Strack 1979) or Hertz-Mindlin"});
+  {  // the choices and their sentences come from the one name table (contact_laws.hpp)
+    std::vector<std::string> names;
+    std::string help = "contact law:";
+    for (std::size_t k = 0; k < contact_law_names.size(); ++k) {
+      names.emplace_back(contact_law_names[k]);
+      help += (k ? "; " : " ") + names.back() + " = " + std::string(contact_law_summaries[k]);
+    }
+    m.law = *contact_law_from_name(r.get_choice("material.contact_law", "linear", names, {"", help}));
+  }
   const double Ec = r.get("material.contact_modulus", 20e9, Range::positive(),
                           {"Pa", "linear law: contact modulus E_c, k_n = 2 E_c (PFC2D, unit thickness)"});
   const double kratio = r.get("material.stiffness_ratio", 2.5, Range::positive(), {"1", "linear law: k_n/k_s"});
@@ -99,14 +111,16 @@ RunConfig read_config(ConfigReader& r, bool describe) {
       r.get("material.youngs_modulus", 20e9, Range::positive(), {"Pa", "Hertz-Mindlin: particle Young's modulus"});
   const double nu = r.get("material.poisson_ratio", 0.25, Range::closed_open(0.0, 0.5),
                           {"1", "Hertz-Mindlin: particle Poisson's ratio"});
-  if (law == "linear") {
-    m.law = LinearSpringCoulomb{2 * Ec, 2 * Ec / kratio};
-  } else {
-    HertzMindlin h;
-    h.youngs = E;
-    h.poisson = nu;
-    m.law = h;
-  }
+  // One case per law and no generic one: a law added to ContactLaw without its case fails to compile.
+  std::visit(Overloaded{[&](LinearSpringCoulomb& l) {
+                          l.kn = 2 * Ec;
+                          l.ks = 2 * Ec / kratio;
+                        },
+                        [&](HertzMindlin& h) {
+                          h.youngs = E;
+                          h.poisson = nu;
+                        }},
+             m.law);
   m.contact.friction = r.get("material.friction", 0.5, Range::non_negative(), {"1", "contact friction coefficient mu"});
   m.contact.restitution =
       r.get("material.restitution", 0.5, Range::open_closed(0.0, 1.0), {"1", "normal restitution coefficient e"});

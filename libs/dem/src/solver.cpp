@@ -262,7 +262,7 @@ void DemSolver::pair_forces(const Law& law) {
   const double mu = contact.friction;
   const double mu_r = contact.rolling_friction;
   const double eta_r = contact.rolling_damping;
-  const double zeta = damping_ratio_from_restitution(contact.restitution);
+  const double zeta = Law::pair_damping(contact.restitution);
   const double mu_joint = settings.joint_friction;
   const bool same = same_layout_ && hist_.offsets.size() == n + 1;
   const bool any_joints = !joints_.empty();
@@ -323,28 +323,15 @@ void DemSolver::pair_forces(const Law& law) {
             break;
           }
       }
-      fs -= c.kt * vt * dt;
-      const double limit = mu_c * std::max(fn, 0.0);
-      if (std::abs(fs) > limit) fs = sgn(fs) * limit;
-      double mdamp = 0.0, kr = 0.0;
-      if (mu_rc > 0.0) {
-        kr = rolling_stiffness(mu_rc, c.kn, reff);
-        const double wr = w[i] - w[j];
-        mr -= kr * wr * dt;
-        const double mmax = mu_rc * reff * std::max(fn, 0.0);
-        if (std::abs(mr) >= mmax) {
-          mr = sgn(mr) * mmax;
-        } else {
-          const double Ir = rolling_inertia(I[i], m[i], Ri, I[j], m[j], R[j]);
-          mdamp = -eta_r * 2.0 * std::sqrt(Ir * kr) * wr;
-        }
-      } else {
-        mr = 0.0;
-      }
+      const auto fr =
+          CoulombFrictionRolling::update(fs, mr, c.kt, c.kn, vt, fn, reff, w[i] - w[j], mu_c, mu_rc, eta_r, dt,
+                                         [&] { return rolling_inertia(I[i], m[i], Ri, I[j], m[j], R[j]); });
+      fs = fr.shear;
+      mr = fr.roll;
       f += fn * nrm + fs * t;
-      tq += -li * fs + mr + mdamp;
+      tq += -li * fs + mr + fr.roll_damping;
       ktr += std::max(c.kn, c.kt);
-      krot += c.kt * Ri * Ri + kr;
+      krot += c.kt * Ri * Ri + fr.kr;
       hist_next_.partner[k] = pj;
       hist_next_.shear[k] = fs;
       hist_next_.roll[k] = mr;
@@ -560,25 +547,15 @@ void DemSolver::wall_forces(const Law& law) {
             fs = old(1, q);
             mr = old(2, q);
           }
-        fs -= c.kt * vrel.dot(t) * dt;
-        const double limit = s.friction * std::max(fn, 0.0);
-        if (std::abs(fs) > limit) fs = sgn(fs) * limit;
-        double md = 0.0, kr = 0.0;
         const double mu_rw = s.rolling_friction >= 0.0 ? s.rolling_friction : mu_r;  // the wall's own, if set
-        if (mu_rw > 0) {
-          kr = rolling_stiffness(mu_rw, c.kn, Ri);
-          mr -= kr * w[i] * dt;
-          const double mmax = mu_rw * Ri * std::max(fn, 0.0);
-          if (std::abs(mr) >= mmax)
-            mr = sgn(mr) * mmax;
-          else
-            md = -eta_r * 2.0 * std::sqrt((I[i] + m[i] * Ri * Ri) * kr) * w[i];
-        } else {
-          mr = 0.0;
-        }
+        const auto fr = CoulombFrictionRolling::update(fs, mr, c.kt, c.kn, vrel.dot(t), fn, Ri, w[i], s.friction, mu_rw,
+                                                       eta_r, dt, [&] { return I[i] + m[i] * Ri * Ri; });
+        fs = fr.shear;
+        mr = fr.roll;
+        const double kr = fr.kr;
         const Vec2 fc = fn * nrm + fs * t;
         f += fc;
-        tq += -Ri * fs + mr + md;
+        tq += -Ri * fs + mr + fr.roll_damping;
         // Time step: a dashpot of ratio ζ lowers the critical step of the explicit scheme to
         // (2/ω)(√(1+ζ²) − ζ) (Belytschko et al. 2000, §6.3), i.e. k acts as k (ζ + √(1+ζ²))².
         // Without it a strongly damped contact (e = 0.1, ζ = 1.24) changes v by 57 % per step
@@ -810,7 +787,7 @@ double DemSolver::kinetic_energy() const {
 
 double DemSolver::strain_energy() const {
   double e = 0.0;
-  // Contacts: normal spring energy from the overlap (linear: ½k δ²; Hertz: 2/5 F δ), shear ½F_s²/k_s.
+  // Contacts: normal spring energy from the overlap (the law's normal_energy), shear ½F_s²/k_s.
   const auto& x = discs.get<Position<2>>();
   const auto& R = discs.get<Radius>();
   const auto& m = discs.get<Mass>();
@@ -827,11 +804,7 @@ double DemSolver::strain_energy() const {
       std::visit(
           [&](const auto& l) {
             const ContactResponse c = l.evaluate(delta, meff, reff, R[i] + R[j], 0.0);
-            using L = std::decay_t<decltype(l)>;
-            if constexpr (std::is_same_v<L, LinearSpringCoulomb>)
-              e += 0.5 * c.fn_elastic * delta;
-            else
-              e += 0.4 * c.fn_elastic * delta;
+            e += l.normal_energy(c.fn_elastic, delta);
             const double fs = hist_.partner.size() > k && hist_.partner[k] >= 0 ? hist_.shear[k] : 0.0;
             if (c.kt > 0) e += 0.5 * fs * fs / c.kt;
           },

@@ -1,7 +1,11 @@
 #pragma once
 /// \file contact_laws.hpp
-/// Disc–disc and disc–wall contact laws. Each law is a small value type with an `evaluate`
-/// member inlined into the force loop; the solver picks one with std::visit once per step.
+/// Disc–disc and disc–wall contact laws. Each law is a small value type (see the concept
+/// `DemContactLaw` below for what it declares: config name, normal force and stiffnesses, its
+/// dashpot from the restitution, its stored elastic energy, reference stiffnesses for the time
+/// step); the solver picks one with std::visit once per step. The tangential friction and the
+/// rolling resistance are one sub-model shared by every law (`CoulombFrictionRolling`), for
+/// disc–disc and disc–wall contacts alike.
 ///
 /// Sign conventions (2D, unit thickness): overlap δ = R_i + R_j − |x_i − x_j| > 0 in contact,
 /// the normal n points from j to i, the tangent t = ẑ × n. The normal force on i is
@@ -11,8 +15,13 @@
 /// clamped to F_n ≥ 0 (a wall never pulls); their damping comes from `wall_damping(e)`, which for
 /// the linear law is the clamped-dashpot inverse, so the configured e is reproduced there too.
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <concepts>
 #include <numbers>
+#include <optional>
+#include <string_view>
 #include <variant>
 
 namespace geohaz::dem {
@@ -66,6 +75,8 @@ inline double clamped_damping_ratio_from_restitution(double e) {
 /// F_n = k_n δ − c_n v_n, c_n = 2ζ√(m* k_n); ΔF_t = −k_s Δu_t, |F_t| ≤ μ F_n.
 /// Undamped contact duration t_c = π√(m*/k_n).
 struct LinearSpringCoulomb {
+  static constexpr const char* name = "linear";
+  static constexpr const char* summary = "linear spring-dashpot + Coulomb friction (Cundall & Strack 1979)";
   double kn = 1e8;  ///< normal stiffness (N/m per m thickness)
   double ks = 1e8;  ///< shear stiffness (N/m per m thickness)
 
@@ -73,8 +84,12 @@ struct LinearSpringCoulomb {
   ContactResponse evaluate(double delta, double meff, double /*reff*/, double /*slice*/, double zeta) const noexcept {
     return {kn * delta, kn, 2.0 * zeta * std::sqrt(meff * kn), ks};
   }
+  /// Damping ratio of a disc–disc contact (unclamped) giving restitution e.
+  static double pair_damping(double e) { return damping_ratio_from_restitution(e); }
   /// Damping ratio of a disc–wall contact (normal force clamped to ≥ 0) giving restitution e.
   static double wall_damping(double e) { return clamped_damping_ratio_from_restitution(e); }
+  /// Elastic energy of the normal spring at overlap δ with elastic force F = k_n δ: ∫F dδ = ½ F δ (J/m).
+  static double normal_energy(double fn_elastic, double delta) noexcept { return 0.5 * fn_elastic * delta; }
   /// Stiffness used for the critical time step before any contact exists.
   double reference_kn(double /*radius*/) const noexcept { return kn; }
   double reference_kt(double /*radius*/) const noexcept { return ks; }
@@ -90,6 +105,9 @@ struct LinearSpringCoulomb {
 ///   E* = E/(2(1−ν²)), G* = E/(4(2−ν)(1+ν)) for identical materials.
 /// Elastic contact duration t_c = 2.868 (m*² l² /(R* E*² v))^{1/5} (m* per unit thickness).
 struct HertzMindlin {
+  static constexpr const char* name = "hertz";
+  static constexpr const char* summary =
+      "Hertz-Mindlin no-slip, spheres of the disc diameter per metre (Tsuji et al. 1992)";
   double youngs = 1e9;               ///< particle Young's modulus E (Pa)
   double poisson = 0.25;             ///< Poisson's ratio ν
   double reference_overlap = 0.005;  ///< δ/R used for the time step of a disc with no contact yet
@@ -104,9 +122,14 @@ struct HertzMindlin {
     return {4.0 / 3.0 * Es * a * delta, sn, 2.0 * std::sqrt(5.0 / 6.0) * beta * std::sqrt(sn * meff),
             8.0 * gstar() / slice * a};
   }
+  /// Damping factor β of a disc–disc contact giving restitution e (Tsuji et al. 1992).
+  static double pair_damping(double e) { return damping_ratio_from_restitution(e); }
   /// Damping factor β of a disc–wall contact. Tsuji's β, not corrected for the clamp to F_n ≥ 0
   /// (no closed form for the Hertz law; docs/dem.md gives the measured bias).
   static double wall_damping(double e) { return damping_ratio_from_restitution(e); }
+  /// Elastic energy of the normal spring at overlap δ with elastic force F ∝ δ^{3/2}:
+  /// ∫F dδ = ⅖ F δ (J/m).
+  static double normal_energy(double fn_elastic, double delta) noexcept { return 0.4 * fn_elastic * delta; }
   /// Stiffness of a contact of a disc of radius R with an equal disc at the reference overlap.
   double reference_kn(double radius) const noexcept {
     return 2.0 * estar() * std::sqrt(0.5 * radius * reference_overlap * radius) / (2.0 * radius);
@@ -116,8 +139,63 @@ struct HertzMindlin {
   }
 };
 
-/// The contact law chosen by the configuration (visited once per step).
+/// What the solver requires of a contact law. Every member is used by the solver; a law that
+/// lacks one does not compile (no default stands in for it).
+///   name, summary          config name (`material.contact_law`) and a sentence for --help-config;
+///   evaluate(δ, m*, R*, l, z)  elastic normal force, normal and tangential stiffness, dashpot
+///                          coefficient from the damping parameter z;
+///   pair_damping(e), wall_damping(e)  z giving restitution e for a disc–disc (unclamped) and a
+///                          disc–wall (clamped to F_n ≥ 0) contact;
+///   normal_energy(F_el, δ) elastic energy stored in the normal spring (J/m);
+///   reference_kn(R), reference_kt(R)  stiffnesses for the time step of a disc with no contact.
+template <class L>
+concept DemContactLaw = requires(const L& l, double x) {
+  { L::name } -> std::convertible_to<const char*>;
+  { L::summary } -> std::convertible_to<const char*>;
+  { l.evaluate(x, x, x, x, x) } -> std::same_as<ContactResponse>;
+  { L::pair_damping(x) } -> std::same_as<double>;
+  { L::wall_damping(x) } -> std::same_as<double>;
+  { L::normal_energy(x, x) } -> std::same_as<double>;
+  { l.reference_kn(x) } -> std::same_as<double>;
+  { l.reference_kt(x) } -> std::same_as<double>;
+};
+
+/// The contact law chosen by the configuration (visited once per step), and the one name table
+/// of the laws: its alternatives' `name`s are the values of `material.contact_law`. A law is
+/// added here and nowhere else in the solver; the app's exhaustive visit (which sets the law's
+/// parameters) then fails to compile until it has a case for it.
 using ContactLaw = std::variant<LinearSpringCoulomb, HertzMindlin>;
+
+namespace detail {
+template <class V>
+struct ContactLawTable;
+template <class... L>
+struct ContactLawTable<std::variant<L...>> {
+  static_assert((DemContactLaw<L> && ...), "every alternative of ContactLaw is a DemContactLaw");
+  static constexpr std::array<std::string_view, sizeof...(L)> names{std::string_view(L::name)...};
+  static constexpr std::array<std::string_view, sizeof...(L)> summaries{std::string_view(L::summary)...};
+  static std::optional<std::variant<L...>> from_name(std::string_view n) {
+    std::optional<std::variant<L...>> out;
+    (void)((n == L::name ? (out = L{}, true) : false) || ...);
+    return out;
+  }
+};
+}  // namespace detail
+
+/// Config names of the contact laws, in the order of ContactLaw.
+inline constexpr auto contact_law_names = detail::ContactLawTable<ContactLaw>::names;
+/// One sentence per law (same order), for --help-config.
+inline constexpr auto contact_law_summaries = detail::ContactLawTable<ContactLaw>::summaries;
+
+/// The law of that config name with its default parameters; std::nullopt for an unknown name.
+inline std::optional<ContactLaw> contact_law_from_name(std::string_view name) {
+  return detail::ContactLawTable<ContactLaw>::from_name(name);
+}
+
+/// Config name of a law.
+inline std::string_view contact_law_name(const ContactLaw& law) noexcept {
+  return contact_law_names[law.index()];
+}
 
 /// Parameters shared by the contact laws.
 struct ContactProperties {
@@ -135,5 +213,53 @@ struct ContactProperties {
 inline double rolling_stiffness(double mu_r, double kn, double reff) noexcept {
   return 2.25 * mu_r * mu_r * kn * reff * reff;
 }
+
+/// Tangential friction and rolling resistance of one contact, shared by every contact law and by
+/// disc–disc and disc–wall contacts (the law only supplies k_n, k_t and F_n):
+///   Coulomb friction on an incremental tangential spring (Cundall & Strack 1979):
+///     F_s ← F_s − k_t v_t Δt,  |F_s| ≤ μ max(F_n, 0);
+///   elastic–plastic rolling spring with viscous damping (Ai et al. 2011, model C; Iwashita &
+///   Oda 1998), for μ_r > 0:
+///     k_r = 2.25 μ_r² k_n R*²,  M_r ← M_r − k_r ω_r Δt,  |M_r| ≤ μ_r R* max(F_n, 0),
+///     M_d = −η_r 2√(I_r k_r) ω_r while |M_r| is below the limit (0 at the limit);
+///   μ_r = 0 gives M_r = M_d = 0.
+struct CoulombFrictionRolling {
+  /// State after the update: shear force (N/m), rolling moment (N·m/m), rolling damping moment
+  /// (N·m/m, not part of the history) and the rolling stiffness k_r (N·m/m per rad, for the step).
+  struct Result {
+    double shear, roll, roll_damping, kr;
+  };
+  /// \param shear, roll       history of the contact (F_s, M_r) from the last step
+  /// \param kt, kn            tangential and normal stiffness of the law at this overlap
+  /// \param vt                relative tangential velocity at the contact point (m/s)
+  /// \param fn                normal force (N/m; the friction limits use max(F_n, 0))
+  /// \param reff              R* of the rolling law (m)
+  /// \param omega_r           relative angular velocity ω_i − ω_j (rad/s; ω_i for a wall)
+  /// \param rolling_inertia   callable returning I_r (kg·m²/m), called only when it is needed
+  template <class RollingInertia>
+  static Result update(double shear, double roll, double kt, double kn, double vt, double fn, double reff,
+                       double omega_r, double mu, double mu_r, double eta_r, double dt,
+                       RollingInertia&& rolling_inertia) noexcept {
+    shear -= kt * vt * dt;
+    const double limit = mu * std::max(fn, 0.0);
+    if (std::abs(shear) > limit) shear = sign(shear) * limit;
+    double damping = 0.0, kr = 0.0;
+    if (mu_r > 0.0) {
+      kr = rolling_stiffness(mu_r, kn, reff);
+      roll -= kr * omega_r * dt;
+      const double mmax = mu_r * reff * std::max(fn, 0.0);
+      if (std::abs(roll) >= mmax)
+        roll = sign(roll) * mmax;
+      else
+        damping = -eta_r * 2.0 * std::sqrt(rolling_inertia() * kr) * omega_r;
+    } else {
+      roll = 0.0;
+    }
+    return {shear, roll, damping, kr};
+  }
+
+ private:
+  static double sign(double v) noexcept { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
+};
 
 }  // namespace geohaz::dem
