@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "geohaz/core/snapshot.hpp"
+#include "geohaz/sph/constitutive.hpp"
 #include "run_command.hpp"
 
 namespace {
@@ -438,6 +439,20 @@ TEST(SphSlopeApp, StrengthReductionBadRangeExitsTwoNamingTheKey) {
 
 namespace {
 
+/// Column `col` (from 0) of a CSV file with one header line.
+std::vector<double> csv_column(const fs::path& p, std::size_t col) {
+  std::ifstream in(p);
+  std::string line;
+  std::getline(in, line);
+  std::vector<double> v;
+  while (std::getline(in, line)) {
+    std::size_t start = 0;
+    for (std::size_t k = 0; k < col; ++k) start = line.find(',', start) + 1;
+    v.push_back(std::stod(line.substr(start)));
+  }
+  return v;
+}
+
 /// Deviator column (Pa, compression negative) of stress_strain.csv.
 std::vector<double> deviators(const fs::path& p) {
   std::ifstream in(p);
@@ -448,17 +463,23 @@ std::vector<double> deviators(const fs::path& p) {
   return q;
 }
 
-/// Plane-strain Drucker–Prager constants (Bui et al. 2010, eqs. 18–19).
+/// Drucker–Prager constants of the app's default 2D fit (plane strain matched to the flow rule,
+/// constitutive.hpp; with ψ = 0: α = sinφ/3, k = c cosφ).
 std::pair<double, double> dp_plane_strain(double c, double phi_deg) {
-  const double t = std::tan(phi_deg * 3.14159265358979323846 / 180.0), d = std::sqrt(9.0 + 12.0 * t * t);
-  return {t / d, 3.0 * c / d};
+  const auto k = geohaz::sph::drucker_prager_constants(c, phi_deg * 3.14159265358979323846 / 180.0, 0.0,
+                                                       geohaz::sph::DruckerPragerFit::PlaneStrainFlowRule);
+  return {k.alpha_phi, k.kc};
 }
 
 // Strain softening in the SPH biaxial test (unconfined plane strain, rough platens, 10 × 20
 // particles, ψ = 0): c = 20 kPa, φ = 25° falling to c_r = 2 kPa, φ_r = 20° over κ_r = 0.02. Peak: first
 // yield of the elastic state (σ_lateral = 0, σ_zz = −ν q) on the peak surface, solved for q by
 // bisection; residual: steady plastic flow on the residual surface (s_zz = 0 with ψ = 0 and
-// ε̇_zz = 0), q = k_r/(½ − 3α_r/2). Tolerance 5 % (the issue's). About 3 s.
+// ε̇_zz = 0), q = k_r/(½ − 3α_r/2) (= 2c_r cosφ_r/(1 − sinφ_r), Mohr–Coulomb, with the default
+// flow-rule fit). The residual is the mean deviator over the last 2 % of axial strain (8–10 %):
+// once the band has formed the platen deviator oscillates by ±15 % about it (4.4–6.3 kPa), so
+// the single last sample the test used to take is a draw from that oscillation. Tolerance 5 % (the
+// issue's). About 3 s.
 TEST(SphSlopeApp, SofteningBiaxialDropsFromPeakToResidual) {
   const fs::path out = kWork / "softening_biaxial";
   fs::remove_all(out);
@@ -471,7 +492,17 @@ TEST(SphSlopeApp, SofteningBiaxialDropsFromPeakToResidual) {
   ASSERT_EQ(r.code, 0) << r.err;
   const auto q = deviators(out / "stress_strain.csv");
   ASSERT_GT(q.size(), 100u);
-  const double peak = -*std::min_element(q.begin(), q.end()), residual = -q.back();
+  const auto strain = csv_column(out / "stress_strain.csv", 1);
+  ASSERT_EQ(strain.size(), q.size());
+  double sum = 0.0;
+  int count = 0;
+  for (std::size_t k = 0; k < q.size(); ++k)
+    if (strain[k] >= 0.08) {
+      sum -= q[k];
+      ++count;
+    }
+  ASSERT_GT(count, 10);
+  const double peak = -*std::min_element(q.begin(), q.end()), residual = sum / count;
   const auto [a, k] = dp_plane_strain(20e3, 25.0);
   const double nu = 0.3;
   auto f = [&](double qq) {  // yield function at σ = diag(0, −q, −ν q)
@@ -483,8 +514,8 @@ TEST(SphSlopeApp, SofteningBiaxialDropsFromPeakToResidual) {
   for (int it = 0; it < 200; ++it) (f(0.5 * (lo + hi)) > 0.0 ? hi : lo) = 0.5 * (lo + hi);
   const auto [ar, kr] = dp_plane_strain(2e3, 20.0);
   const double q_res = kr / (0.5 - 1.5 * ar);
-  EXPECT_NEAR(peak, lo, 0.05 * lo);            // 51.2 kPa against 52.5 kPa
-  EXPECT_NEAR(residual, q_res, 0.05 * q_res);  // 5.58 kPa against 5.55 kPa
+  EXPECT_NEAR(peak, lo, 0.05 * lo);            // 53.1 kPa against 54.9 kPa
+  EXPECT_NEAR(residual, q_res, 0.05 * q_res);  // 5.59 kPa against 5.71 kPa
 }
 
 TEST(SphSlopeApp, ResidualAbovePeakExitsTwoNamingTheKey) {

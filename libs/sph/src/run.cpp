@@ -627,8 +627,8 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
     for (std::size_t k = 0; k < mats.size(); ++k)
       std::fprintf(stderr, "  material %zu (%s): c_p = %.4g m/s, DP fit %s, %s %s\n", k,
                    k < c.material_names.size() ? c.material_names[k].c_str() : "", mats[k].p_wave_speed,
-                   mats[k].fit == DruckerPragerFit::PlaneStrain ? "plane_strain" : "compression_3d",
-                   solver.model_name().c_str(), model_parameters(c.model, mats[k]).dump().c_str());
+                   drucker_prager_fit_name(mats[k].fit), solver.model_name().c_str(),
+                   model_parameters(c.model, mats[k]).dump().c_str());
   }
 
   make_output_dir(out);
@@ -651,7 +651,7 @@ int run_dim(const RunConfig& c, const std::filesystem::path& out, bool quiet) {
   for (std::size_t k = 0; k < mats.size(); ++k) {
     nlohmann::json e = {{"name", k < c.material_names.size() ? c.material_names[k] : ""},
                         {"p_wave_speed_m_per_s", mats[k].p_wave_speed},
-                        {"dp_fit", mats[k].fit == DruckerPragerFit::PlaneStrain ? "plane_strain" : "compression_3d"}};
+                        {"dp_fit", drucker_prager_fit_name(mats[k].fit)}};
     e.update(model_parameters(c.model, mats[k]));
     summary["materials"].push_back(e);
   }
