@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "geohaz/core/snapshot.hpp"
+#include "geohaz/sph/constitutive.hpp"
 #include "run_command.hpp"
 
 namespace {
@@ -438,6 +440,20 @@ TEST(SphSlopeApp, StrengthReductionBadRangeExitsTwoNamingTheKey) {
 
 namespace {
 
+/// Column `col` (from 0) of a CSV file with one header line.
+std::vector<double> csv_column(const fs::path& p, std::size_t col) {
+  std::ifstream in(p);
+  std::string line;
+  std::getline(in, line);
+  std::vector<double> v;
+  while (std::getline(in, line)) {
+    std::size_t start = 0;
+    for (std::size_t k = 0; k < col; ++k) start = line.find(',', start) + 1;
+    v.push_back(std::stod(line.substr(start)));
+  }
+  return v;
+}
+
 /// Deviator column (Pa, compression negative) of stress_strain.csv.
 std::vector<double> deviators(const fs::path& p) {
   std::ifstream in(p);
@@ -448,17 +464,23 @@ std::vector<double> deviators(const fs::path& p) {
   return q;
 }
 
-/// Plane-strain Drucker–Prager constants (Bui et al. 2010, eqs. 18–19).
+/// Drucker–Prager constants of the app's default 2D fit (plane strain matched to the flow rule,
+/// constitutive.hpp; with ψ = 0: α = sinφ/3, k = c cosφ).
 std::pair<double, double> dp_plane_strain(double c, double phi_deg) {
-  const double t = std::tan(phi_deg * 3.14159265358979323846 / 180.0), d = std::sqrt(9.0 + 12.0 * t * t);
-  return {t / d, 3.0 * c / d};
+  const auto k = geohaz::sph::drucker_prager_constants(c, phi_deg * 3.14159265358979323846 / 180.0, 0.0,
+                                                       geohaz::sph::DruckerPragerFit::PlaneStrainFlowRule);
+  return {k.alpha_phi, k.kc};
 }
 
 // Strain softening in the SPH biaxial test (unconfined plane strain, rough platens, 10 × 20
 // particles, ψ = 0): c = 20 kPa, φ = 25° falling to c_r = 2 kPa, φ_r = 20° over κ_r = 0.02. Peak: first
 // yield of the elastic state (σ_lateral = 0, σ_zz = −ν q) on the peak surface, solved for q by
 // bisection; residual: steady plastic flow on the residual surface (s_zz = 0 with ψ = 0 and
-// ε̇_zz = 0), q = k_r/(½ − 3α_r/2). Tolerance 5 % (the issue's). About 3 s.
+// ε̇_zz = 0), q = k_r/(½ − 3α_r/2) (= 2c_r cosφ_r/(1 − sinφ_r), Mohr–Coulomb, with the default
+// flow-rule fit). The residual is the mean deviator over the last 2 % of axial strain (8–10 %):
+// once the band has formed the platen deviator oscillates by ±15 % about it (4.4–6.3 kPa), so
+// the single last sample the test used to take is a draw from that oscillation. Tolerance 5 % (the
+// issue's). About 3 s.
 TEST(SphSlopeApp, SofteningBiaxialDropsFromPeakToResidual) {
   const fs::path out = kWork / "softening_biaxial";
   fs::remove_all(out);
@@ -471,7 +493,17 @@ TEST(SphSlopeApp, SofteningBiaxialDropsFromPeakToResidual) {
   ASSERT_EQ(r.code, 0) << r.err;
   const auto q = deviators(out / "stress_strain.csv");
   ASSERT_GT(q.size(), 100u);
-  const double peak = -*std::min_element(q.begin(), q.end()), residual = -q.back();
+  const auto strain = csv_column(out / "stress_strain.csv", 1);
+  ASSERT_EQ(strain.size(), q.size());
+  double sum = 0.0;
+  int count = 0;
+  for (std::size_t k = 0; k < q.size(); ++k)
+    if (strain[k] >= 0.08) {
+      sum -= q[k];
+      ++count;
+    }
+  ASSERT_GT(count, 10);
+  const double peak = -*std::min_element(q.begin(), q.end()), residual = sum / count;
   const auto [a, k] = dp_plane_strain(20e3, 25.0);
   const double nu = 0.3;
   auto f = [&](double qq) {  // yield function at σ = diag(0, −q, −ν q)
@@ -483,8 +515,8 @@ TEST(SphSlopeApp, SofteningBiaxialDropsFromPeakToResidual) {
   for (int it = 0; it < 200; ++it) (f(0.5 * (lo + hi)) > 0.0 ? hi : lo) = 0.5 * (lo + hi);
   const auto [ar, kr] = dp_plane_strain(2e3, 20.0);
   const double q_res = kr / (0.5 - 1.5 * ar);
-  EXPECT_NEAR(peak, lo, 0.05 * lo);            // 51.2 kPa against 52.5 kPa
-  EXPECT_NEAR(residual, q_res, 0.05 * q_res);  // 5.58 kPa against 5.55 kPa
+  EXPECT_NEAR(peak, lo, 0.05 * lo);            // 53.1 kPa against 54.9 kPa
+  EXPECT_NEAR(residual, q_res, 0.05 * q_res);  // 5.59 kPa against 5.71 kPa
 }
 
 TEST(SphSlopeApp, ResidualAbovePeakExitsTwoNamingTheKey) {
@@ -585,6 +617,94 @@ TEST(SphSlopeApp, ClampOutsideTheBodyExitsTwoNamingTheKey) {
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("clamp.boxes"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
+}
+
+}  // namespace
+
+namespace {
+
+/// Plastic zone of a 2D snapshot (particles with accumulated plastic strain above `threshold`), in
+/// initial positions (position − displacement): the number of plastic particles in the band
+/// x ∈ [x_lo, x_hi] and the highest initial z among them (m; −∞ if none), and the number outside it.
+struct PlasticZone {
+  std::size_t inside = 0, outside = 0;
+  double top = -std::numeric_limits<double>::infinity();
+};
+PlasticZone plastic_zone(const geohaz::SnapshotReader& snap, std::size_t k, double threshold, double x_lo,
+                         double x_hi) {
+  const auto x = snap.read(k, "position"), u = snap.read(k, "displacement"), e = snap.read(k, "plastic_strain");
+  PlasticZone z;
+  for (std::size_t i = 0; i < e.count; ++i)
+    if (e.values[i] > threshold) {
+      const double x0 = x.values[2 * i] - u.values[2 * i], z0 = x.values[2 * i + 1] - u.values[2 * i + 1];
+      if (x0 >= x_lo && x0 <= x_hi) {
+        ++z.inside;
+        z.top = std::max(z.top, z0);
+      } else {
+        ++z.outside;
+      }
+    }
+  return z;
+}
+
+// Progressive failure with strain softening (issue #18, item 4; data/sph/slope_softening.toml,
+// shortened to 3 s): the ACADS 1(a) section with a soil 15 % stronger than ACADS's at peak (F of
+// strength reduction ≈ 1.15 × 0.99) softening to 20 % weaker (≈ 0.8 × 0.99) over κ_r = 0.02.
+// (1) The same slope with the peak strength and no softening stands: max displacement < 0.2 m
+// (the plastic adjustment from the elastic geostatic state, 0.095 m) and at rest. (2) With the
+// residual strength it fails (> 1 m). (3) The softening slope fails (> 1 m), and progressively:
+// at the first output (0.05 s) its plastic zone (κ > 0.01) is no larger than the peak slope's
+// (at most 1.5 × the peak slope's final plastic fraction), then it grows to at least 5 × that,
+// and at 1 s it is still smaller than the residual slope's, which yields everywhere at once; in the
+// snapshots (every 0.1 s) the zone in the slope climbs monotonically, by at least H/3, to the
+// crest. About 10 s of one idle core (three runs).
+TEST(SphSlopeApp, SofteningSlopeFailsProgressivelyWherePeakStrengthStands) {
+  const std::string base = "--config " + (kData / "slope_softening.toml").string() +
+                           " --set run.end_time=3 --set run.snapshot_interval=0.1 --quiet";
+  const fs::path soft = kWork / "softening_slope", peak = kWork / "softening_slope_peak",
+                 resid = kWork / "softening_slope_residual";
+  for (const auto& p : {soft, peak, resid}) fs::remove_all(p);
+  auto r = run(base + " --out " + soft.string(), "softening_slope");
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run(base + " --out " + peak.string() + " --set model.constitutive=drucker_prager", "softening_slope_peak");
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run(base + " --out " + resid.string() +
+              " --set model.constitutive=drucker_prager --set material[0].cohesion=2400"
+              " --set material[0].friction=15.90",
+          "softening_slope_residual");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto sp = summary(peak), sr = summary(resid), ss = summary(soft);
+  EXPECT_LT(sp["max_displacement_m"].get<double>(), 0.2);
+  EXPECT_LT(sp["final_max_speed_m_per_s"].get<double>(), 0.01);
+  EXPECT_GT(sr["max_displacement_m"].get<double>(), 1.0);
+  EXPECT_GT(ss["max_displacement_m"].get<double>(), 1.0);
+  const auto fs_ = csv_column(soft / "series.csv", 8), fp = csv_column(peak / "series.csv", 8),
+             fr = csv_column(resid / "series.csv", 8), t = csv_column(soft / "series.csv", 0);
+  ASSERT_GT(fs_.size(), 21u);
+  ASSERT_EQ(fs_.size(), fr.size());
+  EXPECT_NEAR(t[20], 1.0, 1e-6);
+  EXPECT_LE(fs_[1], 1.5 * fp.back()) << "starts as the peak slope's local zone";
+  EXPECT_GE(fs_.back(), 5.0 * fp.back()) << "then spreads";
+  EXPECT_LT(fs_[20], fr[20]) << "at 1 s smaller than the residual slope's";
+  // The slip zone away from the walls (≥ 10 m from either: x ∈ [10, 55] m; toe at x = 45 m, z =
+  // 5 m; crest edge at x = 25 m, z = 15 m): it appears in the lower part of the slope and climbs to
+  // the crest (0.4 s: top z = 10.4 m; 0.8 s: 14.4 m). The particles next to the fixed walls that
+  // yield on leaving the elastic geostatic state (about 24, in the peak-only slope too) are left out.
+  geohaz::SnapshotReader snap(soft / "snapshots.h5");
+  double prev = -std::numeric_limits<double>::infinity(), first = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t k = 0; k < snap.snapshot_count(); ++k) {
+    const auto z = plastic_zone(snap, k, 0.01, 10.0, 55.0);
+    std::printf("softening slope: t = %.2f s, plastic particles %zu (+%zu near the walls), zone top z = %.2f m\n",
+                snap.time(k), z.inside, z.outside, z.top);
+    if (z.inside == 0) continue;
+    if (std::isnan(first)) first = z.top;
+    EXPECT_GE(z.top, prev - 1e-9) << "the zone climbs monotonically";
+    prev = z.top;
+  }
+  EXPECT_GT(prev, 14.0) << "it reaches the crest (top row at z = 14.4 m)";
+  EXPECT_GT(prev - first, 10.0 / 3.0) << "having climbed at least H/3 from where it appeared";
+  std::printf("plastic fraction: softening %.3f (0.05 s) %.3f (1 s) %.3f (end); peak %.3f; residual %.3f (1 s)\n",
+              fs_[1], fs_[20], fs_.back(), fp.back(), fr[20]);
 }
 
 }  // namespace

@@ -104,14 +104,19 @@ void read_model_and_materials(ConfigReader& r, RunConfig& c) {
         r.get_choice("model.constitutive", std::string(constitutive_model_name(c.model)), names, {"", help});
     c.model = *constitutive_model_from_name(model);  // get_choice has checked the name
   }
-  const auto fit = r.get_choice("model.dp_fit", "auto", {"auto", "plane_strain", "compression_3d"},
-                                {"",
-                                 "Drucker-Prager constants: auto = plane_strain in 2D (Bui et al. 2010, eqs. 18-19), "
-                                 "compression_3d in 3D (SPH-slope paper 2020, eq. 21)"});
-  const DruckerPragerFit dpfit =
-      fit == "plane_strain"     ? DruckerPragerFit::PlaneStrain
-      : fit == "compression_3d" ? DruckerPragerFit::Compression3D
-                                : (c.dimension == 2 ? DruckerPragerFit::PlaneStrain : DruckerPragerFit::Compression3D);
+  const auto fit = r.get_choice(
+      "model.dp_fit", "auto", {"auto", "plane_strain_flow_rule", "plane_strain", "compression_3d"},
+      {"",
+       "Drucker-Prager constants from (cohesion, friction, dilatancy): plane_strain_flow_rule = plane strain "
+       "matched to Mohr-Coulomb for the flow rule in use (alpha = sin(phi)/3, k = c cos(phi) for dilatancy 0; "
+       "equal to plane_strain for dilatancy = friction; docs/sph.md); plane_strain = Bui et al. 2010, eqs. "
+       "18-19 (matches Mohr-Coulomb in plane strain for associated flow only); compression_3d = SPH-slope "
+       "paper 2020, eq. 21; auto = plane_strain_flow_rule in 2D, compression_3d in 3D"});
+  const DruckerPragerFit dpfit = fit == "plane_strain"             ? DruckerPragerFit::PlaneStrain
+                                 : fit == "plane_strain_flow_rule" ? DruckerPragerFit::PlaneStrainFlowRule
+                                 : fit == "compression_3d"         ? DruckerPragerFit::Compression3D
+                                                           : (c.dimension == 2 ? DruckerPragerFit::PlaneStrainFlowRule
+                                                                               : DruckerPragerFit::Compression3D);
   // [[material]]
   auto mats = r.tables("material", {"", "soil materials, indexed from 0 in order (base layer first)"});
   for (auto& m : mats) {

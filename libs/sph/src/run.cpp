@@ -828,7 +828,7 @@ void DynamicRun<Dim>::print_header() const {
   for (std::size_t k = 0; k < mats.size(); ++k)
     std::fprintf(stderr, "  material %zu (%s): c_p = %.4g m/s, DP fit %s, %s %s\n", k,
                  k < c_.material_names.size() ? c_.material_names[k].c_str() : "", mats[k].p_wave_speed,
-                 mats[k].fit == DruckerPragerFit::PlaneStrain ? "plane_strain" : "compression_3d",
+                 drucker_prager_fit_name(mats[k].fit),
                  solver_.model_name().c_str(), model_parameters(c_.model, mats[k]).dump().c_str());
 }
 
@@ -1176,7 +1176,7 @@ nlohmann::json DynamicRun<Dim>::summary_with(const ReleaseOutput& rel) const {
   for (std::size_t k = 0; k < mats.size(); ++k) {
     nlohmann::json e = {{"name", k < c_.material_names.size() ? c_.material_names[k] : ""},
                         {"p_wave_speed_m_per_s", mats[k].p_wave_speed},
-                        {"dp_fit", mats[k].fit == DruckerPragerFit::PlaneStrain ? "plane_strain" : "compression_3d"}};
+                        {"dp_fit", drucker_prager_fit_name(mats[k].fit)}};
     e.update(model_parameters(c_.model, mats[k]));
     s["materials"].push_back(e);
   }

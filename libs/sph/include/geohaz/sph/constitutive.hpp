@@ -66,8 +66,29 @@ namespace geohaz::sph {
 /// Which Drucker–Prager fit to the Mohr–Coulomb parameters (c, φ).
 enum class DruckerPragerFit {
   PlaneStrain,  ///< Bui et al. (2010), eqs. 18–19: α = tanφ/√(9+12tan²φ), k = 3c/√(9+12tan²φ)
-  Compression3D  ///< SPH-slope paper (2020), eq. 21: α = 2sinφ/(√3(3−sinφ)), k = 6c cosφ/(√3(3−sinφ)) (outer cone)
+  Compression3D,  ///< SPH-slope paper (2020), eq. 21: α = 2sinφ/(√3(3−sinφ)), k = 6c cosφ/(√3(3−sinφ)) (outer cone)
+  /// Plane strain matched to Mohr–Coulomb for the flow rule in use (dilatancy ψ):
+  /// α = sinφ √(3 + sin²ψ) / (√3 (3 + sinφ sinψ)), k = √3 c cosφ √(3 + sin²ψ) / (3 + sinφ sinψ),
+  /// α_ψ as PlaneStrain. ψ = φ gives PlaneStrain exactly; ψ = 0 gives α = sinφ/3, k = c cosφ.
+  /// Derivation (docs/sph.md, "Drucker–Prager constants"): in plane-strain plastic flow ε̇ᵖ_zz = 0,
+  /// i.e. α_ψ + s_zz/(2√J2) = 0, so s_zz = −2α_ψ√J2 and J2 = t²/(1 − 3α_ψ²) with t = (σ1 − σ3)/2;
+  /// the cone α I1 + √J2 = k then reads t = (k − 3α m) √(1 − 3α_ψ²)/(1 − 3α α_ψ), m = (σ1 + σ3)/2,
+  /// which is Mohr–Coulomb t = c cosφ − m sinφ for the constants above.
+  PlaneStrainFlowRule
 };
+
+/// Config name of a fit (`model.dp_fit`).
+inline const char* drucker_prager_fit_name(DruckerPragerFit f) noexcept {
+  switch (f) {
+    case DruckerPragerFit::PlaneStrain:
+      return "plane_strain";
+    case DruckerPragerFit::Compression3D:
+      return "compression_3d";
+    case DruckerPragerFit::PlaneStrainFlowRule:
+      return "plane_strain_flow_rule";
+  }
+  return "";
+}
 
 /// Drucker–Prager constants α_φ, k_c (Pa) and α_ψ.
 struct DruckerPragerConstants {
@@ -84,6 +105,12 @@ inline DruckerPragerConstants drucker_prager_constants(double c, double phi, dou
     const double d = std::sqrt(9.0 + 12.0 * tp * tp);
     k.alpha_phi = tp / d;
     k.kc = 3.0 * c / d;
+    k.alpha_psi = tq / std::sqrt(9.0 + 12.0 * tq * tq);
+  } else if (fit == DruckerPragerFit::PlaneStrainFlowRule) {
+    const double sp = std::sin(phi), sq = std::sin(psi), tq = std::tan(psi);
+    const double r = std::sqrt(3.0 + sq * sq), d = 3.0 + sp * sq;
+    k.alpha_phi = sp * r / (std::sqrt(3.0) * d);
+    k.kc = std::sqrt(3.0) * c * std::cos(phi) * r / d;
     k.alpha_psi = tq / std::sqrt(9.0 + 12.0 * tq * tq);
   } else {
     const double sp = std::sin(phi), sq = std::sin(psi);
