@@ -45,7 +45,8 @@ std::vector<std::set<std::uint32_t>> brute_force(const std::vector<Vec<Dim>>& x,
 template <int Dim>
 void check(Layout layout, bool periodic, int threads) {
   const double L = 1.0, rc = 0.09;
-  auto x = make_points<Dim>(1500, layout, 11 + Dim, L);
+  // 2500 > kParallelMin: the builds fork a team when the test asks for several threads.
+  auto x = make_points<Dim>(2500, layout, 11 + Dim, L);
   Periodicity<Dim> p;
   if (periodic) {
     p.axis.fill(false);
@@ -186,7 +187,7 @@ TEST(NeighbourList, PairLoopSeesEveryPairWithMinimumImage) {
 template <int Dim>
 void check_scan(Layout layout, bool periodic, int threads) {
   const double L = 1.0, rc = 0.09;
-  auto x = make_points<Dim>(1500, layout, 17 + Dim, L);
+  auto x = make_points<Dim>(2500, layout, 17 + Dim, L);
   Periodicity<Dim> p;
   if (periodic) {
     p.axis.fill(false);
@@ -247,7 +248,7 @@ TEST(CellPairScan, Periodic3D) {
 template <int Dim>
 void check_forward(Layout layout, bool periodic) {
   const double L = 1.0, rc = 0.09;
-  auto x = make_points<Dim>(1500, layout, 29 + Dim, L);
+  auto x = make_points<Dim>(2500, layout, 29 + Dim, L);
   Periodicity<Dim> p;
   if (periodic) {
     p.axis.fill(true);
