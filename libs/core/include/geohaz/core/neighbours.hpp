@@ -376,15 +376,25 @@ struct PairBlocks {
 #pragma omp parallel for schedule(static) if (parallel_worth(n))
     for (std::int64_t bb = 0; bb < nblocks; ++bb) gather_block(static_cast<std::size_t>(bb), all, take, add, finish);
   }
-  /// gather() whose finish(a) returns a double: returns the largest (0 if none; max is exact in
+  /// The same gather for a sum that starts from a value of index a's own and is completed in
+  /// registers: t = start(a), add(t, r) for each reaction r in ascending block order, then
+  /// finish(a, t), which returns a double. Returns the largest of those (0 if none; max is exact in
   /// any order, so thread-count independent).
-  template <class T, class Take, class Add, class Finish>
-  double gather_max(const T* all, Take&& take, Add&& add, Finish&& finish) const {
+  template <class T, class Start, class Add, class Finish>
+  double gather_max(const T* all, Start&& start, Add&& add, Finish&& finish) const {
     const auto nblocks = static_cast<std::int64_t>(count());
     double m = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : m) if (parallel_worth(n))
-    for (std::int64_t bb = 0; bb < nblocks; ++bb)
-      gather_block(static_cast<std::size_t>(bb), all, take, add, [&](std::size_t a) { m = std::max(m, finish(a)); });
+    for (std::int64_t bb = 0; bb < nblocks; ++bb) {
+      const auto b = static_cast<std::size_t>(bb);
+      const std::size_t c0 = first_block_reaching(b), end = last(b);
+      for (std::size_t a = first(b); a < end; ++a) {
+        auto t = start(a);
+        for (std::size_t c = c0; c <= b; ++c)
+          if (a < c * size + window()) add(t, all[c * reach + a]);
+        m = std::max(m, finish(a, t));
+      }
+    }
     return m;
   }
 

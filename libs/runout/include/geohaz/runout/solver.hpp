@@ -373,8 +373,7 @@ class RunoutSolver {
     else
       pass(std::false_type{});
     // Every particle: its own sums, then the reactions of the blocks that reach it, in block order.
-    const auto add = [&](std::size_t a, const PairSums& r) {
-      PairSums& t = own_[a];
+    const auto add = [](PairSums& t, const PairSums& r) {
       t.depth += r.depth;
       t.vx += r.vx;
       t.vy += r.vy;
@@ -383,8 +382,7 @@ class RunoutSolver {
       t.ay += r.ay;
       t.az += r.az;
     };
-    const auto finish = [&](std::size_t a) {
-      const PairSums& t = own_[a];
+    const auto finish = [&](std::size_t a, const PairSums& t) {
       const std::size_t i = ids[a];
       vmean[i] = tangent_mean(grad[i], Vec2(t.vx, t.vy) / t.depth, t.vz / t.depth);
       h[i] = t.depth * sigma;
@@ -394,7 +392,7 @@ class RunoutSolver {
       return std::sqrt(v[i].squaredNorm() + vzi * vzi) + std::sqrt(g * h[i]);
     };
     return blocks.gather_max(
-        reactions_.data(), [](std::size_t) { return true; }, add, finish);
+        reactions_.data(), [&](std::size_t a) { return own_[a]; }, add, finish);
   }
   /// The head-pressure force F = (F_h, F_z) along the 3D chords, as the map-view acceleration of a
   /// particle held on a bed of gradient p: P (F_h + p F_z) (docs/runout.md).
