@@ -349,7 +349,9 @@ struct PairBlocks {
   }
   std::size_t count() const noexcept { return (n + size - 1) / size; }
   std::size_t window() const noexcept { return size + reach; }  ///< reaction slots per block
-  std::size_t slots() const noexcept { return count() * reach + n + size; }
+  /// Buffer size: block b uses [b·W + bB, b·W + bB + B + W), so count·(B + W) slots (the SPH
+  /// passes clear a block's whole window; the runout stops at n).
+  std::size_t slots() const noexcept { return count() * window(); }
   std::size_t first(std::size_t b) const noexcept { return b * size; }
   std::size_t last(std::size_t b) const noexcept { return std::min(n, (b + 1) * size); }
   /// Block b's buffer, to be indexed by s ∈ [bB, min(n, bB + B + W)).
