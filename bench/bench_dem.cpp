@@ -20,6 +20,7 @@
 #include <random>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "geohaz/dem/experiments.hpp"
 #include "geohaz/dem/packing.hpp"
@@ -55,6 +56,24 @@ void box(DemSolver& s, double w, double h) {
     wl.servo_normal = n[k];
     s.walls.push_back(wl);
   }
+}
+
+/// FNV-1a hash of the positions and rotations in disc-id order (the store is reordered by cell):
+/// equal hashes mean the same run to the last bit.
+unsigned long long state_hash(const DemSolver& s) {
+  const auto& id = s.discs.get<ParticleId>();
+  std::vector<std::size_t> at(s.discs.size());
+  for (std::size_t i = 0; i < at.size(); ++i) at[static_cast<std::size_t>(id[i])] = i;
+  unsigned long long h = 1469598103934665603ull;
+  const auto add = [&](const auto& value) {
+    const auto* p = reinterpret_cast<const unsigned char*>(&value);
+    for (std::size_t k = 0; k < sizeof(value); ++k) h = (h ^ p[k]) * 1099511628211ull;
+  };
+  for (std::size_t i : at) {
+    add(s.discs.get<Position<2>>()[i]);
+    add(s.discs.get<Rotation>()[i]);
+  }
+  return h;
 }
 
 /// Particle-steps per wall-clock second, and per CPU second of the process (all threads): on a
@@ -188,8 +207,9 @@ int main(int argc, char** argv) {
       for (int k = 0; k < 200; ++k) s.step();
       const auto [r, rc] = rate(s, steps);
       std::printf(
-          "  unbonded settling, %d thread(s): %.3g particle-steps/s (%.3g per CPU-second; %zu contacts, dt = %.3g s)\n",
-          threads, r, rc, s.contact_count(), s.time_step());
+          "  unbonded settling, %d thread(s): %.3g particle-steps/s (%.3g per CPU-second; %zu contacts, dt = %.3g s; "
+          "%lld list builds; state %016llx)\n",
+          threads, r, rc, s.contact_count(), s.time_step(), static_cast<long long>(s.rebuild_count()), state_hash(s));
     }
     {
       DemSolver s;
@@ -217,8 +237,9 @@ int main(int argc, char** argv) {
       s.initialise();
       const auto [r, rc] = rate(s, steps);
       std::printf(
-          "  bonded compression, %d thread(s): %.3g particle-steps/s (%.3g per CPU-second; %zu bonds, %zu broken)\n",
-          threads, r, rc, s.bonds.size(), s.events.size());
+          "  bonded compression, %d thread(s): %.3g particle-steps/s (%.3g per CPU-second; %zu bonds, %zu broken; "
+          "state %016llx)\n",
+          threads, r, rc, s.bonds.size(), s.events.size(), state_hash(s));
     }
   }
   return 0;

@@ -45,7 +45,8 @@ std::vector<std::set<std::uint32_t>> brute_force(const std::vector<Vec<Dim>>& x,
 template <int Dim>
 void check(Layout layout, bool periodic, int threads) {
   const double L = 1.0, rc = 0.09;
-  auto x = make_points<Dim>(1500, layout, 11 + Dim, L);
+  // 2500 > kParallelMin: the builds fork a team when the test asks for several threads.
+  auto x = make_points<Dim>(2500, layout, 11 + Dim, L);
   Periodicity<Dim> p;
   if (periodic) {
     p.axis.fill(false);
@@ -186,7 +187,7 @@ TEST(NeighbourList, PairLoopSeesEveryPairWithMinimumImage) {
 template <int Dim>
 void check_scan(Layout layout, bool periodic, int threads) {
   const double L = 1.0, rc = 0.09;
-  auto x = make_points<Dim>(1500, layout, 17 + Dim, L);
+  auto x = make_points<Dim>(2500, layout, 17 + Dim, L);
   Periodicity<Dim> p;
   if (periodic) {
     p.axis.fill(false);
@@ -247,7 +248,7 @@ TEST(CellPairScan, Periodic3D) {
 template <int Dim>
 void check_forward(Layout layout, bool periodic) {
   const double L = 1.0, rc = 0.09;
-  auto x = make_points<Dim>(1500, layout, 29 + Dim, L);
+  auto x = make_points<Dim>(2500, layout, 29 + Dim, L);
   Periodicity<Dim> p;
   if (periodic) {
     p.axis.fill(true);
@@ -361,6 +362,223 @@ TEST(CellPairScan, ShortPeriodicAxisAndTooShortAxis) {
   }
   p.hi = Vec2(0.15, 1);
   EXPECT_THROW(scan.build(x, 0.1, p), std::invalid_argument);
+}
+
+// ---- Neighbours: the object the three solvers share ----------------------------------------------
+
+// Rebuild decision: a particle may drift exactly skin/2 without a rebuild (no pair can then have
+// closed by more than the skin); one ulp more rebuilds. Particle count changes and invalidate()
+// rebuild too.
+TEST(Neighbours, RebuildsWhenTheDriftExceedsHalfTheSkin) {
+  NeighbourSettings<2> s;
+  s.cutoff = 1.0;
+  s.skin = 0.5;  // skin/2 = 0.25, exact in binary
+  Neighbours<2> nb(s);
+  std::vector<Vec2> x = {Vec2(0.0, 0.0), Vec2(1.25, 0.0), Vec2(3.5, 0.0)}, xb(3);
+  EXPECT_TRUE(nb.update(x, xb).rebuilt);  // first update
+  EXPECT_EQ(xb, x);
+  EXPECT_EQ(nb.builds(), 1);
+  x[2] = Vec2(3.5 - 0.25, 0.0);  // exactly skin/2
+  EXPECT_FALSE(nb.update(x, xb).rebuilt);
+  EXPECT_EQ(nb.max_drift(x, xb), 0.25);
+  x[2] = Vec2(std::nextafter(3.5 - 0.25, 0.0), 0.0);  // one ulp more
+  EXPECT_TRUE(nb.update(x, xb).rebuilt);
+  EXPECT_EQ(nb.builds(), 2);
+  EXPECT_FALSE(nb.update(x, xb).rebuilt);
+  EXPECT_FALSE(nb.update(x, xb, 0.25).rebuilt);  // a drift the caller computed itself
+  EXPECT_TRUE(nb.update(x, xb, std::nextafter(0.25, 1.0)).rebuilt);
+  nb.invalidate();
+  EXPECT_TRUE(nb.update(x, xb).rebuilt);
+  x.push_back(Vec2(5.0, 5.0));
+  xb.resize(4);
+  EXPECT_TRUE(nb.update(x, xb).rebuilt);  // one particle more
+  // Skin 0: every update rebuilds; a cell scan needs no reference positions.
+  s.skin = 0.0;
+  s.storage = PairStorage::scan;
+  nb.configure(s);
+  EXPECT_TRUE(nb.update(x, {}).rebuilt);
+  EXPECT_TRUE(nb.update(x, {}).rebuilt);
+  // The pairs within cut-off + skin of a list (0–1 at 1.25 < 1.5 with the skin), none beyond.
+  s.skin = 0.5;
+  s.storage = PairStorage::list;
+  nb.configure(s);
+  nb.update(x, xb);
+  std::set<std::pair<std::size_t, std::size_t>> pairs;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    nb.for_each_neighbour(x, i, [&](std::size_t j, const Vec2&, double) { pairs.insert({i, j}); });
+  EXPECT_EQ(pairs, (std::set<std::pair<std::size_t, std::size_t>>{{0, 1}, {1, 0}}));
+}
+
+TEST(Neighbours, BadSettingsAreRejected) {
+  NeighbourSettings<2> s;
+  EXPECT_THROW(Neighbours<2>{s}, std::invalid_argument);  // cut-off 0
+  s.cutoff = 1.0;
+  s.skin = -0.1;
+  EXPECT_THROW(Neighbours<2>{s}, std::invalid_argument);
+  s.skin = 0.1;
+  s.storage = PairStorage::scan;  // a scan keeps no list to reuse
+  EXPECT_THROW(Neighbours<2>{s}, std::invalid_argument);
+  s.storage = PairStorage::list;
+  s.reorder_every = -1;
+  EXPECT_THROW(Neighbours<2>{s}, std::invalid_argument);
+  s.reorder_every = 0;
+  Neighbours<2> nb(s);
+  std::vector<Vec2> x(3, Vec2::Zero()), xb(2);
+  EXPECT_THROW(nb.update(x, xb), std::invalid_argument);  // x_build of the wrong size with a skin
+}
+
+// Reordering every second rebuild: the permutation sorts by cell, the caller applies it to its
+// store and to a side table (here particle ids), and the pairs are already those of the new order.
+template <int Dim>
+void check_reorder(PairStorage storage) {
+  const double L = 1.0, rc = 0.09;
+  auto x = make_points<Dim>(1500, Layout::Clustered, 41 + Dim, L);
+  std::vector<Vec<Dim>> xb(x.size());
+  std::vector<int> id(x.size());
+  for (std::size_t i = 0; i < id.size(); ++i) id[i] = static_cast<int>(i);
+  const auto original = x;
+  NeighbourSettings<Dim> s;
+  s.cutoff = rc;
+  s.skin = storage == PairStorage::list ? 0.01 : 0.0;
+  s.reorder_every = 2;
+  s.storage = storage;
+  Neighbours<Dim> nb(s);
+  std::vector<std::int64_t> reordered_at;
+  for (int k = 0; k < 5; ++k) {
+    nb.invalidate();
+    const auto u = nb.update(x, xb);
+    ASSERT_TRUE(u.rebuilt);
+    if (!u.reordered()) continue;
+    reordered_at.push_back(nb.builds());
+    const auto apply = [&](auto& v) {
+      auto old = v;
+      for (std::size_t q = 0; q < v.size(); ++q) v[q] = old[u.permutation[q]];
+    };
+    apply(x);
+    apply(xb);
+    apply(id);
+    // Sorted by cell, and the cell order of the new positions is the identity.
+    CellList<Dim> cells;
+    cells.build(x, nb.list_cutoff() / NeighbourList<Dim>::kReach, s.periodic);
+    for (std::size_t q = 0; q < x.size(); ++q) ASSERT_EQ(cells.sorted()[q], q);
+  }
+  EXPECT_EQ(reordered_at, (std::vector<std::int64_t>{3, 5}));  // rebuilds 2 and 4 (the first is 0)
+  EXPECT_EQ(xb, x);                                            // reference positions reordered with the store
+  EXPECT_FALSE(s.skin > 0.0 && nb.update(x, xb).rebuilt);
+  for (std::size_t i = 0; i < x.size(); ++i) ASSERT_EQ(x[i], original[static_cast<std::size_t>(id[i])]);
+  // The pairs are those of the reordered positions.
+  const auto ref = brute_force<Dim>(x, rc, s.periodic);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    std::set<std::uint32_t> got;
+    nb.for_each_neighbour(x, i, [&](std::size_t j, const Vec<Dim>&, double r2) {
+      if (r2 < rc * rc) got.insert(static_cast<std::uint32_t>(j));
+    });
+    ASSERT_EQ(got, ref[i]) << "particle " << i;
+  }
+}
+TEST(Neighbours, PermutationReordersTheStoreAndASideTableList2D) {
+  check_reorder<2>(PairStorage::list);
+}
+TEST(Neighbours, PermutationReordersTheStoreAndASideTableScan3D) {
+  check_reorder<3>(PairStorage::scan);
+}
+
+// Σ_j φ(r_ij) x_j,0 by half pairs (forward pairs by slot, reactions in the object's blocks,
+// gathered by PairBlocks::gather) against the full-pair sum; and 1 vs 3 threads bit-identical,
+// with enough particles (4000 > kParallelMin) for the loops to fork.
+template <int Dim>
+void check_half_sum(bool periodic) {
+  const double L = 1.0, rc = Dim == 2 ? 0.06 : 0.12;
+  auto x = make_points<Dim>(4000, Layout::Uniform, 53 + Dim, L);
+  ASSERT_TRUE(parallel_worth(x.size()));
+  NeighbourSettings<Dim> s;
+  s.cutoff = rc;
+  s.storage = PairStorage::scan;
+  if (periodic) {
+    s.periodic.axis.fill(true);
+    s.periodic.lo.setZero();
+    s.periodic.hi.setConstant(L);
+    for (auto& xi : x) xi = s.periodic.wrap(xi);
+  }
+  Neighbours<Dim> nb(s);
+  nb.update(x, {});
+  const auto phi = [&](double r2) { return std::exp(-r2 / (rc * rc)); };
+  const auto half_sum = [&](int threads) {
+    const std::size_t n = x.size();
+    const PairBlocks& blocks = nb.blocks();
+    const auto order = nb.cell_order();
+    std::vector<double> own(n), buf(blocks.slots()), out(n);
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(threads);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t bb = 0; bb < static_cast<std::int64_t>(blocks.count()); ++bb) {
+      const auto b = static_cast<std::size_t>(bb);
+      double* mine = blocks.buffer(buf.data(), b);
+      std::fill(mine + blocks.first(b), mine + blocks.window_end(b), 0.0);
+      for (std::size_t a = blocks.first(b); a < blocks.last(b); ++a) {
+        double sum = 0.0;
+        nb.for_each_forward_neighbour(a, [&](std::size_t q, const Vec<Dim>&, double r2) {
+          sum += phi(r2) * x[order[q]][0];
+          mine[q] += phi(r2) * x[order[a]][0];
+        });
+        own[a] = sum;
+      }
+    }
+    blocks.gather(
+        buf.data(), [](std::size_t) { return true; }, [&](std::size_t a, double r) { own[a] += r; },
+        [&](std::size_t a) { out[order[a]] = own[a]; });
+    omp_set_num_threads(saved);
+    return out;
+  };
+  const auto one = half_sum(1), three = half_sum(3);
+  for (std::size_t i = 0; i < x.size(); ++i) ASSERT_EQ(one[i], three[i]) << "particle " << i;  // bits
+  std::size_t pairs = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    double full = 0.0;
+    nb.for_each_neighbour(x, i, [&](std::size_t j, const Vec<Dim>&, double r2) {
+      full += phi(r2) * x[j][0];
+      ++pairs;
+    });
+    // Same terms, summed in another order: round-off of a sum of ~30 terms of size ≤ 1.
+    EXPECT_NEAR(one[i], full, 1e-13 * (1.0 + std::abs(full))) << "particle " << i;
+  }
+  EXPECT_GT(pairs, 10 * x.size());
+}
+TEST(Neighbours, HalfPairSumEqualsFullSumAndIsThreadCountIndependent2D) {
+  check_half_sum<2>(false);
+}
+TEST(Neighbours, HalfPairSumEqualsFullSumAndIsThreadCountIndependentPeriodic3D) {
+  check_half_sum<3>(true);
+}
+
+// Periodic axes: a pair across the boundary is found with its minimum-image displacement, and a
+// particle wrapped back into the box has drifted only its true displacement.
+TEST(Neighbours, PeriodicPairsUseTheMinimumImage) {
+  NeighbourSettings<2> s;
+  s.cutoff = 0.2;
+  s.skin = 0.1;
+  s.periodic.axis = {true, false};
+  s.periodic.lo = Vec2(0.0, 0.0);
+  s.periodic.hi = Vec2(1.0, 1.0);
+  Neighbours<2> nb(s);
+  std::vector<Vec2> x = {Vec2(0.05, 0.5), Vec2(0.95, 0.5), Vec2(0.5, 0.5)}, xb(3);
+  nb.update(x, xb);
+  std::vector<std::pair<std::size_t, Vec2>> seen;
+  nb.for_each_neighbour(x, 0, [&](std::size_t j, const Vec2& xij, double r2) {
+    seen.push_back({j, xij});
+    EXPECT_NEAR(r2, 0.01, 1e-15);
+  });
+  ASSERT_EQ(seen.size(), 1u);
+  EXPECT_EQ(seen[0].first, 1u);
+  EXPECT_NEAR(seen[0].second.x(), 0.1, 1e-15);  // x_0 − x_1 through the boundary, not −0.9
+  EXPECT_EQ(nb.displacement(x[0], x[1]), seen[0].second);
+  // Particle 1 moves 0.08 to the right, through the boundary (0.95 → 1.03, wrapped to 0.03).
+  x[1] = s.periodic.wrap(Vec2(0.95 + 0.08, 0.5));
+  EXPECT_NEAR(nb.max_drift(x, xb), 0.08, 1e-12);       // 0.95 → 1.03: 0.08 through the boundary
+  EXPECT_TRUE(nb.update(x, xb).rebuilt);               // 0.08 > skin/2 = 0.05
+  x[1] = s.periodic.wrap(Vec2(x[1].x() + 0.98, 0.5));  // −0.02 through the boundary
+  EXPECT_NEAR(nb.max_drift(x, xb), 0.02, 1e-12);
+  EXPECT_FALSE(nb.update(x, xb).rebuilt);
 }
 
 }  // namespace

@@ -22,7 +22,7 @@ void CellList<Dim>::build(std::span<const Vec<Dim>> x, double cell_size, const P
   Vec<Dim> lo = Vec<Dim>::Constant(std::numeric_limits<double>::max());
   Vec<Dim> hi = Vec<Dim>::Constant(std::numeric_limits<double>::lowest());
   std::int64_t bad = -1;
-#pragma omp parallel
+#pragma omp parallel if (parallel_worth(n))
   {
     Vec<Dim> tlo = lo, thi = hi;
     std::int64_t tbad = -1;
@@ -83,7 +83,7 @@ void CellList<Dim>::build(std::span<const Vec<Dim>> x, double cell_size, const P
   for (int d = 0; d < Dim; ++d) ncell *= static_cast<std::size_t>(dims_[d]);
 
   cell_of_.resize(x.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
   for (std::int64_t i = 0; i < n; ++i) cell_of_[i] = cell_index(x[static_cast<std::size_t>(i)]);
 
   // Counting sort by cell (stable in particle index).
@@ -147,13 +147,13 @@ void NeighbourList<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const
   // the order of the store.
   sorted_x_.resize(n);
   const std::int64_t nn = static_cast<std::int64_t>(n);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (parallel_worth(nn))
   for (std::int64_t s = 0; s < nn; ++s) sorted_x_[s] = x[sorted[s]];
 
   const int nthreads = omp_get_max_threads();
   if (thread_buffers_.size() < static_cast<std::size_t>(nthreads)) thread_buffers_.resize(nthreads);
 
-#pragma omp parallel num_threads(nthreads)
+#pragma omp parallel num_threads(nthreads) if (parallel_worth(nn))
   {
     const int t = omp_get_thread_num();
     const int T = omp_get_num_threads();
@@ -196,7 +196,7 @@ void CellPairScan<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const 
   const std::int64_t n = static_cast<std::int64_t>(x.size());
   sorted_x_.resize(x.size());
   rank_.resize(x.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
   for (std::int64_t s = 0; s < n; ++s) {
     sorted_x_[s] = x[sorted[s]];
     rank_[sorted[s]] = static_cast<std::uint32_t>(s);
@@ -214,13 +214,13 @@ void CellPairScan<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const 
       corner += kReach * stride;
       stride *= cells_.dims()[d];
     }
-#pragma omp parallel for schedule(static) reduction(max : reach)
+#pragma omp parallel for schedule(static) reduction(max : reach) if (parallel_worth(ncell))
     for (std::int64_t c = 0; c < ncell; ++c)
       reach = std::max<std::size_t>(reach, start[std::min(c + corner + 1, ncell)] - start[c]);
     forward_reach_ = reach;
     return;
   }
-#pragma omp parallel for schedule(static) reduction(max : reach)
+#pragma omp parallel for schedule(static) reduction(max : reach) if (parallel_worth(ncell))
   for (std::int64_t c = 0; c < ncell; ++c) {
     if (start[c] == start[c + 1]) continue;
     typename CellList<Dim>::template ScanRanges<kReach> ranges;
@@ -233,11 +233,90 @@ void CellPairScan<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const 
   forward_reach_ = reach;
 }
 
+template <int Dim>
+void Neighbours<Dim>::configure(const NeighbourSettings<Dim>& s) {
+  if (!(s.cutoff > 0.0) || !std::isfinite(s.cutoff))
+    throw std::invalid_argument("Neighbours: the cut-off must be positive and finite");
+  if (!(s.skin >= 0.0) || !std::isfinite(s.skin))
+    throw std::invalid_argument("Neighbours: the skin must be non-negative and finite");
+  if (s.reorder_every < 0) throw std::invalid_argument("Neighbours: reorder_every must be >= 0");
+  if (s.storage == PairStorage::scan && s.skin > 0.0)
+    throw std::invalid_argument("Neighbours: a cell scan keeps no list, so it cannot have a skin");
+  s_ = s;
+  periodic_any_ = s.periodic.any();
+  valid_ = false;
+}
+
+template <int Dim>
+double Neighbours<Dim>::max_drift(std::span<const Vec<Dim>> x, std::span<const Vec<Dim>> x_build) const {
+  const std::int64_t n = static_cast<std::int64_t>(std::min(x.size(), x_build.size()));
+  double m2 = 0.0;
+#pragma omp parallel for reduction(max : m2) schedule(static) if (parallel_worth(n))
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    m2 = std::max(m2, displacement(x[i], x_build[i]).squaredNorm());
+  }
+  return std::sqrt(m2);
+}
+
+template <int Dim>
+void Neighbours<Dim>::build(std::span<const Vec<Dim>> x) {
+  if (s_.storage == PairStorage::scan) {
+    scan_.build(x, s_.cutoff, s_.periodic);
+    blocks_ = PairBlocks::choose(x.size(), scan_.forward_reach());
+  } else {
+    list_.build(x, list_cutoff(), s_.periodic);
+  }
+  size_ = x.size();
+  valid_ = true;
+  ++builds_;
+}
+
+template <int Dim>
+NeighbourUpdate Neighbours<Dim>::update(std::span<const Vec<Dim>> x, std::span<Vec<Dim>> x_build, double max_drift,
+                                        bool reorder) {
+  if (!(s_.cutoff > 0.0)) throw std::logic_error("Neighbours::update before configure");
+  const bool track = s_.skin > 0.0;
+  if (track && x_build.size() != x.size())
+    throw std::invalid_argument("Neighbours::update: x_build must have one entry per particle with a skin");
+  if (track && valid_ && x.size() == size_ && max_drift < 0.0 && !reorder) max_drift = this->max_drift(x, x_build);
+  NeighbourUpdate u;
+  if (!reorder && !rebuild_due(x.size(), max_drift)) return u;
+  u.rebuilt = true;
+  if ((reorder || reorder_scheduled()) && x.size() > 1) {
+    // The cell order of the pairs' own grid (cells of edge list_cutoff/kReach, as the list and the
+    // scan bin them), so the permutation is the one a build would report.
+    order_.build(x, list_cutoff() / NeighbourList<Dim>::kReach, s_.periodic);
+    const auto order = order_.sorted();
+    perm_.assign(order.begin(), order.end());
+    const std::int64_t n = static_cast<std::int64_t>(x.size());
+    permuted_x_.resize(x.size());
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
+    for (std::int64_t s = 0; s < n; ++s)
+      permuted_x_[static_cast<std::size_t>(s)] = x[perm_[static_cast<std::size_t>(s)]];
+    build(permuted_x_);
+    u.permutation = perm_;
+  } else {
+    build(x);
+  }
+  // The caller reorders x_build with its store: the unpermuted x becomes the permuted one.
+  if (x_build.size() == x.size()) std::copy(x.begin(), x.end(), x_build.begin());
+  return u;
+}
+
+template <int Dim>
+void Neighbours<Dim>::restore(std::span<const Vec<Dim>> x_build) {
+  if (!(s_.cutoff > 0.0)) throw std::logic_error("Neighbours::restore before configure");
+  build(x_build);
+}
+
 template class CellList<2>;
 template class CellList<3>;
 template class NeighbourList<2>;
 template class NeighbourList<3>;
 template class CellPairScan<2>;
 template class CellPairScan<3>;
+template class Neighbours<2>;
+template class Neighbours<3>;
 
 }  // namespace geohaz

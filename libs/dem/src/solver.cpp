@@ -14,7 +14,6 @@ namespace geohaz::dem {
 namespace {
 
 /// Below this many discs (or bonds) a loop runs on one thread: fork/join costs more than it saves.
-constexpr std::int64_t kParallelMin = 2048;
 
 inline Vec2 perp(const Vec2& n) noexcept {
   return Vec2(-n.y(), n.x());
@@ -167,6 +166,11 @@ void DemSolver::initialise() {
   rmax_ = rmax;
   skin_ = settings.skin > 0 ? settings.skin : 0.3 * rmin;
   cutoff_ = 2.0 * rmax + skin_;
+  NeighbourSettings<2> ns;
+  ns.cutoff = 2.0 * rmax;  // list cut-off 2 R_max + skin, as cutoff_
+  ns.skin = skin_;
+  ns.reorder_every = settings.reorder_interval;
+  nb_.configure(ns);
   double reach = rmax;
   terrain.build(reach);
   damping_law_ = SIZE_MAX;  // terrain or walls may have been replaced: recompute their damping
@@ -176,39 +180,21 @@ void DemSolver::initialise() {
     hist_ = {};
     hist_.offsets.assign(discs.size() + 1, 0);
   }
-  rebuild_neighbours();
+  update_neighbours(-1.0);  // configure() asked for a rebuild
   same_layout_ = false;
   update_time_step();
 }
 
-void DemSolver::rebuild_neighbours() {
-  auto& x = discs.get<Position<2>>();
-  auto& xb = discs.get<PositionAtBuild>();
-  const std::int64_t n = static_cast<std::int64_t>(discs.size());
-  ++rebuilds_;
-  // Small problems build the list on one thread (the core build always forks a team); the guard
-  // restores the thread count even if the build throws.
-  struct ThreadCount {
-    int saved = omp_get_max_threads();
-    bool changed;
-    explicit ThreadCount(bool one) : changed(one) {
-      if (changed) omp_set_num_threads(1);
-    }
-    ~ThreadCount() {
-      if (changed) omp_set_num_threads(saved);
-    }
-  } guard(n <= kParallelMin);
-  if (settings.reorder_interval > 0 && rebuilds_ > 1 && (rebuilds_ - 1) % settings.reorder_interval == 0) {
-    list_.build(x, cutoff_);
-    reorder();
-  }
-  list_.build(x, cutoff_);
-  std::copy(x.begin(), x.end(), xb.begin());
+void DemSolver::update_neighbours(double max_drift) {
+  // The core Neighbours object decides (drift > skin/2 since the last build) and reorders by cell
+  // every reorder_interval rebuilds; the contact histories follow the permutation.
+  const auto u = nb_.update(discs.get<Position<2>>(), discs.get<PositionAtBuild>(), max_drift);
+  if (!u.rebuilt) return;
+  if (u.reordered()) reorder(u.permutation);
   same_layout_ = false;
 }
 
-void DemSolver::reorder() {
-  const auto order = list_.cell_order();
+void DemSolver::reorder(std::span<const std::uint32_t> order) {
   perm_scratch_.assign(order.begin(), order.end());
   discs.reorder(perm_scratch_);
   // Move each disc's history segment with it.
@@ -251,8 +237,8 @@ void DemSolver::pair_forces(const Law& law) {
   auto& F = discs.get<Force>();
   auto& T = discs.get<Torque>();
   auto& K = discs.get<StiffnessSum>();
-  const auto off = list_.offsets();
-  const auto nbr = list_.indices();
+  const auto off = nb_.list().offsets();
+  const auto nbr = nb_.list().indices();
   const std::size_t n = discs.size();
   hist_next_.offsets.assign(off.begin(), off.end());
   hist_next_.partner.resize(nbr.size());
@@ -695,7 +681,7 @@ void DemSolver::step() {
   time_ += dt;
   ++steps_;
   // 2. neighbours
-  if (4.0 * dmax2 >= skin_ * skin_) rebuild_neighbours();
+  update_neighbours(std::sqrt(dmax2));
   // 3. forces, 4. second half kick, blow-up check and next time step (the law is resolved once here)
   std::visit(
       [&](const auto& l) {
@@ -791,8 +777,8 @@ double DemSolver::strain_energy() const {
   const auto& x = discs.get<Position<2>>();
   const auto& R = discs.get<Radius>();
   const auto& m = discs.get<Mass>();
-  const auto off = list_.offsets();
-  const auto nbr = list_.indices();
+  const auto off = nb_.list().offsets();
+  const auto nbr = nb_.list().indices();
   for (std::size_t i = 0; i < discs.size(); ++i) {
     for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
       const std::uint32_t j = nbr[k];
@@ -841,8 +827,8 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> DemSolver::contact_pairs() 
   std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
   const auto& x = discs.get<Position<2>>();
   const auto& R = discs.get<Radius>();
-  const auto off = list_.offsets();
-  const auto nbr = list_.indices();
+  const auto off = nb_.list().offsets();
+  const auto nbr = nb_.list().indices();
   for (std::size_t i = 0; i < discs.size(); ++i)
     for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
       const std::uint32_t j = nbr[k];

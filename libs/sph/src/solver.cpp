@@ -59,25 +59,14 @@ Mat<Dim> artificial_stress(const Mat<Dim>& s, double eps, double rho) {
 constexpr std::uint8_t kSoil = static_cast<std::uint8_t>(Kind::Soil);
 constexpr std::uint8_t kRoller = static_cast<std::uint8_t>(Kind::RollerWall);
 
-/// Minimum-image displacement a − b without std::round: positions are wrapped into the box after
-/// every move, so a difference along a periodic axis lies in (−L, L) and one conditional shift suffices.
+/// Minimum-image displacement a − b: the core's (Periodicity::min_image, the one Neighbours uses).
 template <int Dim>
 struct MinimumImage {
-  bool any = false;
-  Vec<Dim> period = Vec<Dim>::Zero();
-  explicit MinimumImage(const Periodicity<Dim>& per) : any(per.any()) {
-    for (int k = 0; k < Dim; ++k)
-      if (per.axis[k]) period[k] = per.hi[k] - per.lo[k];
-  }
+  const Periodicity<Dim>& per;
+  bool any;
+  explicit MinimumImage(const Periodicity<Dim>& p) : per(p), any(p.any()) {}
   Vec<Dim> operator()(const Vec<Dim>& a, const Vec<Dim>& b) const noexcept {
-    Vec<Dim> d = a - b;
-    if (any) {
-      for (int k = 0; k < Dim; ++k) {
-        const double L = period[k];
-        if (L > 0.0) d[k] -= d[k] > 0.5 * L ? L : (d[k] < -0.5 * L ? -L : 0.0);
-      }
-    }
-    return d;
+    return any ? per.min_image(a - b) : Vec<Dim>(a - b);
   }
 };
 
@@ -116,28 +105,10 @@ void reset_internal_variables(Store& s, std::type_identity<std::variant<Models..
   (zero_fields(s, typename Models::InternalVariables{}), ...);
 }
 
-/// The fixed-order reactions of the pair passes (steps 2 and 4; docs/sph.md, "Determinism").
-/// Each soil–soil pair is evaluated once, by the particle of lower index, which adds the partner's
-/// share (the reaction) to a buffer. The buffers belong to blocks of B consecutive particles — not
-/// to threads — so that every sum is grouped the same way whatever the thread count: block b adds,
-/// in the order of its particles, the reactions to particles [bB, bB + B + W), W the reach of the
-/// list (the largest index distance of a soil–soil pair, after the cell reordering a few rows or
-/// layers of cells); particle i then adds to its own sum the buffers of the blocks that reach it,
-/// in ascending order. Block b's slots are addressed as buffer[b·W + j], so the pair loop indexes
-/// its buffer by the partner's index, exactly as a per-thread buffer of size n would be.
-struct PairBlocks {
-  std::size_t size = 64;  ///< B, particles per block
-  std::size_t reach = 0;  ///< W, largest j − i of a soil–soil pair in the list
-  std::size_t n = 0;      ///< particles
-  std::size_t count() const noexcept { return (n + size - 1) / size; }
-  std::size_t window() const noexcept { return size + reach; }  ///< reaction slots per block
-  std::size_t slots() const noexcept { return count() * window(); }
-  /// Block b's buffer, to be indexed by particle index j ∈ [bB, bB + B + W).
-  template <class T>
-  T* buffer(T* all, std::size_t b) const noexcept {
-    return all + b * reach;
-  }
-};
+// The fixed-order reactions of the pair passes (steps 2 and 4; docs/sph.md, "Determinism") use
+// the core's PairBlocks (neighbours.hpp): each soil–soil pair is evaluated once, by the particle
+// of lower index, which adds the partner's share to the buffer of its block of B particles; the
+// reach W is the largest index distance of a soil–soil pair of the list (Neighbours::blocks_for).
 
 /// ρ_i ρ_j Π_ij of Monaghan's artificial viscosity, Π_ij = (−α c̄ μ + β μ²)/ρ̄ with c̄ and ρ̄ the pair's
 /// mean sound speed and density, for an approaching pair (μ = h v_ij·x_ij/(r² + 0.01h²) < 0).
@@ -220,8 +191,9 @@ std::string SphSolver<Dim>::model_name() const {
 template <int Dim>
 double SphSolver<Dim>::bytes_per_particle() const {
   const double n = std::max<double>(1.0, static_cast<double>(store_.size()));
-  return static_cast<double>(SphStore<Dim>::bytes_per_particle()) + 4.0 * static_cast<double>(list_.pair_count()) / n +
-         4.0 + 3.0 * 4.0 + 1.0 +  // CSR indices + offsets + cell data + artificial-stress flag
+  return static_cast<double>(SphStore<Dim>::bytes_per_particle()) +
+         4.0 * static_cast<double>(nb_.list().pair_count()) / n + 4.0 + 3.0 * 4.0 +
+         1.0 +  // CSR indices + offsets + cell data + artificial-stress flag
          static_cast<double>(pair_acc_.size() * sizeof(Vec<Dim>) + pair_grad_.size() * sizeof(GradientReaction)) /
              n +  // block buffers of the pair reactions (n (1 + W/B) slots each)
          static_cast<double>(correction_.size() * sizeof(Mat<Dim>)) / n;  // C_i (kernel_correction)
@@ -269,45 +241,41 @@ void SphSolver<Dim>::step_impl(const Model& model) {
 
 template <int Dim>
 void SphSolver<Dim>::update_neighbours(double cutoff) {
-  // Cell reordering keeps neighbours close in memory; an optional Verlet skin lets the list be
-  // reused while no particle has moved more than half the skin (max_drift_, from step 5).
+  // The core Neighbours object: an optional Verlet skin lets the list be reused while no particle
+  // has moved more than half the skin (max_drift_, from step 5); cell reordering keeps neighbours
+  // close in memory, every reorder_every steps at a rebuild.
   auto& S = store_;
-  const double skin = settings_.neighbour_skin * h_;
-  const bool rebuild = skin <= 0.0 || list_.size() != S.size() || max_drift_ > 0.5 * skin;
-  if (!rebuild) return;
-  if (settings_.reorder_every > 0 && step_ - last_reorder_ >= settings_.reorder_every) {
-    list_.build(S.template get<Position<Dim>>(), cutoff + skin, settings_.periodic);
-    S.reorder(list_.cell_order());
+  if (nb_.settings().cutoff != cutoff) {
+    NeighbourSettings<Dim> ns;
+    ns.cutoff = cutoff;
+    ns.skin = settings_.neighbour_skin * h_;
+    ns.periodic = settings_.periodic;
+    nb_.configure(ns);
+  }
+  const bool reorder = settings_.reorder_every > 0 && step_ - last_reorder_ >= settings_.reorder_every &&
+                       nb_.rebuild_due(S.size(), max_drift_);
+  const auto u =
+      nb_.update(S.template get<Position<Dim>>(), S.template get<PositionAtBuild<Dim>>(), max_drift_, reorder);
+  if (!u.rebuilt) return;
+  if (u.reordered()) {
+    S.reorder(u.permutation);
     last_reorder_ = step_;
   }
-  list_.build(S.template get<Position<Dim>>(), cutoff + skin, settings_.periodic);
-  ++builds_;
   choose_pair_blocks();
-  S.template get<PositionAtBuild<Dim>>() = S.template get<Position<Dim>>();
   max_drift_ = 0.0;
 }
 
 template <int Dim>
 void SphSolver<Dim>::choose_pair_blocks() {
-  // The reach W of the list: the largest index distance of a soil–soil pair (PairBlocks).
-  const std::int64_t n = static_cast<std::int64_t>(store_.size());
+  // The reach W of the list: the largest index distance of a soil–soil pair (the others are
+  // evaluated from both sides). B = n/8: eight blocks for the threads (a static share of blocks is
+  // then the contiguous share of particles the threads had before), and few slots beyond n,
+  // n (1 + W/B) in all (1.08n in the 2D benchmark, 2.6n in 3D); but at least W/3 and 64.
   const std::uint8_t* kind = field<ParticleKind>();
-  const std::uint32_t* off = list_.offsets().data();
-  const std::uint32_t* idx = list_.indices().data();
-  std::uint32_t band = 0;
-#pragma omp parallel for schedule(static) reduction(max : band)
-  for (std::int64_t ii = 0; ii < n; ++ii) {
-    const auto i = static_cast<std::uint32_t>(ii);
-    if (kind[i] != kSoil) continue;
-    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k)
-      if (idx[k] > i && kind[idx[k]] == kSoil) band = std::max(band, idx[k] - i);
-  }
-  // B = n/8: eight blocks for the threads (a static share of blocks is then the contiguous share of
-  // particles the threads had before), and few slots beyond n, n (1 + W/B) in all (1.08n in the 2D
-  // benchmark, 2.6n in 3D); but at least W/3 (at most 4n slots) and 64.
-  const std::size_t nn = static_cast<std::size_t>(n), reach = band;
-  block_size_ = std::max<std::size_t>({64, (nn + 7) / 8, (reach + 2) / 3});  // ceil: eight blocks, not nine
-  block_reach_ = reach;
+  const PairBlocks blocks =
+      nb_.blocks_for([kind](std::uint32_t i, std::uint32_t j) { return kind[i] == kSoil && kind[j] == kSoil; });
+  block_size_ = blocks.size;
+  block_reach_ = blocks.reach;
 }
 
 template <int Dim>
@@ -326,8 +294,12 @@ void SphSolver<Dim>::resume(const SolverState& st) {
       break;
   }
   const auto& xb = store_.template get<PositionAtBuild<Dim>>();
-  list_.build(xb, support * h_ + settings_.neighbour_skin * h_, settings_.periodic);
-  ++builds_;
+  NeighbourSettings<Dim> ns;
+  ns.cutoff = support * h_;
+  ns.skin = settings_.neighbour_skin * h_;
+  ns.periodic = settings_.periodic;
+  nb_.configure(ns);
+  nb_.restore(xb);
   choose_pair_blocks();
   // The drift since that build, as step 5 computes it.
   const MinimumImage<Dim> image(settings_.periodic);
@@ -403,21 +375,8 @@ template <class T, class Add, class Finish>
 void SphSolver<Dim>::gather_reactions(const std::vector<T>& buffer, Add&& add, Finish&& finish) {
   const PairBlocks blocks{block_size_, block_reach_, store_.size()};
   const std::uint8_t* kind = field<ParticleKind>();
-  const T* all = buffer.data();
-  const std::size_t B = blocks.size, W = blocks.reach;
-#pragma omp parallel for schedule(static)
-  for (std::int64_t bb = 0; bb < static_cast<std::int64_t>(blocks.count()); ++bb) {
-    const auto b = static_cast<std::size_t>(bb);
-    const std::size_t first = b * B, last = std::min(blocks.n, first + B);
-    // The earliest block whose window [cB, cB + B + W) reaches this one (no division per particle).
-    const std::size_t c0 = first >= B + W ? (first - W) / B : 0;
-    for (std::size_t i = first; i < last; ++i) {
-      if (kind[i] != kSoil) continue;
-      for (std::size_t c = c0; c <= b; ++c)
-        if (i < c * B + B + W) add(i, all[c * W + i]);
-      finish(i);
-    }
-  }
+  blocks.gather(
+      buffer.data(), [kind](std::size_t i) { return kind[i] == kSoil; }, add, finish);
 }
 
 // (The pair loops of steps 2 and 4 repeat the same ten-line neighbour header on purpose: folded
@@ -448,8 +407,8 @@ void SphSolver<Dim>::gradient_correction() {
   const Vec<Dim>* x = field<Position<Dim>>();
   const double* vol = field<Volume>();
   const std::uint8_t* kind = field<ParticleKind>();
-  const std::uint32_t* off = list_.offsets().data();
-  const std::uint32_t* idx = list_.indices().data();
+  const std::uint32_t* off = nb_.list().offsets().data();
+  const std::uint32_t* idx = nb_.list().indices().data();
   correction_.resize(static_cast<std::size_t>(n));
   Mat<Dim>* C = correction_.data();
 #pragma omp parallel for schedule(static)
@@ -494,8 +453,8 @@ void SphSolver<Dim>::velocity_gradient() {
   double* drho = field<DensityRate>();
   double* rsum = field<SummationDensity>();
   Vec<Dim>* xs = field<XsphCorrection<Dim>>();
-  const std::uint32_t* off = list_.offsets().data();
-  const std::uint32_t* idx = list_.indices().data();
+  const std::uint32_t* off = nb_.list().offsets().data();
+  const std::uint32_t* idx = nb_.list().indices().data();
   const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
   const std::int64_t nblocks = static_cast<std::int64_t>(blocks.count());
   pair_grad_.resize(blocks.slots());
@@ -670,8 +629,8 @@ void SphSolver<Dim>::momentum() {
   const std::uint8_t* has_as = has_as_.data();
   Vec<Dim>* acc = field<Acceleration<Dim>>();
   const Mat<Dim>* C = Corrected ? correction_.data() : nullptr;
-  const std::uint32_t* off = list_.offsets().data();
-  const std::uint32_t* idx = list_.indices().data();
+  const std::uint32_t* off = nb_.list().offsets().data();
+  const std::uint32_t* idx = nb_.list().indices().data();
   const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
   const std::int64_t nblocks = static_cast<std::int64_t>(blocks.count());
   pair_acc_.resize(blocks.slots());
@@ -780,8 +739,8 @@ void SphSolver<Dim>::structure_forces() {
   const Mat<Dim>* ps = field<PairStress<Dim>>();
   const Mat<Dim>* R = field<ArtificialStress<Dim>>();
   const std::uint8_t* has_as = has_as_.data();
-  const std::uint32_t* off = list_.offsets().data();
-  const std::uint32_t* idx = list_.indices().data();
+  const std::uint32_t* off = nb_.list().offsets().data();
+  const std::uint32_t* idx = nb_.list().indices().data();
   const Vec<Dim>* base = structure_base_.data();
   const Mat<Dim>* C = Corrected ? correction_.data() : nullptr;
   const auto ns = static_cast<std::int32_t>(structure_base_.size());

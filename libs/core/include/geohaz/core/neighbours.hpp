@@ -20,6 +20,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "geohaz/core/parallel.hpp"
 #include "geohaz/core/vec.hpp"
 
 namespace geohaz {
@@ -348,7 +349,9 @@ struct PairBlocks {
   }
   std::size_t count() const noexcept { return (n + size - 1) / size; }
   std::size_t window() const noexcept { return size + reach; }  ///< reaction slots per block
-  std::size_t slots() const noexcept { return count() * reach + n + size; }
+  /// Buffer size: block b uses [b·W + bB, b·W + bB + B + W), so count·(B + W) slots (the SPH
+  /// passes clear a block's whole window; the runout stops at n).
+  std::size_t slots() const noexcept { return count() * window(); }
   std::size_t first(std::size_t b) const noexcept { return b * size; }
   std::size_t last(std::size_t b) const noexcept { return std::min(n, (b + 1) * size); }
   /// Block b's buffer, to be indexed by s ∈ [bB, min(n, bB + B + W)).
@@ -363,6 +366,224 @@ struct PairBlocks {
     const std::size_t f = b * size;
     return f >= size + reach ? (f - reach) / size : 0;
   }
+
+  /// The fixed-order gather after a half-pair pass that wrote its reactions through buffer():
+  /// for every index a with take(a), add(a, r) for the reaction r of each block whose window holds
+  /// a, in ascending block order, then finish(a). Blocks run in parallel (each a is written by one
+  /// thread) when there are enough indices (parallel_worth); the sums are the same on any thread
+  /// count.
+  template <class T, class Take, class Add, class Finish>
+  void gather(const T* all, Take&& take, Add&& add, Finish&& finish) const {
+    const auto nblocks = static_cast<std::int64_t>(count());
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
+    for (std::int64_t bb = 0; bb < nblocks; ++bb) gather_block(static_cast<std::size_t>(bb), all, take, add, finish);
+  }
+  /// The same gather for a sum that starts from a value of index a's own and is completed in
+  /// registers: t = start(a), add(t, r) for each reaction r in ascending block order, then
+  /// finish(a, t), which returns a double. Returns the largest of those (0 if none; max is exact in
+  /// any order, so thread-count independent).
+  template <class T, class Start, class Add, class Finish>
+  double gather_max(const T* all, Start&& start, Add&& add, Finish&& finish) const {
+    const auto nblocks = static_cast<std::int64_t>(count());
+    double m = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : m) if (parallel_worth(n))
+    for (std::int64_t bb = 0; bb < nblocks; ++bb) {
+      const auto b = static_cast<std::size_t>(bb);
+      const std::size_t c0 = first_block_reaching(b), end = last(b);
+      for (std::size_t a = first(b); a < end; ++a) {
+        auto t = start(a);
+        for (std::size_t c = c0; c <= b; ++c)
+          if (a < c * size + window()) add(t, all[c * reach + a]);
+        m = std::max(m, finish(a, t));
+      }
+    }
+    return m;
+  }
+
+ private:
+  template <class T, class Take, class Add, class Finish>
+  void gather_block(std::size_t b, const T* all, Take& take, Add& add, Finish&& finish) const {
+    const std::size_t c0 = first_block_reaching(b), end = last(b);
+    for (std::size_t a = first(b); a < end; ++a) {
+      if (!take(a)) continue;
+      for (std::size_t c = c0; c <= b; ++c)
+        if (a < c * size + window()) add(a, all[c * reach + a]);
+      finish(a);
+    }
+  }
+};
+
+/// How a Neighbours object keeps its pairs.
+enum class PairStorage {
+  list,  ///< a CSR NeighbourList (pairs read several times per build, or a Verlet skin)
+  scan,  ///< no list: pairs visited straight from the cell scan (CellPairScan; no skin)
+};
+
+/// Settings of a Neighbours object: one meaning for each number in all three solvers.
+template <int Dim>
+struct NeighbourSettings {
+  double cutoff = 0.0;  ///< interaction cut-off (m): every pair closer than this is visited
+  /// Verlet skin (m): the list holds the pairs closer than cutoff + skin and is rebuilt when a
+  /// particle has drifted more than skin/2 since the last build; 0 rebuilds at every update.
+  double skin = 0.0;
+  /// Sort the particles by cell at every reorder_every-th rebuild (counted in rebuilds, the first
+  /// build being rebuild 0; 0: only when update() is asked to).
+  int reorder_every = 0;
+  PairStorage storage = PairStorage::list;
+  Periodicity<Dim> periodic;
+};
+
+/// What Neighbours::update did.
+struct NeighbourUpdate {
+  bool rebuilt = false;
+  /// Non-empty when the particles were sorted by cell: the caller must reorder its store and every
+  /// side table with it (new slot s holds old particle permutation[s]), x_build included. The
+  /// pairs are already those of the new order. Valid until the next update.
+  std::span<const std::uint32_t> permutation;
+  bool reordered() const noexcept { return !permutation.empty(); }
+};
+
+/// The neighbour object of the three solvers (SPH, runout, DEM): owns the cut-off and skin, the
+/// rebuild decision, the cell reordering, the pairs and the block layout of half-pair reactions.
+///
+/// One step of a solver:
+///
+///     const auto u = nb.update(x, x_build);          // rebuild if a particle drifted > skin/2
+///     if (u.reordered()) store.reorder(u.permutation); // and its side tables
+///     ... pair passes: nb.for_each_neighbour(i, f), nb.list(), or nb.for_each_forward_neighbour(a, f)
+///     with reactions in nb.blocks() buffers, gathered in fixed order by blocks().gather(...)
+///
+/// Rebuild rule: at the first update, after invalidate() or configure(), when the particle count
+/// changed, when the skin is 0, when a reorder is asked for, or when the largest drift since the
+/// last build, |x_i − x_build,i| (minimum image), exceeds skin/2 (strictly: at exactly skin/2 no
+/// pair can have closed by more than the skin). The reference positions x_build belong to the
+/// caller's store (so they move with every reordering and are saved in snapshots); update() writes
+/// x into them at each rebuild.
+///
+/// Reordering: at a rebuild that is due one (settings.reorder_every, or asked for by the caller),
+/// the particles' cell order is returned as a permutation, and the pairs are built for the
+/// permuted positions, so the caller applies the permutation and carries on: the same pairs as a
+/// rebuild after reordering the store, for one pair search instead of two.
+///
+/// Hot loops are the caller's: the pair visitors are templates, always inlined, with no virtual
+/// call or std::function. Loops of the object itself run on one thread below kParallelMin
+/// particles; it never changes the global thread count.
+template <int Dim>
+class Neighbours {
+ public:
+  Neighbours() = default;
+  explicit Neighbours(const NeighbourSettings<Dim>& s) { configure(s); }
+
+  /// Set (or change) the settings; the next update rebuilds. Throws std::invalid_argument if the
+  /// cut-off is not positive and finite, the skin is negative or not finite, reorder_every < 0, or
+  /// storage is scan with a skin.
+  void configure(const NeighbourSettings<Dim>& s);
+  const NeighbourSettings<Dim>& settings() const noexcept { return s_; }
+  /// Cut-off of the stored pairs: cutoff + skin.
+  double list_cutoff() const noexcept { return s_.cutoff + s_.skin; }
+
+  /// Force a rebuild at the next update (particles added or removed, positions reset by hand).
+  void invalidate() noexcept { valid_ = false; }
+  /// Largest drift |x_i − x_build,i| (minimum image), for callers that do not fuse it into their
+  /// own position update. Max is exact in any order: thread-count independent.
+  double max_drift(std::span<const Vec<Dim>> x, std::span<const Vec<Dim>> x_build) const;
+  /// Whether update() would rebuild, given the particle count and the largest drift.
+  bool rebuild_due(std::size_t n, double max_drift) const noexcept {
+    return !valid_ || n != size_ || s_.skin <= 0.0 || max_drift > 0.5 * s_.skin;
+  }
+  /// Whether a rebuild now would reorder by the schedule of settings.reorder_every.
+  bool reorder_scheduled() const noexcept {
+    return s_.reorder_every > 0 && builds_ > 0 && builds_ % s_.reorder_every == 0;
+  }
+
+  /// Rebuild the pairs if due (see the class comment) and reorder if due or if `reorder` is set
+  /// (which forces a rebuild). max_drift < 0: computed here from x and x_build. x_build may be
+  /// empty when the skin is 0 (no drift to track); otherwise it must have x.size() entries.
+  NeighbourUpdate update(std::span<const Vec<Dim>> x, std::span<Vec<Dim>> x_build, double max_drift = -1.0,
+                         bool reorder = false);
+  /// Build the pairs for the given reference positions without reordering (resuming a run from a
+  /// snapshot: the pairs, and so the order of every pair sum, are those of the saved run).
+  void restore(std::span<const Vec<Dim>> x_build);
+
+  /// Pair builds so far (reorderings do not count twice).
+  std::int64_t builds() const noexcept { return builds_; }
+  std::size_t size() const noexcept { return size_; }
+
+  /// The stored list (storage list): CSR offsets/indices, for pair loops that index side tables
+  /// by the list entry (DEM contact histories).
+  const NeighbourList<Dim>& list() const noexcept { return list_; }
+  /// The cell scan (storage scan).
+  const CellPairScan<Dim>& scan() const noexcept { return scan_; }
+  /// Displacement x_i − x_j with the minimum image along periodic axes.
+  Vec<Dim> displacement(const Vec<Dim>& xi, const Vec<Dim>& xj) const noexcept {
+    return periodic_any_ ? s_.periodic.min_image(xi - xj) : Vec<Dim>(xi - xj);
+  }
+
+  /// Full pairs: f(j, xij, r2) for every neighbour j of particle i, xij = x_i − x_j (minimum
+  /// image), r2 = |xij|². With a list these are the stored pairs (those within the skin included:
+  /// the caller tests its own support); with a scan, those closer than the cut-off. x: the
+  /// current positions (the list reads them; the scan uses the positions of its build).
+  template <class F>
+  [[gnu::always_inline]] inline void for_each_neighbour(std::span<const Vec<Dim>> x, std::size_t i, F&& f) const {
+    if (s_.storage == PairStorage::scan) {
+      scan_.for_each_neighbour(i, f);
+      return;
+    }
+    const std::uint32_t* off = list_.offsets().data();
+    const std::uint32_t* idx = list_.indices().data();
+    const Vec<Dim> xi = x[i];
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+      const std::uint32_t j = idx[k];
+      const Vec<Dim> xij = displacement(xi, x[j]);
+      f(static_cast<std::size_t>(j), xij, xij.squaredNorm());
+    }
+  }
+  /// Forward half pairs by slot (storage scan): f(s, xas, r2) for every slot s > a closer than the
+  /// cut-off (CellPairScan::for_each_forward_neighbour); slot s holds particle cell_order()[s].
+  template <class F>
+  [[gnu::always_inline]] inline void for_each_forward_neighbour(std::size_t a, F&& f) const {
+    scan_.for_each_forward_neighbour(a, f);
+  }
+  /// Permutation sorting the particles by cell at the last build (slot → particle; storage scan).
+  std::span<const std::uint32_t> cell_order() const noexcept {
+    return s_.storage == PairStorage::scan ? scan_.cell_order() : list_.cell_order();
+  }
+
+  /// Block layout of the forward half pairs by slot (storage scan), chosen at the last build:
+  /// PairBlocks::choose(n, scan().forward_reach()). With a list, see blocks_for().
+  const PairBlocks& blocks() const noexcept { return blocks_; }
+  /// The block layout for the half pairs of a list that a pass evaluates from the lower index only
+  /// when keep(i, j) (e.g. soil–soil pairs; the others are evaluated from both sides): the reach
+  /// is the largest j − i of a kept pair. Same rule of block size as blocks().
+  template <class Keep>
+  PairBlocks blocks_for(Keep&& keep) const {
+    const std::int64_t n = static_cast<std::int64_t>(size_);
+    const std::uint32_t* off = list_.offsets().data();
+    const std::uint32_t* idx = list_.indices().data();
+    std::uint32_t band = 0;
+#pragma omp parallel for schedule(static) reduction(max : band) if (parallel_worth(n))
+    for (std::int64_t ii = 0; ii < n; ++ii) {
+      const auto i = static_cast<std::uint32_t>(ii);
+      for (std::uint32_t k = off[i]; k < off[i + 1]; ++k)
+        if (idx[k] > i && keep(i, idx[k])) band = std::max(band, idx[k] - i);
+    }
+    return PairBlocks::choose(size_, band);
+  }
+
+ private:
+  void build(std::span<const Vec<Dim>> x);
+
+  NeighbourSettings<Dim> s_;
+  bool periodic_any_ = false;
+  bool valid_ = false;
+  std::size_t size_ = 0;
+  std::int64_t builds_ = 0;
+  NeighbourList<Dim> list_;
+  CellPairScan<Dim> scan_;
+  CellList<Dim> order_;               // cells of a reordering (the permutation)
+  std::vector<std::uint32_t> perm_;   // the permutation of the last reordering
+  std::vector<Vec<Dim>> permuted_x_;  // positions in the new order, to build the pairs for it
+  PairBlocks blocks_;
 };
 
 extern template class CellList<2>;
@@ -371,5 +592,7 @@ extern template class NeighbourList<2>;
 extern template class NeighbourList<3>;
 extern template class CellPairScan<2>;
 extern template class CellPairScan<3>;
+extern template class Neighbours<2>;
+extern template class Neighbours<3>;
 
 }  // namespace geohaz

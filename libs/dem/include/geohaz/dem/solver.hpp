@@ -92,7 +92,7 @@ class DemSolver {
   /// Largest neighbour-list cut-off used (m).
   double cutoff() const noexcept { return cutoff_; }
   /// Number of neighbour-list rebuilds so far.
-  std::int64_t rebuild_count() const noexcept { return rebuilds_; }
+  std::int64_t rebuild_count() const noexcept { return nb_.builds(); }
   /// Contact pairs (unordered, by current index) of the last step, for coordination numbers.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> contact_pairs() const;
 
@@ -108,8 +108,8 @@ class DemSolver {
   template <class Law>
   void update_wall_damping(const Law& law);
   void bond_forces();
-  void rebuild_neighbours();
-  void reorder();
+  void update_neighbours(double max_drift);  // max_drift < 0: computed
+  void reorder(std::span<const std::uint32_t> order);
   void rebuild_id_index();
   void rebuild_bond_index();
   void rebuild_joint_index();
@@ -124,9 +124,8 @@ class DemSolver {
   PairHistory hist_, hist_next_;
   bool same_layout_ = false;  ///< hist_ was written with the current neighbour list
 
-  NeighbourList<2> list_;
+  Neighbours<2> nb_;  // core neighbour object: list, skin, rebuilds, reordering
   double cutoff_ = 0, skin_ = 0, rmax_ = 0;
-  std::int64_t rebuilds_ = 0;
   std::vector<std::uint32_t> index_of_id_;
   std::vector<std::uint32_t> bond_offsets_;  ///< per id: CSR into bond_entries_
   std::vector<std::int64_t> bond_entries_;   ///< bond index, negated−1 for side B

@@ -119,10 +119,6 @@ struct VolumeBudget {
   double balance_error() const noexcept { return mobile + deposited + lost - total_in(); }
 };
 
-/// Below this many particles the per-particle loops run on one thread: the work of a step is then
-/// smaller than the cost of waking the team (and, on a loaded machine, of waiting for it).
-inline constexpr std::int64_t kParallelMin = 2048;
-
 template <class Surface>
 class RunoutSolver {
  public:
@@ -182,6 +178,7 @@ class RunoutSolver {
   /// terrain, records start elevations and the initial volume, computes depths. Throws
   /// std::invalid_argument when a particle is off the terrain or has a non-positive volume.
   void initialise() {
+    configure_neighbours();
     auto& x = store_.get<Position<2>>();
     const auto& vol = store_.get<Volume>();
     for (std::size_t i = 0; i < store_.size(); ++i) {
@@ -211,9 +208,9 @@ class RunoutSolver {
 
   /// Advance one adaptive step; returns Δt. SimulationError on NaN or time-step collapse.
   double step() {
-    // 1-2. Neighbours and the pair pass, which also returns the signal speed of the time step.
-    if (step_ % p_.reorder_interval == 0 && store_.size() > 1) reorder_by_cell();
-    const double signal = compute_pair_terms();
+    // 1-2. Neighbours (reordered by cell every reorder_interval steps) and the pair pass, which
+    // also returns the signal speed of the time step.
+    const double signal = compute_pair_terms(step_ % p_.reorder_interval == 0);
 
     // 3. Time step (max is exact in any order: thread-count independent).
     double dt = signal > 0.0 ? p_.cfl * p_.d0 / signal : p_.dt_max;
@@ -260,36 +257,26 @@ class RunoutSolver {
   const VolumeBudget& budget() const noexcept { return budget_; }
 
   /// Recompute the depths and head-pressure accelerations for the current positions (also done
-  /// by step(); public for tests and outputs). Returns the signal speed of the time step,
-  /// max_i (S_i + √(g h_i)) (m/s), computed in the same pass.
-  double compute_pair_terms() {
+  /// by step(); public for tests and outputs), after sorting the store by cell if `reorder`.
+  /// Returns the signal speed of the time step, max_i (S_i + √(g h_i)) (m/s), computed in the same
+  /// pass.
+  double compute_pair_terms(bool reorder = false) {
     if (store_.empty()) return 0.0;
-    if (p_.skin > 0.0) {
-      // Verlet list: rebuilt when a particle has moved more than half the skin since the build.
-      if (!list_valid_ || max_displacement() > 0.5 * p_.skin * p_.d0) {
-        build_list();
-        list_valid_ = true;
-      }
+    // Neighbours (core Neighbours): with numerics.skin > 0 a Verlet list rebuilt when a particle
+    // has moved more than half the skin since the build; without, the pairs are used once per
+    // build, so they are visited straight from the cell scan (same pairs in the same order as the
+    // list, without writing and re-reading it), and without the velocity smoothing each pair
+    // once (half_pair_terms).
+    {
       const auto& x = store_.get<Position<2>>();
-      const auto offsets = list_.offsets();
-      const auto indices = list_.indices();
-      const bool periodic = periodic_.any();
-      return pair_terms([&](std::size_t i, auto&& f) {
-        const Vec2 xi = x[i];
-        for (std::uint32_t k = offsets[i]; k < offsets[i + 1]; ++k) {
-          const std::uint32_t j = indices[k];
-          const Vec2 xij = periodic ? periodic_.min_image(xi - x[j]) : Vec2(xi - x[j]);
-          f(static_cast<std::size_t>(j), xij, xij.squaredNorm());
-        }
-      });
+      auto& xb = store_.get<ListPosition>();
+      const auto u =
+          nb_.update(x, p_.skin > 0.0 ? std::span<Vec2>(xb) : std::span<Vec2>(), -1.0, reorder && store_.size() > 1);
+      if (u.reordered()) store_.reorder(u.permutation);
     }
-    // No skin: the pairs are used once per build, so they are visited straight from the cell scan
-    // (same pairs in the same order as the list, without writing and re-reading it); without the
-    // velocity smoothing each pair once (half_pair_terms).
-    const auto& x = store_.get<Position<2>>();
-    scan_.build(std::span<const Vec2>(x.data(), x.size()), HeadPressureForce::support * p_.d0, periodic_);
-    if (p_.smoothing == 0.0) return half_pair_terms();
-    return pair_terms([&](std::size_t i, auto&& f) { scan_.for_each_neighbour(i, f); });
+    const std::span<const Vec2> x = store_.get<Position<2>>();
+    if (p_.skin == 0.0 && p_.smoothing == 0.0) return half_pair_terms();
+    return pair_terms([&](std::size_t i, auto&& f) { nb_.for_each_neighbour(x, i, f); });
   }
 
  private:
@@ -315,12 +302,12 @@ class RunoutSolver {
     const auto& vz = store_.get<VerticalVelocity>();
     auto& vmean = store_.get<MeanVelocity>();
     auto& dv = store_.get<VelocityCorrection>();
-    const std::uint32_t* ids = scan_.cell_order().data();
+    const std::uint32_t* ids = nb_.cell_order().data();
     const double d0 = p_.d0, inv_d0 = 1.0 / d0;
     const double coef = 0.5 * p_.pressure_scale * p_.gravity * inv_d0 * inv_d0 * inv_d0;
     const double g = p_.gravity, support2 = 4.0 * d0 * d0, sigma = CubicSpline<2>::sigma(d0);
     const std::size_t n = store_.size();
-    const PairBlocks blocks = PairBlocks::choose(n, scan_.forward_reach());
+    const PairBlocks& blocks = nb_.blocks();
     own_.resize(n);
     reactions_.resize(blocks.slots());
     const auto nblocks = static_cast<std::int64_t>(blocks.count());
@@ -342,7 +329,7 @@ class RunoutSolver {
           Vec2 acc = Vec2::Zero();
           double accz = 0.0;
           // W/σ (kernels.hpp) and f (head_pressure.hpp) written out per branch of q.
-          scan_.for_each_forward_neighbour(a, [&](std::size_t s, const Vec2& xij, double r2) {
+          nb_.for_each_forward_neighbour(a, [&](std::size_t s, const Vec2& xij, double r2) {
             const std::size_t j = ids[s];
             double zij = zi - z[j];
             if constexpr (kPeriodic) zij += grad[i].dot(xij - (x[i] - x[j]));
@@ -386,35 +373,26 @@ class RunoutSolver {
     else
       pass(std::false_type{});
     // Every particle: its own sums, then the reactions of the blocks that reach it, in block order.
-    const PairSums* all = reactions_.data();
-    double signal = 0.0;
-#pragma omp parallel for reduction(max : signal) schedule(static) if (static_cast <std::int64_t>(n) >= kParallelMin)
-    for (std::int64_t bb = 0; bb < nblocks; ++bb) {
-      const auto b = static_cast<std::size_t>(bb);
-      const std::size_t c0 = blocks.first_block_reaching(b);
-      for (std::size_t a = blocks.first(b); a < blocks.last(b); ++a) {
-        PairSums t = own_[a];
-        for (std::size_t c = c0; c <= b; ++c) {
-          if (a >= blocks.window_end(c)) continue;
-          const PairSums& r = all[c * blocks.reach + a];
-          t.depth += r.depth;
-          t.vx += r.vx;
-          t.vy += r.vy;
-          t.vz += r.vz;
-          t.ax += r.ax;
-          t.ay += r.ay;
-          t.az += r.az;
-        }
-        const std::size_t i = ids[a];
-        vmean[i] = tangent_mean(grad[i], Vec2(t.vx, t.vy) / t.depth, t.vz / t.depth);
-        h[i] = t.depth * sigma;
-        ap[i] = on_bed(grad[i], Vec2(t.ax, t.ay), t.az);
-        dv[i] = Vec2::Zero();
-        const double vzi = grad[i].dot(v[i]);
-        signal = std::max(signal, std::sqrt(v[i].squaredNorm() + vzi * vzi) + std::sqrt(g * h[i]));
-      }
-    }
-    return signal;
+    const auto add = [](PairSums& t, const PairSums& r) {
+      t.depth += r.depth;
+      t.vx += r.vx;
+      t.vy += r.vy;
+      t.vz += r.vz;
+      t.ax += r.ax;
+      t.ay += r.ay;
+      t.az += r.az;
+    };
+    const auto finish = [&](std::size_t a, const PairSums& t) {
+      const std::size_t i = ids[a];
+      vmean[i] = tangent_mean(grad[i], Vec2(t.vx, t.vy) / t.depth, t.vz / t.depth);
+      h[i] = t.depth * sigma;
+      ap[i] = on_bed(grad[i], Vec2(t.ax, t.ay), t.az);
+      dv[i] = Vec2::Zero();
+      const double vzi = grad[i].dot(v[i]);
+      return std::sqrt(v[i].squaredNorm() + vzi * vzi) + std::sqrt(g * h[i]);
+    };
+    return blocks.gather_max(
+        reactions_.data(), [&](std::size_t a) { return own_[a]; }, add, finish);
   }
   /// The head-pressure force F = (F_h, F_z) along the 3D chords, as the map-view acceleration of a
   /// particle held on a bed of gradient p: P (F_h + p F_z) (docs/runout.md).
@@ -570,37 +548,15 @@ class RunoutSolver {
     return signal;
   }
 
-  /// Sort the store by cell for memory locality (every reorder_interval steps); the pairs are
-  /// then rebuilt for the new order.
-  void reorder_by_cell() {
-    const auto& x = store_.get<Position<2>>();
-    if (p_.skin > 0.0) {
-      build_list();
-      store_.reorder(list_.cell_order());
-    } else {
-      scan_.build(std::span<const Vec2>(x.data(), x.size()), HeadPressureForce::support * p_.d0, periodic_);
-      store_.reorder(scan_.cell_order());
-    }
-    list_valid_ = false;
-  }
-  void build_list() {
-    const auto& x = store_.get<Position<2>>();
-    list_.build(std::span<const Vec2>(x.data(), x.size()), (HeadPressureForce::support + p_.skin) * p_.d0, periodic_);
-    store_.get<ListPosition>() = x;
-  }
-  /// Largest distance moved since the list was built (max: order-independent, exact).
-  double max_displacement() const {
-    const auto& x = store_.get<Position<2>>();
-    const auto& x0 = store_.get<ListPosition>();
-    const std::int64_t n = static_cast<std::int64_t>(store_.size());
-    double m2 = 0.0;
-#pragma omp parallel for reduction(max : m2) schedule(static) if (n >= kParallelMin)
-    for (std::int64_t ii = 0; ii < n; ++ii) {
-      const auto i = static_cast<std::size_t>(ii);
-      const Vec2 d = periodic_.any() ? periodic_.min_image(x[i] - x0[i]) : Vec2(x[i] - x0[i]);
-      m2 = std::max(m2, d.squaredNorm());
-    }
-    return std::sqrt(m2);
+  /// The neighbour object's settings: cut-off 2·d0 (the support), skin numerics.skin·d0 (list
+  /// cut-off (2 + skin)·d0), reordering on request (every reorder_interval steps, step()).
+  void configure_neighbours() {
+    NeighbourSettings<2> s;
+    s.cutoff = HeadPressureForce::support * p_.d0;
+    s.skin = p_.skin * p_.d0;
+    s.storage = p_.skin > 0.0 ? PairStorage::list : PairStorage::scan;
+    s.periodic = periodic_;
+    nb_.configure(s);
   }
 
   /// What the integration found, so the serial checks run only when needed.
@@ -924,7 +880,7 @@ class RunoutSolver {
     store_.get<Speed>()[i] = q.speed;
     store_.get<VerticalVelocity>()[i] = s.grad.dot(vp);
     store_.get<Moving>()[i] = 1;
-    list_valid_ = false;
+    nb_.invalidate();
   }
 
   /// Name the first particle with a non-finite state (integrate() found one).
@@ -954,7 +910,7 @@ class RunoutSolver {
       }
     if (any) {
       store_.remove_if(std::span<const std::uint8_t>(leaving.data(), leaving.size()));
-      list_valid_ = false;
+      nb_.invalidate();
     }
   }
 
@@ -978,8 +934,7 @@ class RunoutSolver {
   RunoutParameters p_;
   Periodicity<2> periodic_;
   RunoutStore store_;
-  NeighbourList<2> list_;            // with a skin (numerics.skin > 0)
-  CellPairScan<2> scan_;             // without (the default)
+  Neighbours<2> nb_;                 // a list with a skin (numerics.skin > 0), a cell scan without
   std::vector<PairSums> own_;        // half_pair_terms: each slot's own sums
   std::vector<PairSums> reactions_;  // half_pair_terms: the blocks' reaction buffers
   VolumeBudget budget_;
@@ -1001,7 +956,6 @@ class RunoutSolver {
   std::vector<double> push_depth_;        // h_w within d0 of the wall (m), else 0
   std::vector<std::int64_t> slot_;        // per inflow: particles emitted
   std::int64_t next_id_ = 0;
-  bool list_valid_ = false;
   bool energy_stop_ = false;
   double time_ = 0.0, dt_ = 0.0;
   std::int64_t step_ = 0;

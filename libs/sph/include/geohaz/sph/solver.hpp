@@ -204,7 +204,7 @@ class SphSolver {
   const std::vector<StructureLoad<Dim>>& structure_loads() const noexcept { return structure_loads_; }
 
   /// Number of neighbour-list builds so far.
-  std::int64_t neighbour_builds() const noexcept { return builds_; }
+  std::int64_t neighbour_builds() const noexcept { return nb_.builds(); }
   /// Memory actually held per particle (store + neighbour list), bytes.
   double bytes_per_particle() const;
 
@@ -246,7 +246,7 @@ class SphSolver {
   std::vector<MaterialParams> materials_;
   ConstitutiveModel model_;
   SolverSettings<Dim> settings_;
-  NeighbourList<Dim> list_;
+  Neighbours<Dim> nb_;  // core neighbour object: list, skin, rebuilds, reordering
   double h_ = 0.0;
   double time_ = 0.0;
   double dt_ = 0.0;
@@ -264,8 +264,8 @@ class SphSolver {
   // the momentum pass need not read a neighbour's R (as big as its stress) to find it is zero.
   std::vector<std::uint8_t> has_as_;
   // The pair passes' reactions are summed per block of block_size_ particles reaching block_reach_
-  // particles beyond (solver.cpp, PairBlocks), chosen at each list build: the same grouping of
-  // every sum on any thread count.
+  // particles beyond (core PairBlocks, Neighbours::blocks_for), chosen at each list build: the
+  // same grouping of every sum on any thread count.
   std::size_t block_size_ = 64, block_reach_ = 0;
   std::vector<double> block_sums_;  // Σ Δλ per block (step 3)
   // Scratch of the momentum pass: reactions V_i T ∇W of the soil–soil pairs, block_size_ +
@@ -288,7 +288,6 @@ class SphSolver {
   // every particle (identity for boundary particles; empty when the correction is off).
   std::vector<Mat<Dim>> correction_;
   std::int64_t last_reorder_ = -1000000;
-  std::int64_t builds_ = 0;
   StepStats stats_;
 };
 
