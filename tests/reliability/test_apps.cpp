@@ -184,6 +184,9 @@ TEST_F(Reliability, ValuesThatWouldRunForHoursAreBadInput) {
       {{DEM_AVALANCHE_EXE, "--config", (kData / "dem/biaxial_compression.toml").string(), "--set", "sample.height=3.5",
         "--out", (dir_ / "o").string(), "--quiet"},
        "sample.height"},
+      // Fuzz case 126 (after the data of 2026-12-02 05:00): a runout depth resolution of 0.25 mm,
+      // 8.5 million particles on the Alplehner release.
+      {runout_valley(dir_ / "o") + std::vector<std::string>{"--set", "model.h0=2.5e-4"}, "model.h0"},
   };
   for (const auto& [argv, key] : cases) {
     ChildLimits lim;
