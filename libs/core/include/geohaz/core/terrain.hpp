@@ -95,10 +95,18 @@ class BilinearGrid {
   bool sample(const Vec2& p, TerrainSample& s, BilinearPatch& patch) const noexcept {
     const double px = (p.x() - g_.x0) / g_.dx - 0.5;
     const double py = (g_.y0 - p.y()) / g_.dy - 0.5;
-    // Negated test so that NaN coordinates are rejected too.
-    if (!(px >= 0.0 && py >= 0.0 && px <= g_.nx - 1 && py <= g_.ny - 1)) return false;
-    // On the last centre line the last patch, with fraction 1.
-    const int i = std::min(static_cast<int>(px), g_.nx - 2), j = std::min(static_cast<int>(py), g_.ny - 2);
+    int i, j;
+    if (px >= 0.0 && py >= 0.0 && px < g_.nx - 1 && py < g_.ny - 1) [[likely]] {
+      i = static_cast<int>(px);
+      j = static_cast<int>(py);
+    } else {
+      // Off the half-open patches: only the east and south lines of centres are still on the
+      // surface (the last patch, fraction 1). Negated test so that NaN coordinates are rejected.
+      // Kept out of the common path, which then costs what the half-open test alone did.
+      if (!(px >= 0.0 && py >= 0.0 && px <= g_.nx - 1 && py <= g_.ny - 1)) return false;
+      i = std::min(static_cast<int>(px), g_.nx - 2);
+      j = std::min(static_cast<int>(py), g_.ny - 2);
+    }
     const double fx = px - i, fy = py - j;
     const std::size_t k = g_.index(i, j);
     const double z00 = z_[k], z10 = z_[k + 1], z01 = z_[k + g_.nx], z11 = z_[k + g_.nx + 1];
