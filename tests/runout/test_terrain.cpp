@@ -227,3 +227,46 @@ TEST(BedCurvature, TroughOnADsmTurnsWhereTheExactMotionDoes) {
     EXPECT_NEAR(model, exact, 1.0) << "mu " << mu;
   }
 }
+
+namespace {
+
+// GridSurface is the core sampler plus curvature: its elevation and gradient are BilinearGrid's bit
+// for bit, it is defined exactly where the sampler is (the closed hull of the centres, east and
+// south border lines included since the samplers were merged; not the half-cell band), and a
+// quadratic surface's Hessian comes back from the second differences with the sampler's weights.
+TEST(GridSurface, IsTheCoreSamplerPlusCurvature) {
+  const GridGeometry g{12, 9, 100.0, 500.0, 2.0, 2.0};
+  // z = 0.01 x'² − 0.02 x'y' + 0.03 y'²: second differences are exact, z_xx = 0.02, z_xy = −0.02,
+  // z_yy = 0.06 at every centre whose stencil fits (k = 1 here); float storage: 1e-7 relative.
+  const GridSurface s = GridSurface::from_function(g, [](double x, double y) {
+    const double u = x - 110.0, v = y - 490.0;
+    return 0.01 * u * u - 0.02 * u * v + 0.03 * v * v;
+  });
+  const BilinearGrid& grid = s.grid();
+  const Vec2 lo = g.centre(0, g.ny - 1), hi = g.centre(g.nx - 1, 0);
+  int checked = 0;
+  for (double x = lo.x() - 1.5; x <= hi.x() + 1.5; x += 0.25)
+    for (double y = lo.y() - 1.5; y <= hi.y() + 1.5; y += 0.25) {
+      SurfaceSample a{};
+      TerrainSample b{};
+      const bool ok = s.sample(Vec2(x, y), a);
+      ASSERT_EQ(ok, grid.sample(Vec2(x, y), b)) << x << " " << y;
+      ASSERT_EQ(ok, x >= lo.x() && x <= hi.x() && y >= lo.y() && y <= hi.y()) << x << " " << y;
+      if (!ok) continue;
+      EXPECT_EQ(a.z, b.z);
+      EXPECT_EQ(a.grad, b.gradient);
+      // Away from the border cells (where the stencil shrinks to nothing) the Hessian is exact.
+      if (x >= lo.x() + 2.0 && x <= hi.x() - 2.0 && y >= lo.y() + 2.0 && y <= hi.y() - 2.0) {
+        EXPECT_NEAR(a.hess[0], 0.02, 1e-8);
+        EXPECT_NEAR(a.hess[1], -0.02, 1e-8);
+        EXPECT_NEAR(a.hess[2], 0.06, 1e-8);
+        ++checked;
+      }
+    }
+  EXPECT_GT(checked, 500);
+  // The south-east corner centre, off the terrain for the old half-open rule, is on it.
+  SurfaceSample c{};
+  EXPECT_TRUE(s.sample(g.centre(g.nx - 1, g.ny - 1), c));
+}
+
+}  // namespace

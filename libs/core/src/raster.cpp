@@ -295,30 +295,47 @@ void write_geotiff(const std::filesystem::path& path, const Raster& r, bool floa
 // Terrain: bilinear surface through the cell centres. These functions are called per particle
 // per step, so they do no allocation and no GDAL calls.
 
-Terrain::Terrain(Raster elevation) : r_(std::move(elevation)) {
-  if (r_.nx < 2 || r_.ny < 2)
-    throw InputError("a terrain needs at least 2 x 2 cells (got " + std::to_string(r_.nx) + " x " +
-                     std::to_string(r_.ny) + ")");
-  if (r_.data.size() != static_cast<std::size_t>(r_.nx) * static_cast<std::size_t>(r_.ny))
+namespace {
+
+/// The grid of a north-up raster (checked by the caller).
+GridGeometry north_up_geometry(const Raster& r) {
+  return {r.nx, r.ny, r.geotransform[0], r.geotransform[3], r.cell_size_x(), r.cell_size_y()};
+}
+
+/// The raster's values with nodata (the declared value or NaN) as NaN, for BilinearGrid.
+std::vector<double> values_with_nan_nodata(Raster& r) {
+  std::vector<double> z = std::move(r.data);
+  for (double& v : z)
+    if (r.is_nodata(v)) v = std::numeric_limits<double>::quiet_NaN();
+  return z;
+}
+
+}  // namespace
+
+Terrain::Terrain(Raster r) {
+  if (r.nx < 2 || r.ny < 2)
+    throw InputError("a terrain needs at least 2 x 2 cells (got " + std::to_string(r.nx) + " x " +
+                     std::to_string(r.ny) + ")");
+  if (r.data.size() != static_cast<std::size_t>(r.nx) * static_cast<std::size_t>(r.ny))
     throw InputError("terrain raster size does not match its data");
-  if (!(r_.geotransform[1] > 0.0) || !(r_.geotransform[5] < 0.0) || r_.geotransform[2] != 0.0 ||
-      r_.geotransform[4] != 0.0)
+  if (!(r.geotransform[1] > 0.0) || !(r.geotransform[5] < 0.0) || r.geotransform[2] != 0.0 || r.geotransform[4] != 0.0)
     throw InputError("terrain raster must be north-up with dx > 0 and dy < 0");
+  const GridGeometry g = north_up_geometry(r);
+  grid_ = BilinearGrid(g, values_with_nan_nodata(r));
 }
 
 bool Terrain::valid(double x, double y) const noexcept {
-  TerrainSample s;
-  return sample_terrain(r_, x, y, s);
+  return grid_.valid(Vec2(x, y));
 }
 
 double Terrain::elevation(double x, double y) const noexcept {
   TerrainSample s;
-  return sample_terrain(r_, x, y, s) ? s.z : std::numeric_limits<double>::quiet_NaN();
+  return grid_.sample(Vec2(x, y), s) ? s.z : std::numeric_limits<double>::quiet_NaN();
 }
 
 Vec2 Terrain::gradient(double x, double y) const noexcept {
   TerrainSample s;
-  return sample_terrain(r_, x, y, s) ? s.gradient : Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
+  return grid_.sample(Vec2(x, y), s) ? s.gradient : Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
 }
 
 Vec3 Terrain::normal(double x, double y) const noexcept {

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "geohaz/core/terrain.hpp"
 #include "geohaz/core/vec.hpp"
 
 namespace geohaz {
@@ -69,12 +70,17 @@ bool crs_equal(const std::string& a, const std::string& b);
 std::vector<Vec2> transform_points(const std::vector<Vec2>& pts, const std::string& from_wkt,
                                    const std::string& to_wkt);
 
-/// A bilinear terrain surface over an elevation raster.
+/// A bilinear terrain surface over an elevation raster: the core BilinearGrid (terrain.hpp, which
+/// states the formulas and the one edge rule) over the raster's grid, nodata turned into NaN.
+/// Defined on the closed hull of the cell centres wherever the four surrounding centres hold data.
 class Terrain {
  public:
+  /// InputError when the raster is smaller than 2 × 2 cells, not north-up, or its data do not
+  /// match its size. The values are moved into the grid (no second copy).
   explicit Terrain(Raster elevation);
-  const Raster& raster() const noexcept { return r_; }
-  /// True when the four cell centres around (x, y) all hold data.
+  /// The sampled grid (values with nodata as NaN).
+  const BilinearGrid& grid() const noexcept { return grid_; }
+  /// True when the four cell centres around (x, y) all hold data (closed centre hull).
   bool valid(double x, double y) const noexcept;
   /// Bilinear elevation (NaN outside or over nodata).
   double elevation(double x, double y) const noexcept;
@@ -84,7 +90,7 @@ class Terrain {
   Vec3 normal(double x, double y) const noexcept;
 
  private:
-  Raster r_;
+  BilinearGrid grid_;
 };
 
 /// A point of an elevation profile: distance along the polyline s, position, elevation.

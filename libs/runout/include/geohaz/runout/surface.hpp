@@ -3,11 +3,12 @@
 /// The terrain a debris flow runs over, as seen by the solver: elevation z(x, y), its gradient and
 /// its curvature (Hessian) at a map point, or "not here" (outside the raster or over nodata).
 /// Implementations are chosen at compile time (the solver is a template on the surface type):
-///  - GridSurface: bilinear interpolation of a north-up elevation grid between cell centres (the
-///    DSM; the same convention as geohaz::Raster / geohaz::Terrain, without GDAL), with the
+///  - GridSurface: the core bilinear sampler (geohaz::BilinearGrid, core/terrain.hpp: the same
+///    surface, edge rule and nodata rule as geohaz::Terrain, without GDAL) over the DSM, plus the
 ///    Hessian from second differences of the grid over a stencil of the particle scale (below);
 ///  - InclinedPlane, SlopeToRunout, CylindricalTrough: analytical surfaces for tests.
-/// GridGeometry is the north-up grid shared by the DSM, the release thickness and the hazard maps.
+/// GridGeometry (core/terrain.hpp) is the north-up grid shared by the DSM, the release thickness
+/// and the hazard maps.
 
 #include <algorithm>
 #include <cmath>
@@ -17,31 +18,13 @@
 #include <limits>
 #include <vector>
 
+#include "geohaz/core/terrain.hpp"
 #include "geohaz/core/vec.hpp"
 
 namespace geohaz::runout {
 
-/// A north-up grid: column c, row r (row 0 north) covers [x0 + c·dx, x0 + (c+1)·dx] ×
-/// [y0 − (r+1)·dy, y0 − r·dy]; x0 is the west edge, y0 the north edge, dx, dy > 0 (m).
-struct GridGeometry {
-  int nx = 0, ny = 0;
-  double x0 = 0.0, y0 = 0.0, dx = 1.0, dy = 1.0;
-
-  std::size_t cells() const noexcept { return static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny); }
-  std::size_t index(int col, int row) const noexcept {
-    return static_cast<std::size_t>(row) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(col);
-  }
-  Vec2 centre(int col, int row) const noexcept { return {x0 + (col + 0.5) * dx, y0 - (row + 0.5) * dy}; }
-  /// Cell holding p; false when p is outside the grid.
-  bool cell_of(const Vec2& p, int& col, int& row) const noexcept {
-    const double fc = (p.x() - x0) / dx, fr = (y0 - p.y()) / dy;
-    if (!(fc >= 0.0 && fr >= 0.0 && fc < nx && fr < ny)) return false;
-    col = static_cast<int>(fc);
-    row = static_cast<int>(fr);
-    return true;
-  }
-  double cell_area() const noexcept { return dx * dy; }
-};
+/// The north-up grid of the DSM, release and hazard maps (moved to the core with the sampler).
+using geohaz::GridGeometry;
 
 /// Elevation, gradient and curvature at a point.
 struct SurfaceSample {
@@ -50,7 +33,9 @@ struct SurfaceSample {
   Vec3 hess;  ///< (∂²z/∂x², ∂²z/∂x∂y, ∂²z/∂y²) (1/m)
 };
 
-/// Bilinear surface over a north-up elevation grid (values at cell centres; NaN = nodata).
+/// Bilinear surface over a north-up elevation grid (values at cell centres; NaN = nodata): elevation
+/// and gradient from the core sampler geohaz::BilinearGrid (where it is defined: the closed hull of
+/// the cell centres, away from nodata; see core/terrain.hpp), curvature added here.
 ///
 /// Curvature. The bilinear surface is flat inside a cell and kinks at cell edges, so its own second
 /// derivatives are useless to a particle (zero, or Dirac). The Hessian is instead taken from
@@ -66,48 +51,45 @@ class GridSurface {
   GridSurface() = default;
   /// \param values nx·ny elevations (m), row-major, row 0 north; NaN marks nodata.
   /// \param curvature_scale L (m) of the Hessian stencil; ≤ 0: one cell.
-  GridSurface(GridGeometry g, std::vector<double> values, double curvature_scale = 0.0) : g_(g), z_(std::move(values)) {
+  /// InputError when the grid is smaller than 2 × 2 or the values do not match it (BilinearGrid).
+  GridSurface(const GridGeometry& g, std::vector<double> values, double curvature_scale = 0.0)
+      : grid_(g, std::move(values)) {
     compute_curvature(curvature_scale);
   }
 
-  const GridGeometry& geometry() const noexcept { return g_; }
-  const std::vector<double>& values() const noexcept { return z_; }
+  const GridGeometry& geometry() const noexcept { return grid_.geometry(); }
+  const std::vector<double>& values() const noexcept { return grid_.values(); }
+  /// The elevation sampler without the curvature (the same surface as geohaz::Terrain).
+  const BilinearGrid& grid() const noexcept { return grid_; }
   /// Stencil half-width of the Hessian (cells).
   int curvature_cells() const noexcept { return k_; }
   /// The stencil half-width for a curvature scale L (m) on this grid: max(1, round(L/Δ)).
   int curvature_cells_for(double scale) const noexcept {
-    const double cell = std::min(g_.dx, g_.dy);
+    const double cell = std::min(grid_.geometry().dx, grid_.geometry().dy);
     return scale > cell ? std::max(1, static_cast<int>(std::lround(scale / cell))) : 1;
   }
   /// A copy whose Hessian is taken over the scale L (m).
   GridSurface with_curvature_scale(double scale) const {
     GridSurface s;
-    s.g_ = g_;
-    s.z_ = z_;
+    s.grid_ = grid_;
     s.compute_curvature(scale);
     return s;
   }
 
-  /// Elevation, gradient and Hessian at p; false outside the area where the four surrounding cell
-  /// centres hold data (a particle there leaves the simulation).
+  /// Elevation, gradient and Hessian at p; false where the bilinear surface is not defined
+  /// (outside the closed hull of the cell centres or next to nodata: a particle there leaves the
+  /// simulation). The Hessian is interpolated with the weights of the elevation's patch.
   bool sample(const Vec2& p, SurfaceSample& s) const noexcept {
-    const double px = (p.x() - g_.x0) / g_.dx - 0.5;
-    const double py = (g_.y0 - p.y()) / g_.dy - 0.5;
-    if (!(px >= 0.0 && py >= 0.0 && px < g_.nx - 1 && py < g_.ny - 1)) return false;
-    const int i = static_cast<int>(px), j = static_cast<int>(py);
-    const double fx = px - i, fy = py - j;
-    const std::size_t k = g_.index(i, j);
-    const double z00 = z_[k], z10 = z_[k + 1], z01 = z_[k + g_.nx], z11 = z_[k + g_.nx + 1];
-    if (std::isnan(z00 + z10 + z01 + z11)) return false;
-    const double top = z00 + fx * (z10 - z00), bottom = z01 + fx * (z11 - z01);
-    s.z = top + fy * (bottom - top);
-    const double dzdpx = (1.0 - fy) * (z10 - z00) + fy * (z11 - z01);
-    const double dzdpy = (1.0 - fx) * (z01 - z00) + fx * (z11 - z10);
-    s.grad = Vec2(dzdpx / g_.dx, -dzdpy / g_.dy);
+    TerrainSample t;
+    BilinearPatch patch;
+    if (!grid_.sample(p, t, patch)) return false;
+    s.z = t.z;
+    s.grad = t.gradient;
+    const double fx = patch.fx, fy = patch.fy;
     const double w00 = (1.0 - fx) * (1.0 - fy), w10 = fx * (1.0 - fy), w01 = (1.0 - fx) * fy, w11 = fx * fy;
-    const float* h00 = &hess_[3 * k];
+    const float* h00 = &hess_[3 * patch.index];
     const float* h10 = h00 + 3;
-    const float* h01 = h00 + 3 * static_cast<std::size_t>(g_.nx);
+    const float* h01 = h00 + 3 * static_cast<std::size_t>(grid_.geometry().nx);
     const float* h11 = h01 + 3;
     for (int c = 0; c < 3; ++c) s.hess[c] = w00 * h00[c] + w10 * h10[c] + w01 * h01[c] + w11 * h11[c];
     return true;
@@ -127,29 +109,30 @@ class GridSurface {
 
  private:
   void compute_curvature(double scale) {
+    const GridGeometry& g = grid_.geometry();
+    const std::vector<double>& values = grid_.values();
     k_ = curvature_cells_for(scale);
-    hess_.assign(3 * g_.cells(), 0.0f);
-    const auto z = [&](int c, int r) { return z_[g_.index(c, r)]; };
+    hess_.assign(3 * g.cells(), 0.0f);
+    const auto z = [&](int c, int r) { return values[g.index(c, r)]; };
 #pragma omp parallel for schedule(static)
-    for (int r = 0; r < g_.ny; ++r)
-      for (int c = 0; c < g_.nx; ++c) {
-        const int k = std::min({k_, c, g_.nx - 1 - c, r, g_.ny - 1 - r});
+    for (int r = 0; r < g.ny; ++r)
+      for (int c = 0; c < g.nx; ++c) {
+        const int k = std::min({k_, c, g.nx - 1 - c, r, g.ny - 1 - r});
         if (k < 1) continue;
-        const double hx = k * g_.dx, hy = k * g_.dy;
+        const double hx = k * g.dx, hy = k * g.dy;
         // Map y points north while rows run south: r − k is north (+y).
         const double xx = (z(c + k, r) - 2.0 * z(c, r) + z(c - k, r)) / (hx * hx);
         const double yy = (z(c, r - k) - 2.0 * z(c, r) + z(c, r + k)) / (hy * hy);
         const double xy = (z(c + k, r - k) - z(c + k, r + k) - z(c - k, r - k) + z(c - k, r + k)) / (4.0 * hx * hy);
         if (!std::isfinite(xx + yy + xy)) continue;  // the stencil reaches nodata
-        float* h = &hess_[3 * g_.index(c, r)];
+        float* h = &hess_[3 * g.index(c, r)];
         h[0] = static_cast<float>(xx);
         h[1] = static_cast<float>(xy);
         h[2] = static_cast<float>(yy);
       }
   }
 
-  GridGeometry g_;
-  std::vector<double> z_;
+  BilinearGrid grid_;
   std::vector<float> hess_;  // (z_xx, z_xy, z_yy) per cell centre
   int k_ = 1;
 };
