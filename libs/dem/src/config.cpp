@@ -16,11 +16,6 @@ namespace geohaz::dem {
 
 namespace {
 
-template <class... F>
-struct Overloaded : F... {
-  using F::operator()...;
-};
-
 std::vector<Vec2> points(ConfigReader& r, const char* kx, const char* kz, const char* what, bool required,
                          std::size_t min_points) {
   std::vector<double> x, z;
@@ -95,15 +90,9 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   MaterialSpec& m = c.material;
   p.density = m.density =
       r.get("material.density", m.density, Range::positive(), {"kg/m^3", "disc density (discs are 1 m thick)"});
-  {  // the choices and their sentences come from the one name table (contact_laws.hpp)
-    std::vector<std::string> names;
-    std::string help = "contact law:";
-    for (std::size_t k = 0; k < contact_law_names.size(); ++k) {
-      names.emplace_back(contact_law_names[k]);
-      help += (k ? "; " : " ") + names.back() + " = " + std::string(contact_law_summaries[k]);
-    }
-    m.law = *contact_law_from_name(r.get_choice("material.contact_law", "linear", names, {"", help}));
-  }
+  // the choices and their sentences come from the one name table (contact_laws.hpp)
+  m.law = *contact_law_from_name(r.get_choice("material.contact_law", "linear", ContactLawNames::choices(),
+                                              {"", ContactLawNames::help("contact law")}));
   const double Ec = r.get("material.contact_modulus", 20e9, Range::positive(),
                           {"Pa", "linear law: contact modulus E_c, k_n = 2 E_c (PFC2D, unit thickness)"});
   const double kratio = r.get("material.stiffness_ratio", 2.5, Range::positive(), {"1", "linear law: k_n/k_s"});

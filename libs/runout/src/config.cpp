@@ -17,9 +17,8 @@ namespace {
 BasalFriction read_friction(ConfigReader& cfg) {
   const ModifiedManningFriction manning;
   const VoellmyFriction voellmy;
-  const std::string law = cfg.get_choice("model.friction", ModifiedManningFriction::name,
-                                         {ModifiedManningFriction::name, VoellmyFriction::name, CoulombFriction::name},
-                                         {"", "basal shear law: modified Manning (debris flow), Voellmy or Coulomb"});
+  const std::string law = cfg.get_choice("model.friction", ModifiedManningFriction::name, BasalFrictionNames::choices(),
+                                         {"", BasalFrictionNames::help("basal shear law")});
   const double n = cfg.get("model.n", manning.n, Range::closed(0.005, 0.5),
                            {"s/m^(1/3)", "Manning roughness (manning); 0.02–0.1 for natural channels"});
   const double icr = cfg.get("model.icr", manning.i_cr, Range::closed(0.0, 2.0),
@@ -46,9 +45,17 @@ BasalFriction read_friction(ConfigReader& cfg) {
   used_by("model.m", {ModifiedManningFriction::name});
   used_by("model.mu", {VoellmyFriction::name, CoulombFriction::name});
   used_by("model.xi", {VoellmyFriction::name});
-  if (law == VoellmyFriction::name) return VoellmyFriction{mu, xi};
-  if (law == CoulombFriction::name) return CoulombFriction{mu};
-  return ModifiedManningFriction{n, icr, m};
+  // One case per law and no generic one: a law added to BasalFriction without its case fails to compile.
+  BasalFriction f = *BasalFrictionNames::from_name(law);  // get_choice has checked the name
+  std::visit(Overloaded{[&](ModifiedManningFriction& l) {
+                          l = ModifiedManningFriction{n, icr, m};
+                        },
+                        [&](VoellmyFriction& l) {
+                          l = VoellmyFriction{mu, xi};
+                        },
+                        [&](CoulombFriction& l) { l = CoulombFriction{mu}; }},
+             f);
+  return f;
 }
 
 /// A path given in the config: relative to the config file's folder when it does not exist as

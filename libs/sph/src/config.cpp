@@ -94,14 +94,9 @@ void read_run(ConfigReader& r, RunConfig& c) {
 void read_model_and_materials(ConfigReader& r, RunConfig& c) {
   // [model]
   {  // the choices and their sentences come from the one name table (constitutive.hpp)
-    std::vector<std::string> names;
-    std::string help = "constitutive model of all soil materials:";
-    for (std::size_t k = 0; k < constitutive_model_names.size(); ++k) {
-      names.emplace_back(constitutive_model_names[k]);
-      help += (k ? "; " : " ") + names.back() + " = " + std::string(constitutive_model_summaries[k]);
-    }
-    const auto model =
-        r.get_choice("model.constitutive", std::string(constitutive_model_name(c.model)), names, {"", help});
+    const auto model = r.get_choice("model.constitutive", std::string(constitutive_model_name(c.model)),
+                                    ConstitutiveModelNames::choices(),
+                                    {"", ConstitutiveModelNames::help("constitutive model of all soil materials")});
     c.model = *constitutive_model_from_name(model);  // get_choice has checked the name
   }
   const auto fit = r.get_choice(

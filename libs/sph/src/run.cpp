@@ -42,11 +42,6 @@ const char* scenario_name(ScenarioType t) {
   return "?";
 }
 
-template <class... F>
-struct Overloaded : F... {
-  using F::operator()...;
-};
-
 /// What a material means under the model of the run, for summary.json and the log. One case per
 /// model and no generic fallback: a model added to ConstitutiveModel without its case here fails to
 /// compile.
@@ -828,8 +823,8 @@ void DynamicRun<Dim>::print_header() const {
   for (std::size_t k = 0; k < mats.size(); ++k)
     std::fprintf(stderr, "  material %zu (%s): c_p = %.4g m/s, DP fit %s, %s %s\n", k,
                  k < c_.material_names.size() ? c_.material_names[k].c_str() : "", mats[k].p_wave_speed,
-                 drucker_prager_fit_name(mats[k].fit),
-                 solver_.model_name().c_str(), model_parameters(c_.model, mats[k]).dump().c_str());
+                 drucker_prager_fit_name(mats[k].fit), solver_.model_name().c_str(),
+                 model_parameters(c_.model, mats[k]).dump().c_str());
 }
 
 template <int Dim>

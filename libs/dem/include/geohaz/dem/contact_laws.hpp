@@ -22,7 +22,10 @@
 #include <numbers>
 #include <optional>
 #include <string_view>
+#include <type_traits>
 #include <variant>
+
+#include "geohaz/core/name_table.hpp"
 
 namespace geohaz::dem {
 
@@ -166,30 +169,22 @@ concept DemContactLaw = requires(const L& l, double x) {
 /// parameters) then fails to compile until it has a case for it.
 using ContactLaw = std::variant<LinearSpringCoulomb, HertzMindlin>;
 
-namespace detail {
-template <class V>
-struct ContactLawTable;
 template <class... L>
-struct ContactLawTable<std::variant<L...>> {
-  static_assert((DemContactLaw<L> && ...), "every alternative of ContactLaw is a DemContactLaw");
-  static constexpr std::array<std::string_view, sizeof...(L)> names{std::string_view(L::name)...};
-  static constexpr std::array<std::string_view, sizeof...(L)> summaries{std::string_view(L::summary)...};
-  static std::optional<std::variant<L...>> from_name(std::string_view n) {
-    std::optional<std::variant<L...>> out;
-    (void)((n == L::name ? (out = L{}, true) : false) || ...);
-    return out;
-  }
-};
-}  // namespace detail
+constexpr bool every_law_is_a_contact_law(std::type_identity<std::variant<L...>>) {
+  return (DemContactLaw<L> && ...);
+}
+static_assert(every_law_is_a_contact_law(std::type_identity<ContactLaw>{}),
+              "every alternative of ContactLaw is a DemContactLaw");
+using ContactLawNames = NameTable<ContactLaw>;
 
 /// Config names of the contact laws, in the order of ContactLaw.
-inline constexpr auto contact_law_names = detail::ContactLawTable<ContactLaw>::names;
+inline constexpr auto contact_law_names = ContactLawNames::names;
 /// One sentence per law (same order), for --help-config.
-inline constexpr auto contact_law_summaries = detail::ContactLawTable<ContactLaw>::summaries;
+inline constexpr auto contact_law_summaries = ContactLawNames::summaries;
 
 /// The law of that config name with its default parameters; std::nullopt for an unknown name.
 inline std::optional<ContactLaw> contact_law_from_name(std::string_view name) {
-  return detail::ContactLawTable<ContactLaw>::from_name(name);
+  return ContactLawNames::from_name(name);
 }
 
 /// Config name of a law.

@@ -16,6 +16,8 @@
 #include <string>
 #include <variant>
 
+#include "geohaz/core/name_table.hpp"
+
 namespace geohaz::runout {
 
 /// Per-particle friction coefficients: deceleration = rest + drag·|v|² (m/s², 1/m).
@@ -35,6 +37,7 @@ struct ModifiedManningFriction {
   double i_cr = 0.15;
   double m = 0.0;
   static constexpr const char* name = "manning";
+  static constexpr const char* summary = "modified Manning for a debris flow (n, icr, m; SWJTU lecture 2010)";
   FrictionTerms terms(double g, double g_n, double h_n, double speed) const noexcept {
     const double rest = m == 0.0 ? g_n * i_cr : g_n * i_cr * std::pow(speed, m);
     return {rest, g * n * n / (h_n * std::cbrt(h_n))};
@@ -48,6 +51,7 @@ struct VoellmyFriction {
   double mu = 0.15;
   double xi = 500.0;
   static constexpr const char* name = "voellmy";
+  static constexpr const char* summary = "Voellmy, Coulomb plus turbulent drag (mu, xi; Voellmy 1955, as in RAMMS)";
   FrictionTerms terms(double g, double g_n, double h_n, double /*speed*/) const noexcept {
     return {g_n * mu, g / (xi * h_n)};
   }
@@ -57,17 +61,21 @@ struct VoellmyFriction {
 struct CoulombFriction {
   double mu = 0.15;
   static constexpr const char* name = "coulomb";
+  static constexpr const char* summary = "dry Coulomb friction (mu)";
   FrictionTerms terms(double /*g*/, double g_n, double /*h_n*/, double /*speed*/) const noexcept {
     return {g_n * mu, 0.0};
   }
 };
 
-/// The law of a run, chosen from the config.
+/// The law of a run, chosen from the config, and the one name table of the laws: its
+/// alternatives' `name`s are the values of `model.friction`. The config reader sets a law's
+/// coefficients in an exhaustive visit, so a law added here without its case fails to compile.
 using BasalFriction = std::variant<ModifiedManningFriction, VoellmyFriction, CoulombFriction>;
+using BasalFrictionNames = NameTable<BasalFriction>;
 
 /// The name of the law held ("manning", "voellmy", "coulomb").
 inline std::string friction_name(const BasalFriction& f) {
-  return std::visit([](const auto& law) { return std::string(law.name); }, f);
+  return std::string(BasalFrictionNames::name_of(f));
 }
 
 /// Speed after one implicit friction step: solves s = s* − dt (a_rest + k s²) for s ≥ 0, i.e. the

@@ -55,9 +55,11 @@
 #include <limits>
 #include <optional>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 #include <variant>
 
+#include "geohaz/core/name_table.hpp"
 #include "geohaz/core/vec.hpp"
 #include "geohaz/sph/fields.hpp"
 
@@ -369,30 +371,22 @@ concept ConstitutiveLaw = requires(const MaterialParams& p, double h) {
 /// `model.constitutive`. A model is added here and nowhere else in the solver or the app.
 using ConstitutiveModel = std::variant<LinearElastic, VonMises, DruckerPrager, DruckerPragerSoftening, NewtonianFluid>;
 
-namespace detail {
-template <class V>
-struct ModelTable;
 template <class... M>
-struct ModelTable<std::variant<M...>> {
-  static_assert((ConstitutiveLaw<M> && ...), "every alternative of ConstitutiveModel is a ConstitutiveLaw");
-  static constexpr std::array<std::string_view, sizeof...(M)> names{std::string_view(M::name)...};
-  static constexpr std::array<std::string_view, sizeof...(M)> summaries{std::string_view(M::summary)...};
-  static std::optional<std::variant<M...>> from_name(std::string_view n) {
-    std::optional<std::variant<M...>> out;
-    (void)((n == M::name ? (out = M{}, true) : false) || ...);
-    return out;
-  }
-};
-}  // namespace detail
+constexpr bool every_model_is_a_law(std::type_identity<std::variant<M...>>) {
+  return (ConstitutiveLaw<M> && ...);
+}
+static_assert(every_model_is_a_law(std::type_identity<ConstitutiveModel>{}),
+              "every alternative of ConstitutiveModel is a ConstitutiveLaw");
+using ConstitutiveModelNames = NameTable<ConstitutiveModel>;
 
 /// Config names of the models, in the order of ConstitutiveModel.
-inline constexpr auto constitutive_model_names = detail::ModelTable<ConstitutiveModel>::names;
+inline constexpr auto constitutive_model_names = ConstitutiveModelNames::names;
 /// One sentence per model (same order), for --help-config.
-inline constexpr auto constitutive_model_summaries = detail::ModelTable<ConstitutiveModel>::summaries;
+inline constexpr auto constitutive_model_summaries = ConstitutiveModelNames::summaries;
 
 /// The model of that config name; std::nullopt for an unknown name.
 inline std::optional<ConstitutiveModel> constitutive_model_from_name(std::string_view name) {
-  return detail::ModelTable<ConstitutiveModel>::from_name(name);
+  return ConstitutiveModelNames::from_name(name);
 }
 
 /// Name of a model.
