@@ -734,6 +734,28 @@ struct ReleaseOutput {
 
 /// A run in time: the geostatic phase (or a restart), then the main phase with its series,
 /// structure loads, quick-looks and the summary's figures (docs/sph.md).
+/// The geostatic phase of `solver` over `dur` seconds, the observer told at the start, every 50
+/// steps and at the end (phase "geostatic").
+template <int Dim>
+GeostaticReport geostatic_with_progress(SphSolver<Dim>& solver, double dur, const RunConfig& c,
+                                        const SphSimulation& self, RunObserver* obs) {
+  RunProgress p{"geostatic", 0.0, dur, 0, solver.store().size(), 0.0, false};
+  if (obs) obs->progress(self, p);
+  std::int64_t k = 0;
+  const auto rep = solver.apply_gravity_gradually(dur, c.geostatic_damping, c.geostatic_elastic, [&] {
+    if (++k % 50 == 0 && obs) {
+      p.time = solver.time();
+      p.steps = k;
+      obs->progress(self, p);
+    }
+  });
+  p.time = dur;
+  p.steps = rep.steps;
+  p.done = true;
+  if (obs) obs->progress(self, p);
+  return rep;
+}
+
 template <int Dim>
 class DynamicRun final : public SimulationModel {
  public:
@@ -859,20 +881,7 @@ void DynamicRun<Dim>::load_restart_state() {
 template <int Dim>
 void DynamicRun<Dim>::geostatic_phase(const SphSimulation& self, RunObserver* obs) {
   const double dur = c_.geostatic_duration > 0.0 ? c_.geostatic_duration : 20.0 * href_ / solver_.max_wave_speed();
-  RunProgress p{"geostatic", 0.0, dur, 0, solver_.store().size(), 0.0, false};
-  if (obs) obs->progress(self, p);
-  std::int64_t k = 0;
-  const auto rep = solver_.apply_gravity_gradually(dur, c_.geostatic_damping, c_.geostatic_elastic, [&] {
-    if (++k % 50 == 0 && obs) {
-      p.time = solver_.time();
-      p.steps = k;
-      obs->progress(self, p);
-    }
-  });
-  p.time = dur;
-  p.steps = rep.steps;
-  p.done = true;
-  if (obs) obs->progress(self, p);
+  const auto rep = geostatic_with_progress(solver_, dur, c_, self, obs);
   have_loads_ = rep.steps > 0;
   const double tol = c_.rest_tolerance * std::sqrt(c_.numerics.gravity * href_);
   const bool at_rest = rep.max_speed < tol;
@@ -1318,20 +1327,7 @@ void StrengthReductionRun<Dim>::geostatic_state(const SphSimulation& self, RunOb
     phase_summary_["restart"] = {{"file", c_.restart.string()}, {"time_s", rs.time}};
   } else {
     const double dur = c_.geostatic_duration > 0.0 ? c_.geostatic_duration : 20.0 * href_ / cmax_;
-    RunProgress p{"geostatic", 0.0, dur, 0, geo_.store().size(), 0.0, false};
-    if (obs) obs->progress(self, p);
-    std::int64_t k = 0;
-    const auto rep = geo_.apply_gravity_gradually(dur, c_.geostatic_damping, c_.geostatic_elastic, [&] {
-      if (++k % 50 == 0 && obs) {
-        p.time = geo_.time();
-        p.steps = k;
-        obs->progress(self, p);
-      }
-    });
-    p.time = dur;
-    p.steps = rep.steps;
-    p.done = true;
-    if (obs) obs->progress(self, p);
+    const auto rep = geostatic_with_progress(geo_, dur, c_, self, obs);
     phase_summary_["geostatic"] = {{"duration_s", dur}, {"steps", rep.steps}, {"max_speed_m_per_s", rep.max_speed}};
   }
   initial_ = geo_.store();
