@@ -483,6 +483,37 @@ TEST(Neighbours, PermutationReordersTheStoreAndASideTableScan3D) {
   check_reorder<3>(PairStorage::scan);
 }
 
+// A restart: restore(x_build, builds) rebuilds the saved pairs without reordering and carries on
+// the build count, so an object resumed after five builds reorders at the same rebuild as the one
+// that never stopped (0-based rebuild 6 with reorder_every = 3, builds() = 7 after it); without the
+// count the restored build is rebuild 0 and the reordering comes three rebuilds early.
+TEST(Neighbours, RestoreCarriesTheReorderScheduleOn) {
+  const auto x = make_points<2>(600, Layout::Clustered, 7, 1.0);
+  std::vector<Vec<2>> xb(x.size());
+  NeighbourSettings<2> s;
+  s.cutoff = 0.09;
+  s.skin = 0.01;
+  s.reorder_every = 3;
+  const auto reorders = [&](Neighbours<2>& nb, int updates) {
+    std::vector<std::int64_t> at;
+    for (int k = 0; k < updates; ++k) {
+      nb.invalidate();
+      if (nb.update(x, xb).reordered()) at.push_back(nb.builds());
+    }
+    return at;
+  };
+  Neighbours<2> a(s);
+  EXPECT_EQ(reorders(a, 8), (std::vector<std::int64_t>{4, 7}));
+  Neighbours<2> b(s);
+  b.restore(xb, 5);  // the saved run had built five times
+  EXPECT_EQ(b.builds(), 5);
+  EXPECT_EQ(reorders(b, 3), (std::vector<std::int64_t>{7}));
+  Neighbours<2> c(s);
+  c.restore(xb);  // no count: the restored build is the first
+  EXPECT_EQ(c.builds(), 1);
+  EXPECT_EQ(reorders(c, 3), (std::vector<std::int64_t>{4}));
+}
+
 // Σ_j φ(r_ij) x_j,0 by half pairs (forward pairs by slot, reactions in the object's blocks,
 // gathered by PairBlocks::gather) against the full-pair sum; and 1 vs 3 threads bit-identical,
 // with enough particles (4000 > kParallelMin) for the loops to fork.

@@ -220,7 +220,7 @@ TEST(DemContact, HistorySurvivesSorting) {
   // round-off (the history is looked up by partner id, not by index).
   auto run = [](int reorder) {
     DemSolver s;
-    s.settings.reorder_interval = reorder;
+    s.settings.reorder_every = reorder;
     s.settings.skin = 0.002;
     s.law = LinearSpringCoulomb{1e6, 1e6};
     s.contact.friction = 0.5;

@@ -305,9 +305,10 @@ NeighbourUpdate Neighbours<Dim>::update(std::span<const Vec<Dim>> x, std::span<V
 }
 
 template <int Dim>
-void Neighbours<Dim>::restore(std::span<const Vec<Dim>> x_build) {
+void Neighbours<Dim>::restore(std::span<const Vec<Dim>> x_build, std::int64_t builds) {
   if (!(s_.cutoff > 0.0)) throw std::logic_error("Neighbours::restore before configure");
   build(x_build);
+  if (builds >= 0) builds_ = builds;
 }
 
 template class CellList<2>;

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "geohaz/core/errors.hpp"
+#include "geohaz/core/parallel.hpp"
 
 namespace geohaz::dem {
 
@@ -169,7 +170,7 @@ void DemSolver::initialise() {
   NeighbourSettings<2> ns;
   ns.cutoff = 2.0 * rmax;  // list cut-off 2 R_max + skin, as cutoff_
   ns.skin = skin_;
-  ns.reorder_every = settings.reorder_interval;
+  ns.reorder_every = settings.reorder_every;
   nb_.configure(ns);
   double reach = rmax;
   terrain.build(reach);
@@ -187,7 +188,7 @@ void DemSolver::initialise() {
 
 void DemSolver::update_neighbours(double max_drift) {
   // The core Neighbours object decides (drift > skin/2 since the last build) and reorders by cell
-  // every reorder_interval rebuilds; the contact histories follow the permutation.
+  // at every reorder_every-th rebuild; the contact histories follow the permutation.
   const auto u = nb_.update(discs.get<Position<2>>(), discs.get<PositionAtBuild>(), max_drift);
   if (!u.rebuilt) return;
   if (u.reordered()) reorder(u.permutation);
@@ -253,7 +254,7 @@ void DemSolver::pair_forces(const Law& law) {
   const bool same = same_layout_ && hist_.offsets.size() == n + 1;
   const bool any_joints = !joints_.empty();
 
-#pragma omp parallel for schedule(static) if (static_cast <std::int64_t>(n) > kParallelMin)
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
   for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
     const auto i = static_cast<std::size_t>(ii);
     const Vec2 xi = x[i];
@@ -340,7 +341,7 @@ void DemSolver::bond_forces() {
   const double dt = dt_;
   const int nthreads = omp_get_max_threads();
   std::vector<std::vector<AcousticEvent>> local(static_cast<std::size_t>(nthreads));
-#pragma omp parallel if (static_cast <std::int64_t>(nb) > kParallelMin)
+#pragma omp parallel if (parallel_worth(nb))
   {
     auto& ev = local[static_cast<std::size_t>(omp_get_thread_num())];
 #pragma omp for schedule(static)
@@ -394,7 +395,7 @@ void DemSolver::bond_forces() {
   auto& broken = discs.get<BrokenBonds>();
   const auto& id = discs.get<ParticleId>();
   const std::int64_t n = static_cast<std::int64_t>(discs.size());
-#pragma omp parallel for schedule(static) if (n > kParallelMin)
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
     Vec2 f = Vec2::Zero();
@@ -480,7 +481,7 @@ void DemSolver::wall_forces(const Law& law) {
     box_lo[k] = wl.a.cwiseMin(wl.b) - Vec2::Constant(1.1 * rmax_);  // 10 %: radii grow while packing
     box_hi[k] = wl.a.cwiseMax(wl.b) + Vec2::Constant(1.1 * rmax_);
   }
-#pragma omp parallel if (n > kParallelMin)
+#pragma omp parallel if (parallel_worth(n))
   {
     std::vector<Vec2> wf(nw, Vec2::Zero());
     std::vector<double> wk(nw, 0.0);
@@ -612,7 +613,7 @@ void DemSolver::update_time_step() {
   const auto& K = discs.get<StiffnessSum>();
   const std::int64_t n = static_cast<std::int64_t>(discs.size());
   double inv2 = 0.0;  // max of k/m
-#pragma omp parallel for reduction(max : inv2) schedule(static) if (n > kParallelMin)
+#pragma omp parallel for reduction(max : inv2) schedule(static) if (parallel_worth(n))
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
     const double kn0 = std::visit([&](const auto& l) { return l.reference_kn(R[i]); }, law) * wall_step_factor_;
@@ -636,7 +637,7 @@ void DemSolver::check_state() const {
   const std::int64_t n = static_cast<std::int64_t>(discs.size());
   const double vmax2 = settings.max_speed * settings.max_speed;
   std::int64_t bad = -1;
-#pragma omp parallel for reduction(max : bad) schedule(static) if (n > kParallelMin)
+#pragma omp parallel for reduction(max : bad) schedule(static) if (parallel_worth(n))
   for (std::int64_t i = 0; i < n; ++i)
     if (!x[i].allFinite() || !v[i].allFinite() || v[i].squaredNorm() > vmax2) bad = std::max(bad, i);
   if (bad >= 0) {
@@ -663,7 +664,7 @@ void DemSolver::step() {
   const std::int64_t n = static_cast<std::int64_t>(discs.size());
   // 1. half kick + drift (and the largest displacement since the last list build)
   double dmax2 = 0.0;
-#pragma omp parallel for schedule(static) reduction(max : dmax2) if (n > kParallelMin)
+#pragma omp parallel for schedule(static) reduction(max : dmax2) if (parallel_worth(n))
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
     if (!kin[i]) {
@@ -713,7 +714,7 @@ void DemSolver::finish_step(const Law& law) {
   const std::int64_t n = static_cast<std::int64_t>(discs.size());
   double inv2 = 0.0;
   std::int64_t bad = -1;
-#pragma omp parallel for schedule(static) reduction(max : inv2, bad) if (n > kParallelMin)
+#pragma omp parallel for schedule(static) reduction(max : inv2, bad) if (parallel_worth(n))
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
     if (!kin[i]) {

@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "geohaz/core/kernels.hpp"
+#include "geohaz/core/parallel.hpp"
 
 namespace geohaz::runout {
 
@@ -32,7 +33,7 @@ void HazardMaps::record(const RunoutStore& store, double t) {
   // runs over all particles and paints only the rows of its band. Maxima and the first arrival
   // (one t per call) do not depend on the order of painting, so the maps are the same for any
   // number of threads, and no two threads write the same cell.
-  const int threads = n >= kParallelMin ? omp_get_max_threads() : 1;
+  const int threads = parallel_worth(n) ? omp_get_max_threads() : 1;
   band_start_.assign(static_cast<std::size_t>(threads) + 1, 0);
   band_start_.back() = g_.ny;
   if (threads > 1) {

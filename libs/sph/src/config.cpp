@@ -195,8 +195,12 @@ void read_numerics(ConfigReader& r, RunConfig& c) {
                     {"1", "Cundall local damping zeta in the main phase (Bui et al. 2010 uses 0.2 under shaking)"});
   n.stress_free_fraction = r.get("numerics.stress_free_fraction", d.stress_free_fraction, Range::closed_open(0.0, 1.0),
                                  {"1", "stress vanishes where the kernel-sum density < fraction rho0 (0: off)"});
-  n.reorder_every = static_cast<int>(r.get_int("numerics.reorder_every", d.reorder_every, Range::closed(0, 1e6),
-                                               {"1", "steps between cell reorderings (0: never)"}));
+  if (r.has("numerics.reorder_every"))  // counted steps until Dec 2026; now list rebuilds, as in every model
+    throw InputError("renamed to numerics.reorder_every_rebuilds (it counts neighbour-list rebuilds, not steps)",
+                     r.source(), "numerics.reorder_every");
+  n.reorder_every = static_cast<int>(
+      r.get_int("numerics.reorder_every_rebuilds", d.reorder_every, Range::closed(0, 1e6),
+                {"1", "sort the particles by cell at every N-th neighbour-list rebuild (memory locality; 0: never)"}));
   n.wall_repulsion = r.get("numerics.wall_repulsion", d.wall_repulsion, Range::closed(0.0, 1.0),
                            {"1", "soil closer than this x dx to a wall particle is pushed back (0: off)"});
   {  // auto: the solver's default (off) except for linear_elastic, where it was validated (docs/sph.md)

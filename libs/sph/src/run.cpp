@@ -338,8 +338,8 @@ void write_snapshot(SnapshotWriter& w, const SphSolver<Dim>& solver, std::int64_
   write_fields<Dim>(w, solver.store(), solver.time(), step);
   const SolverState st = solver.state();
   char buf[160];
-  std::snprintf(buf, sizeof buf, "snapshot %zu step %lld dt %a last_reorder %lld", w.snapshot_count() - 1,
-                static_cast<long long>(st.step), st.dt, static_cast<long long>(st.last_reorder));
+  std::snprintf(buf, sizeof buf, "snapshot %zu step %lld dt %a builds %lld", w.snapshot_count() - 1,
+                static_cast<long long>(st.step), st.dt, static_cast<long long>(st.neighbour_builds));
   w.set_attribute(kSolverStateAttribute, buf);
 }
 
@@ -386,12 +386,15 @@ Restart load_restart(const std::filesystem::path& path, SphStore<Dim>& s) {
   out.step = r.step(k);
   // The solver state, if it belongs to this snapshot and the neighbour-list positions are there.
   std::istringstream is(r.attribute(kSolverStateAttribute));
+  // Files written before Dec 2026 end in "last_reorder m" (the step of the last reordering, when
+  // the schedule counted steps): the run goes on with the rebuild count from 0, so its reorderings,
+  // and the round-off of its pair sums, differ from an uninterrupted run's.
   std::string w1, w2, w3, w4, dt;
   std::size_t snap = 0;
-  long long step = 0, reorder = 0;
-  if (is >> w1 >> snap >> w2 >> step >> w3 >> dt >> w4 >> reorder && snap == k &&
+  long long step = 0, builds = 0;
+  if (is >> w1 >> snap >> w2 >> step >> w3 >> dt >> w4 >> builds && snap == k &&
       r.has_field(k, PositionAtBuild<Dim>::label))
-    out.state = SolverState{out.time, step, std::strtod(dt.c_str(), nullptr), reorder};
+    out.state = SolverState{out.time, step, std::strtod(dt.c_str(), nullptr), w4 == "builds" ? builds : 0};
   return out;
 }
 

@@ -13,6 +13,7 @@
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/kernels.hpp"
+#include "geohaz/core/parallel.hpp"
 
 namespace geohaz::sph {
 
@@ -243,26 +244,24 @@ template <int Dim>
 void SphSolver<Dim>::update_neighbours(double cutoff) {
   // The core Neighbours object: an optional Verlet skin lets the list be reused while no particle
   // has moved more than half the skin (max_drift_, from step 5); cell reordering keeps neighbours
-  // close in memory, every reorder_every steps at a rebuild.
+  // close in memory, at every reorder_every-th rebuild (the object's schedule).
   auto& S = store_;
-  if (nb_.settings().cutoff != cutoff) {
-    NeighbourSettings<Dim> ns;
-    ns.cutoff = cutoff;
-    ns.skin = settings_.neighbour_skin * h_;
-    ns.periodic = settings_.periodic;
-    nb_.configure(ns);
-  }
-  const bool reorder = settings_.reorder_every > 0 && step_ - last_reorder_ >= settings_.reorder_every &&
-                       nb_.rebuild_due(S.size(), max_drift_);
-  const auto u =
-      nb_.update(S.template get<Position<Dim>>(), S.template get<PositionAtBuild<Dim>>(), max_drift_, reorder);
+  if (nb_.settings().cutoff != cutoff) configure_neighbours(cutoff);
+  const auto u = nb_.update(S.template get<Position<Dim>>(), S.template get<PositionAtBuild<Dim>>(), max_drift_);
   if (!u.rebuilt) return;
-  if (u.reordered()) {
-    S.reorder(u.permutation);
-    last_reorder_ = step_;
-  }
+  if (u.reordered()) S.reorder(u.permutation);
   choose_pair_blocks();
   max_drift_ = 0.0;
+}
+
+template <int Dim>
+void SphSolver<Dim>::configure_neighbours(double cutoff) {
+  NeighbourSettings<Dim> ns;
+  ns.cutoff = cutoff;
+  ns.skin = settings_.neighbour_skin * h_;
+  ns.reorder_every = settings_.reorder_every;
+  ns.periodic = settings_.periodic;
+  nb_.configure(ns);
 }
 
 template <int Dim>
@@ -283,7 +282,6 @@ void SphSolver<Dim>::resume(const SolverState& st) {
   time_ = st.time;
   step_ = st.step;
   dt_ = st.dt;
-  last_reorder_ = st.last_reorder;
   double support = 0.0;
   switch (settings_.kernel) {
     case KernelChoice::CubicSpline:
@@ -294,12 +292,8 @@ void SphSolver<Dim>::resume(const SolverState& st) {
       break;
   }
   const auto& xb = store_.template get<PositionAtBuild<Dim>>();
-  NeighbourSettings<Dim> ns;
-  ns.cutoff = support * h_;
-  ns.skin = settings_.neighbour_skin * h_;
-  ns.periodic = settings_.periodic;
-  nb_.configure(ns);
-  nb_.restore(xb);
+  configure_neighbours(support * h_);
+  nb_.restore(xb, st.neighbour_builds);
   choose_pair_blocks();
   // The drift since that build, as step 5 computes it.
   const MinimumImage<Dim> image(settings_.periodic);
@@ -353,7 +347,7 @@ void SphSolver<Dim>::prepare_boundary_pairs(const Vec<Dim>& gbar) {
   const Vec<Dim>* lnrm = field<LayerNormal<Dim>>();
   Mat<Dim>* ps = field<PairStress<Dim>>();
   double* vol = field<Volume>();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
     vol[i] = m[i] / rho[i];
@@ -411,7 +405,7 @@ void SphSolver<Dim>::gradient_correction() {
   const std::uint32_t* idx = nb_.list().indices().data();
   correction_.resize(static_cast<std::size_t>(n));
   Mat<Dim>* C = correction_.data();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
     C[i].setIdentity();
@@ -458,7 +452,7 @@ void SphSolver<Dim>::velocity_gradient() {
   const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
   const std::int64_t nblocks = static_cast<std::int64_t>(blocks.count());
   pair_grad_.resize(blocks.slots());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
   for (std::int64_t bb = 0; bb < nblocks; ++bb) {
     const auto b = static_cast<std::size_t>(bb);
     const std::size_t first = b * blocks.size, last = std::min(blocks.n, first + blocks.size);
@@ -547,7 +541,7 @@ void SphSolver<Dim>::update_stress(const Model& /*model*/) {
   // Σ Δλ by blocks of particles, then over the blocks in order: the same sum on any thread count.
   const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
   block_sums_.assign(blocks.count(), 0.0);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
   for (std::int64_t bb = 0; bb < static_cast<std::int64_t>(blocks.count()); ++bb) {
     const auto b = static_cast<std::size_t>(bb);
     double plastic = 0.0;
@@ -634,7 +628,7 @@ void SphSolver<Dim>::momentum() {
   const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
   const std::int64_t nblocks = static_cast<std::int64_t>(blocks.count());
   pair_acc_.resize(blocks.slots());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
   for (std::int64_t bb = 0; bb < nblocks; ++bb) {
     const auto b = static_cast<std::size_t>(bb);
     const std::size_t first = b * blocks.size, last = std::min(blocks.n, first + blocks.size);
@@ -748,7 +742,7 @@ void SphSolver<Dim>::structure_forces() {
   const std::int64_t nblocks = static_cast<std::int64_t>(blocks.count());
   structure_block_loads_.assign(blocks.count() * structure_base_.size(), StructureLoad<Dim>{});
   StructureLoad<Dim>* all = structure_block_loads_.data();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
   for (std::int64_t bb = 0; bb < nblocks; ++bb) {
     const auto b = static_cast<std::size_t>(bb);
     const std::size_t first = b * blocks.size, last = std::min(blocks.n, first + blocks.size);
@@ -834,7 +828,7 @@ void SphSolver<Dim>::integrate(const Vec<Dim>& gbar) {
   Vec<Dim>* disp = field<Displacement<Dim>>();
   const std::uint8_t* clamped = field<Clamped>();
   double vmax = 0.0, amax = 0.0, drift = 0.0;
-#pragma omp parallel for schedule(static) reduction(max : vmax, amax, drift)
+#pragma omp parallel for schedule(static) reduction(max : vmax, amax, drift) if (parallel_worth(n))
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
     if (kind[i] != kSoil) {

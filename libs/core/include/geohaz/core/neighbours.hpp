@@ -193,7 +193,7 @@ class NeighbourList {
   template <class F>
   void for_each_pair(std::span<const Vec<Dim>> x, F&& f) const {
     const std::int64_t n = static_cast<std::int64_t>(size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
       const Vec<Dim> xi = x[i];
@@ -502,8 +502,10 @@ class Neighbours {
   NeighbourUpdate update(std::span<const Vec<Dim>> x, std::span<Vec<Dim>> x_build, double max_drift = -1.0,
                          bool reorder = false);
   /// Build the pairs for the given reference positions without reordering (resuming a run from a
-  /// snapshot: the pairs, and so the order of every pair sum, are those of the saved run).
-  void restore(std::span<const Vec<Dim>> x_build);
+  /// snapshot: the pairs, and so the order of every pair sum, are those of the saved run), and set
+  /// the build count to `builds` (the saved run's builds(), so the reordering schedule goes on where
+  /// it stopped); builds < 0 counts this build as a new one.
+  void restore(std::span<const Vec<Dim>> x_build, std::int64_t builds = -1);
 
   /// Pair builds so far (reorderings do not count twice).
   std::int64_t builds() const noexcept { return builds_; }

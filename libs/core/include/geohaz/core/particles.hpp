@@ -25,6 +25,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "geohaz/core/parallel.hpp"
 #include "geohaz/core/vec.hpp"
 
 namespace geohaz {
@@ -191,7 +192,7 @@ class ParticleStore {
     T* tmp = reinterpret_cast<T*>(scratch_.data());
     const T* src = v.data();
     const std::int64_t n = static_cast<std::int64_t>(perm.size());
-#pragma omp parallel for schedule(static) if (n >= 65536)
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
     for (std::int64_t i = 0; i < n; ++i) new (tmp + i) T(src[perm[static_cast<std::size_t>(i)]]);
     std::copy(tmp, tmp + n, v.data());
   }

@@ -9,7 +9,7 @@
 ///     (CellPairScan: the pairs are used once, so no list is written); with numerics.skin > 0 a
 ///     Verlet list within (2 + skin)·d0 (NeighbourList), rebuilt when a particle has moved more
 ///     than skin·d0/2 since the last build and after removals. The particles are reordered by cell
-///     every reorder_interval steps;
+///     at every reorder_every-th rebuild;
 ///  2. pair pass (each pair once, the partner's share through fixed-order block reactions, so the
 ///     sums do not depend on the thread count; with the velocity smoothing or a Verlet list each
 ///     particle visits all its neighbours): vertical depth h_i = Σ_j V_j W(r_ij, d0) (cubic spline, self included), the
@@ -66,6 +66,7 @@
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/kernels.hpp"
 #include "geohaz/core/neighbours.hpp"
+#include "geohaz/core/parallel.hpp"
 #include "geohaz/runout/barriers.hpp"
 #include "geohaz/runout/basal_friction.hpp"
 #include "geohaz/runout/fields.hpp"
@@ -96,8 +97,8 @@ struct RunoutParameters {
   bool curvature = true;
   /// The run ends when the kinetic energy falls below this fraction of its peak (1); 0: never.
   double stop_energy_fraction = 0.01;
-  int reorder_interval = 25;  ///< steps between cell reorderings of the store
-  double skin = 0.0;          ///< neighbour-list skin in units of d0 (list cutoff (2 + skin)·d0)
+  int reorder_every = 25;  ///< sort the store by cell at every this-many-th neighbour rebuild (0: never)
+  double skin = 0.0;       ///< neighbour-list skin in units of d0 (list cutoff (2 + skin)·d0)
   BasalFriction friction = ModifiedManningFriction{};
   /// Bed erosion law and coefficients (the erodible layer is a field: SpatialProcesses).
   EntrainmentParameters entrainment;
@@ -208,9 +209,9 @@ class RunoutSolver {
 
   /// Advance one adaptive step; returns Δt. SimulationError on NaN or time-step collapse.
   double step() {
-    // 1-2. Neighbours (reordered by cell every reorder_interval steps) and the pair pass, which
-    // also returns the signal speed of the time step.
-    const double signal = compute_pair_terms(step_ % p_.reorder_interval == 0);
+    // 1-2. Neighbours (reordered by cell at every reorder_every-th rebuild) and the pair pass,
+    // which also returns the signal speed of the time step.
+    const double signal = compute_pair_terms();
 
     // 3. Time step (max is exact in any order: thread-count independent).
     double dt = signal > 0.0 ? p_.cfl * p_.d0 / signal : p_.dt_max;
@@ -257,10 +258,11 @@ class RunoutSolver {
   const VolumeBudget& budget() const noexcept { return budget_; }
 
   /// Recompute the depths and head-pressure accelerations for the current positions (also done
-  /// by step(); public for tests and outputs), after sorting the store by cell if `reorder`.
+  /// by step(); public for tests and outputs), rebuilding the neighbours (and reordering the store)
+  /// when due.
   /// Returns the signal speed of the time step, max_i (S_i + √(g h_i)) (m/s), computed in the same
   /// pass.
-  double compute_pair_terms(bool reorder = false) {
+  double compute_pair_terms() {
     if (store_.empty()) return 0.0;
     // Neighbours (core Neighbours): with numerics.skin > 0 a Verlet list rebuilt when a particle
     // has moved more than half the skin since the build; without, the pairs are used once per
@@ -270,8 +272,7 @@ class RunoutSolver {
     {
       const auto& x = store_.get<Position<2>>();
       auto& xb = store_.get<ListPosition>();
-      const auto u =
-          nb_.update(x, p_.skin > 0.0 ? std::span<Vec2>(xb) : std::span<Vec2>(), -1.0, reorder && store_.size() > 1);
+      const auto u = nb_.update(x, p_.skin > 0.0 ? std::span<Vec2>(xb) : std::span<Vec2>());
       if (u.reordered()) store_.reorder(u.permutation);
     }
     const std::span<const Vec2> x = store_.get<Position<2>>();
@@ -314,7 +315,7 @@ class RunoutSolver {
     const bool periodic = periodic_.any();
     const auto pass = [&](auto periodic_tag) {
       constexpr bool kPeriodic = decltype(periodic_tag)::value;
-#pragma omp parallel for schedule(static) if (static_cast <std::int64_t>(n) >= kParallelMin)
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
       for (std::int64_t bb = 0; bb < nblocks; ++bb) {
         const auto b = static_cast<std::size_t>(bb);
         PairSums* mine = blocks.buffer(reactions_.data(), b);  // mine[s]: the reactions to slot s
@@ -456,7 +457,7 @@ class RunoutSolver {
       // periodic test of the pair height is hoisted out of the pair loop (two instantiations).
       const auto one_pass = [&](auto periodic_tag) {
         constexpr bool kPeriodic = decltype(periodic_tag)::value;
-#pragma omp parallel for reduction(max : signal) schedule(static) if (n >= kParallelMin)
+#pragma omp parallel for reduction(max : signal) schedule(static) if (parallel_worth(n))
         for (std::int64_t ii = 0; ii < n; ++ii) {
           const auto i = static_cast<std::size_t>(ii);
           double depth = vol[i] * (2.0 / 3.0);
@@ -507,7 +508,7 @@ class RunoutSolver {
       return signal;
     }
     // Pass 1: depths and mean velocities.
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
       double depth = vol[i] * w0;
@@ -524,7 +525,7 @@ class RunoutSolver {
       vmean[i] = tangent_mean_i(i, vsum / depth, vzsum / depth);
     }
     // Pass 2: head pressure and velocity smoothing (needs every depth).
-#pragma omp parallel for reduction(max : signal) schedule(static) if (n >= kParallelMin)
+#pragma omp parallel for reduction(max : signal) schedule(static) if (parallel_worth(n))
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
       Vec2 acc = Vec2::Zero(), corr = Vec2::Zero();
@@ -549,12 +550,13 @@ class RunoutSolver {
   }
 
   /// The neighbour object's settings: cut-off 2·d0 (the support), skin numerics.skin·d0 (list
-  /// cut-off (2 + skin)·d0), reordering on request (every reorder_interval steps, step()).
+  /// cut-off (2 + skin)·d0), the store sorted by cell at every reorder_every-th rebuild.
   void configure_neighbours() {
     NeighbourSettings<2> s;
     s.cutoff = HeadPressureForce::support * p_.d0;
     s.skin = p_.skin * p_.d0;
     s.storage = p_.skin > 0.0 ? PairStorage::list : PairStorage::scan;
+    s.reorder_every = p_.reorder_every;
     s.periodic = periodic_;
     nb_.configure(s);
   }
@@ -614,7 +616,7 @@ class RunoutSolver {
     int any_leaving = 0, any_non_finite = 0, any_entraining = 0, any_wall = 0;
 #pragma omp parallel for reduction(max                                                      \
                                    : any_leaving, any_non_finite, any_entraining, any_wall) \
-    schedule(static) if (n >= kParallelMin)
+    schedule(static) if (parallel_worth(n))
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
       const std::size_t cell = cells ? proc_.cell(x[i]) : SpatialProcesses::npos;

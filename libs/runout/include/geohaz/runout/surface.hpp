@@ -18,6 +18,7 @@
 #include <limits>
 #include <vector>
 
+#include "geohaz/core/parallel.hpp"
 #include "geohaz/core/terrain.hpp"
 #include "geohaz/core/vec.hpp"
 
@@ -114,7 +115,7 @@ class GridSurface {
     k_ = curvature_cells_for(scale);
     hess_.assign(3 * g.cells(), 0.0f);
     const auto z = [&](int c, int r) { return values[g.index(c, r)]; };
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (parallel_worth(g.cells()))
     for (int r = 0; r < g.ny; ++r)
       for (int c = 0; c < g.nx; ++c) {
         const int k = std::min({k_, c, g.nx - 1 - c, r, g.ny - 1 - r});

@@ -4,8 +4,8 @@
 /// the three source documents (docs/references.md). One step (step_impl in solver.cpp: one function per item, in this
 /// order):
 ///   0. update_neighbours: neighbour list (rebuilt every step, or with a Verlet skin only when a
-///      particle has moved more than half the skin; store reordered by cell every `reorder_every`
-///      steps at a rebuild);
+///      particle has moved more than half the skin; store reordered by cell at every
+///      `reorder_every`-th rebuild);
 ///   1. prepare_boundary_pairs: particle volumes V = m/ρ; boundary particles act in each pair with a
 ///      soil particle i as its mirror image (Bui et al. 2008): full fixity v_B = 2v_wall − v_i, roller
 ///      v_i with the normal component mirrored; stress σ_B = σ_i − ρ_i d [ḡ_n I + ḡ_t ⊗ ν + ν ⊗ ḡ_t]
@@ -82,9 +82,9 @@ struct NumericalSettings {
   double xsph = 0.0;                  ///< ε of the XSPH correction (SWJTU lecture 2010), 0 = off
   double damping = 0.0;               ///< Cundall ζ in the main phase
   double stress_free_fraction = 0.0;  ///< stress vanishes where Σ m W < fraction·ρ0 (0 = off)
-  int reorder_every = 20;             ///< steps between cell reorderings of the store
+  int reorder_every = 20;             ///< sort the store by cell at every this-many-th list rebuild (0: never)
   /// Verlet skin in units of h: the list is built with cutoff 2h + skin·h and rebuilt when a particle
-  /// has moved more than skin·h/2 (or at a reordering). 0 rebuilds the list every step.
+  /// has moved more than skin·h/2. 0 rebuilds the list every step.
   double neighbour_skin = 0.3;
   /// Soil particles closer than this many Δx to a boundary particle are pushed back with
   /// a = c_p² ((r0/r)⁴ − (r0/r)²) x/r² (Monaghan 1994 form); 0 switches it off.
@@ -118,10 +118,10 @@ struct GeostaticReport {
 /// decides the next step (PositionAtBuild included, for the neighbour list) lets a restarted run
 /// continue bit for bit like the uninterrupted one (run.cpp writes it with every snapshot).
 struct SolverState {
-  double time = 0.0;              ///< s
-  std::int64_t step = 0;          ///< steps so far (geostatic phase included)
-  double dt = 0.0;                ///< Δt of the next step (from the last step's speeds and accelerations), s
-  std::int64_t last_reorder = 0;  ///< step of the last cell reordering of the store
+  double time = 0.0;                  ///< s
+  std::int64_t step = 0;              ///< steps so far (geostatic phase included)
+  double dt = 0.0;                    ///< Δt of the next step (from the last step's speeds and accelerations), s
+  std::int64_t neighbour_builds = 0;  ///< neighbour-list builds so far (the reordering schedule counts them)
 };
 
 /// The load the soil exerts on one structure (a wall, a pile) in the last step: the sum over the
@@ -171,7 +171,7 @@ class SphSolver {
   /// Set the simulated time (a restart from a snapshot without the solver state).
   void set_time(double t) noexcept { time_ = t; }
   /// The state to store beside the particle fields for an exact restart.
-  SolverState state() const noexcept { return {time_, step_, dt_, last_reorder_}; }
+  SolverState state() const noexcept { return {time_, step_, dt_, nb_.builds()}; }
   /// Continue from a restored store (all fields of the snapshot, PositionAtBuild included) and the
   /// state written with it: the neighbour list is rebuilt from the positions of its last build, in
   /// the store's order, so that the Verlet-skin decisions and the order of every pair sum are those
@@ -212,7 +212,8 @@ class SphSolver {
   // One step (solver.cpp), the numbered passes of the file comment:
   template <class Kernel, class Model>
   void step_impl(const Model& model);
-  void update_neighbours(double cutoff);              // 0
+  void update_neighbours(double cutoff);  // 0
+  void configure_neighbours(double cutoff);
   void choose_pair_blocks();                          //   block size of the pair reactions (PairBlocks)
   Vec<Dim> body_acceleration() const;                 //   ḡ = g + a_earthquake
   void prepare_boundary_pairs(const Vec<Dim>& gbar);  // 1
@@ -287,7 +288,6 @@ class SphSolver {
   // Scratch of the kernel-gradient correction (steps 2 and 4, `kernel_correction` only): C_i of
   // every particle (identity for boundary particles; empty when the correction is off).
   std::vector<Mat<Dim>> correction_;
-  std::int64_t last_reorder_ = -1000000;
   StepStats stats_;
 };
 
