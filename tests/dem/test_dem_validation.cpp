@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <vector>
@@ -349,6 +350,40 @@ TEST_P(SingleBlockOutlineResolution, TravelAngleOfSeveralPackings) {
 INSTANTIATE_TEST_SUITE_P(DemValidation, SingleBlockOutlineResolution,
                          ::testing::Values(BlockResolutionCase{0.4, 1, 10}, BlockResolutionCase{0.2, 1, 10},
                                            BlockResolutionCase{0.1, 1, 3}, BlockResolutionCase{0.1, 4, 6}));
+
+TEST(DemValidation, SingleBlockOutlineResolutionFigure) {
+  // Collects the JSON files of SingleBlockOutlineResolution (run those first; skipped when none
+  // exist) into docs/figures/dem/single_block_resolution.png: x the mean disc radius R from 0 to
+  // 0.45 m (grid 0.05), y the travel angle from 0 to 45° (grid 5°); blue dots one packing each,
+  // black the mean over packings, grey the 28° and 35° of rockfall practice (Evans & Hungr 1993),
+  // red the 38° and 41° of the rigid-square hand estimate (docs/validation/dem.md).
+  geohaz::testing::Curve runs{{}, {}, {0, 90, 200}, true}, means{{}, {}, {0, 0, 0}, false},
+      lo{{0, 0.45}, {28, 28}, {150, 150, 150}, false}, hi{{0, 0.45}, {35, 35}, {150, 150, 150}, false},
+      sq_lo{{0, 0.45}, {38, 38}, {200, 0, 0}, false}, sq_hi{{0, 0.45}, {41, 41}, {200, 0, 0}, false};
+  std::map<double, std::vector<double>> by_radius;
+  for (const auto& f : fs::directory_iterator(out_dir())) {
+    const std::string name = f.path().filename().string();
+    if (name.rfind("single_block_resolution_R", 0) != 0 || f.path().extension() != ".json") continue;
+    for (const auto& r : nlohmann::json::parse(std::ifstream(f.path())))
+      by_radius[r["radius"].get<double>()].push_back(r["fahrboeschung_deg"].get<double>());
+  }
+  if (by_radius.empty()) GTEST_SKIP() << "run SingleBlockOutlineResolution first";
+  for (const auto& [R, angles] : by_radius) {
+    double mean = 0;
+    for (const double a : angles) {
+      runs.x.push_back(R);
+      runs.y.push_back(a);
+      mean += a / static_cast<double>(angles.size());
+    }
+    means.x.push_back(R);
+    means.y.push_back(mean);
+    std::printf("R = %.3f m: %zu packings, mean travel angle %.1f deg\n", R, angles.size(), mean);
+    EXPECT_GT(mean, 5.0);
+    EXPECT_LT(mean, 60.0);
+  }
+  geohaz::testing::plot(fs::path(GEOHAZ_SOURCE_DIR) / "docs/figures/dem/single_block_resolution.png",
+                        {lo, hi, sq_lo, sq_hi, means, runs}, 0.0, 0.45, 0.0, 45.0, 0.05, 5.0);
+}
 
 TEST(DemValidation, SingleBlockTravelAngleWithFragmentShapeTerrainRolling) {
   // Sensitivity, not a fit: the disc–terrain rolling resistance set to that of an angular
