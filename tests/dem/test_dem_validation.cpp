@@ -7,8 +7,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <vector>
 
 #include "bonded_lab_spec.hpp"
 #include "column_collapse.hpp"
@@ -185,6 +187,10 @@ AvalancheSpec example_avalanche() {
   a.record_interval = 0.25;
   a.terrain_friction = 0.5;
   a.terrain_restitution = 0.3;
+  // Rolling friction coefficient tan β of a rock rolling on landslide debris, STONE (Guzzetti et
+  // al. 2002; lithological table of Alvioli et al. 2021): docs/dem.md, "Rolling resistance of rock on
+  // terrain".
+  a.terrain_rolling_friction = 0.65;
   return a;
 }
 
@@ -207,6 +213,7 @@ AvalancheSpec single_block(std::uint64_t seed, double mu_r) {
   a.packing.r_min = 0.3;
   a.packing.r_max = 0.5;
   a.material.contact.rolling_friction = mu_r;
+  a.terrain_rolling_friction = mu_r;  // the block studies vary disc and terrain μ_r together (their tables)
   a.material.joint_sets.clear();
   a.material.bond.tensile_strength = a.material.bond.shear_strength = 200e6;
   a.material.bond.tensile_strength_std = a.material.bond.shear_strength_std = 0;
@@ -268,6 +275,116 @@ TEST(DemValidation, SingleBlockTravelAngle) {
   std::ofstream(out_dir() / "single_block.json") << j.dump(2) << "\n";
 }
 
+/// Outline resolution study of the single block (docs/validation/dem.md): the same 4 m × 4 m
+/// block, slope, laws and coefficients as SingleBlockTravelAngle at μ_r = 0.1, built of discs of
+/// mean radius R (radii R ± 25 %, so R = 0.4 is the 0.3–0.5 m of the original), several packings
+/// (seeds) each. A travel angle that means something must converge as R → 0 (the outline tends to
+/// the square). Each (R, seeds) case is its own test so they can run in separate processes; each
+/// writes single_block_resolution_R<R>_seeds<a>-<b>.json.
+struct BlockResolutionCase {
+  double radius;
+  int first_seed, last_seed;
+};
+
+class SingleBlockOutlineResolution : public ::testing::TestWithParam<BlockResolutionCase> {};
+
+TEST_P(SingleBlockOutlineResolution, TravelAngleOfSeveralPackings) {
+  const double R = GetParam().radius;
+  nlohmann::json j = nlohmann::json::array();
+  std::vector<double> angles;
+  for (int seed = GetParam().first_seed; seed <= GetParam().last_seed; ++seed) {
+    AvalancheSpec a = single_block(static_cast<std::uint64_t>(seed), 0.1);
+    a.packing.r_min = 0.75 * R;
+    a.packing.r_max = 1.25 * R;
+    DemSolver s;
+    const auto r = run_avalanche(a, s);
+    const RunoutQuantile& far = r.quantiles.back();
+    const double angle = std::atan(far.h_over_l) * 180 / std::numbers::pi;
+    const double angle_com = std::atan(r.com_h_over_l) * 180 / std::numbers::pi;
+    // How the block moved: its rotation since release in turns (mean over its discs, which turn
+    // with the block while it stays whole; + is counter-clockwise, so a block rolling downhill in
+    // +x turns negatively). A block that slides turns little; one that rolls turns ≈ L/(2π r).
+    double turns = 0;
+    for (const double phi : s.discs.get<Rotation>()) turns += phi;
+    turns /= 2 * std::numbers::pi * static_cast<double>(s.discs.size());
+    std::printf(
+        "single block, R = %.3f m, seed %d: %zu discs, %zu fragments (largest %zu), at rest %d after %.1f s; "
+        "farthest point L = %.1f m, Fahrboeschung %.2f deg; centre of mass %.2f deg; %.1f turns\n",
+        R, seed, r.discs, r.fragment_sizes.size(), r.fragment_sizes.front(), r.at_rest, r.duration, far.runout, angle,
+        angle_com, turns);
+    std::fflush(stdout);
+    j.push_back({{"radius", R},
+                 {"seed", seed},
+                 {"discs", r.discs},
+                 {"fragments", r.fragment_sizes.size()},
+                 {"largest_fragment", r.fragment_sizes.front()},
+                 {"at_rest", r.at_rest},
+                 {"duration_s", r.duration},
+                 {"L_farthest", far.runout},
+                 {"fahrboeschung_deg", angle},
+                 {"com_travel_angle_deg", angle_com},
+                 {"turns", turns}});
+    char name[96];
+    std::snprintf(name, sizeof name, "single_block_R%.3f_seed%d.png", R, seed);
+    write_avalanche_png(out_dir() / name, s, a.terrain, a.source);
+    angles.push_back(angle);
+    EXPECT_TRUE(r.at_rest);
+    EXPECT_GT(angle, 5.0);
+    EXPECT_LT(angle, 60.0);
+    // The study is of a block: bonds 200 MPa keep it whole (at most one loose disc in ten).
+    EXPECT_GE(10 * r.fragment_sizes.front(), 9 * r.discs) << "seed " << seed;
+  }
+  double mean = 0, var = 0;
+  for (const double x : angles) mean += x / static_cast<double>(angles.size());
+  for (const double x : angles) var += (x - mean) * (x - mean) / static_cast<double>(angles.size() - 1);
+  std::printf("single block, R = %.3f m: %zu packings, Fahrboeschung mean %.1f deg, standard deviation %.1f deg\n", R,
+              angles.size(), mean, std::sqrt(var));
+  char name[96];
+  std::snprintf(name, sizeof name, "single_block_resolution_R%.3f_seeds%d-%d.json", R, GetParam().first_seed,
+                GetParam().last_seed);
+  std::ofstream(out_dir() / name) << j.dump(2) << "\n";
+}
+
+// R = 0.1 is split in two so that its two halves can run side by side (≈ 5 min per packing on one
+// busy core); R = 0.05 (≈ 40 min per packing) was not run.
+INSTANTIATE_TEST_SUITE_P(DemValidation, SingleBlockOutlineResolution,
+                         ::testing::Values(BlockResolutionCase{0.4, 1, 10}, BlockResolutionCase{0.2, 1, 10},
+                                           BlockResolutionCase{0.1, 1, 3}, BlockResolutionCase{0.1, 4, 6}));
+
+TEST(DemValidation, SingleBlockOutlineResolutionFigure) {
+  // Collects the JSON files of SingleBlockOutlineResolution (run those first; skipped when none
+  // exist) into docs/figures/dem/single_block_resolution.png: x the mean disc radius R from 0 to
+  // 0.45 m (grid 0.05), y the travel angle from 0 to 45° (grid 5°); blue dots one packing each,
+  // black the mean over packings, grey the 28° and 35° of rockfall practice (Evans & Hungr 1993),
+  // red the 38° and 41° of the rigid-square hand estimate (docs/validation/dem.md).
+  geohaz::testing::Curve runs{{}, {}, {0, 90, 200}, true}, means{{}, {}, {0, 0, 0}, false},
+      lo{{0, 0.45}, {28, 28}, {150, 150, 150}, false}, hi{{0, 0.45}, {35, 35}, {150, 150, 150}, false},
+      sq_lo{{0, 0.45}, {38, 38}, {200, 0, 0}, false}, sq_hi{{0, 0.45}, {41, 41}, {200, 0, 0}, false};
+  std::map<double, std::vector<double>> by_radius;
+  for (const auto& f : fs::directory_iterator(out_dir())) {
+    const std::string name = f.path().filename().string();
+    if (name.rfind("single_block_resolution_R", 0) != 0 || f.path().extension() != ".json") continue;
+    for (const auto& r : nlohmann::json::parse(std::ifstream(f.path())))
+      by_radius[r["radius"].get<double>()].push_back(r["fahrboeschung_deg"].get<double>());
+  }
+  if (by_radius.empty()) GTEST_SKIP() << "run SingleBlockOutlineResolution first";
+  for (const auto& [R, angles] : by_radius) {
+    double mean = 0;
+    for (const double a : angles) {
+      runs.x.push_back(R);
+      runs.y.push_back(a);
+      mean += a / static_cast<double>(angles.size());
+    }
+    means.x.push_back(R);
+    means.y.push_back(mean);
+    std::printf("R = %.3f m: %zu packings, mean travel angle %.1f deg\n", R, angles.size(), mean);
+    EXPECT_GT(mean, 5.0);
+    EXPECT_LT(mean, 60.0);
+  }
+  geohaz::testing::plot(fs::path(GEOHAZ_SOURCE_DIR) / "docs/figures/dem/single_block_resolution.png",
+                        {lo, hi, sq_lo, sq_hi, means, runs}, 0.0, 0.45, 0.0, 45.0, 0.05, 5.0);
+}
+
 TEST(DemValidation, SingleBlockTravelAngleWithFragmentShapeTerrainRolling) {
   // Sensitivity, not a fit: the disc–terrain rolling resistance set to that of an angular
   // fragment of n faces, the discs among themselves keep the example's μ_r = 0.1. A disc with
@@ -314,7 +431,7 @@ TEST(DemValidation, AvalancheHoverLVersusVolume) {
   // Run to rest. Reported against Scheidegger (1973); asserted only to be physical.
   nlohmann::json j = nlohmann::json::array();
   geohaz::testing::Curve dem99{{}, {}, {0, 90, 200}, true}, dem50{{}, {}, {0, 170, 0}, true},
-      line{{}, {}, {0, 0, 0}, false};
+      line{{}, {}, {0, 0, 0}, false}, com{{}, {}, {230, 120, 0}, true};
   for (double lv = 3.0; lv <= 5.6 + 1e-9; lv += 0.05) {
     line.x.push_back(lv);
     line.y.push_back(scheidegger_h_over_l(std::pow(10.0, lv)));
@@ -329,7 +446,7 @@ TEST(DemValidation, AvalancheHoverLVersusVolume) {
     a.support = {o + Vec2(Lx + 0.5, -Lx * t - 10), o + Vec2(Lx + 0.5, -Lx * t + h + 10)};
     DemSolver s;
     const auto r = run_avalanche(a, s);
-    const double q50 = r.quantiles[0].h_over_l;
+    const double q50 = r.quantiles[0].h_over_l, q90 = r.quantiles[1].h_over_l;
     j.push_back({{"scale", sc},
                  {"discs", r.discs},
                  {"area", r.area},
@@ -347,15 +464,19 @@ TEST(DemValidation, AvalancheHoverLVersusVolume) {
                  {"breaks_before_release", r.events_before_release},
                  {"breaks", r.events.size()}});
     std::printf(
-        "avalanche scale %.1f: %zu discs, V = %.3g m3, H/L = %.3f at 99 %% of the mass, %.3f at 50 %%, %.3f "
-        "farthest, centre of mass %.3f (Scheidegger %.3f); %zu fragments (largest %zu), at rest %d after "
-        "%.1f s\n",
-        sc, r.discs, r.volume, r.h_over_l, q50, r.quantiles.back().h_over_l, r.com_h_over_l, r.scheidegger_h_over_l,
-        r.fragment_sizes.size(), r.fragment_sizes.front(), r.at_rest, r.duration);
+        "avalanche scale %.1f: %zu discs, V = %.3g m3, H/L = %.3f at 99 %% of the mass, %.3f at 90 %%, %.3f at 50 "
+        "%%, %.3f farthest, centre of mass %.3f (Scheidegger %.3f); L99 = %.0f m, Lfar = %.0f m; %zu fragments "
+        "(largest %zu), at rest %d after %.1f s\n",
+        sc, r.discs, r.volume, r.h_over_l, q90, q50, r.quantiles.back().h_over_l, r.com_h_over_l,
+        r.scheidegger_h_over_l, r.runout, r.quantiles.back().runout, r.fragment_sizes.size(), r.fragment_sizes.front(),
+        r.at_rest, r.duration);
+    std::fflush(stdout);
     dem99.x.push_back(std::log10(r.volume));
     dem99.y.push_back(r.h_over_l);
     dem50.x.push_back(std::log10(r.volume));
     dem50.y.push_back(q50);
+    com.x.push_back(std::log10(r.volume));
+    com.y.push_back(r.com_h_over_l);
     if (sc == 1.0) write_avalanche_png(out_dir() / "avalanche_deposit.png", s, a.terrain, a.source);
     EXPECT_TRUE(r.at_rest);
     EXPECT_GT(r.h_over_l, 0.05);
@@ -363,7 +484,7 @@ TEST(DemValidation, AvalancheHoverLVersusVolume) {
   }
   std::ofstream(out_dir() / "avalanche_h_over_l.json") << j.dump(2) << "\n";
   // x: log10 V from 3 to 5.6 (grid 0.5... ticks every 0.2); y: H/L from 0 to 1.4 (grid 0.2);
-  // black Scheidegger (1973), blue the DEM at 99 % of the mass, green at 50 %.
+  // black Scheidegger (1973), blue the DEM at 99 % of the mass, green at 50 %, orange the centre of mass.
   geohaz::testing::plot(fs::path(GEOHAZ_SOURCE_DIR) / "docs/figures/dem/avalanche_h_over_l_vs_volume.png",
-                        {line, dem99, dem50}, 3.0, 5.6, 0.0, 1.4, 0.2, 0.2);
+                        {line, dem99, dem50, com}, 3.0, 5.6, 0.0, 1.4, 0.2, 0.2);
 }
