@@ -422,6 +422,27 @@ TEST(SphSlopeApp, StrengthReductionBracketsTheAcadsFactor) {
   EXPECT_NEAR(s["bishop"]["exit_x_m"].get<double>(), 45.0, 2.0);
 }
 
+// Strength reduction on a layered slope: the two-layer undrained clay slope of Griffiths & Lane (1999)
+// on a weak foundation (data/sph/griffiths_lane_two_layer_srm.toml, c_u2 = 0.6 c_u1) at 1 m spacing,
+// bracket [0.85, 1.1], ΔF = 0.04 (5 trials): a bracketed factor within 5 % of Bishop's on the same
+// section (0.989; the validation test runs 0.5 m and the full bracket), whose critical circle goes
+// down to the rigid base through the weak foundation. About 7 s.
+TEST(SphSlopeApp, StrengthReductionOnTwoLayerSlopeAgreesWithBishop) {
+  const fs::path out = kWork / "srm_two_layer";
+  fs::remove_all(out);
+  const auto r = run("--config " + (kData / "griffiths_lane_two_layer_srm.toml").string() + " --out " + out.string() +
+                         " --set strength_reduction.f_min=0.85 --set strength_reduction.f_max=1.1"
+                         " --set strength_reduction.tolerance=0.04 --quiet",
+                     "srm_two_layer");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto s = summary(out);
+  EXPECT_EQ(s["outcome"], "bracketed");
+  const double F = s["factor_of_safety"].get<double>(), Fb = s["bishop"]["factor"].get<double>();
+  EXPECT_NEAR(Fb, 0.989, 0.005);  // limit_equilibrium unit tests: the deep circle of the layered section
+  EXPECT_NEAR(F, Fb, 0.05 * Fb);
+  EXPECT_LT(s["bishop"]["centre_z_m"].get<double>() - s["bishop"]["radius_m"].get<double>(), 1.0);
+}
+
 TEST(SphSlopeApp, StrengthReductionBadRangeExitsTwoNamingTheKey) {
   const fs::path out = kWork / "srm_bad";
   fs::remove_all(out);

@@ -112,6 +112,76 @@ TEST(Bishop, LayersWithEqualSoilsAreOneSoil) {
   EXPECT_LT(bishop_factor(s, c).factor, F);
 }
 
+// Two-layer undrained clay slope of Griffiths & Lane (1999), their slope on a weak foundation
+// (data/sph/griffiths_lane_two_layer_srm.toml): 2H:1V, H = 10 m, on a foundation H deep (D = 2) over a
+// rigid base, φ_u = 0, γ = 20 kN/m³; slope soil (above the toe level z = 10 m) c_u1 = 0.25 γH = 50 kPa,
+// foundation c_u2 = λ c_u1. Materials: 0 foundation, 1 slope soil. Crest and front 20 m.
+SlopeSection griffiths_lane_section(double lambda, double base = 10.0) {
+  SlopeGeometry g;
+  g.height = 10.0;
+  g.gradient = 2.0;
+  g.base_thickness = base;
+  g.crest_length = 20.0;
+  g.front_length = 20.0;
+  auto s = SlopeSection::from_profile(g.profile(), {{20e3, lambda * 50e3, 0.0}, {20e3, 50e3, 0.0}});
+  s.layer_tops = {base};
+  s.layer_materials = {0, 1};
+  return s;
+}
+
+// λ = 1 is the homogeneous slope with a firm base at D = 2: Taylor's (1937) chart gives N = 0.17 at
+// β = 26.57°, F = 0.25/0.17 = 1.47, the value Griffiths & Lane quote for it. Chart reading ±2 %; the
+// issue's 3 %.
+TEST(Bishop, TwoLayerClaySlopeWithEqualLayersMatchesTaylorChart) {
+  const auto r = bishop_critical_circle(griffiths_lane_section(1.0));
+  ASSERT_TRUE(r.admissible());
+  EXPECT_NEAR(r.factor, 1.47, 0.03 * 1.47);
+  // Taylor's base circle for β < 53°: the circle touches the firm base.
+  EXPECT_NEAR(r.circle.zc - r.circle.radius, 0.0, 0.5);
+}
+
+// The slice base takes the strength of the layer it lies in: for φ = 0 and one circle,
+// F = R (c_u1 ℓ₁ + c_u2 ℓ₂) / Σ W (x_c − x), so F(λ)/F(1) = (ℓ₁ + λ ℓ₂)/(ℓ₁ + ℓ₂) with ℓ₂ the arc below
+// the layer top, 2R acos((z_c − z_top)/R), and ℓ₁ the rest of the arc in soil (angles from the entry
+// and exit points). Tolerance: the slices (200) cut the arc at the layer top to within one slice.
+TEST(Bishop, UndrainedFactorWeighsTheArcInEachLayer) {
+  const SlipCircle circ{30.0, 28.0, 27.5};  // a deep circle: enters the crest, dips 7.5 m into the foundation
+  const auto one = bishop_factor(griffiths_lane_section(1.0), circ);
+  ASSERT_TRUE(one.admissible());
+  const double a0 = std::asin((circ.xc - one.x_entry) / circ.radius);
+  const double a1 = std::asin((one.x_exit - circ.xc) / circ.radius);
+  const double arc = circ.radius * (a0 + a1);
+  const double below = 2.0 * circ.radius * std::acos((circ.zc - 10.0) / circ.radius);
+  // The level ground in front of the toe is the layer top: the circle leaves the soil where it crosses it.
+  EXPECT_NEAR(circ.xc + circ.radius * std::sin(std::acos((circ.zc - 10.0) / circ.radius)), one.x_exit, 0.05);
+  for (double lambda : {0.4, 0.6, 1.4, 3.0}) {
+    const auto r = bishop_factor(griffiths_lane_section(lambda), circ);
+    EXPECT_NEAR(r.factor / one.factor, (arc - below + lambda * below) / arc, 5e-3) << lambda;
+  }
+}
+
+// Griffiths & Lane (1999; code_aster's reproduction of their example, SSNP507, states it): with a weak
+// foundation the critical circle goes deep into it and F grows with λ; from λ ≈ 1.5 on the circle
+// stays in the slope layer (a circle tangent to the foundation, leaving through the face just above the
+// toe) and F no longer depends on the foundation. That circle is the critical circle of the slope
+// layer on a rigid base at the toe level (Taylor's D = 1).
+TEST(Bishop, StrongFoundationLeavesTheToeCircleInTheSlopeLayer) {
+  const auto weak = bishop_critical_circle(griffiths_lane_section(0.6));
+  const auto below_switch = bishop_critical_circle(griffiths_lane_section(1.4));
+  const auto strong = bishop_critical_circle(griffiths_lane_section(2.0));
+  const auto stronger = bishop_critical_circle(griffiths_lane_section(3.0));
+  const auto rigid = bishop_critical_circle(griffiths_lane_section(1.0, 0.0));  // D = 1: no foundation
+  // Deep circles, tangent to the rigid base, below the switch.
+  EXPECT_LT(weak.circle.zc - weak.circle.radius, 1.0);
+  EXPECT_LT(below_switch.circle.zc - below_switch.circle.radius, 1.0);
+  EXPECT_LT(weak.factor, below_switch.factor);
+  // Above it: the toe circle of the slope layer, the same for every stronger foundation.
+  EXPECT_NEAR(strong.circle.zc - strong.circle.radius, 10.0, 0.05);
+  EXPECT_NEAR(strong.factor, stronger.factor, 1e-3 * strong.factor);
+  EXPECT_NEAR(strong.factor, rigid.factor, 3e-3 * rigid.factor);
+  EXPECT_GT(strong.factor, below_switch.factor);
+}
+
 TEST(Bishop, CircleBelowTheRigidBottomIsNotAdmissible) {
   const auto s = slope(10.0, 2.0, 5.0, 25.0, 20.0, {20e3, 3e3, 19.6 * kDeg});
   EXPECT_FALSE(bishop_factor(s, {38.0, 24.0, 30.0}).admissible());
