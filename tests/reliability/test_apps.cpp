@@ -187,6 +187,11 @@ TEST_F(Reliability, ValuesThatWouldRunForHoursAreBadInput) {
       // Fuzz case 126 (after the data of 2026-12-02 05:00): a runout depth resolution of 0.25 mm,
       // 8.5 million particles on the Alplehner release.
       {runout_valley(dir_ / "o") + std::vector<std::string>{"--set", "model.h0=2.5e-4"}, "model.h0"},
+      // Fuzz case 119 (after the data of 2026-12-02 07:30): a 50 m base under a 0.25 m slope at 1 cm
+      // spacing, 640,000 particles (21 s for the fuzz's short run, minutes under the sanitizers).
+      {{SPH_SLOPE_EXE, "--config", (kData / "sph/slope_2d_granular.toml").string(), "--set", "slope.base_thickness=50",
+        "--out", (dir_ / "o").string(), "--quiet"},
+       "slope.base_thickness"},
   };
   for (const auto& [argv, key] : cases) {
     ChildLimits lim;
