@@ -218,7 +218,7 @@ class SphSolver {
   void prepare_boundary_pairs(const Vec<Dim>& gbar);  // 1
   template <class Kernel>
   void gradient_correction();  // 2 (kernel_correction only)
-  template <class Kernel>
+  template <class Kernel, bool Corrected>
   void velocity_gradient();  // 2
   template <class Model>
   void update_stress(const Model& model);  // 3
@@ -272,21 +272,29 @@ class SphSolver {
   // block_reach_ slots per block (2n–4n).
   std::vector<Vec<Dim>> pair_acc_;
   // Scratch of the velocity-gradient pass: reactions of the soil–soil pairs, as pair_acc_.
-  struct GradientReaction {
-    Mat<Dim> L;   // Σ V_i (v_i − v_j) ⊗ ∇W_ji
+  // With the kernel-gradient correction L holds Σ V_i (v_i − v_j) ⊗ b_ji, b the Dim + Dim(Dim+1)/2
+  // components of the quadratic-complete basis (solver.cpp, step 2); without it Σ V_i (v_i − v_j) ⊗ ∇W_ji.
+  static constexpr int kBasis = Dim + Dim * (Dim + 1) / 2;
+  template <int Cols>
+  struct GradientReactionT {
+    Eigen::Matrix<double, Dim, Cols> L;
     Vec<Dim> xs;  // XSPH sum
     double drho;  // continuity
     double rsum;  // summation density
   };
+  using GradientReaction = GradientReactionT<Dim>;
+  using CorrectedGradientReaction = GradientReactionT<kBasis>;
   std::vector<GradientReaction> pair_grad_;
+  std::vector<CorrectedGradientReaction> pair_grad_corrected_;
   // Tracked structures (pass 4b): base points, the loads of the last step, and the per-block sums
   // (structure count per PairBlocks block, added in block order: the same on any thread count).
   std::vector<Vec<Dim>> structure_base_;
   std::vector<StructureLoad<Dim>> structure_loads_;
   std::vector<StructureLoad<Dim>> structure_block_loads_;
-  // Scratch of the kernel-gradient correction (steps 2 and 4, `kernel_correction` only): C_i of
-  // every particle (identity for boundary particles; empty when the correction is off).
-  std::vector<Mat<Dim>> correction_;
+  // Scratch of the kernel-gradient correction (steps 2 and 4, `kernel_correction` only): A_i of
+  // every particle, the first Dim rows of B_i⁻¹ (solver.cpp, step 2), so that the corrected
+  // gradient vector is g_ij = A_i b_ij ([I 0] for boundary particles; empty when the correction is off).
+  std::vector<Eigen::Matrix<double, Dim, kBasis>> correction_;
   std::int64_t last_reorder_ = -1000000;
   StepStats stats_;
 };
