@@ -424,8 +424,9 @@ void SphSolver<Dim>::gather_reactions(const std::vector<T>& buffer, Add&& add, F
 //    geometric mean of M_i's eigenvalues below 0.2) the particle keeps the plain gradient
 //    (A_i = [I 0]): a particle with few neighbours or all of them near one line (a detached grain, a
 //    thin tongue after failure) has a near-singular M_i whose inverse would amplify noise into the
-//    stress. Where B_i is ill-conditioned (reciprocal condition estimate < 1e-4, e.g. neighbours
-//    on two lines only) it keeps the linear correction (A_i = [M_i⁻¹ 0]). The surfaces, edges and
+//    stress. Where B_i is ill-conditioned (B_i = Σ_j V_j F_ij p_ij ⊗ p_ij is symmetric positive
+//    semi-definite: its Cholesky factor fails, or (max/min of the factor's diagonal)² > 10⁴, e.g.
+//    neighbours on two lines only) it keeps the linear correction (A_i = [M_i⁻¹ 0]). The surfaces, edges and
 //    corners of an intact lattice are fully corrected: det M_i (cubic spline, h = 1.2–1.5Δx, lattice
 //    sums) is 0.95–1.03 inside, 0.37–0.39 on a face (2D) and 0.12–0.14 at a corner; in 3D 0.28–0.30
 //    on a face, 0.07–0.09 on an edge, 0.014–0.025 at a corner (threshold 0.008). Boundary particles
@@ -455,34 +456,67 @@ void SphSolver<Dim>::gradient_correction() {
     A[i].setZero();
     A[i].template leftCols<Dim>().setIdentity();
     if (kind[i] != kSoil) continue;
-    Moments B = Moments::Zero();
+    Moments B = Moments::Zero();  // upper triangle only until the factorisation
     for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
       const std::uint32_t j = idx[k];
       const Vec<Dim> xij = image(x[i], x[j]);
       const double r2 = xij.squaredNorm();
       if (r2 >= K.cutoff2 || r2 == 0.0) continue;
       const double r = std::sqrt(r2);
-      const double q = r * K.inv_h;
-      const double fq = K.sigma_h * Kernel::shape_derivative(q) / r;  // −F_ij
-      const Vec<Dim> gw = xij * fq;
-      const Basis b = kernel_basis<Dim, N>(gw, -fq, xij, K.inv_h);
-      Basis p;  // [r; h m(r/h)], r = x_j − x_i
+      const double F = -K.sigma_h * Kernel::shape_derivative(r * K.inv_h) / r;  // |∇_i W_ij|/r
+      Basis p;                                                                  // [r; h m(r/h)], r = x_j − x_i
       p.template head<Dim>() = -xij;
       int c = Dim;
       for (int a = 0; a < Dim; ++a)
         for (int d = a; d < Dim; ++d) p[c++] = xij[a] * xij[d] * K.inv_h;
-      B.noalias() += vol[j] * b * p.transpose();  // V_j b_ij ⊗ p_ij
+      const double wgt = vol[j] * F;
+      for (int a = 0; a < N; ++a)  // V_j b_ij ⊗ p_ij = V_j F_ij p_ij ⊗ p_ij (symmetric)
+        for (int d = a; d < N; ++d) B(a, d) += wgt * p[a] * p[d];
     }
-    const Mat<Dim> M = B.template topLeftCorner<Dim, Dim>();
+    Mat<Dim> M;
+    for (int a = 0; a < Dim; ++a)
+      for (int d = 0; d < Dim; ++d) M(a, d) = B(std::min(a, d), std::max(a, d));
     if (!(M.determinant() >= kMinMomentDet)) continue;
-    // Reciprocal condition number in the 1-norm, from the inverse itself (Eigen's estimate trips
-    // GCC 12's -Wmaybe-uninitialized).
-    const Moments Binv = B.partialPivLu().inverse();
-    const double norms = B.cwiseAbs().colwise().sum().maxCoeff() * Binv.cwiseAbs().colwise().sum().maxCoeff();
-    if (Binv.allFinite() && norms * kMinRcond <= 1.0)
-      A[i] = Binv.template topRows<Dim>();
-    else
+    // Cholesky B = L Lᵀ (B is symmetric positive semi-definite), in place in the lower triangle;
+    // (max L_kk / min L_kk)² estimates the condition number.
+    bool ok = true;
+    double dmin = std::numeric_limits<double>::infinity(), dmax = 0.0;
+    for (int c = 0; c < N && ok; ++c) {
+      double d = B(c, c);
+      for (int k = 0; k < c; ++k) d -= B(c, k) * B(c, k);
+      if (!(d > 0.0)) {
+        ok = false;
+        break;
+      }
+      d = std::sqrt(d);
+      B(c, c) = d;
+      dmin = std::min(dmin, d);
+      dmax = std::max(dmax, d);
+      for (int row = c + 1; row < N; ++row) {
+        double e = B(c, row);  // upper triangle holds the sums
+        for (int k = 0; k < c; ++k) e -= B(row, k) * B(c, k);
+        B(row, c) = e / d;
+      }
+    }
+    if (ok && dmax * dmax * kMinRcond <= dmin * dmin) {
+      // A_iᵀ = the first Dim columns of B⁻¹ (B symmetric): solve L Lᵀ X = [I; 0].
+      for (int col = 0; col < Dim; ++col) {
+        Basis y;
+        for (int row = 0; row < N; ++row) {
+          double e = row == col ? 1.0 : 0.0;
+          for (int k = 0; k < row; ++k) e -= B(row, k) * y[k];
+          y[row] = e / B(row, row);
+        }
+        for (int row = N - 1; row >= 0; --row) {
+          double e = y[row];
+          for (int k = row + 1; k < N; ++k) e -= B(k, row) * y[k];
+          y[row] = e / B(row, row);
+        }
+        A[i].row(col) = y.transpose();
+      }
+    } else {
       A[i].template leftCols<Dim>() = M.inverse();
+    }
   }
 }
 
