@@ -202,7 +202,8 @@ void read_numerics(ConfigReader& r, RunConfig& c) {
   {  // auto: the solver's default (off) except for linear_elastic, where it was validated (docs/sph.md)
     const auto kc = r.get_choice("numerics.kernel_correction", "auto", {"auto", "on", "off"},
                                  {"",
-                                  "first-order consistent kernel gradients (Bonet & Lok 1999) in the strain-rate "
+                                  "kernel gradients exact for linear and quadratic fields (Bonet & Lok 1999 to second "
+                                  "order; docs/sph.md) in the strain-rate "
                                   "and momentum sums: auto = on for model.constitutive = linear_elastic (elastic "
                                   "bending, docs/validation/sph.md), off for the other models"});
     n.kernel_correction =
