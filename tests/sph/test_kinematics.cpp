@@ -24,7 +24,8 @@ const auto* const kOneThread = ::testing::AddGlobalTestEnvironment(new OneThread
 
 template <int Dim>
 SphSolver<Dim> make_block(const Mat<Dim>& A, const Vec<Dim>& v0, KernelChoice kernel, double hf, bool corrected = false,
-                          double dt_max = 1e-9, const std::function<Vec<Dim>(const Vec<Dim>&)>& extra = {}) {
+                          double dt_max = 1e-9, const std::function<Vec<Dim>(const Vec<Dim>&)>& extra = {},
+                          bool quadratic = false) {
   ProfileDomain d;
   const double W = Dim == 2 ? 0.3 : 0.16;
   d.surface = {{0.0, W}, {W, W}};
@@ -53,6 +54,7 @@ SphSolver<Dim> make_block(const Mat<Dim>& A, const Vec<Dim>& v0, KernelChoice ke
   s.dt_max = dt_max;  // default: the field barely moves during the step
   s.artificial_stress = 0.0;
   s.kernel_correction = corrected;
+  s.quadratic_correction = quadratic;
   return SphSolver<Dim>(std::move(sc.store), {m}, LinearElastic{}, s);
 }
 
@@ -174,7 +176,7 @@ void check_corrected_quadratic_field(KernelChoice kernel, double hf) {
     }
     return L;
   };
-  auto solver = make_block<Dim>(A, Vec<Dim>::Constant(0.5), kernel, hf, true, 1e-9, quad);
+  auto solver = make_block<Dim>(A, Vec<Dim>::Constant(0.5), kernel, hf, true, 1e-9, quad, true);
   solver.step();
   const auto& S = solver.store();
   const auto& x = S.template get<Position<Dim>>();
@@ -207,7 +209,7 @@ TEST(KernelCorrection, BendingStressExactAtEveryRow) {
     const double y = x[1] - ybar;
     return Vec<2>(-kdot * x[0] * y, 0.5 * kdot * x[0] * x[0] + 0.5 * nu / (1.0 - nu) * kdot * y * y);
   };
-  auto solver = make_block<2>(Mat<2>::Zero(), Vec<2>::Zero(), KernelChoice::CubicSpline, 1.2, true, 1e-9, bend);
+  auto solver = make_block<2>(Mat<2>::Zero(), Vec<2>::Zero(), KernelChoice::CubicSpline, 1.2, true, 1e-9, bend, true);
   solver.step();
   const double dt = solver.time(), Ep = E / (1.0 - nu * nu);
   const auto& S = solver.store();
@@ -228,10 +230,10 @@ TEST(KernelCorrection, BendingStressExactAtEveryRow) {
 // walls, no gravity) set moving with a non-uniform velocity field develops stress at once; the pair
 // forces are equal and opposite, so Σ m v stays at its initial value to round-off over many steps
 // (1e-12 of Σ m|v|: ~50 steps of sums whose terms cancel pairwise).
-TEST(KernelCorrection, FreeBlockConservesLinearMomentum) {
+void check_free_block_momentum(bool quadratic) {
   Mat<2> A;
   A << 0.3, -0.7, 1.1, -0.2;
-  auto solver = make_block<2>(A, Vec<2>(0.5, -0.2), KernelChoice::CubicSpline, 1.2, true, 1e-5);
+  auto solver = make_block<2>(A, Vec<2>(0.5, -0.2), KernelChoice::CubicSpline, 1.2, true, 1e-5, {}, quadratic);
   auto momentum = [&] {
     const auto& S = solver.store();
     Vec<2> p = Vec<2>::Zero();
@@ -250,6 +252,12 @@ TEST(KernelCorrection, FreeBlockConservesLinearMomentum) {
   std::printf("momentum change %.3g of %.3g, max |stress| %.3g Pa\n", (p1 - p0).norm(), scale, stress);
   EXPECT_GT(stress, 1.0) << "the block must be stressed for the test to mean anything";
   EXPECT_LT((p1 - p0).norm(), 1e-12 * scale);
+}
+TEST(KernelCorrection, FreeBlockConservesLinearMomentum) {
+  check_free_block_momentum(false);
+}
+TEST(KernelCorrection, QuadraticFreeBlockConservesLinearMomentum) {
+  check_free_block_momentum(true);
 }
 
 TEST(VelocityGradient, TranslationHasNoStrainRateAnywhere) {

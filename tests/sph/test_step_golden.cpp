@@ -173,7 +173,7 @@ void block_velocities(SphStore<2>& S) {
   }
 }
 
-SphSolver<2> drucker_prager_block(bool corrected = false) {
+SphSolver<2> drucker_prager_block(bool corrected = false, bool quadratic = false) {
   const double dx = kBlockDx;
   const int nx = kBlockNx, nz = kBlockNz;
   Builder<2> b;
@@ -232,6 +232,7 @@ SphSolver<2> drucker_prager_block(bool corrected = false) {
   s.domain_hi = Vec2(1.0, 1.0);
   s.earthquake = EarthquakeLoading::sine(3.0, 5.0, 0.0, 1.0, 0.0);
   s.kernel_correction = corrected;
+  s.quadratic_correction = quadratic;
   return SphSolver<2>(std::move(b.S), {m0, m1}, DruckerPrager{}, s);
 }
 
@@ -315,16 +316,84 @@ TEST(StepGolden, DruckerPragerBlockWithFixedAndRollerWalls) {
   expect_matches("DruckerPragerBlock", solver, kBlockIds, kDruckerPragerBlockTime, kDruckerPragerBlock);
 }
 
-// ---- Case 1b: the same block with the kernel-gradient correction (numerics.kernel_correction):
-// the quadratic-complete A_i in the velocity gradient and the stress pair, its guards at the corners
-// and next to the walls, the walls' pairs with g_ib = A_i b_ib of the soil particle. Values stored
-// 2026-12-02 when the correction became quadratic-complete (solver.cpp step 2; the linear C_i =
-// M_i⁻¹ of Bonet & Lok 1999 before: interior particles moved by ~1 % in acceleration, free-surface
-// and corner ones by up to 25 %, e.g. particle 9, top corner by the fixed wall, σ_xx 491 → 590 Pa);
-// the corrected gradient itself is checked against closed forms in test_kinematics.cpp
-// (KernelCorrection.*: exact for linear and quadratic fields at every particle).
-constexpr double kCorrectedDruckerPragerBlockTime = 0.00017388265698893923;
+// ---- Case 1b: the same block with the kernel-gradient correction (numerics.kernel_correction,
+// Bonet & Lok 1999): C_i in the velocity gradient and the stress pair, its guard at the corners and
+// next to the walls, the walls' pairs with C_i of the soil particle. Values stored from the code
+// that introduced the correction (no older reference exists); the corrected gradient itself is
+// checked against closed forms in test_kinematics.cpp (KernelCorrection.*).
+constexpr double kCorrectedDruckerPragerBlockTime = 0.00017388387504289779;
 const std::vector<Golden> kCorrectedDruckerPragerBlock = {
+    {0,
+     {0.005000226391791783, 0.00500240166142789, 0},
+     {-0.0016227201335347187, 0.0078287512028292379, 0},
+     {-14.558056310920719, -42.672448692634369, 0},
+     -513.43195663063102,
+     2100,
+     0.0004083006038449022,
+     {-541.25246225608203, -205.08989420643397, 0, -205.08989420643397, -302.56954876186933, 0, 0, 0,
+      -473.99864384464479}},
+    {9,
+     {0.0049990901978375487, 0.094998173957025117, 0},
+     {-0.0062993676115613989, -0.0068863959735413014, 0},
+     {-13.152701734509922, 2.9402919272344898, 0},
+     335.74624327472964,
+     1800.348666809133,
+     0.00026412281729376157,
+     {490.75436704641947, -55.112537367738696, 0, -55.112537367738696, -109.08255090829427, 0, 0, 0,
+      -46.432144219729608}},
+    {65,
+     {0.064996586731002351, 0.054997767500428597, 0},
+     {-0.015479191862265653, -0.01055278911971012, 0},
+     {13.574491192717508, 2.4730754999328681, 0},
+     630.09118354289149,
+     1799.1523159910225,
+     0,
+     {-628.47181111480074, -100.88370194107155, 0, -100.88370194107155, -934.40762921738178, 0, 0, 0,
+      -588.05533209965472}},
+    {69,
+     {0.065001342574716084, 0.094996694620252009, 0},
+     {0.0057153445942435188, -0.014774461554772926, 0},
+     {-11.644467797387611, 0.6888970902411955, 0},
+     1466.5046881797525,
+     1818.3901995602573,
+     0,
+     {0, 0, 0, 0, 0, 0, 0, 0, 0}},
+    {110,
+     {0.11500108152480522, 0.0050023116268306895, 0},
+     {0.006868159792331973, 0.01056510583981461, 0},
+     {27.401443010082886, -24.18918601664782, 0},
+     -843.84491847448089,
+     2120.3556451649506,
+     0.00034063379810145213,
+     {-106.89429377312098, -44.059960577222725, 0, -44.059960577222725, -64.114353428878587, 0, 0, 0,
+      -109.00745857562801}},
+    {115,
+     {0.1199095394605771, 0.055000779762403459, 0},
+     {-4.2615311586066715, 0.0040209375807413296, 0},
+     {961.7107111725694, 0.18975299110350258, 0},
+     -713653.47576635215,
+     1799.0651783115111,
+     0.09277485650149718,
+     {866.02540378443871, 0, 0, 0, 866.02540378443871, 0, 0, 0, 866.02540378443871}},
+};
+
+TEST(StepGolden, CorrectedDruckerPragerBlockWithFixedAndRollerWalls) {
+  auto solver = drucker_prager_block(true);
+  solver.apply_gravity_gradually(2.5 * solver.dt(), 0.7, true);
+  block_velocities(solver.store());
+  for (int k = 0; k < 5; ++k) solver.step();
+  expect_matches("CorrectedDruckerPragerBlock", solver, kBlockIds, kCorrectedDruckerPragerBlockTime,
+                 kCorrectedDruckerPragerBlock);
+}
+
+// ---- Case 1c: the same block with the quadratic-complete correction (numerics.kernel_correction =
+// "quadratic", solver.cpp step 2: A_i = the first rows of B_i⁻¹, g_ij = A_i b_ij in the velocity
+// gradient, the stress pair and the walls' pairs, the guards). Values stored 2026-12-02 from the code
+// that introduced it; against case 1b interior particles differ by ~1 % in acceleration, free-surface
+// and corner ones by up to 25 % (particle 9, top corner by the fixed wall: σ_xx 491 → 590 Pa). The
+// gradient itself is checked against closed forms in test_kinematics.cpp (KernelCorrection.Quadratic*).
+constexpr double kQuadraticDruckerPragerBlockTime = 0.00017388265698893923;
+const std::vector<Golden> kQuadraticDruckerPragerBlock = {
     {0,
      {0.0050002267162260802, 0.005002402285711101, 0},
      {-0.0016171852336685287, 0.0078380599459025434, 0},
@@ -378,13 +447,13 @@ const std::vector<Golden> kCorrectedDruckerPragerBlock = {
      {866.02540378443871, 0, 0, 0, 866.02540378443871, 0, 0, 0, 866.02540378443871}},
 };
 
-TEST(StepGolden, CorrectedDruckerPragerBlockWithFixedAndRollerWalls) {
-  auto solver = drucker_prager_block(true);
+TEST(StepGolden, QuadraticCorrectedDruckerPragerBlockWithFixedAndRollerWalls) {
+  auto solver = drucker_prager_block(true, true);
   solver.apply_gravity_gradually(2.5 * solver.dt(), 0.7, true);
   block_velocities(solver.store());
   for (int k = 0; k < 5; ++k) solver.step();
-  expect_matches("CorrectedDruckerPragerBlock", solver, kBlockIds, kCorrectedDruckerPragerBlockTime,
-                 kCorrectedDruckerPragerBlock);
+  expect_matches("QuadraticDruckerPragerBlock", solver, kBlockIds, kQuadraticDruckerPragerBlockTime,
+                 kQuadraticDruckerPragerBlock);
 }
 
 // ---- Case 2: 2D Newtonian fluid in a box under a lid sliding at 0.05 m/s, under gravity: the
@@ -656,6 +725,7 @@ TEST(StepThreads, DruckerPragerBlockSameBitsOnOneAndTwoThreads) {
 
 TEST(StepThreads, CorrectedDruckerPragerBlockSameBitsOnOneAndTwoThreads) {
   expect_same_bits_on_one_and_two_threads<2>([] { return drucker_prager_block(true); }, 8);
+  expect_same_bits_on_one_and_two_threads<2>([] { return drucker_prager_block(true, true); }, 8);
 }
 
 TEST(StepThreads, DruckerPrager3DSameBitsOnOneAndTwoThreads) {
@@ -699,6 +769,7 @@ void expect_resume_reproduces(Make make, int before, int after) {
 TEST(StepRestart, ResumedSolverContinuesBitForBit) {
   expect_resume_reproduces<2>([] { return drucker_prager_block(); }, 5, 5);
   expect_resume_reproduces<2>([] { return drucker_prager_block(true); }, 5, 5);
+  expect_resume_reproduces<2>([] { return drucker_prager_block(true, true); }, 5, 5);
   expect_resume_reproduces<3>(drucker_prager_3d, 4, 6);
 }
 

@@ -241,7 +241,10 @@ void SphSolver<Dim>::step_impl(const Model& model) {
   const bool corrected = settings_.kernel_correction;
   if (corrected) {                  // 2. A_i (consistent kernel gradients)
     gradient_correction<Kernel>();  //    L, dρ/dt, ρ̃, XSPH
-    velocity_gradient<Kernel, true>();
+    if (settings_.quadratic_correction)
+      velocity_gradient<Kernel, true>();
+    else
+      velocity_gradient<Kernel, false>();  // with L_i ← L_i C_iᵀ at the end
   } else {
     velocity_gradient<Kernel, false>();
   }
@@ -403,9 +406,10 @@ void SphSolver<Dim>::gather_reactions(const std::vector<T>& buffer, Add&& add, F
 // (The pair loops of steps 2 and 4 repeat the same ten-line neighbour header on purpose: folded
 //  into a shared lambda it cost 20 % of the 2D speed, the captures defeating register reuse.)
 
-// 2. Kernel-gradient correction, only with `kernel_correction`: a gradient exact for any quadratic
-//    field, at the free surface too (Zhang & Batra 2004, the symmetric-smoothing/MSPH idea; with
-//    only the linear part it is Bonet & Lok 1999, Randles & Libersky 1996). For a field
+// 2. Kernel-gradient correction, only with `kernel_correction`. Linear (the default, Bonet & Lok
+//    1999, Randles & Libersky 1996): A_i = [C_i 0], C_i = M_i⁻¹, g_ij = C_i ∇_i W_ij, exact for linear
+//    fields. With `quadratic_correction`: a gradient exact for any quadratic field, at the free
+//    surface too (the idea of Zhang & Batra 2004's modified SPH, with the SPH gradient's weight). For a field
 //    u_j − u_i = ∇u·r + Σ_{a≤b} c_ab r_a r_b (r = x_j − x_i) the Dim + Dim(Dim+1)/2 kernel moments
 //    Σ_j V_j (u_j − u_i) b_ij, b_ij = F_ij p_ij = [∇_i W_ij; F_ij h m(r/h)] (kernel_basis; F_ij =
 //    |∇_i W_ij|/r, so ∇_i W_ij = F_ij r), are B_i z with
@@ -418,7 +422,8 @@ void SphSolver<Dim>::gather_reactions(const std::vector<T>& buffer, Add&& add, F
 //    spline, h = 1.2Δx): the outer fibres' strain is 6 % low at 10 particles through a beam, its
 //    bending stiffness 6.7 % low and its period 3.5 % long (docs/validation/sph.md, "Clamped elastic
 //    cantilever"). Inside a regular lattice the odd moments vanish, B_i is block diagonal and
-//    g_ij = M_i⁻¹ ∇W_ij: the two corrections agree there.
+//    g_ij = M_i⁻¹ ∇W_ij: the two corrections agree there. Not the default because a bent beam then
+//    goes unstable earlier at fine resolution (docs/validation/sph.md, cantilever, second round).
 //    The sums run over every neighbour the velocity-gradient sum uses, boundary particles included
 //    (they stand in for the missing support at a wall). Guards: where det M_i < 0.2^Dim (the
 //    geometric mean of M_i's eigenvalues below 0.2) the particle keeps the plain gradient
@@ -450,12 +455,27 @@ void SphSolver<Dim>::gradient_correction() {
   const std::uint32_t* idx = nb_.list().indices().data();
   correction_.resize(static_cast<std::size_t>(n));
   auto* A = correction_.data();
+  const bool quadratic = settings_.quadratic_correction;
 #pragma omp parallel for schedule(static)
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
     A[i].setZero();
     A[i].template leftCols<Dim>().setIdentity();
     if (kind[i] != kSoil) continue;
+    if (!quadratic) {  // the linear correction alone: C_i = M_i⁻¹ (Bonet & Lok 1999)
+      Mat<Dim> M = Mat<Dim>::Zero();
+      for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+        const std::uint32_t j = idx[k];
+        const Vec<Dim> xij = image(x[i], x[j]);
+        const double r2 = xij.squaredNorm();
+        if (r2 >= K.cutoff2 || r2 == 0.0) continue;
+        const double r = std::sqrt(r2);
+        const Vec<Dim> gw = xij * (K.sigma_h * Kernel::shape_derivative(r * K.inv_h) / r);
+        M.noalias() -= vol[j] * gw * xij.transpose();  // V_j ∇W_ij ⊗ (x_j − x_i)
+      }
+      if (M.determinant() >= kMinMomentDet) A[i].template leftCols<Dim>() = M.inverse();
+      continue;
+    }
     Moments B = Moments::Zero();  // upper triangle only until the factorisation
     for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
       const std::uint32_t j = idx[k];
@@ -653,7 +673,15 @@ void SphSolver<Dim>::velocity_gradient() {
       rsum[i] += g.rsum;
       xs[i] += g.xs;
     };
-    gather_reactions(pair_grad_, add, [](std::size_t) {});
+    if (settings_.kernel_correction) {  // the linear correction: L_i ← L_i C_iᵀ, C_i = A_i's first Dim columns
+      const auto* A = correction_.data();
+      gather_reactions(pair_grad_, add, [&](std::size_t i) {
+        const Mat<Dim> C = A[i].template leftCols<Dim>();
+        L[i] = (L[i] * C.transpose()).eval();
+      });
+    } else {
+      gather_reactions(pair_grad_, add, [](std::size_t) {});
+    }
   }
 }
 
@@ -769,6 +797,7 @@ void SphSolver<Dim>::momentum() {
   const std::uint8_t* has_as = has_as_.data();
   Vec<Dim>* acc = field<Acceleration<Dim>>();
   const auto* A = Corrected ? correction_.data() : nullptr;
+  const bool quadratic = settings_.quadratic_correction;
   const std::uint32_t* off = nb_.list().offsets().data();
   const std::uint32_t* idx = nb_.list().indices().data();
   const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
@@ -816,14 +845,22 @@ void SphSolver<Dim>::momentum() {
         }
         Vec<Dim> Tg = T * gw;
         if constexpr (Corrected) {  // σ_i g_ij − σ_j g_ji, g_ij = A_i b_ij (step 2); b_ji: ∇W negated
-          auto b =
-              kernel_basis<Dim, kBasis>(gw, r > 0.0 ? -K.sigma_h * Kernel::shape_derivative(q) / r : 0.0, xij, K.inv_h);
-          const Vec<Dim> gij = A[i] * b;
-          if (soil_j) {
-            b.template head<Dim>() = -gw;
-            Tg.noalias() += si * gij - sj * (A[j] * b);
+          if (!quadratic) {         // the linear correction: g_ij = C_i ∇W_ij, g_ji = −C_j ∇W_ij
+            const Vec<Dim> cgi = A[i].template leftCols<Dim>() * gw;
+            if (soil_j)
+              Tg.noalias() += si * cgi + sj * (A[j].template leftCols<Dim>() * gw);
+            else
+              Tg.noalias() += (si + sj) * cgi;
           } else {
-            Tg.noalias() += (si + sj) * gij;
+            auto b = kernel_basis<Dim, kBasis>(gw, r > 0.0 ? -K.sigma_h * Kernel::shape_derivative(q) / r : 0.0, xij,
+                                               K.inv_h);
+            const Vec<Dim> gij = A[i] * b;
+            if (soil_j) {
+              b.template head<Dim>() = -gw;
+              Tg.noalias() += si * gij - sj * (A[j] * b);
+            } else {
+              Tg.noalias() += (si + sj) * gij;
+            }
           }
         }
         ai.noalias() += vol[j] * Tg;
@@ -887,6 +924,7 @@ void SphSolver<Dim>::structure_forces() {
   const std::uint32_t* idx = nb_.list().indices().data();
   const Vec<Dim>* base = structure_base_.data();
   const auto* A = Corrected ? correction_.data() : nullptr;
+  const bool quadratic = settings_.quadratic_correction;
   const auto ns = static_cast<std::int32_t>(structure_base_.size());
   const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
   const std::int64_t nblocks = static_cast<std::int64_t>(blocks.count());
@@ -930,10 +968,14 @@ void SphSolver<Dim>::structure_forces() {
           T += (std::pow(f, n_as) * rhoi * rho[j]) * (Ri + R[j]);
         }
         Vec<Dim> Tg = T * gw;
-        if constexpr (Corrected)
-          Tg.noalias() +=
-              (si + sj) * (A[i] * kernel_basis<Dim, kBasis>(
-                                      gw, r > 0.0 ? -K.sigma_h * Kernel::shape_derivative(q) / r : 0.0, xij, K.inv_h));
+        if constexpr (Corrected) {
+          if (quadratic)
+            Tg.noalias() += (si + sj) * (A[i] * kernel_basis<Dim, kBasis>(
+                                                    gw, r > 0.0 ? -K.sigma_h * Kernel::shape_derivative(q) / r : 0.0,
+                                                    xij, K.inv_h));
+          else
+            Tg.noalias() += (si + sj) * (A[i].template leftCols<Dim>() * gw);
+        }
         Vec<Dim> fi = vol[j] * Tg;  // force density on i from j
         if (r < r_rep) {
           const double q2 = (r_rep * r_rep) / r2;

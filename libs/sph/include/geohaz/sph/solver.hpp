@@ -98,6 +98,10 @@ struct NumericalSettings {
   /// sph-slope's `numerics.kernel_correction = "auto"` keeps this default except for the
   /// linear_elastic model, where it turns it on (docs/sph.md, "Kernel-gradient correction").
   bool kernel_correction = false;
+  /// With kernel_correction: the quadratic-complete correction (exact for quadratic fields at free
+  /// surfaces too: a bent beam's outer fibres; docs/sph.md) instead of the linear C_i = M_i⁻¹.
+  /// sph-slope: `numerics.kernel_correction = "quadratic"`.
+  bool quadratic_correction = false;
   EarthquakeLoading earthquake;  ///< applied in the main phase (time from 0 after the geostatic phase)
 };
 
