@@ -5,7 +5,7 @@
 //   bench_sph [steps] [scale] [2d|3d|all] [threads] [skin] [structures] [correction]   (scale < 1
 //   shrinks the problems for a quick look; the others select runs, e.g. `bench_sph 50 1 2d 2 0.3` for
 //   one figure; structures = 1 sums the loads on the walls every step, pass 4b, as sph-slope does;
-//   correction 1 turns numerics.kernel_correction on, 0 off, default: the solver's default)
+//   correction 1 turns numerics.kernel_correction on, 2 quadratic, 0 off, default: the solver's default)
 #include <omp.h>
 
 #include <algorithm>
@@ -43,7 +43,7 @@ struct Selection {
   int threads = 0;          ///< 0: 1 and 2
   double skin = -1;         ///< < 0: 0 and 0.3
   bool structures = false;  ///< track the loads on the scenario's structures (pass 4b)
-  int correction = -1;      ///< kernel-gradient correction: 1 on, 0 off, < 0 the solver's default
+  int correction = -1;      ///< kernel-gradient correction: 1 on, 2 quadratic, 0 off, < 0 the solver's default
 };
 Selection selection;
 
@@ -62,7 +62,10 @@ void run(const char* name, Scenario<Dim> sc, const MaterialParams& m, int steps)
       s.domain_lo = sc.domain_lo;
       s.domain_hi = sc.domain_hi;
       s.neighbour_skin = skin;
-      if (selection.correction >= 0) s.kernel_correction = selection.correction == 1;
+      if (selection.correction >= 0) {
+        s.kernel_correction = selection.correction >= 1;
+        s.quadratic_correction = selection.correction == 2;
+      }
       SphSolver<Dim> solver(sc.store, {m}, DruckerPrager{}, s);
       if (selection.structures) {
         std::vector<Vec<Dim>> bases;
@@ -78,8 +81,8 @@ void run(const char* name, Scenario<Dim> sc, const MaterialParams& m, int steps)
           "%-26s%s skin %.1fh threads %d  particles %7zu  steps %4d  %7.3f s  %.3e particle-steps/s  "
           "%.0f B/particle  %lld list builds  correction %d  state %016llx\n",
           name, selection.structures ? " +loads" : "", skin, threads, solver.store().size(), steps, sec, rate,
-          solver.bytes_per_particle(), static_cast<long long>(solver.neighbour_builds()), s.kernel_correction ? 1 : 0,
-          state_hash(solver.store()));
+          solver.bytes_per_particle(), static_cast<long long>(solver.neighbour_builds()),
+          s.kernel_correction ? (s.quadratic_correction ? 2 : 1) : 0, state_hash(solver.store()));
     }
 }
 

@@ -317,6 +317,9 @@ TEST(Validation, GriffithsLaneTwoLayerFactorOfSafety) {
 // sags twice as far — docs/validation/sph.md), Cundall damping 0.3, 0.15 s (4 periods of
 // T = 0.0377 s); δ = 0.5356 + 0.0061 = 0.5417 mm; measured as the mean tip displacement over the
 // last period (the residual oscillation averages out).
+// A fourth variant, the quadratic-complete correction (numerics.kernel_correction = "quadratic";
+// hand runs 2026-12-02: +3.2 / +16 / +35 %), is run and drawn (orange) but not checked: at 15 and
+// 20 particles an instability grows in the bent beam (docs/validation/sph.md, second round).
 // Checks: the corrected period converges (its error falls with every refinement) and is within 3 %
 // of Timoshenko at 20 particles; the plain gradient is farther off at every resolution; the static
 // deflection is within 3 % at 20 particles. The numbers go to docs/validation/sph.md.
@@ -339,7 +342,8 @@ TEST(Validation, CantileverPeriodAndDeflectionConverge) {
     const std::string base = std::string(" --set numerics.spacing=") + dx + " --set run.end_time=0.14";
     for (const auto& [variant, sets] : {std::pair<std::string, std::string>{"corrected", ""},
                                         {"plain", " --set numerics.kernel_correction=off"},
-                                        {"corrected_as03", " --set numerics.artificial_stress=0.3"}}) {
+                                        {"corrected_as03", " --set numerics.artificial_stress=0.3"},
+                                        {"quadratic", " --set numerics.kernel_correction=quadratic"}}) {
       const std::string name = "cantilever_" + variant + "_n" + std::to_string(n);
       run_case(name, "cantilever.toml", base + sets);
       const double T = first_period(kWork / name / "series.csv");
@@ -385,8 +389,10 @@ TEST(Validation, CantileverPeriodAndDeflectionConverge) {
         {ns, pct(err["plain"]), {200, 40, 40}, true},
         {ns, pct(err["corrected_as03"]), {40, 160, 60}, false},
         {ns, pct(err["corrected_as03"]), {40, 160, 60}, true},
+        {ns, pct(err["quadratic"]), {230, 140, 20}, false},
+        {ns, pct(err["quadratic"]), {230, 140, 20}, true},
         {ns, pct(static_err), {0, 0, 0}, true}},
-       5.0, 25.0, -5.0, 25.0, 5.0, 5.0);
+       5.0, 25.0, -5.0, 40.0, 5.0, 5.0);
 }
 
 TEST(Validation, Figures) {

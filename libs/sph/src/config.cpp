@@ -204,13 +204,16 @@ void read_numerics(ConfigReader& r, RunConfig& c) {
   n.wall_repulsion = r.get("numerics.wall_repulsion", d.wall_repulsion, Range::closed(0.0, 1.0),
                            {"1", "soil closer than this x dx to a wall particle is pushed back (0: off)"});
   {  // auto: the solver's default (off) except for linear_elastic, where it was validated (docs/sph.md)
-    const auto kc = r.get_choice("numerics.kernel_correction", "auto", {"auto", "on", "off"},
-                                 {"",
-                                  "first-order consistent kernel gradients (Bonet & Lok 1999) in the strain-rate "
-                                  "and momentum sums: auto = on for model.constitutive = linear_elastic (elastic "
-                                  "bending, docs/validation/sph.md), off for the other models"});
-    n.kernel_correction =
-        kc == "on" || (kc == "auto" && (d.kernel_correction || std::holds_alternative<LinearElastic>(c.model)));
+    const auto kc = r.get_choice(
+        "numerics.kernel_correction", "auto", {"auto", "on", "off", "quadratic"},
+        {"",
+         "consistent kernel gradients in the strain-rate and momentum sums: on = exact for linear fields "
+         "(Bonet & Lok 1999), quadratic = also for quadratic fields at free surfaces (bending; unstable at "
+         "fine resolution without a cure, docs/validation/sph.md), auto = on for model.constitutive = "
+         "linear_elastic, off for the other models"});
+    n.kernel_correction = kc == "on" || kc == "quadratic" ||
+                          (kc == "auto" && (d.kernel_correction || std::holds_alternative<LinearElastic>(c.model)));
+    n.quadratic_correction = kc == "quadratic";
   }
   n.neighbour_skin = r.get("numerics.neighbour_skin", d.neighbour_skin, Range::closed(0.0, 1.0),
                            {"1", "Verlet skin in units of h (0: rebuild the neighbour list every step)"});

@@ -140,6 +140,22 @@ inline Mat<Dim> mirror_stress(const Mat<Dim>& si, double rhoi, const Vec<Dim>& x
   return sb;
 }
 
+/// The quadratic-complete kernel basis of pair (i, j) (step 2): b_ij = F_ij p_ij with
+/// p_ij = [r; h m(r/h)], r = x_j − x_i, m the Dim(Dim+1)/2 products r_a r_b/h² (a ≤ b), and
+/// F_ij = |∇_i W_ij|/|r| ≥ 0, so that its first Dim components are ∇_i W_ij = F_ij r (passed as gw).
+/// m is even in r, so b_ji is b_ij with its first Dim components negated.
+template <int Dim, int N>
+inline Eigen::Matrix<double, N, 1> kernel_basis(const Vec<Dim>& gw, double F, const Vec<Dim>& xij,
+                                                double inv_h) noexcept {
+  Eigen::Matrix<double, N, 1> b;
+  b.template head<Dim>() = gw;
+  const Vec<Dim> s = xij * (F * inv_h);
+  int k = Dim;
+  for (int a = 0; a < Dim; ++a)
+    for (int c = a; c < Dim; ++c) b[k++] = s[a] * xij[c];
+  return b;
+}
+
 }  // namespace
 
 template <int Dim>
@@ -195,9 +211,10 @@ double SphSolver<Dim>::bytes_per_particle() const {
   return static_cast<double>(SphStore<Dim>::bytes_per_particle()) +
          4.0 * static_cast<double>(nb_.list().pair_count()) / n + 4.0 + 3.0 * 4.0 +
          1.0 +  // CSR indices + offsets + cell data + artificial-stress flag
-         static_cast<double>(pair_acc_.size() * sizeof(Vec<Dim>) + pair_grad_.size() * sizeof(GradientReaction)) /
+         static_cast<double>(pair_acc_.size() * sizeof(Vec<Dim>) + pair_grad_.size() * sizeof(GradientReaction) +
+                             pair_grad_corrected_.size() * sizeof(CorrectedGradientReaction)) /
              n +  // block buffers of the pair reactions (n (1 + W/B) slots each)
-         static_cast<double>(correction_.size() * sizeof(Mat<Dim>)) / n;  // C_i (kernel_correction)
+         static_cast<double>(correction_.size() * sizeof(correction_[0])) / n;  // A_i (kernel_correction)
 }
 
 template <int Dim>
@@ -223,10 +240,17 @@ void SphSolver<Dim>::step_impl(const Model& model) {
   const Vec<Dim> gbar = body_acceleration();  //    ḡ = g + a_earthquake of this step
   prepare_boundary_pairs(gbar);               // 1. volumes; the walls' stress extrapolation
   const bool corrected = settings_.kernel_correction;
-  if (corrected) gradient_correction<Kernel>();  // 2. C_i = M_i⁻¹ (consistent kernel gradients)
-  velocity_gradient<Kernel>();                   //    L, dρ/dt, ρ̃, XSPH
-  update_stress(model);                          // 3. density, constitutive model, artificial stress
-  if (corrected) {                               // 4. pair forces → acceleration
+  if (corrected) {                  // 2. A_i (consistent kernel gradients)
+    gradient_correction<Kernel>();  //    L, dρ/dt, ρ̃, XSPH
+    if (settings_.quadratic_correction)
+      velocity_gradient<Kernel, true>();
+    else
+      velocity_gradient<Kernel, false>();  // with L_i ← L_i C_iᵀ at the end
+  } else {
+    velocity_gradient<Kernel, false>();
+  }
+  update_stress(model);  // 3. density, constitutive model, artificial stress
+  if (corrected) {       // 4. pair forces → acceleration
     momentum<Kernel, true>();
     structure_forces<Kernel, true>();  // 4b. loads on tracked walls and piles (read only)
   } else {
@@ -376,25 +400,45 @@ void SphSolver<Dim>::gather_reactions(const std::vector<T>& buffer, Add&& add, F
 // (The pair loops of steps 2 and 4 repeat the same ten-line neighbour header on purpose: folded
 //  into a shared lambda it cost 20 % of the 2D speed, the captures defeating register reuse.)
 
-// 2. Kernel-gradient correction (Bonet & Lok 1999; Randles & Libersky 1996), only with
-//    `kernel_correction`: C_i = M_i⁻¹ with the moment matrix M_i = Σ_j V_j ∇W_ij ⊗ (x_j − x_i), so
-//    that the corrected gradient ∇̃W_ij = C_i ∇W_ij gives Σ_j V_j (v_j − v_i) ⊗ ∇̃W_ij = A exactly for
-//    any linear field v = A x + b, at the free surface too (where the plain sum loses the missing
-//    half of the support: M_i ≈ diag(1, ½) at a flat surface). The sum runs over every neighbour the
-//    velocity-gradient sum uses, boundary particles included (they stand in for the missing support
-//    at a wall, M_i ≈ I there, and the correction is small). Guard: where det M_i < 0.2^Dim (the
-//    geometric mean of M_i's eigenvalues below 0.2) the particle keeps the plain gradient (C_i = I):
-//    a particle with few neighbours or all of them near one line (a detached grain, a thin tongue
-//    after failure) has a near-singular M_i whose inverse would amplify noise into the stress. The
-//    surfaces, edges and corners of an intact lattice are corrected: det M_i (cubic spline, h =
-//    1.2–1.5Δx, lattice sums) is 0.95–1.03 inside, 0.37–0.39 on a face (2D) and 0.12–0.14 at a
-//    corner; in 3D 0.28–0.30 on a face, 0.07–0.09 on an edge, 0.014–0.025 at a corner (threshold
-//    0.008). Boundary particles keep C = I. Each particle sums its own row (no reactions): the sum
-//    is then the same on any thread count.
+// 2. Kernel-gradient correction, only with `kernel_correction`. Linear (the default, Bonet & Lok
+//    1999, Randles & Libersky 1996): A_i = [C_i 0], C_i = M_i⁻¹, g_ij = C_i ∇_i W_ij, exact for linear
+//    fields. With `quadratic_correction`: a gradient exact for any quadratic field, at the free
+//    surface too (the idea of Zhang & Batra 2004's modified SPH, with the SPH gradient's weight). For a field
+//    u_j − u_i = ∇u·r + Σ_{a≤b} c_ab r_a r_b (r = x_j − x_i) the Dim + Dim(Dim+1)/2 kernel moments
+//    Σ_j V_j (u_j − u_i) b_ij, b_ij = F_ij p_ij = [∇_i W_ij; F_ij h m(r/h)] (kernel_basis; F_ij =
+//    |∇_i W_ij|/r, so ∇_i W_ij = F_ij r), are B_i z with
+//    z = [∇u; h c], B_i = Σ_j V_j b_ij ⊗ p_ij, p_ij = [r; h m(r/h)]. So z = B_i⁻¹ Σ_j V_j (u_j − u_i) b_ij and
+//    the corrected gradient is ∇u_i = Σ_j V_j (u_j − u_i) g_ij with g_ij = A_i b_ij, A_i the first Dim
+//    rows of B_i⁻¹. Why quadratic and not only linear (C_i = M_i⁻¹, M_i = Σ_j V_j ∇_i W_ij ⊗ r, the
+//    top-left block of B_i; used before 2026-12-02): a bending beam's displacement is quadratic, and
+//    at a free surface, where all neighbours lie on one side, the linear correction evaluates the
+//    gradient at the centroid of the one-sided neighbourhood, 0.27Δx inside the outer row (cubic
+//    spline, h = 1.2Δx): the outer fibres' strain is 6 % low at 10 particles through a beam, its
+//    bending stiffness 6.7 % low and its period 3.5 % long (docs/validation/sph.md, "Clamped elastic
+//    cantilever"). Inside a regular lattice the odd moments vanish, B_i is block diagonal and
+//    g_ij = M_i⁻¹ ∇W_ij: the two corrections agree there. Not the default because a bent beam then
+//    goes unstable earlier at fine resolution (docs/validation/sph.md, cantilever, second round).
+//    The sums run over every neighbour the velocity-gradient sum uses, boundary particles included
+//    (they stand in for the missing support at a wall). Guards: where det M_i < 0.2^Dim (the
+//    geometric mean of M_i's eigenvalues below 0.2) the particle keeps the plain gradient
+//    (A_i = [I 0]): a particle with few neighbours or all of them near one line (a detached grain, a
+//    thin tongue after failure) has a near-singular M_i whose inverse would amplify noise into the
+//    stress. Where B_i is ill-conditioned (B_i = Σ_j V_j F_ij p_ij ⊗ p_ij is symmetric positive
+//    semi-definite: its Cholesky factor fails, or (max/min of the factor's diagonal)² > 10⁴, e.g.
+//    neighbours on two lines only) it keeps the linear correction (A_i = [M_i⁻¹ 0]). The surfaces, edges and
+//    corners of an intact lattice are fully corrected: det M_i (cubic spline, h = 1.2–1.5Δx, lattice
+//    sums) is 0.95–1.03 inside, 0.37–0.39 on a face (2D) and 0.12–0.14 at a corner; in 3D 0.28–0.30
+//    on a face, 0.07–0.09 on an edge, 0.014–0.025 at a corner (threshold 0.008). Boundary particles
+//    keep A = [I 0]. Each particle sums its own row (no reactions): the sum is then the same on any
+//    thread count.
 template <int Dim>
 template <class Kernel>
 void SphSolver<Dim>::gradient_correction() {
   constexpr double kMinMomentDet = Dim == 2 ? 0.2 * 0.2 : 0.2 * 0.2 * 0.2;
+  constexpr double kMinRcond = 1e-4;
+  constexpr int N = kBasis;
+  using Basis = Eigen::Matrix<double, N, 1>;
+  using Moments = Eigen::Matrix<double, N, N>;
   const PairKernel<Kernel> K(h_);
   const MinimumImage<Dim> image(settings_.periodic);
   const std::int64_t n = static_cast<std::int64_t>(store_.size());
@@ -404,23 +448,89 @@ void SphSolver<Dim>::gradient_correction() {
   const std::uint32_t* off = nb_.list().offsets().data();
   const std::uint32_t* idx = nb_.list().indices().data();
   correction_.resize(static_cast<std::size_t>(n));
-  Mat<Dim>* C = correction_.data();
+  auto* A = correction_.data();
+  const bool quadratic = settings_.quadratic_correction;
 #pragma omp parallel for schedule(static) if (parallel_worth(n))
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
-    C[i].setIdentity();
+    A[i].setZero();
+    A[i].template leftCols<Dim>().setIdentity();
     if (kind[i] != kSoil) continue;
-    Mat<Dim> M = Mat<Dim>::Zero();
+    if (!quadratic) {  // the linear correction alone: C_i = M_i⁻¹ (Bonet & Lok 1999)
+      Mat<Dim> M = Mat<Dim>::Zero();
+      for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+        const std::uint32_t j = idx[k];
+        const Vec<Dim> xij = image(x[i], x[j]);
+        const double r2 = xij.squaredNorm();
+        if (r2 >= K.cutoff2 || r2 == 0.0) continue;
+        const double r = std::sqrt(r2);
+        const Vec<Dim> gw = xij * (K.sigma_h * Kernel::shape_derivative(r * K.inv_h) / r);
+        M.noalias() -= vol[j] * gw * xij.transpose();  // V_j ∇W_ij ⊗ (x_j − x_i)
+      }
+      if (M.determinant() >= kMinMomentDet) A[i].template leftCols<Dim>() = M.inverse();
+      continue;
+    }
+    Moments B = Moments::Zero();  // upper triangle only until the factorisation
     for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
       const std::uint32_t j = idx[k];
       const Vec<Dim> xij = image(x[i], x[j]);
       const double r2 = xij.squaredNorm();
       if (r2 >= K.cutoff2 || r2 == 0.0) continue;
       const double r = std::sqrt(r2);
-      const Vec<Dim> gw = xij * (K.sigma_h * Kernel::shape_derivative(r * K.inv_h) / r);
-      M.noalias() -= vol[j] * gw * xij.transpose();  // V_j ∇W_ij ⊗ (x_j − x_i)
+      const double F = -K.sigma_h * Kernel::shape_derivative(r * K.inv_h) / r;  // |∇_i W_ij|/r
+      Basis p;                                                                  // [r; h m(r/h)], r = x_j − x_i
+      p.template head<Dim>() = -xij;
+      int c = Dim;
+      for (int a = 0; a < Dim; ++a)
+        for (int d = a; d < Dim; ++d) p[c++] = xij[a] * xij[d] * K.inv_h;
+      const double wgt = vol[j] * F;
+      for (int a = 0; a < N; ++a)  // V_j b_ij ⊗ p_ij = V_j F_ij p_ij ⊗ p_ij (symmetric)
+        for (int d = a; d < N; ++d) B(a, d) += wgt * p[a] * p[d];
     }
-    if (M.determinant() >= kMinMomentDet) C[i] = M.inverse();
+    Mat<Dim> M;
+    for (int a = 0; a < Dim; ++a)
+      for (int d = 0; d < Dim; ++d) M(a, d) = B(std::min(a, d), std::max(a, d));
+    if (!(M.determinant() >= kMinMomentDet)) continue;
+    // Cholesky B = L Lᵀ (B is symmetric positive semi-definite), in place in the lower triangle;
+    // (max L_kk / min L_kk)² estimates the condition number.
+    bool ok = true;
+    double dmin = std::numeric_limits<double>::infinity(), dmax = 0.0;
+    for (int c = 0; c < N && ok; ++c) {
+      double d = B(c, c);
+      for (int k = 0; k < c; ++k) d -= B(c, k) * B(c, k);
+      if (!(d > 0.0)) {
+        ok = false;
+        break;
+      }
+      d = std::sqrt(d);
+      B(c, c) = d;
+      dmin = std::min(dmin, d);
+      dmax = std::max(dmax, d);
+      for (int row = c + 1; row < N; ++row) {
+        double e = B(c, row);  // upper triangle holds the sums
+        for (int k = 0; k < c; ++k) e -= B(row, k) * B(c, k);
+        B(row, c) = e / d;
+      }
+    }
+    if (ok && dmax * dmax * kMinRcond <= dmin * dmin) {
+      // A_iᵀ = the first Dim columns of B⁻¹ (B symmetric): solve L Lᵀ X = [I; 0].
+      for (int col = 0; col < Dim; ++col) {
+        Basis y;
+        for (int row = 0; row < N; ++row) {
+          double e = row == col ? 1.0 : 0.0;
+          for (int k = 0; k < row; ++k) e -= B(row, k) * y[k];
+          y[row] = e / B(row, row);
+        }
+        for (int row = N - 1; row >= 0; --row) {
+          double e = y[row];
+          for (int k = row + 1; k < N; ++k) e -= B(k, row) * y[k];
+          y[row] = e / B(row, row);
+        }
+        A[i].row(col) = y.transpose();
+      }
+    } else {
+      A[i].template leftCols<Dim>() = M.inverse();
+    }
   }
 }
 
@@ -429,11 +539,17 @@ void SphSolver<Dim>::gradient_correction() {
 //    ρ̃_i = Σ_j m_j W_ij, ξ_i = Σ_j V_j W_ij (v_j − v_i), v_j the mirror velocity of a boundary j.
 //    As in step 4, each soil–soil pair is evaluated once; j's share (V_i dv ⊗ ∇W_ij,
 //    −m_i dv·∇W_ij, m_i W_ij, −V_i W_ij dv with dv = v_j − v_i) goes to a block buffer (PairBlocks).
-//    With the kernel-gradient correction L_i = Σ_j V_j dv ⊗ C_i ∇W_ij = (Σ_j V_j dv ⊗ ∇W_ij) C_iᵀ: the
-//    plain sum, multiplied by C_iᵀ once it is complete. Continuity, ρ̃ and XSPH keep the plain kernel.
+//    With the kernel-gradient correction (Corrected) L_i = Σ_j V_j dv ⊗ A_i b_ij = S_i A_iᵀ with
+//    S_i = Σ_j V_j dv ⊗ b_ij (Dim × (Dim + Dim(Dim+1)/2)): S_i is summed like the plain L (j's share
+//    V_i (−dv) ⊗ b_ji = V_i [dv ⊗ ∇W_ij, −dv ⊗ F_ij h m]), the particle's own part in its own slot
+//    of its block's buffer, and multiplied by A_iᵀ once complete (the gather's finish). Continuity,
+//    ρ̃ and XSPH keep the plain kernel.
 template <int Dim>
-template <class Kernel>
+template <class Kernel, bool Corrected>
 void SphSolver<Dim>::velocity_gradient() {
+  constexpr int Cols = Corrected ? kBasis : Dim;
+  using Reaction = GradientReactionT<Cols>;
+  using Sum = Eigen::Matrix<double, Dim, Cols>;
   const PairKernel<Kernel> K(h_);
   const MinimumImage<Dim> image(settings_.periodic);
   const std::int64_t n = static_cast<std::int64_t>(store_.size());
@@ -451,17 +567,22 @@ void SphSolver<Dim>::velocity_gradient() {
   const std::uint32_t* idx = nb_.list().indices().data();
   const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
   const std::int64_t nblocks = static_cast<std::int64_t>(blocks.count());
-  pair_grad_.resize(blocks.slots());
+  std::vector<Reaction>* buffer;
+  if constexpr (Corrected)
+    buffer = &pair_grad_corrected_;
+  else
+    buffer = &pair_grad_;
+  buffer->resize(blocks.slots());
+  Reaction* all = buffer->data();
 #pragma omp parallel for schedule(static) if (parallel_worth(n))
   for (std::int64_t bb = 0; bb < nblocks; ++bb) {
     const auto b = static_cast<std::size_t>(bb);
     const std::size_t first = b * blocks.size, last = std::min(blocks.n, first + blocks.size);
-    GradientReaction* mine = blocks.buffer(pair_grad_.data(), b);  // mine[j]: the reaction to j
-    std::fill(mine + first, mine + first + blocks.window(),
-              GradientReaction{Mat<Dim>::Zero(), Vec<Dim>::Zero(), 0.0, 0.0});
+    Reaction* mine = blocks.buffer(all, b);  // mine[j]: the reaction to j
+    std::fill(mine + first, mine + first + blocks.window(), Reaction{Sum::Zero(), Vec<Dim>::Zero(), 0.0, 0.0});
     for (std::size_t i = first; i < last; ++i) {
       if (kind[i] != kSoil) continue;
-      Mat<Dim> Li = Mat<Dim>::Zero();
+      Sum Li = Sum::Zero();
       Vec<Dim> xi_sum = Vec<Dim>::Zero();
       double dr = 0.0, rs = m[i] * K.w_self;
       const Vec<Dim> vi = v[i];
@@ -478,7 +599,13 @@ void SphSolver<Dim>::velocity_gradient() {
         const Vec<Dim> gw = xij * (r > 0.0 ? K.sigma_h * Kernel::shape_derivative(q) / r : 0.0);
         const double w = K.sigma * Kernel::shape(q);
         const Vec<Dim> dv = (soil_j ? v[j] : mirror_velocity<Dim>(v[i], v[j], nrm[j], kind[j] == kRoller)) - vi;
-        const Mat<Dim> dvg = dv * gw.transpose();
+        Sum dvg;
+        if constexpr (Corrected)
+          dvg.noalias() = dv * kernel_basis<Dim, Cols>(gw, r > 0.0 ? -K.sigma_h * Kernel::shape_derivative(q) / r : 0.0,
+                                                       xij, K.inv_h)
+                                   .transpose();
+        else
+          dvg.noalias() = dv * gw.transpose();
         const double dvgw = dv.dot(gw);
         const double Vj = vol[j];
         Li.noalias() += Vj * dvg;
@@ -486,30 +613,69 @@ void SphSolver<Dim>::velocity_gradient() {
         rs += m[j] * w;
         xi_sum += (Vj * w) * dv;
         if (soil_j) {
-          GradientReaction& g = mine[j];
-          g.L.noalias() += Vi * dvg;
+          Reaction& g = mine[j];
+          if constexpr (Corrected) {
+            g.L.template leftCols<Dim>().noalias() += Vi * dvg.template leftCols<Dim>();
+            g.L.template rightCols<Cols - Dim>().noalias() -= Vi * dvg.template rightCols<Cols - Dim>();
+          } else {
+            g.L.noalias() += Vi * dvg;
+          }
           g.drho -= mi * dvgw;
           g.rsum += mi * w;
           g.xs -= (Vi * w) * dv;
         }
       }
-      L[i] = Li;
-      drho[i] = dr;
-      rsum[i] = rs;
-      xs[i] = xi_sum;
+      if constexpr (Corrected) {  // the own sums in the own slot, completed by the gather below
+        Reaction& g = mine[i];
+        g.L += Li;
+        g.drho += dr;
+        g.rsum += rs;
+        g.xs += xi_sum;
+      } else {
+        L[i] = Li;
+        drho[i] = dr;
+        rsum[i] = rs;
+        xs[i] = xi_sum;
+      }
     }
   }
-  const auto add = [&](std::size_t i, const GradientReaction& g) {
-    L[i] += g.L;
-    drho[i] += g.drho;
-    rsum[i] += g.rsum;
-    xs[i] += g.xs;
-  };
-  if (settings_.kernel_correction) {
-    const Mat<Dim>* C = correction_.data();
-    gather_reactions(pair_grad_, add, [&](std::size_t i) { L[i] = (L[i] * C[i].transpose()).eval(); });
+  if constexpr (Corrected) {
+    const auto* A = correction_.data();
+    blocks.gather_max(
+        all,
+        [](std::size_t) {
+          return Reaction{Sum::Zero(), Vec<Dim>::Zero(), 0.0, 0.0};
+        },
+        [](Reaction& t, const Reaction& g) {
+          t.L += g.L;
+          t.drho += g.drho;
+          t.rsum += g.rsum;
+          t.xs += g.xs;
+        },
+        [&](std::size_t i, const Reaction& t) {
+          if (kind[i] != kSoil) return 0.0;
+          L[i].noalias() = t.L * A[i].transpose();
+          drho[i] = t.drho;
+          rsum[i] = t.rsum;
+          xs[i] = t.xs;
+          return 0.0;
+        });
   } else {
-    gather_reactions(pair_grad_, add, [](std::size_t) {});
+    const auto add = [&](std::size_t i, const Reaction& g) {
+      L[i] += g.L;
+      drho[i] += g.drho;
+      rsum[i] += g.rsum;
+      xs[i] += g.xs;
+    };
+    if (settings_.kernel_correction) {  // the linear correction: L_i ← L_i C_iᵀ, C_i = A_i's first Dim columns
+      const auto* A = correction_.data();
+      gather_reactions(pair_grad_, add, [&](std::size_t i) {
+        const Mat<Dim> C = A[i].template leftCols<Dim>();
+        L[i] = (L[i] * C.transpose()).eval();
+      });
+    } else {
+      gather_reactions(pair_grad_, add, [](std::size_t) {});
+    }
   }
 }
 
@@ -591,10 +757,12 @@ void SphSolver<Dim>::update_stress(const Model& /*model*/) {
 //    on any number of threads) gathered after the pass; soil–boundary pairs act on the soil
 //    particle only.
 //    With the kernel-gradient correction (Corrected, step 2) the stress pair becomes
-//    V_j (σ_i C_i + σ_j C_j) ∇W_ij (Bonet & Lok 1999, the form whose work rate is Σ_i V_i σ_i : L̃_i
-//    with the corrected L̃ of step 2); it is still symmetric in i and j, so the reactions and linear
-//    momentum are as before. A boundary particle, the mirror image of i, takes C_i. Viscosity and
-//    artificial stress keep the plain gradient (they are stabilisation terms, not the continuum).
+//    V_j (σ_i g_ij − σ_j g_ji), g_ij = A_i b_ij the corrected gradient vector of step 2 (the form
+//    whose work rate is Σ_i V_i σ_i : L̃_i with the corrected L̃ of step 2, as Bonet & Lok 1999 wrote
+//    it for the linear correction, g_ij = C_i ∇W_ij, g_ji = −C_j ∇W_ij); it is still antisymmetric
+//    under i ↔ j, so the reactions and linear momentum are as before. A boundary particle, the
+//    mirror image of i, takes g_ib: (σ_i + σ_b) g_ib. Viscosity and artificial stress keep the plain
+//    gradient (they are stabilisation terms, not the continuum).
 //    Last-resort wall repulsion (Monaghan 1994 form, exponents 4 and 2): only a soil particle closer
 //    than r0 = wall_repulsion·Δx to a boundary particle feels it — nothing in a normal configuration
 //    (spacing ≈ Δx) — and it stops particles from being squeezed through walls.
@@ -622,7 +790,8 @@ void SphSolver<Dim>::momentum() {
   const Mat<Dim>* R = field<ArtificialStress<Dim>>();
   const std::uint8_t* has_as = has_as_.data();
   Vec<Dim>* acc = field<Acceleration<Dim>>();
-  const Mat<Dim>* C = Corrected ? correction_.data() : nullptr;
+  const auto* A = Corrected ? correction_.data() : nullptr;
+  const bool quadratic = settings_.quadratic_correction;
   const std::uint32_t* off = nb_.list().offsets().data();
   const std::uint32_t* idx = nb_.list().indices().data();
   const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
@@ -669,12 +838,24 @@ void SphSolver<Dim>::momentum() {
           T += (std::pow(f, n_as) * rhoi * rho[j]) * (Ri + R[j]);
         }
         Vec<Dim> Tg = T * gw;
-        if constexpr (Corrected) {
-          const Vec<Dim> cgi = C[i] * gw;
-          if (soil_j)
-            Tg.noalias() += si * cgi + sj * (C[j] * gw);
-          else
-            Tg.noalias() += (si + sj) * cgi;
+        if constexpr (Corrected) {  // σ_i g_ij − σ_j g_ji, g_ij = A_i b_ij (step 2); b_ji: ∇W negated
+          if (!quadratic) {         // the linear correction: g_ij = C_i ∇W_ij, g_ji = −C_j ∇W_ij
+            const Vec<Dim> cgi = A[i].template leftCols<Dim>() * gw;
+            if (soil_j)
+              Tg.noalias() += si * cgi + sj * (A[j].template leftCols<Dim>() * gw);
+            else
+              Tg.noalias() += (si + sj) * cgi;
+          } else {
+            auto b = kernel_basis<Dim, kBasis>(gw, r > 0.0 ? -K.sigma_h * Kernel::shape_derivative(q) / r : 0.0, xij,
+                                               K.inv_h);
+            const Vec<Dim> gij = A[i] * b;
+            if (soil_j) {
+              b.template head<Dim>() = -gw;
+              Tg.noalias() += si * gij - sj * (A[j] * b);
+            } else {
+              Tg.noalias() += (si + sj) * gij;
+            }
+          }
         }
         ai.noalias() += vol[j] * Tg;
         if (soil_j) {
@@ -703,7 +884,7 @@ void SphSolver<Dim>::track_structures(std::vector<Vec<Dim>> base_points) {
 //     particle i from boundary particle b is m_i/ρ_i times its force-density term,
 //       F_ib = V_i {V_b [σ_i + σ_b + ρ_i ρ_b (f^n (R_i + R_b) − Π_ib I)] ∇W_ib + ρ_i c_i² ((r0/r)⁴ − (r0/r)²) x_ib/r²},
 //     the wall-repulsion part only for r < r0 (with the kernel-gradient correction the stress pair
-//     is (σ_i + σ_b) C_i ∇W_ib, as in step 4); the structure receives −F_ib at x_b. This pass must
+//     is (σ_i + σ_b) g_ib, g_ib = A_i b_ib, as in step 4); the structure receives −F_ib at x_b. This pass must
 //     repeat step 4's soil–boundary term exactly: test_physics "StructureLoads" checks that the
 //     loads on all structures balance the soil's momentum change from its boundary pairs.
 //     Summed per block of particles (PairBlocks) and then over the blocks in order: the same sums
@@ -736,7 +917,8 @@ void SphSolver<Dim>::structure_forces() {
   const std::uint32_t* off = nb_.list().offsets().data();
   const std::uint32_t* idx = nb_.list().indices().data();
   const Vec<Dim>* base = structure_base_.data();
-  const Mat<Dim>* C = Corrected ? correction_.data() : nullptr;
+  const auto* A = Corrected ? correction_.data() : nullptr;
+  const bool quadratic = settings_.quadratic_correction;
   const auto ns = static_cast<std::int32_t>(structure_base_.size());
   const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
   const std::int64_t nblocks = static_cast<std::int64_t>(blocks.count());
@@ -780,7 +962,14 @@ void SphSolver<Dim>::structure_forces() {
           T += (std::pow(f, n_as) * rhoi * rho[j]) * (Ri + R[j]);
         }
         Vec<Dim> Tg = T * gw;
-        if constexpr (Corrected) Tg.noalias() += (si + sj) * (C[i] * gw);
+        if constexpr (Corrected) {
+          if (quadratic)
+            Tg.noalias() += (si + sj) * (A[i] * kernel_basis<Dim, kBasis>(
+                                                    gw, r > 0.0 ? -K.sigma_h * Kernel::shape_derivative(q) / r : 0.0,
+                                                    xij, K.inv_h));
+          else
+            Tg.noalias() += (si + sj) * (A[i].template leftCols<Dim>() * gw);
+        }
         Vec<Dim> fi = vol[j] * Tg;  // force density on i from j
         if (r < r_rep) {
           const double q2 = (r_rep * r_rep) / r2;

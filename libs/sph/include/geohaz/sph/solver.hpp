@@ -10,11 +10,13 @@
 ///      soil particle i as its mirror image (Bui et al. 2008): full fixity v_B = 2v_wall − v_i, roller
 ///      v_i with the normal component mirrored; stress σ_B = σ_i − ρ_i d [ḡ_n I + ḡ_t ⊗ ν + ν ⊗ ḡ_t]
 ///      extrapolated along the layering normal ν (d = (x_B − x_i)·ν), shear mirrored for a roller;
-///   2. gradient_correction (only with `kernel_correction`): C_i = M_i⁻¹, M_i = Σ_j V_j ∇_i W_ij ⊗
-///      (x_j − x_i) over all neighbours (boundary particles included), C_i = I where det M_i < 0.2^Dim
-///      (Bonet & Lok 1999; Randles & Libersky 1996; docs/sph.md "Kernel-gradient correction");
+///   2. gradient_correction (only with `kernel_correction`): A_i, the first Dim rows of B_i⁻¹,
+///      B_i = Σ_j V_j F_ij p_ij ⊗ p_ij with p_ij = [x_j − x_i; quadratic monomials] and F_ij = |∇_i W_ij|/r,
+///      over all neighbours (boundary particles included); the plain gradient where det M_i < 0.2^Dim
+///      (M_i the linear block), the linear correction M_i⁻¹ where B_i is ill-conditioned (Bonet & Lok
+///      1999; Randles & Libersky 1996, to second order; docs/sph.md "Kernel-gradient correction");
 ///      velocity_gradient: L_i = Σ_j V_j (v_j − v_i) ⊗ ∇_i W_ij (SPH-slope paper 2020, eqs. 24–25), with the
-///      correction ∇̃_i W_ij = C_i ∇_i W_ij, i.e. L_i ← L_i C_iᵀ; continuity
+///      correction ∇_i W_ij → g_ij = A_i b_ij, b_ij = F_ij p_ij; continuity
 ///      dρ_i/dt = Σ_j m_j (v_i − v_j)·∇_i W_ij (SPH-slope paper 2020, eq. 11), kernel-summation density and the
 ///      XSPH term Σ_j V_j (v_j − v_i) W_ij (SWJTU lecture 2010); each soil–soil pair evaluated once;
 ///   3. update_stress: density and stress update (the constitutive model, chosen once per step,
@@ -25,8 +27,8 @@
 ///      a_i = Σ_j m_j ((σ_i + σ_j)/(ρ_i ρ_j) − Π_ij I + f_ij^n (R_i + R_j)) ∇_i W_ij + ḡ
 ///      with Monaghan's viscosity Π_ij (the model's wave speed), f_ij = W(r)/W(Δx),
 ///      ḡ = g + a_earthquake (Bui et al. 2010, eqs. 25–26); with `kernel_correction` the stress pair is
-///      (σ_i C_i + σ_j C_j) ∇_i W_ij / (ρ_i ρ_j) (Bonet & Lok 1999: conserves linear momentum and
-///      pairs with the corrected L of step 2), a boundary particle taking the C_i of its soil partner;
+///      (σ_i g_ij − σ_j g_ji) / (ρ_i ρ_j) (Bonet & Lok 1999: conserves linear momentum and pairs with
+///      the corrected L of step 2), a boundary particle taking the g_ib of its soil partner;
 ///   4b. structure_forces (only when structures are tracked, track_structures): the force the soil
 ///      exerts on each structure, F_s = −Σ_{i soil, b ∈ s} V_i [V_b T_ib ∇_i W_ib + a_rep,ib ρ_i], the
 ///      reaction of step 4's soil–boundary pair terms, and its moment Σ (x_b − x_base) × F_ib;
@@ -89,12 +91,17 @@ struct NumericalSettings {
   /// Soil particles closer than this many Δx to a boundary particle are pushed back with
   /// a = c_p² ((r0/r)⁴ − (r0/r)²) x/r² (Monaghan 1994 form); 0 switches it off.
   double wall_repulsion = 0.5;
-  /// First-order consistent kernel gradients (Bonet & Lok 1999; Randles & Libersky 1996) in the
-  /// velocity-gradient and momentum sums (solver.cpp, steps 2 and 4); false: the plain kernel
-  /// gradient. One Dim×Dim matrix per particle and one extra pair pass (docs/performance.md).
+  /// Kernel gradients exact for linear and quadratic fields (Bonet & Lok 1999; Randles & Libersky
+  /// 1996, extended to second order) in the velocity-gradient and momentum sums (solver.cpp, steps
+  /// 2 and 4); false: the plain kernel gradient. One Dim × (Dim + Dim(Dim+1)/2) matrix per particle
+  /// and one extra pair pass (docs/performance.md).
   /// sph-slope's `numerics.kernel_correction = "auto"` keeps this default except for the
   /// linear_elastic model, where it turns it on (docs/sph.md, "Kernel-gradient correction").
   bool kernel_correction = false;
+  /// With kernel_correction: the quadratic-complete correction (exact for quadratic fields at free
+  /// surfaces too: a bent beam's outer fibres; docs/sph.md) instead of the linear C_i = M_i⁻¹.
+  /// sph-slope: `numerics.kernel_correction = "quadratic"`.
+  bool quadratic_correction = false;
   EarthquakeLoading earthquake;  ///< applied in the main phase (time from 0 after the geostatic phase)
 };
 
@@ -219,7 +226,7 @@ class SphSolver {
   void prepare_boundary_pairs(const Vec<Dim>& gbar);  // 1
   template <class Kernel>
   void gradient_correction();  // 2 (kernel_correction only)
-  template <class Kernel>
+  template <class Kernel, bool Corrected>
   void velocity_gradient();  // 2
   template <class Model>
   void update_stress(const Model& model);  // 3
@@ -273,21 +280,29 @@ class SphSolver {
   // block_reach_ slots per block (2n–4n).
   std::vector<Vec<Dim>> pair_acc_;
   // Scratch of the velocity-gradient pass: reactions of the soil–soil pairs, as pair_acc_.
-  struct GradientReaction {
-    Mat<Dim> L;   // Σ V_i (v_i − v_j) ⊗ ∇W_ji
+  // With the kernel-gradient correction L holds Σ V_i (v_i − v_j) ⊗ b_ji, b the Dim + Dim(Dim+1)/2
+  // components of the quadratic-complete basis (solver.cpp, step 2); without it Σ V_i (v_i − v_j) ⊗ ∇W_ji.
+  static constexpr int kBasis = Dim + Dim * (Dim + 1) / 2;
+  template <int Cols>
+  struct GradientReactionT {
+    Eigen::Matrix<double, Dim, Cols> L;
     Vec<Dim> xs;  // XSPH sum
     double drho;  // continuity
     double rsum;  // summation density
   };
+  using GradientReaction = GradientReactionT<Dim>;
+  using CorrectedGradientReaction = GradientReactionT<kBasis>;
   std::vector<GradientReaction> pair_grad_;
+  std::vector<CorrectedGradientReaction> pair_grad_corrected_;
   // Tracked structures (pass 4b): base points, the loads of the last step, and the per-block sums
   // (structure count per PairBlocks block, added in block order: the same on any thread count).
   std::vector<Vec<Dim>> structure_base_;
   std::vector<StructureLoad<Dim>> structure_loads_;
   std::vector<StructureLoad<Dim>> structure_block_loads_;
-  // Scratch of the kernel-gradient correction (steps 2 and 4, `kernel_correction` only): C_i of
-  // every particle (identity for boundary particles; empty when the correction is off).
-  std::vector<Mat<Dim>> correction_;
+  // Scratch of the kernel-gradient correction (steps 2 and 4, `kernel_correction` only): A_i of
+  // every particle, the first Dim rows of B_i⁻¹ (solver.cpp, step 2), so that the corrected
+  // gradient vector is g_ij = A_i b_ij ([I 0] for boundary particles; empty when the correction is off).
+  std::vector<Eigen::Matrix<double, Dim, kBasis>> correction_;
   StepStats stats_;
 };
 
