@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include "geohaz/core/errors.hpp"
@@ -180,6 +181,67 @@ TEST(Bishop, StrongFoundationLeavesTheToeCircleInTheSlopeLayer) {
   EXPECT_NEAR(strong.factor, stronger.factor, 1e-3 * strong.factor);
   EXPECT_NEAR(strong.factor, rigid.factor, 3e-3 * rigid.factor);
   EXPECT_GT(strong.factor, below_switch.factor);
+}
+
+// Two-layer undrained clay slope of Table 1 of "Influence of Both Soil Properties and Geometric
+// Parameters on Failure Mechanisms and Stability of Two-Layer Undrained Slopes" (Advances in Materials
+// Science and Engineering 2020, article 4253026; data/sph/two_layer_d15.toml): cot β = 1.5, H = 10 m,
+// firm base D H = 15 m below the crest (a foundation 0.5 H thick below the toe level), φ_u = 0,
+// c_u1 above the toe level, c_u2 = λ c_u1 below it. The paper's c_u1/(γH) is not known to us; with
+// φ = 0 every factor is proportional to c_u1 at fixed λ, so the ratios F(λ)/F(2) are independent of it
+// and of H and γ: those are compared with the paper's limit-equilibrium (LEM) ratios, 3 % (issue #18's
+// tolerance for Bishop). From λ = 1.5 on the paper's mechanism is the shallow toe circle in the slope
+// layer (F the same for every stronger foundation), and at λ = 1.4 both mechanisms give that F: λ = 1.4,
+// 1.5 and 3 within 0.5 % of λ = 2. λ = 0.5 to 1.2 "deep": the critical circle reaches the firm base.
+SlopeSection two_layer_d15_section(double lambda) {
+  SlopeGeometry g;
+  g.height = 10.0;
+  g.gradient = 1.5;
+  g.base_thickness = 5.0;
+  g.crest_length = 20.0;
+  g.front_length = 20.0;
+  auto s = SlopeSection::from_profile(g.profile(), {{20e3, lambda * 50e3, 0.0}, {20e3, 50e3, 0.0}});
+  s.layer_tops = {5.0};
+  s.layer_materials = {0, 1};
+  return s;
+}
+
+TEST(Bishop, TwoLayerSlopeD15MatchesPublishedFactorRatios) {
+  constexpr double kLemShallow = 1.185;  // Table 1, LEM, λ = 1.5 to 3
+  const auto ref = bishop_critical_circle(two_layer_d15_section(2.0));
+  ASSERT_TRUE(ref.admissible());
+  for (const auto& [lambda, lem] : {std::pair{0.5, 0.647}, {0.8, 0.851}, {1.1, 1.060}, {1.2, 1.130}}) {
+    const auto r = bishop_critical_circle(two_layer_d15_section(lambda));
+    ASSERT_TRUE(r.admissible()) << lambda;
+    const double ratio = r.factor / ref.factor, published = lem / kLemShallow;
+    std::printf("lambda %.2f: F %.4f  F/F(2) %.4f  published %.4f  (%+.2f %%)  circle bottom z = %.2f m\n", lambda,
+                r.factor, ratio, published, 100.0 * (ratio / published - 1.0), r.circle.zc - r.circle.radius);
+    EXPECT_NEAR(ratio, published, 0.03 * published) << lambda;
+    // The paper's "deep" mechanism: the critical circle goes down to the firm base.
+    EXPECT_LT(r.circle.zc - r.circle.radius, 0.5) << lambda;
+  }
+  // λ = 1 (one soil): the published 0.967 lies 2.4 % below the chord of its neighbours 0.851 (λ = 0.8)
+  // and 1.130 (1.2), 0.9905, which no factor of safety can: for φ = 0 the factor of every mechanism is
+  // linear in λ (F = (a + λ b)/M), so the minimum over mechanisms is concave in λ (true of the
+  // limit-equilibrium minimum over circles and of the collapse factor, the minimum over kinematic
+  // mechanisms, alike). Ours (+3.3 % from the published λ = 1 ratio) is checked against the chord of
+  // the published λ = 0.8 and 1.2 ratios instead, 3 %.
+  {
+    const auto r = bishop_critical_circle(two_layer_d15_section(1.0));
+    const double ratio = r.factor / ref.factor, chord = 0.5 * (0.851 + 1.130) / kLemShallow;
+    std::printf("lambda 1.00: F %.4f  F/F(2) %.4f  published %.4f (%+.2f %%), chord of 0.8 and 1.2 %.4f (%+.2f %%)\n",
+                r.factor, ratio, 0.967 / kLemShallow, 100.0 * (ratio * kLemShallow / 0.967 - 1.0), chord,
+                100.0 * (ratio / chord - 1.0));
+    EXPECT_NEAR(ratio, chord, 0.03 * chord);
+  }
+  std::printf("lambda 2.00: F %.4f  circle bottom z = %.2f m\n", ref.factor, ref.circle.zc - ref.circle.radius);
+  for (double lambda : {1.4, 1.5, 3.0}) {
+    const auto r = bishop_critical_circle(two_layer_d15_section(lambda));
+    std::printf("lambda %.2f: F %.4f  circle bottom z = %.2f m\n", lambda, r.factor, r.circle.zc - r.circle.radius);
+    EXPECT_NEAR(r.factor, ref.factor, 5e-3 * ref.factor) << lambda;
+  }
+  // "Shallow": the circle stays in the slope layer, above the toe level z = 5 m.
+  EXPECT_GT(ref.circle.zc - ref.circle.radius, 5.0 - 0.05);
 }
 
 TEST(Bishop, CircleBelowTheRigidBottomIsNotAdmissible) {
