@@ -462,8 +462,8 @@ void check_reorder(PairStorage storage) {
     cells.build(x, nb.list_cutoff() / NeighbourList<Dim>::kReach, s.periodic);
     for (std::size_t q = 0; q < x.size(); ++q) ASSERT_EQ(cells.sorted()[q], q);
   }
-  EXPECT_EQ(reordered_at, (std::vector<std::int64_t>{3, 5}));  // rebuilds 2 and 4 (the first is 0)
-  EXPECT_EQ(xb, x);                                            // reference positions reordered with the store
+  EXPECT_EQ(reordered_at, (std::vector<std::int64_t>{1, 3, 5}));  // rebuilds 0, 2 and 4
+  EXPECT_EQ(xb, x);                                               // reference positions reordered with the store
   EXPECT_FALSE(s.skin > 0.0 && nb.update(x, xb).rebuilt);
   for (std::size_t i = 0; i < x.size(); ++i) ASSERT_EQ(x[i], original[static_cast<std::size_t>(id[i])]);
   // The pairs are those of the reordered positions.
@@ -485,8 +485,9 @@ TEST(Neighbours, PermutationReordersTheStoreAndASideTableScan3D) {
 
 // A restart: restore(x_build, builds) rebuilds the saved pairs without reordering and carries on
 // the build count, so an object resumed after five builds reorders at the same rebuild as the one
-// that never stopped (0-based rebuild 6 with reorder_every = 3, builds() = 7 after it); without the
-// count the restored build is rebuild 0 and the reordering comes three rebuilds early.
+// that never stopped (0-based rebuilds 0, 3, 6 with reorder_every = 3; builds() = 7 after the last);
+// without the count the restored build is rebuild 0 and the next reordering comes three rebuilds
+// early.
 TEST(Neighbours, RestoreCarriesTheReorderScheduleOn) {
   const auto x = make_points<2>(600, Layout::Clustered, 7, 1.0);
   std::vector<Vec<2>> xb(x.size());
@@ -503,7 +504,7 @@ TEST(Neighbours, RestoreCarriesTheReorderScheduleOn) {
     return at;
   };
   Neighbours<2> a(s);
-  EXPECT_EQ(reorders(a, 8), (std::vector<std::int64_t>{4, 7}));
+  EXPECT_EQ(reorders(a, 8), (std::vector<std::int64_t>{1, 4, 7}));
   Neighbours<2> b(s);
   b.restore(xb, 5);  // the saved run had built five times
   EXPECT_EQ(b.builds(), 5);

@@ -426,8 +426,9 @@ struct NeighbourSettings {
   /// Verlet skin (m): the list holds the pairs closer than cutoff + skin and is rebuilt when a
   /// particle has drifted more than skin/2 since the last build; 0 rebuilds at every update.
   double skin = 0.0;
-  /// Sort the particles by cell at every reorder_every-th rebuild (counted in rebuilds, the first
-  /// build being rebuild 0; 0: only when update() is asked to).
+  /// Sort the particles by cell at the first build and then at every reorder_every-th rebuild
+  /// (rebuilds 0, N, 2N, … counted from the first build; the order a generator gives says nothing of
+  /// locality); 0: only when update() is asked to.
   int reorder_every = 0;
   PairStorage storage = PairStorage::list;
   Periodicity<Dim> periodic;
@@ -492,9 +493,7 @@ class Neighbours {
     return !valid_ || n != size_ || s_.skin <= 0.0 || max_drift > 0.5 * s_.skin;
   }
   /// Whether a rebuild now would reorder by the schedule of settings.reorder_every.
-  bool reorder_scheduled() const noexcept {
-    return s_.reorder_every > 0 && builds_ > 0 && builds_ % s_.reorder_every == 0;
-  }
+  bool reorder_scheduled() const noexcept { return s_.reorder_every > 0 && builds_ % s_.reorder_every == 0; }
 
   /// Rebuild the pairs if due (see the class comment) and reorder if due or if `reorder` is set
   /// (which forces a rebuild). max_drift < 0: computed here from x and x_build. x_build may be
