@@ -156,7 +156,126 @@ inline Eigen::Matrix<double, N, 1> kernel_basis(const Vec<Dim>& gw, double F, co
   return b;
 }
 
+/// Step 4's pair term, written once for the momentum pass and for step 4b (structure_forces), which
+/// must repeat its soil–boundary part exactly: for soil particle i and neighbour j (soil, or a
+/// boundary particle acting as i's mirror image) closer than the cut-off, the force density on i
+/// per unit volume of j,
+///   T_ij ∇W_ij,  T_ij = σ_i + σ_j − Π_ij ρ_i ρ_j I + f_ij^n ρ_i ρ_j (R_i + R_j),
+/// with the stress pair taken with the corrected gradients instead when the kernel correction is
+/// on (linear: σ_i C_i ∇W_ij + σ_j C_j ∇W_ij between soil particles, (σ_i + σ_b) C_i ∇W_ib at a
+/// wall; quadratic: the same with g_ij = A_i b_ij); and the wall repulsion on i. The arrays are the
+/// state before the integration; solver.hpp momentum_pair_term() fills them.
+template <int Dim, int Basis, class Kernel, bool Corrected>
+struct MomentumPairTerm {
+  PairKernel<Kernel> K;
+  MinimumImage<Dim> image;
+  double w_dx, n_as, alpha, beta, h, eta2, r_rep;
+  const double* wave;
+  const Vec<Dim>* x;
+  const Vec<Dim>* v;
+  const double* rho;
+  const double* vol;
+  const std::int32_t* mat;
+  const std::uint8_t* kind;
+  const Vec<Dim>* nrm;
+  const Vec<Dim>* lnrm;
+  const Mat<Dim>* ps;
+  const Mat<Dim>* R;
+  const std::uint8_t* has_as;
+  const Eigen::Matrix<double, Dim, Basis>* A;  // correction (Corrected only)
+  bool quadratic;
+
+  /// What particle i brings to each of its pairs, read once.
+  struct Self {
+    Mat<Dim> s, R;
+    bool has_R;
+    double c, V, rho;
+  };
+  Self self(std::size_t i) const { return {ps[i], R[i], has_as[i] != 0, wave[mat[i]], vol[i], rho[i]}; }
+
+  /// T_ij ∇W_ij for the pair at xij = x_i − x_j, r = |xij| below the cut-off.
+  [[gnu::always_inline]] inline Vec<Dim> operator()(const Self& I, std::size_t i, std::size_t j, bool soil_j,
+                                                    const Vec<Dim>& xij, double r) const {
+    const double q = r * K.inv_h;
+    const Vec<Dim> gw = xij * (r > 0.0 ? K.sigma_h * Kernel::shape_derivative(q) / r : 0.0);
+    const bool roller = kind[j] == kRoller;
+    const Mat<Dim> sj = soil_j ? ps[j] : mirror_stress<Dim>(I.s, I.rho, xij, lnrm[j], ps[j], nrm[j], roller);
+    Mat<Dim> T;
+    if constexpr (Corrected)
+      T.setZero();  // the stress pair is added below with the corrected gradients
+    else
+      T = I.s + sj;
+    const Vec<Dim> vij = v[i] - (soil_j ? v[j] : mirror_velocity<Dim>(v[i], v[j], nrm[j], roller));
+    const double vr = vij.dot(xij);
+    if (vr < 0.0 && alpha + beta > 0.0)
+      T.diagonal().array() -= viscous_pressure(alpha, beta, I.c, wave[mat[j]], h * vr / (r * r + eta2), I.rho, rho[j]);
+    if (I.has_R || has_as[j]) {
+      const double f = K.sigma * Kernel::shape(q) / w_dx;
+      T += (std::pow(f, n_as) * I.rho * rho[j]) * (I.R + R[j]);
+    }
+    Vec<Dim> Tg = T * gw;
+    if constexpr (Corrected) {  // σ_i g_ij − σ_j g_ji, g_ij = A_i b_ij (step 2); b_ji: ∇W negated
+      if (!quadratic) {         // the linear correction: g_ij = C_i ∇W_ij, g_ji = −C_j ∇W_ij
+        const Vec<Dim> cgi = A[i].template leftCols<Dim>() * gw;
+        if (soil_j)
+          Tg.noalias() += I.s * cgi + sj * (A[j].template leftCols<Dim>() * gw);
+        else
+          Tg.noalias() += (I.s + sj) * cgi;
+      } else {
+        auto b =
+            kernel_basis<Dim, Basis>(gw, r > 0.0 ? -K.sigma_h * Kernel::shape_derivative(q) / r : 0.0, xij, K.inv_h);
+        const Vec<Dim> gij = A[i] * b;
+        if (soil_j) {
+          b.template head<Dim>() = -gw;
+          Tg.noalias() += I.s * gij - sj * (A[j] * b);
+        } else {
+          Tg.noalias() += (I.s + sj) * gij;
+        }
+      }
+    }
+    return Tg;
+  }
+
+  /// Wall repulsion on soil particle i from a boundary particle at xij (r² = |xij|², r < r_rep):
+  /// ρ_i c_i² ((r0/r)⁴ − (r0/r)²) x_ij/r².
+  Vec<Dim> repulsion(const Self& I, const Vec<Dim>& xij, double r2) const {
+    const double q2 = (r_rep * r_rep) / r2;
+    return (I.rho * I.c * I.c * (q2 * q2 - q2) / r2) * xij;
+  }
+};
+
 }  // namespace
+
+template <int Dim>
+template <class Kernel, bool Corrected>
+auto SphSolver<Dim>::momentum_pair_term() {
+  const PairKernel<Kernel> K(h_);
+  const double w_dx = Kernel::value(settings_.spacing, h_);
+  return MomentumPairTerm<Dim, kBasis, Kernel, Corrected>{
+      .K = K,
+      .image = MinimumImage<Dim>(settings_.periodic),
+      .w_dx = w_dx,
+      .n_as = settings_.artificial_stress_n > 0.0 ? settings_.artificial_stress_n : K.w_self / w_dx,
+      .alpha = settings_.viscosity_alpha,
+      .beta = settings_.viscosity_beta,
+      .h = h_,
+      .eta2 = 0.01 * h_ * h_,
+      .r_rep = settings_.wall_repulsion * settings_.spacing,
+      .wave = wave_speed_.data(),
+      .x = field<Position<Dim>>(),
+      .v = field<Velocity<Dim>>(),
+      .rho = field<Density>(),
+      .vol = field<Volume>(),
+      .mat = field<MaterialId>(),
+      .kind = field<ParticleKind>(),
+      .nrm = field<WallNormal<Dim>>(),
+      .lnrm = field<LayerNormal<Dim>>(),
+      .ps = field<PairStress<Dim>>(),
+      .R = field<ArtificialStress<Dim>>(),
+      .has_as = has_as_.data(),
+      .A = Corrected ? correction_.data() : nullptr,
+      .quadratic = settings_.quadratic_correction};
+}
 
 template <int Dim>
 SphSolver<Dim>::SphSolver(SphStore<Dim> store, std::vector<MaterialParams> materials, ConstitutiveModel model,
@@ -769,29 +888,11 @@ void SphSolver<Dim>::update_stress(const Model& /*model*/) {
 template <int Dim>
 template <class Kernel, bool Corrected>
 void SphSolver<Dim>::momentum() {
-  const PairKernel<Kernel> K(h_);
-  const MinimumImage<Dim> image(settings_.periodic);
-  const double w_dx = Kernel::value(settings_.spacing, h_);
-  const double n_as = settings_.artificial_stress_n > 0.0 ? settings_.artificial_stress_n : K.w_self / w_dx;
-  const double alpha = settings_.viscosity_alpha, beta = settings_.viscosity_beta;
-  const double h = h_, eta2 = 0.01 * h * h;
-  const double r_rep = settings_.wall_repulsion * settings_.spacing;
-  const double* wave = wave_speed_.data();
+  const auto P = momentum_pair_term<Kernel, Corrected>();
   const std::int64_t n = static_cast<std::int64_t>(store_.size());
-  const Vec<Dim>* x = field<Position<Dim>>();
-  const Vec<Dim>* v = field<Velocity<Dim>>();
-  const double* rho = field<Density>();
-  const double* vol = field<Volume>();
-  const std::int32_t* mat = field<MaterialId>();
-  const std::uint8_t* kind = field<ParticleKind>();
-  const Vec<Dim>* nrm = field<WallNormal<Dim>>();
-  const Vec<Dim>* lnrm = field<LayerNormal<Dim>>();
-  const Mat<Dim>* ps = field<PairStress<Dim>>();
-  const Mat<Dim>* R = field<ArtificialStress<Dim>>();
-  const std::uint8_t* has_as = has_as_.data();
+  const double* rho = P.rho;
+  const std::uint8_t* kind = P.kind;
   Vec<Dim>* acc = field<Acceleration<Dim>>();
-  const auto* A = Corrected ? correction_.data() : nullptr;
-  const bool quadratic = settings_.quadratic_correction;
   const std::uint32_t* off = nb_.list().offsets().data();
   const std::uint32_t* idx = nb_.list().indices().data();
   const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
@@ -805,65 +906,22 @@ void SphSolver<Dim>::momentum() {
     std::fill(mine + first, mine + first + blocks.window(), Vec<Dim>::Zero());
     for (std::size_t i = first; i < last; ++i) {
       if (kind[i] != kSoil) continue;
-      const Mat<Dim> si = ps[i];
-      const Mat<Dim> Ri = R[i];
-      const bool has_Ri = has_as[i];
-      const double ci = wave[mat[i]];
-      const double Vi = vol[i], rhoi = rho[i];
+      const auto I = P.self(i);
       Vec<Dim> ai = Vec<Dim>::Zero();
       for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
         const std::uint32_t j = idx[k];
         const bool soil_j = kind[j] == kSoil;
         if (soil_j && j < i) continue;  // evaluated from j's side
-        const Vec<Dim> xij = image(x[i], x[j]);
+        const Vec<Dim> xij = P.image(P.x[i], P.x[j]);
         const double r2 = xij.squaredNorm();
-        if (r2 >= K.cutoff2) continue;
+        if (r2 >= P.K.cutoff2) continue;
         const double r = std::sqrt(r2);
-        const double q = r * K.inv_h;
-        const Vec<Dim> gw = xij * (r > 0.0 ? K.sigma_h * Kernel::shape_derivative(q) / r : 0.0);
-        const Mat<Dim> sj =
-            soil_j ? ps[j] : mirror_stress<Dim>(si, rhoi, xij, lnrm[j], ps[j], nrm[j], kind[j] == kRoller);
-        Mat<Dim> T;
-        if constexpr (Corrected)
-          T.setZero();  // the stress pair is added below with the corrected gradients
-        else
-          T = si + sj;
-        const Vec<Dim> vij = v[i] - (soil_j ? v[j] : mirror_velocity<Dim>(v[i], v[j], nrm[j], kind[j] == kRoller));
-        const double vr = vij.dot(xij);
-        if (vr < 0.0 && alpha + beta > 0.0)
-          T.diagonal().array() -=
-              viscous_pressure(alpha, beta, ci, wave[mat[j]], h * vr / (r * r + eta2), rhoi, rho[j]);
-        if (has_Ri || has_as[j]) {
-          const double f = K.sigma * Kernel::shape(q) / w_dx;
-          T += (std::pow(f, n_as) * rhoi * rho[j]) * (Ri + R[j]);
-        }
-        Vec<Dim> Tg = T * gw;
-        if constexpr (Corrected) {  // σ_i g_ij − σ_j g_ji, g_ij = A_i b_ij (step 2); b_ji: ∇W negated
-          if (!quadratic) {         // the linear correction: g_ij = C_i ∇W_ij, g_ji = −C_j ∇W_ij
-            const Vec<Dim> cgi = A[i].template leftCols<Dim>() * gw;
-            if (soil_j)
-              Tg.noalias() += si * cgi + sj * (A[j].template leftCols<Dim>() * gw);
-            else
-              Tg.noalias() += (si + sj) * cgi;
-          } else {
-            auto b = kernel_basis<Dim, kBasis>(gw, r > 0.0 ? -K.sigma_h * Kernel::shape_derivative(q) / r : 0.0, xij,
-                                               K.inv_h);
-            const Vec<Dim> gij = A[i] * b;
-            if (soil_j) {
-              b.template head<Dim>() = -gw;
-              Tg.noalias() += si * gij - sj * (A[j] * b);
-            } else {
-              Tg.noalias() += (si + sj) * gij;
-            }
-          }
-        }
-        ai.noalias() += vol[j] * Tg;
-        if (soil_j) {
-          mine[j].noalias() -= Vi * Tg;
-        } else if (r < r_rep) {  // wall repulsion
-          const double q2 = (r_rep * r_rep) / r2;
-          ai.noalias() += (rhoi * ci * ci * (q2 * q2 - q2) / r2) * xij;
-        }
+        const Vec<Dim> Tg = P(I, i, j, soil_j, xij, r);
+        ai.noalias() += P.vol[j] * Tg;
+        if (soil_j)
+          mine[j].noalias() -= I.V * Tg;
+        else if (r < P.r_rep)
+          ai.noalias() += P.repulsion(I, xij, r2);
       }
       acc[i] = ai;
     }
@@ -884,41 +942,23 @@ void SphSolver<Dim>::track_structures(std::vector<Vec<Dim>> base_points) {
 //     particle i from boundary particle b is m_i/ρ_i times its force-density term,
 //       F_ib = V_i {V_b [σ_i + σ_b + ρ_i ρ_b (f^n (R_i + R_b) − Π_ib I)] ∇W_ib + ρ_i c_i² ((r0/r)⁴ − (r0/r)²) x_ib/r²},
 //     the wall-repulsion part only for r < r0 (with the kernel-gradient correction the stress pair
-//     is (σ_i + σ_b) g_ib, g_ib = A_i b_ib, as in step 4); the structure receives −F_ib at x_b. This pass must
-//     repeat step 4's soil–boundary term exactly: test_physics "StructureLoads" checks that the
-//     loads on all structures balance the soil's momentum change from its boundary pairs.
+//     is (σ_i + σ_b) g_ib, g_ib = A_i b_ib, as in step 4); the structure receives −F_ib at x_b. The
+//     term is step 4's own (MomentumPairTerm), so the two cannot drift apart; test_physics
+//     "StructureLoads" checks that the loads on all structures balance the soil's momentum change
+//     from its boundary pairs.
 //     Summed per block of particles (PairBlocks) and then over the blocks in order: the same sums
 //     on any number of threads.
 template <int Dim>
 template <class Kernel, bool Corrected>
 void SphSolver<Dim>::structure_forces() {
   if (structure_base_.empty()) return;
-  const PairKernel<Kernel> K(h_);
-  const MinimumImage<Dim> image(settings_.periodic);
-  const double w_dx = Kernel::value(settings_.spacing, h_);
-  const double n_as = settings_.artificial_stress_n > 0.0 ? settings_.artificial_stress_n : K.w_self / w_dx;
-  const double alpha = settings_.viscosity_alpha, beta = settings_.viscosity_beta;
-  const double h = h_, eta2 = 0.01 * h * h;
-  const double r_rep = settings_.wall_repulsion * settings_.spacing;
-  const double* wave = wave_speed_.data();
+  const auto P = momentum_pair_term<Kernel, Corrected>();
   const std::int64_t n = static_cast<std::int64_t>(store_.size());
-  const Vec<Dim>* x = field<Position<Dim>>();
-  const Vec<Dim>* v = field<Velocity<Dim>>();
-  const double* rho = field<Density>();
-  const double* vol = field<Volume>();
-  const std::int32_t* mat = field<MaterialId>();
-  const std::uint8_t* kind = field<ParticleKind>();
+  const std::uint8_t* kind = P.kind;
   const std::int32_t* sid = field<StructureId>();
-  const Vec<Dim>* nrm = field<WallNormal<Dim>>();
-  const Vec<Dim>* lnrm = field<LayerNormal<Dim>>();
-  const Mat<Dim>* ps = field<PairStress<Dim>>();
-  const Mat<Dim>* R = field<ArtificialStress<Dim>>();
-  const std::uint8_t* has_as = has_as_.data();
   const std::uint32_t* off = nb_.list().offsets().data();
   const std::uint32_t* idx = nb_.list().indices().data();
   const Vec<Dim>* base = structure_base_.data();
-  const auto* A = Corrected ? correction_.data() : nullptr;
-  const bool quadratic = settings_.quadratic_correction;
   const auto ns = static_cast<std::int32_t>(structure_base_.size());
   const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
   const std::int64_t nblocks = static_cast<std::int64_t>(blocks.count());
@@ -931,52 +971,18 @@ void SphSolver<Dim>::structure_forces() {
     StructureLoad<Dim>* mine = all + b * structure_base_.size();
     for (std::size_t i = first; i < last; ++i) {
       if (kind[i] != kSoil) continue;
-      const Mat<Dim> si = ps[i];
-      const Mat<Dim> Ri = R[i];
-      const bool has_Ri = has_as[i];
-      const double ci = wave[mat[i]];
-      const double Vi = vol[i], rhoi = rho[i];
+      const auto I = P.self(i);
       for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
         const std::uint32_t j = idx[k];
         if (kind[j] == kSoil || sid[j] < 0 || sid[j] >= ns) continue;
-        const Vec<Dim> xij = image(x[i], x[j]);
+        const Vec<Dim> xij = P.image(P.x[i], P.x[j]);
         const double r2 = xij.squaredNorm();
-        if (r2 >= K.cutoff2) continue;
+        if (r2 >= P.K.cutoff2) continue;
         const double r = std::sqrt(r2);
-        const double q = r * K.inv_h;
-        const Vec<Dim> gw = xij * (r > 0.0 ? K.sigma_h * Kernel::shape_derivative(q) / r : 0.0);
-        const bool roller = kind[j] == kRoller;
-        const Mat<Dim> sj = mirror_stress<Dim>(si, rhoi, xij, lnrm[j], ps[j], nrm[j], roller);
-        Mat<Dim> T;
-        if constexpr (Corrected)
-          T.setZero();  // the stress pair with the corrected gradient, as in step 4
-        else
-          T = si + sj;
-        const Vec<Dim> vij = v[i] - mirror_velocity<Dim>(v[i], v[j], nrm[j], roller);
-        const double vr = vij.dot(xij);
-        if (vr < 0.0 && alpha + beta > 0.0)
-          T.diagonal().array() -=
-              viscous_pressure(alpha, beta, ci, wave[mat[j]], h * vr / (r * r + eta2), rhoi, rho[j]);
-        if (has_Ri || has_as[j]) {
-          const double f = K.sigma * Kernel::shape(q) / w_dx;
-          T += (std::pow(f, n_as) * rhoi * rho[j]) * (Ri + R[j]);
-        }
-        Vec<Dim> Tg = T * gw;
-        if constexpr (Corrected) {
-          if (quadratic)
-            Tg.noalias() += (si + sj) * (A[i] * kernel_basis<Dim, kBasis>(
-                                                    gw, r > 0.0 ? -K.sigma_h * Kernel::shape_derivative(q) / r : 0.0,
-                                                    xij, K.inv_h));
-          else
-            Tg.noalias() += (si + sj) * (A[i].template leftCols<Dim>() * gw);
-        }
-        Vec<Dim> fi = vol[j] * Tg;  // force density on i from j
-        if (r < r_rep) {
-          const double q2 = (r_rep * r_rep) / r2;
-          fi.noalias() += (rhoi * ci * ci * (q2 * q2 - q2) / r2) * xij;
-        }
-        const Vec<Dim> F = -Vi * fi;  // on the structure
-        const Vec<Dim> arm = image(x[j], base[sid[j]]);
+        Vec<Dim> fi = P.vol[j] * P(I, i, j, false, xij, r);  // force density on i from j
+        if (r < P.r_rep) fi.noalias() += P.repulsion(I, xij, r2);
+        const Vec<Dim> F = -I.V * fi;  // on the structure
+        const Vec<Dim> arm = P.image(P.x[j], base[sid[j]]);
         StructureLoad<Dim>& load = mine[sid[j]];
         load.force += F;
         if constexpr (Dim == 3)

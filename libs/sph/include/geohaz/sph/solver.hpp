@@ -233,6 +233,8 @@ class SphSolver {
   template <class T, class Add, class Finish>
   void gather_reactions(const std::vector<T>& buffer, Add&& add, Finish&& finish);  // 2, 4
   template <class Kernel, bool Corrected>
+  auto momentum_pair_term();  // step 4's pair term, shared by 4 and 4b (solver.cpp)
+  template <class Kernel, bool Corrected>
   void momentum();  // 4
   template <class Kernel, bool Corrected>
   void structure_forces();               // 4b (tracked structures only)
