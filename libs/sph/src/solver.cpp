@@ -569,6 +569,16 @@ void SphSolver<Dim>::gradient_correction() {
   correction_.resize(static_cast<std::size_t>(n));
   auto* A = correction_.data();
   const bool quadratic = settings_.quadratic_correction;
+  // f(j, x_ij, r) for every neighbour j of i within the support, i itself excluded.
+  const auto support_pairs = [&](std::size_t i, auto&& f) {
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+      const std::uint32_t j = idx[k];
+      const Vec<Dim> xij = image(x[i], x[j]);
+      const double r2 = xij.squaredNorm();
+      if (r2 >= K.cutoff2 || r2 == 0.0) continue;
+      f(j, xij, std::sqrt(r2));
+    }
+  };
 #pragma omp parallel for schedule(static) if (parallel_worth(n))
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
@@ -577,25 +587,15 @@ void SphSolver<Dim>::gradient_correction() {
     if (kind[i] != kSoil) continue;
     if (!quadratic) {  // the linear correction alone: C_i = M_i⁻¹ (Bonet & Lok 1999)
       Mat<Dim> M = Mat<Dim>::Zero();
-      for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
-        const std::uint32_t j = idx[k];
-        const Vec<Dim> xij = image(x[i], x[j]);
-        const double r2 = xij.squaredNorm();
-        if (r2 >= K.cutoff2 || r2 == 0.0) continue;
-        const double r = std::sqrt(r2);
+      support_pairs(i, [&](std::uint32_t j, const Vec<Dim>& xij, double r) {
         const Vec<Dim> gw = xij * (K.sigma_h * Kernel::shape_derivative(r * K.inv_h) / r);
         M.noalias() -= vol[j] * gw * xij.transpose();  // V_j ∇W_ij ⊗ (x_j − x_i)
-      }
+      });
       if (M.determinant() >= kMinMomentDet) A[i].template leftCols<Dim>() = M.inverse();
       continue;
     }
     Moments B = Moments::Zero();  // upper triangle only until the factorisation
-    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
-      const std::uint32_t j = idx[k];
-      const Vec<Dim> xij = image(x[i], x[j]);
-      const double r2 = xij.squaredNorm();
-      if (r2 >= K.cutoff2 || r2 == 0.0) continue;
-      const double r = std::sqrt(r2);
+    support_pairs(i, [&](std::uint32_t j, const Vec<Dim>& xij, double r) {
       const double F = -K.sigma_h * Kernel::shape_derivative(r * K.inv_h) / r;  // |∇_i W_ij|/r
       Basis p;                                                                  // [r; h m(r/h)], r = x_j − x_i
       p.template head<Dim>() = -xij;
@@ -605,7 +605,7 @@ void SphSolver<Dim>::gradient_correction() {
       const double wgt = vol[j] * F;
       for (int a = 0; a < N; ++a)  // V_j b_ij ⊗ p_ij = V_j F_ij p_ij ⊗ p_ij (symmetric)
         for (int d = a; d < N; ++d) B(a, d) += wgt * p[a] * p[d];
-    }
+    });
     Mat<Dim> M;
     for (int a = 0; a < Dim; ++a)
       for (int d = 0; d < Dim; ++d) M(a, d) = B(std::min(a, d), std::max(a, d));
