@@ -602,15 +602,19 @@ TEST(SphSlopeApp, ClampedCantileverHalfPeriodNearBeamTheory) {
   const fs::path out = kWork / "cantilever";
   fs::remove_all(out);
   const auto r = run("--config " + (kData / "cantilever.toml").string() + " --out " + out.string() +
-                         " --set run.end_time=0.068 --set numerics.kernel_correction=quadratic --quiet",
+                         " --set run.end_time=0.068 --quiet",
                      "cantilever");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto t = zero_crossings(out / "series.csv", 11);
   ASSERT_GE(t.size(), 1u) << "the free end never swung back through zero";
   const double period = 2.0 * t[0], timoshenko = 0.11911;
   std::printf("cantilever: T = %.5f s, %+.2f %% from Timoshenko\n", period, 100.0 * (period / timoshenko - 1.0));
-  EXPECT_NEAR(period, 0.1230, 0.01 * 0.1230) << "stored value";
-  EXPECT_LT(std::abs(period / timoshenko - 1.0), 0.04) << "physics bound";
+  // The default (linear) correction: the CI case. The quadratic one (0.1230 s, +3.2 %) costs twice
+  // the instructions (over 5 minutes under the sanitizers); its exactness is tested at the unit
+  // level (KernelCorrection.Quadratic*, StepGolden.QuadraticCorrected*); its period is measured and
+  // drawn by Validation.CantileverPeriodAndDeflectionConverge.
+  EXPECT_NEAR(period, 0.1253, 0.01 * 0.1253) << "stored value";
+  EXPECT_LT(std::abs(period / timoshenko - 1.0), 0.08) << "physics bound";
   geohaz::SnapshotReader snap(out / "snapshots.h5");
   const std::size_t last = snap.snapshot_count() - 1;
   const auto clamped = snap.read(last, "clamped"), u = snap.read(last, "displacement");
