@@ -273,17 +273,16 @@ void Neighbours<Dim>::build(std::span<const Vec<Dim>> x) {
 }
 
 template <int Dim>
-NeighbourUpdate Neighbours<Dim>::update(std::span<const Vec<Dim>> x, std::span<Vec<Dim>> x_build, double max_drift,
-                                        bool reorder) {
+NeighbourUpdate Neighbours<Dim>::update(std::span<const Vec<Dim>> x, std::span<Vec<Dim>> x_build, double max_drift) {
   if (!(s_.cutoff > 0.0)) throw std::logic_error("Neighbours::update before configure");
   const bool track = s_.skin > 0.0;
   if (track && x_build.size() != x.size())
     throw std::invalid_argument("Neighbours::update: x_build must have one entry per particle with a skin");
-  if (track && valid_ && x.size() == size_ && max_drift < 0.0 && !reorder) max_drift = this->max_drift(x, x_build);
+  if (track && valid_ && x.size() == size_ && max_drift < 0.0) max_drift = this->max_drift(x, x_build);
   NeighbourUpdate u;
-  if (!reorder && !rebuild_due(x.size(), max_drift)) return u;
+  if (!rebuild_due(x.size(), max_drift)) return u;
   u.rebuilt = true;
-  if ((reorder || reorder_scheduled()) && x.size() > 1) {
+  if (reorder_scheduled() && x.size() > 1) {
     // The cell order of the pairs' own grid (cells of edge list_cutoff/kReach, as the list and the
     // scan bin them), so the permutation is the one a build would report.
     order_.build(x, list_cutoff() / NeighbourList<Dim>::kReach, s_.periodic);

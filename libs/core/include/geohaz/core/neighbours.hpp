@@ -428,7 +428,7 @@ struct NeighbourSettings {
   double skin = 0.0;
   /// Sort the particles by cell at the first build and then at every reorder_every-th rebuild
   /// (rebuilds 0, N, 2N, … counted from the first build; the order a generator gives says nothing of
-  /// locality); 0: only when update() is asked to.
+  /// locality); 0: never.
   int reorder_every = 0;
   PairStorage storage = PairStorage::list;
   Periodicity<Dim> periodic;
@@ -455,13 +455,14 @@ struct NeighbourUpdate {
 ///     with reactions in nb.blocks() buffers, gathered in fixed order by blocks().gather(...)
 ///
 /// Rebuild rule: at the first update, after invalidate() or configure(), when the particle count
-/// changed, when the skin is 0, when a reorder is asked for, or when the largest drift since the
+/// changed, when the skin is 0, or when the largest drift since the
 /// last build, |x_i − x_build,i| (minimum image), exceeds skin/2 (strictly: at exactly skin/2 no
 /// pair can have closed by more than the skin). The reference positions x_build belong to the
 /// caller's store (so they move with every reordering and are saved in snapshots); update() writes
 /// x into them at each rebuild.
 ///
-/// Reordering: at a rebuild that is due one (settings.reorder_every, or asked for by the caller),
+/// Reordering: at a rebuild that is due one (settings.reorder_every: the object's schedule is the only
+/// one, the same in every model),
 /// the particles' cell order is returned as a permutation, and the pairs are built for the
 /// permuted positions, so the caller applies the permutation and carries on: the same pairs as a
 /// rebuild after reordering the store, for one pair search instead of two.
@@ -495,11 +496,10 @@ class Neighbours {
   /// Whether a rebuild now would reorder by the schedule of settings.reorder_every.
   bool reorder_scheduled() const noexcept { return s_.reorder_every > 0 && builds_ % s_.reorder_every == 0; }
 
-  /// Rebuild the pairs if due (see the class comment) and reorder if due or if `reorder` is set
-  /// (which forces a rebuild). max_drift < 0: computed here from x and x_build. x_build may be
-  /// empty when the skin is 0 (no drift to track); otherwise it must have x.size() entries.
-  NeighbourUpdate update(std::span<const Vec<Dim>> x, std::span<Vec<Dim>> x_build, double max_drift = -1.0,
-                         bool reorder = false);
+  /// Rebuild the pairs if due (see the class comment), reordering at the scheduled rebuilds.
+  /// max_drift < 0: computed here from x and x_build. x_build may be empty when the skin is 0 (no
+  /// drift to track); otherwise it must have x.size() entries.
+  NeighbourUpdate update(std::span<const Vec<Dim>> x, std::span<Vec<Dim>> x_build, double max_drift = -1.0);
   /// Build the pairs for the given reference positions without reordering (resuming a run from a
   /// snapshot: the pairs, and so the order of every pair sum, are those of the saved run), and set
   /// the build count to `builds` (the saved run's builds(), so the reordering schedule goes on where
