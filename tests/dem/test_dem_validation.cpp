@@ -362,7 +362,9 @@ TEST_P(SingleBlockOutlineResolution, TravelAngleOfSeveralPackings) {
 }
 
 // R = 0.1 is split in two so that its two halves can run side by side (≈ 5 min per packing on one
-// busy core); R = 0.05 (≈ 40 min per packing) was not run.
+// busy core); R = 0.05 (≈ 40 min per packing) was not run. The last three: R = 0.4 with the
+// corner-impact damping options (fragment-mass terrain dashpots and the tangential dashpot, bonds
+// 2e8 and 2e10 Pa) and the 2e10 bonds alone (third session; ≈ 5, 28 and 39 s per packing).
 INSTANTIATE_TEST_SUITE_P(DemValidation, SingleBlockOutlineResolution,
                          ::testing::Values(BlockResolutionCase{0.4, 1, 10}, BlockResolutionCase{0.2, 1, 10},
                                            BlockResolutionCase{0.1, 1, 3}, BlockResolutionCase{0.1, 4, 6},

@@ -204,7 +204,7 @@ struct ContactProperties {
   double rolling_damping = 0.3;
   /// Tangential dashpot as a fraction f ∈ [0, 1] of the normal one's damping ratio: c_t =
   /// f c_n √(k_t/k_n), i.e. the damping ratio f ζ on the tangential spring with the same m*
-  /// (Cundall & Strack 1979 damp both directions; Tsuji et al. 1992 the same ratio). Applied only
+  /// (Cundall & Strack 1979 damp both directions). Applied only
   /// while the contact sticks; 0 (default): no tangential dashpot.
   double tangential_damping = 0.0;
   /// Mass m* of the disc–wall and disc–terrain dashpots (normal and tangential): false (default)
