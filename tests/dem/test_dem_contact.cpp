@@ -468,3 +468,80 @@ TEST(DemContact, DiscRestsOnTerrainWhileTheSlopeIsBelowItsRollingResistance) {
   EXPECT_LT(std::abs(travel(27.0)), 1e-3);
   EXPECT_GT(travel(33.0), 0.1);
 }
+
+namespace {
+/// A disc (R = 0.5 m, no rolling resistance, μ = 10 so that it sticks) thrown obliquely onto
+/// terrain with normal speed vn and tangential speed ut of its contact point, no gravity; returns
+/// the contact-point tangential velocity after / before, the contact duration, and the kinetic
+/// energy after / before.
+struct ObliqueResult {
+  double beta, duration, energy_ratio;
+};
+ObliqueResult oblique_impact(double e, double f_t, double vn, double ut) {
+  DemSolver s;
+  s.settings.gravity = Vec2::Zero();
+  s.law = LinearSpringCoulomb{1e8, 1e8 / 2.5};
+  s.contact.rolling_friction = 0.0;
+  s.contact.tangential_damping = f_t;
+  const double R = 0.5;
+  add_disc(s.discs, Vec2(1.0, R + 1e-6), R, 2650);
+  s.discs.get<Velocity<2>>()[0] = Vec2(ut, -vn);
+  s.terrain.add_polyline({Vec2(-5, 0), Vec2(5, 0)}, 10.0, e);
+  s.initialise();
+  auto energy = [&] {
+    const double m = s.discs.get<Mass>()[0], I = s.discs.get<Inertia>()[0], w = s.discs.get<AngularVelocity>()[0];
+    return 0.5 * m * s.discs.get<Velocity<2>>()[0].squaredNorm() + 0.5 * I * w * w;
+  };
+  const double e0 = energy();
+  double t_in = -1, t_out = -1;
+  for (int k = 0; k < 100000 && t_out < 0; ++k) {
+    s.step();
+    const double y = s.discs.get<Position<2>>()[0].y();
+    if (y < R && t_in < 0) t_in = s.time();
+    if (y >= R && t_in >= 0) t_out = s.time();
+  }
+  // Contact-point velocity along +x: v_x + ω R (the point below the centre).
+  const double u1 = s.discs.get<Velocity<2>>()[0].x() + s.discs.get<AngularVelocity>()[0] * R;
+  return {-u1 / ut, t_out - t_in, energy() / e0};
+}
+}  // namespace
+
+TEST(DemContact, TangentialDashpotGivesTheTangentialRestitutionOfADampedSpring) {
+  // While the contact sticks, the contact point's tangential displacement s obeys
+  // m_t s'' + c_t s' + k_t s = 0 with m_t = m I/(I + m R²) = m/3 (solid disc), s(0) = 0,
+  // s'(0) = u₀; the normal contact (clamped dashpot, ζ_n from e) lasts
+  // t_c = (π − 2 asin ζ_n)/(ω_n √(1 − ζ_n²)), ω_n = √(k_n/m) (contact_laws.hpp). With
+  // c_t = f c_n √(k_t/k_n) = 2 f ζ_n √(m k_t), ζ_t = f ζ_n √3 and ω_t = √(k_t/m_t):
+  //   β = −s'(t_c)/u₀ = −e^{−ζ_t ω_t t_c} [cos ω_d t_c − ζ_t/√(1−ζ_t²) sin ω_d t_c],
+  //   ω_d = ω_t √(1 − ζ_t²)   (β = −cos ω_t t_c without the dashpot: the spring gives back).
+  const double kn = 1e8, kt = kn / 2.5, R = 0.5, m = 2650 * kPi * R * R;
+  for (double e : {0.3, 0.6})
+    for (double f : {0.0, 1.0}) {
+      const double zn = clamped_damping_ratio_from_restitution(e), wn = std::sqrt(kn / m);
+      const double tc = (kPi - 2 * std::asin(zn)) / (wn * std::sqrt(1 - zn * zn));
+      const double zt = f * zn * std::sqrt(3.0), wt = std::sqrt(kt / (m / 3)), wd = wt * std::sqrt(1 - zt * zt);
+      const double beta =
+          -std::exp(-zt * wt * tc) * (std::cos(wd * tc) - zt / std::sqrt(1 - zt * zt) * std::sin(wd * tc));
+      const ObliqueResult r = oblique_impact(e, f, 1.0, 0.5);
+      // (The overlap lasts longer than t_c: after the force reaches zero the disc drifts out.)
+      std::printf("e %.1f, f %.0f: overlap %.5f s (force t_c %.5f), beta %.3f (theory %.3f), KE after/before %.3f\n", e,
+                  f, r.duration, tc, r.beta, beta, r.energy_ratio);
+      EXPECT_NEAR(r.beta, beta, 0.02) << "e " << e << ", f " << f;
+      EXPECT_LT(r.energy_ratio, 1.0);  // no energy created
+    }
+  // The dashpot never exceeds the Coulomb limit: at μ = 0.1 a fast tangential impact slides
+  // with |ΔP_t| = μ P_n, whatever the dashpot.
+  for (double f : {0.0, 1.0}) {
+    DemSolver s;
+    s.settings.gravity = Vec2::Zero();
+    s.law = LinearSpringCoulomb{kn, kt};
+    s.contact.tangential_damping = f;
+    add_disc(s.discs, Vec2(1.0, R + 1e-6), R, 2650);
+    s.discs.get<Velocity<2>>()[0] = Vec2(5.0, -1.0);
+    s.terrain.add_polyline({Vec2(-5, 0), Vec2(10, 0)}, 0.1, 0.3);
+    s.initialise();
+    for (int k = 0; k < 100000 && s.discs.get<Position<2>>()[0].y() < R + 2e-6; ++k) s.step();
+    const Vec2 v = s.discs.get<Velocity<2>>()[0];
+    EXPECT_NEAR((5.0 - v.x()) / (v.y() + 1.0), 0.1, 0.005) << "f " << f;
+  }
+}

@@ -284,6 +284,11 @@ TEST(DemValidation, SingleBlockTravelAngle) {
 struct BlockResolutionCase {
   double radius;
   int first_seed, last_seed;
+  // Corner-impact damping (docs/validation/dem.md, "Corner impact of the bonded block"): the
+  // terrain dashpots on the fragment's effective mass with a tangential dashpot of the same ratio,
+  // and the bond modulus (0: the study's 2e8 Pa).
+  bool fragment_damping = false;
+  double bond_modulus = 0.0;
 };
 
 class SingleBlockOutlineResolution : public ::testing::TestWithParam<BlockResolutionCase> {};
@@ -296,6 +301,11 @@ TEST_P(SingleBlockOutlineResolution, TravelAngleOfSeveralPackings) {
     AvalancheSpec a = single_block(static_cast<std::uint64_t>(seed), 0.1);
     a.packing.r_min = 0.75 * R;
     a.packing.r_max = 1.25 * R;
+    if (GetParam().fragment_damping) {
+      a.material.contact.fragment_damping_mass = true;
+      a.material.contact.tangential_damping = 1.0;
+    }
+    if (GetParam().bond_modulus > 0) a.material.bond.modulus = GetParam().bond_modulus;
     DemSolver s;
     const auto r = run_avalanche(a, s);
     const RunoutQuantile& far = r.quantiles.back();
@@ -325,7 +335,8 @@ TEST_P(SingleBlockOutlineResolution, TravelAngleOfSeveralPackings) {
                  {"com_travel_angle_deg", angle_com},
                  {"turns", turns}});
     char name[96];
-    std::snprintf(name, sizeof name, "single_block_R%.3f_seed%d.png", R, seed);
+    std::snprintf(name, sizeof name, "single_block_R%.3f_seed%d_damped%d_E%.0e.png", R, seed,
+                  static_cast<int>(GetParam().fragment_damping), GetParam().bond_modulus);
     write_avalanche_png(out_dir() / name, s, a.terrain, a.source);
     angles.push_back(angle);
     EXPECT_TRUE(r.at_rest);
@@ -340,16 +351,26 @@ TEST_P(SingleBlockOutlineResolution, TravelAngleOfSeveralPackings) {
   std::printf("single block, R = %.3f m: %zu packings, Fahrboeschung mean %.1f deg, standard deviation %.1f deg\n", R,
               angles.size(), mean, std::sqrt(var));
   char name[96];
-  std::snprintf(name, sizeof name, "single_block_resolution_R%.3f_seeds%d-%d.json", R, GetParam().first_seed,
-                GetParam().last_seed);
+  if (GetParam().fragment_damping || GetParam().bond_modulus > 0)
+    std::snprintf(name, sizeof name, "single_block_damped%d_E%.0e_R%.3f_seeds%d-%d.json",
+                  static_cast<int>(GetParam().fragment_damping), GetParam().bond_modulus, R, GetParam().first_seed,
+                  GetParam().last_seed);
+  else
+    std::snprintf(name, sizeof name, "single_block_resolution_R%.3f_seeds%d-%d.json", R, GetParam().first_seed,
+                  GetParam().last_seed);
   std::ofstream(out_dir() / name) << j.dump(2) << "\n";
 }
 
 // R = 0.1 is split in two so that its two halves can run side by side (≈ 5 min per packing on one
-// busy core); R = 0.05 (≈ 40 min per packing) was not run.
+// busy core); R = 0.05 (≈ 40 min per packing) was not run. The last three: R = 0.4 with the
+// corner-impact damping options (fragment-mass terrain dashpots and the tangential dashpot, bonds
+// 2e8 and 2e10 Pa) and the 2e10 bonds alone (third session; ≈ 5, 28 and 39 s per packing).
 INSTANTIATE_TEST_SUITE_P(DemValidation, SingleBlockOutlineResolution,
                          ::testing::Values(BlockResolutionCase{0.4, 1, 10}, BlockResolutionCase{0.2, 1, 10},
-                                           BlockResolutionCase{0.1, 1, 3}, BlockResolutionCase{0.1, 4, 6}));
+                                           BlockResolutionCase{0.1, 1, 3}, BlockResolutionCase{0.1, 4, 6},
+                                           BlockResolutionCase{0.4, 1, 10, true},
+                                           BlockResolutionCase{0.4, 1, 10, true, 2e10},
+                                           BlockResolutionCase{0.4, 1, 10, false, 2e10}));
 
 TEST(DemValidation, SingleBlockOutlineResolutionFigure) {
   // Collects the JSON files of SingleBlockOutlineResolution (run those first; skipped when none

@@ -110,6 +110,16 @@ void read_material(ConfigReader& r, RunConfig& c) {
                                      {"1", "rolling-resistance coefficient mu_r (Ai et al. 2011, model C)"});
   m.contact.rolling_damping =
       r.get("material.rolling_damping", 0.3, Range::closed(0.0, 1.0), {"1", "rolling viscous damping ratio eta_r"});
+  m.contact.tangential_damping =
+      r.get("material.tangential_damping", 0.0, Range::closed(0.0, 1.0),
+            {"1",
+             "tangential dashpot while sticking, as a fraction of the normal damping ratio (0: none, 1: the same "
+             "ratio, Cundall & Strack 1979)"});
+  m.contact.fragment_damping_mass =
+      r.get_choice("material.terrain_damping_mass", "disc", {"disc", "fragment"},
+                   {"",
+                    "mass of the disc-terrain and disc-wall dashpots: disc = the disc's own; fragment = the "
+                    "effective mass of its bonded fragment at the contact point, 1/(1/M + (r x n)^2/I)"}) == "fragment";
   // [bond]
   ParallelBondProperties& b = m.bond;  // defaults: the struct's (bonds.hpp)
   b.radius_multiplier = r.get("bond.radius_multiplier", b.radius_multiplier, Range::open_closed(0.0, 1.0),

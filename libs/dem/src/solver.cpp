@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <sstream>
 
 #include "geohaz/core/errors.hpp"
@@ -250,6 +251,7 @@ void DemSolver::pair_forces(const Law& law) {
   const double mu_r = contact.rolling_friction;
   const double eta_r = contact.rolling_damping;
   const double zeta = Law::pair_damping(contact.restitution);
+  const double f_t = contact.tangential_damping;
   const double mu_joint = settings.joint_friction;
   const bool same = same_layout_ && hist_.offsets.size() == n + 1;
   const bool any_joints = !joints_.empty();
@@ -310,13 +312,15 @@ void DemSolver::pair_forces(const Law& law) {
             break;
           }
       }
-      const auto fr =
-          CoulombFrictionRolling::update(fs, mr, c.kt, c.kn, vt, fn, reff, w[i] - w[j], mu_c, mu_rc, eta_r, dt,
-                                         [&] { return rolling_inertia(I[i], m[i], Ri, I[j], m[j], R[j]); });
+      // Tangential dashpot: the normal damping ratio (× f_t) on the tangential spring, same m*.
+      const double ct = f_t > 0.0 ? f_t * c.cn * std::sqrt(c.kt / c.kn) : 0.0;
+      const auto fr = CoulombFrictionRolling::update(
+          fs, mr, c.kt, c.kn, vt, fn, reff, w[i] - w[j], mu_c, mu_rc, eta_r, dt,
+          [&] { return rolling_inertia(I[i], m[i], Ri, I[j], m[j], R[j]); }, ct);
       fs = fr.shear;
       mr = fr.roll;
-      f += fn * nrm + fs * t;
-      tq += -li * fs + mr + fr.roll_damping;
+      f += fn * nrm + (fs + fr.shear_damping) * t;
+      tq += -li * (fs + fr.shear_damping) + mr + fr.roll_damping;
       ktr += std::max(c.kn, c.kt);
       krot += c.kt * Ri * Ri + fr.kr;
       hist_next_.partner[k] = pj;
@@ -468,9 +472,12 @@ void DemSolver::wall_forces(const Law& law) {
   auto& WC = discs.get<WallContacts>();
   const double dt = dt_;
   const double mu_r = contact.rolling_friction, eta_r = contact.rolling_damping;
+  const double f_t = contact.tangential_damping;
   const Vec2 gravity = settings.gravity;
   const std::int64_t n = static_cast<std::int64_t>(discs.size());
   update_wall_damping(law);
+  const bool frag_mass = contact.fragment_damping_mass;
+  if (frag_mass) update_fragments();
   // Bounding boxes of the walls grown by the largest radius: a cheap reject before the distance.
   std::vector<Vec2> box_lo(nw), box_hi(nw);
   for (std::size_t k = 0; k < nw; ++k) {
@@ -509,7 +516,15 @@ void DemSolver::wall_forces(const Law& law) {
         const double r = std::sqrt(r2);
         const Vec2 nrm = d / r;
         const Vec2 t = perp(nrm);
-        const ContactResponse c = law.evaluate(Ri - r, m[i], Ri, 2.0 * Ri, zeta);
+        // Dashpot mass: the disc's, or its bonded fragment's effective mass at the contact point.
+        double md = m[i];
+        if (frag_mass) {
+          const std::uint32_t q = frag_of_[i];
+          const Vec2 rc = p - frag_centre_[q];
+          const double rn = rc.x() * nrm.y() - rc.y() * nrm.x();
+          md = std::max(m[i], 1.0 / (1.0 / frag_mass_[q] + rn * rn / frag_inertia_[q]));
+        }
+        const ContactResponse c = law.evaluate(Ri - r, md, Ri, 2.0 * Ri, zeta);
         const Vec2 vrel = v[i] - s.velocity - w[i] * Ri * t;
         // A wall never pulls a disc: the dashpot cannot make the normal force tensile (ζ is
         // the clamped-dashpot value, so the rebound still has the configured restitution).
@@ -535,14 +550,17 @@ void DemSolver::wall_forces(const Law& law) {
             mr = old(2, q);
           }
         const double mu_rw = s.rolling_friction >= 0.0 ? s.rolling_friction : mu_r;  // the wall's own, if set
-        const auto fr = CoulombFrictionRolling::update(fs, mr, c.kt, c.kn, vrel.dot(t), fn, Ri, w[i], s.friction, mu_rw,
-                                                       eta_r, dt, [&] { return I[i] + m[i] * Ri * Ri; });
+        // Tangential dashpot: the wall's normal damping ratio (× f_t) on the tangential spring.
+        const double ct = f_t > 0.0 ? f_t * c.cn * std::sqrt(c.kt / c.kn) : 0.0;
+        const auto fr = CoulombFrictionRolling::update(
+            fs, mr, c.kt, c.kn, vrel.dot(t), fn, Ri, w[i], s.friction, mu_rw, eta_r, dt,
+            [&] { return I[i] + m[i] * Ri * Ri; }, ct);
         fs = fr.shear;
         mr = fr.roll;
         const double kr = fr.kr;
-        const Vec2 fc = fn * nrm + fs * t;
+        const Vec2 fc = fn * nrm + (fs + fr.shear_damping) * t;
         f += fc;
-        tq += -Ri * fs + mr + fr.roll_damping;
+        tq += -Ri * (fs + fr.shear_damping) + mr + fr.roll_damping;
         // Time step: a dashpot of ratio ζ lowers the critical step of the explicit scheme to
         // (2/ω)(√(1+ζ²) − ζ) (Belytschko et al. 2000, §6.3), i.e. k acts as k (ζ + √(1+ζ²))².
         // Without it a strongly damped contact (e = 0.1, ζ = 1.24) changes v by 57 % per step
@@ -604,6 +622,37 @@ void DemSolver::compute_forces(const Law& law) {
   pair_forces(law);
   bond_forces();
   wall_forces(law);
+}
+
+void DemSolver::update_fragments() {
+  const std::size_t n = discs.size();
+  const auto& x = discs.get<Position<2>>();
+  const auto& m = discs.get<Mass>();
+  const auto& I = discs.get<Inertia>();
+  frag_of_.resize(n);
+  std::iota(frag_of_.begin(), frag_of_.end(), 0u);
+  auto find = [&](std::uint32_t a) {
+    while (frag_of_[a] != a) a = frag_of_[a] = frag_of_[frag_of_[a]];
+    return a;
+  };
+  for (std::size_t b = 0; b < bonds.size(); ++b) {
+    if (bonds.state[b] != BondState::Intact) continue;
+    const std::uint32_t a = find(index_of(bonds.id_a[b])), c = find(index_of(bonds.id_b[b]));
+    if (a != c) frag_of_[std::max(a, c)] = std::min(a, c);
+  }
+  for (std::size_t i = 0; i < n; ++i) frag_of_[i] = find(static_cast<std::uint32_t>(i));
+  // Fragments indexed by their root disc (no renumbering: the arrays are per disc, most unused).
+  frag_mass_.assign(n, 0.0);
+  frag_inertia_.assign(n, 0.0);
+  frag_centre_.assign(n, Vec2::Zero());
+  for (std::size_t i = 0; i < n; ++i) {
+    frag_mass_[frag_of_[i]] += m[i];
+    frag_centre_[frag_of_[i]] += m[i] * x[i];
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    if (frag_of_[i] == i) frag_centre_[i] /= frag_mass_[i];
+  for (std::size_t i = 0; i < n; ++i)
+    frag_inertia_[frag_of_[i]] += I[i] + m[i] * (x[i] - frag_centre_[frag_of_[i]]).squaredNorm();
 }
 
 void DemSolver::update_time_step() {

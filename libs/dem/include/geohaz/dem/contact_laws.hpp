@@ -202,6 +202,17 @@ struct ContactProperties {
   /// Rolling viscous damping ratio η_r (of the critical rolling damping 2√(I_r k_r)), applied
   /// while the rolling spring is not at its plastic limit.
   double rolling_damping = 0.3;
+  /// Tangential dashpot as a fraction f ∈ [0, 1] of the normal one's damping ratio: c_t =
+  /// f c_n √(k_t/k_n), i.e. the damping ratio f ζ on the tangential spring with the same m*
+  /// (Cundall & Strack 1979 damp both directions). Applied only
+  /// while the contact sticks; 0 (default): no tangential dashpot.
+  double tangential_damping = 0.0;
+  /// Mass m* of the disc–wall and disc–terrain dashpots (normal and tangential): false (default)
+  /// the disc's own mass; true the effective mass of its bonded fragment at the contact point,
+  /// m* = 1/(1/M_f + (r × n)²/I_f) (M_f, I_f the fragment's mass and inertia about its centre,
+  /// r from that centre to the contact; Stronge 2000), so a bonded block hitting the terrain
+  /// rebounds with the configured e instead of a disc's dashpot on a block's mass.
+  bool fragment_damping_mass = false;
 };
 
 /// Combined rolling stiffness per Ai et al. (2011), eq. (9).
@@ -211,8 +222,11 @@ inline double rolling_stiffness(double mu_r, double kn, double reff) noexcept {
 
 /// Tangential friction and rolling resistance of one contact, shared by every contact law and by
 /// disc–disc and disc–wall contacts (the law only supplies k_n, k_t and F_n):
-///   Coulomb friction on an incremental tangential spring (Cundall & Strack 1979):
-///     F_s ← F_s − k_t v_t Δt,  |F_s| ≤ μ max(F_n, 0);
+///   Coulomb friction on an incremental tangential spring with an optional dashpot c_t (Cundall &
+///   Strack 1979):
+///     F_s ← F_s − k_t v_t Δt;  F_d = −c_t v_t;
+///     stick (|F_s + F_d| ≤ μ max(F_n, 0)): shear force F_s + F_d (F_d is not history);
+///     slip: F_s ← ±μ max(F_n, 0) (sign of F_s + F_d), F_d = 0, so the Coulomb limit holds;
 ///   elastic–plastic rolling spring with viscous damping (Ai et al. 2011, model C; Iwashita &
 ///   Oda 1998), for μ_r > 0:
 ///     k_r = 2.25 μ_r² k_n R*²,  M_r ← M_r − k_r ω_r Δt,  |M_r| ≤ μ_r R* max(F_n, 0),
@@ -223,6 +237,7 @@ struct CoulombFrictionRolling {
   /// (N·m/m, not part of the history) and the rolling stiffness k_r (N·m/m per rad, for the step).
   struct Result {
     double shear, roll, roll_damping, kr;
+    double shear_damping;  ///< tangential dashpot force F_d (N/m, not part of the history)
   };
   /// \param shear, roll       history of the contact (F_s, M_r) from the last step
   /// \param kt, kn            tangential and normal stiffness of the law at this overlap
@@ -231,13 +246,18 @@ struct CoulombFrictionRolling {
   /// \param reff              R* of the rolling law (m)
   /// \param omega_r           relative angular velocity ω_i − ω_j (rad/s; ω_i for a wall)
   /// \param rolling_inertia   callable returning I_r (kg·m²/m), called only when it is needed
+  /// \param ct                tangential dashpot coefficient (N·s/m/m), 0: none
   template <class RollingInertia>
   static Result update(double shear, double roll, double kt, double kn, double vt, double fn, double reff,
                        double omega_r, double mu, double mu_r, double eta_r, double dt,
-                       RollingInertia&& rolling_inertia) noexcept {
+                       RollingInertia&& rolling_inertia, double ct = 0.0) noexcept {
     shear -= kt * vt * dt;
     const double limit = mu * std::max(fn, 0.0);
-    if (std::abs(shear) > limit) shear = sign(shear) * limit;
+    double fd = -ct * vt;
+    if (std::abs(shear + fd) > limit) {
+      shear = sign(shear + fd) * limit;
+      fd = 0.0;
+    }
     double damping = 0.0, kr = 0.0;
     if (mu_r > 0.0) {
       kr = rolling_stiffness(mu_r, kn, reff);
@@ -250,7 +270,7 @@ struct CoulombFrictionRolling {
     } else {
       roll = 0.0;
     }
-    return {shear, roll, damping, kr};
+    return {shear, roll, damping, kr, fd};
   }
 
  private:

@@ -139,6 +139,12 @@ class DemSolver {
   // (Law::wall_damping), cached: recomputed when a wall's e or the law changes, and on initialise().
   std::vector<double> wall_damping_, wall_damping_e_, terrain_damping_;
   std::size_t damping_law_ = SIZE_MAX;  ///< law.index() the caches were computed for
+  // Bonded fragments for contact.fragment_damping_mass (recomputed every step; buffers reused):
+  // per disc its fragment (union–find over intact bonds), per fragment mass, centre, inertia.
+  void update_fragments();
+  std::vector<std::uint32_t> frag_of_;
+  std::vector<double> frag_mass_, frag_inertia_;
+  std::vector<Vec2> frag_centre_;
   /// Largest dashpot time-step factor (ζ + √(1+ζ²))² of the walls and terrain: the reference
   /// stiffness of a disc without contacts is scaled by it, so the step in which a free disc first
   /// touches a strongly damped wall is already short enough.
