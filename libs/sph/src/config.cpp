@@ -229,10 +229,11 @@ void read_numerics(ConfigReader& r, RunConfig& c) {
       throw InputError("total_lagrangian is only for elastic bodies: it needs model.constitutive = linear_elastic",
                        r.source(), "numerics.formulation", f);
   }
-  n.hourglass = r.get("numerics.hourglass", d.hourglass, Range::non_negative(),
+  n.hourglass = r.get("numerics.hourglass", d.hourglass, Range::closed(0.0, 1.0),
                       {"1",
                        "hourglass-control coefficient alpha of the total-Lagrangian formulation (Ganzenmueller "
-                       "2015; 0: off); unused by updated_lagrangian"});
+                       "2015; 0: off; above ~1 its stiffness outgrows the P-wave time step, docs/sph.md); unused "
+                       "by updated_lagrangian"});
   n.neighbour_skin = r.get("numerics.neighbour_skin", d.neighbour_skin, Range::closed(0.0, 1.0),
                            {"1", "Verlet skin in units of h (0: rebuild the neighbour list every step)"});
 }

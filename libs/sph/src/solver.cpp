@@ -389,8 +389,8 @@ SphSolver<Dim>::SphSolver(SphStore<Dim> store, std::vector<MaterialParams> mater
     if (settings_.periodic.any())
       throw InputError("the total-Lagrangian formulation takes no periodic axes", "", "numerics.formulation",
                        "total_lagrangian");
-    if (!(settings_.hourglass >= 0.0))
-      throw InputError("must be >= 0", "", "numerics.hourglass", std::to_string(settings_.hourglass));
+    if (!(settings_.hourglass >= 0.0 && settings_.hourglass <= 1.0))
+      throw InputError("must be in [0, 1]", "", "numerics.hourglass", std::to_string(settings_.hourglass));
   }
   h_ = settings_.h_factor * settings_.spacing;
   damping_ = settings_.damping;

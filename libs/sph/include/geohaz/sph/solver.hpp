@@ -109,8 +109,9 @@ struct NumericalSettings {
   /// linear_elastic soil without boundary particles, periodic axes or a geostatic phase (InputError
   /// otherwise). false: the updated-Lagrangian solver of the numbered passes above.
   bool total_lagrangian = false;
-  /// Ganzenmüller (2015) hourglass coefficient α (dimensionless, ≥ 0) of the total-Lagrangian
-  /// formulation; 0 switches the hourglass force off.
+  /// Ganzenmüller (2015) hourglass coefficient α (dimensionless) of the total-Lagrangian
+  /// formulation, in [0, 1]; 0 switches the hourglass force off. The time step does not include the
+  /// hourglass stiffness: at α = 10 the cantilever blows up within 0.03 s (docs/sph.md).
   double hourglass = 0.1;
   EarthquakeLoading earthquake;  ///< applied in the main phase (time from 0 after the geostatic phase)
 };
