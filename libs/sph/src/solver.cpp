@@ -433,7 +433,11 @@ double SphSolver<Dim>::bytes_per_particle() const {
          static_cast<double>(pair_acc_.size() * sizeof(Vec<Dim>) + pair_grad_.size() * sizeof(GradientReaction) +
                              pair_grad_corrected_.size() * sizeof(CorrectedGradientReaction)) /
              n +  // block buffers of the pair reactions (n (1 + W/B) slots each)
-         static_cast<double>(correction_.size() * sizeof(correction_[0])) / n;  // A_i (kernel_correction)
+         static_cast<double>(correction_.size() * sizeof(correction_[0])) / n +  // A_i (kernel_correction)
+         static_cast<double>(tl_X_.size() * sizeof(Vec<Dim>) + tl_V0_.size() * sizeof(double) +
+                             tl_F_.size() * sizeof(Mat<Dim>) + tl_off_.size() * 4 +
+                             tl_idx_.size() * (4 + 4 + sizeof(Vec<Dim>) + sizeof(double))) /
+             n;  // total-Lagrangian reference data (per pair: index, reverse slot, g⁰, hourglass weight)
 }
 
 template <int Dim>

@@ -39,6 +39,10 @@
 ///   6. check_state, update_dt: Δt = min(C_cfl h/(c + |v|max), C_f √(h/|a|max), the model's own
 ///      limit, Δt_max), c the model's wave speed (constitutive.hpp: P-wave speed of a solid; a
 ///      fluid's sound speed and its viscous limit 0.125 h²ρ/μ).
+/// With `total_lagrangian` (elastic bodies only) one step is instead: F_i from the displacements and
+/// the corrected gradients of the reference configuration (built once), St Venant–Kirchhoff stress,
+/// the pair force Σ_j V⁰_i V⁰_j (P_i g⁰_ij − P_j g⁰_ji) and the Ganzenmüller (2015) hourglass force,
+/// then steps 5 and 6 (solver.cpp, "Total-Lagrangian formulation"; docs/sph.md).
 /// The pair sums of steps 2 and 4 are grouped alike on any thread count, and SolverState + resume
 /// restart a run bit for bit (docs/sph.md, "Determinism: thread count and restart").
 /// Units: SI throughout (m, s, kg, Pa).
