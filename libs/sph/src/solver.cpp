@@ -1167,6 +1167,9 @@ void SphSolver<Dim>::update_dt() {
 template <int Dim>
 GeostaticReport SphSolver<Dim>::apply_gravity_gradually(double duration, double damping, bool elastic,
                                                         const std::function<void()>& on_step) {
+  if (settings_.total_lagrangian)  // its reference is the start of the main phase (docs/sph.md)
+    throw InputError("the total-Lagrangian formulation takes no geostatic phase", "", "numerics.formulation",
+                     "total_lagrangian");
   GeostaticReport rep;
   rep.duration = duration;
   const ConstitutiveModel saved = model_;
