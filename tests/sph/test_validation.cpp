@@ -341,21 +341,30 @@ TEST(Validation, TwoLayerD15FactorRatiosMatchPublishedTable) {
 // weight q L⁴/(8E'I). At L/H = 10 shear and rotary inertia matter at the 1 % level: Timoshenko
 // (κ = 5/6, G = E/(2(1 + ν)); a 200-element Timoshenko finite-element eigen-solution, which
 // reproduces Euler–Bernoulli to 0.01 % at L/H = 100) gives T = 1.0085 × 0.11811 = 0.11911 s, and
-// the static deflection gains the shear term q L²/(2κGA). Those are the references. Runs at 10, 15
-// and 20 particles through the thickness: the corrected gradient (default for linear_elastic)
-// without artificial stress (the example's setting), the plain gradient, and the corrected
-// gradient with the default artificial stress 0.3. Static deflection: gravity on, E = 100 MPa (δ/L
-// = 0.27 %, strains 6e-4: the small-deflection range of beam theory; at 10 MPa the strains of 0.6 %
-// under own weight start the tensile instability of SPH without artificial stress, and the beam
-// sags twice as far — docs/validation/sph.md), Cundall damping 0.3, 0.15 s (4 periods of
-// T = 0.0377 s); δ = 0.5356 + 0.0061 = 0.5417 mm; measured as the mean tip displacement over the
-// last period (the residual oscillation averages out).
-// A fourth variant, the quadratic-complete correction (numerics.kernel_correction = "quadratic";
-// hand runs 2026-12-02: +3.2 / +16 / +35 %), is run and drawn (orange) but not checked: at 15 and
-// 20 particles an instability grows in the bent beam (docs/validation/sph.md, second round).
-// Checks: the corrected period converges (its error falls with every refinement) and is within 3 %
-// of Timoshenko at 20 particles; the plain gradient is farther off at every resolution; the static
-// deflection is within 3 % at 20 particles. The numbers go to docs/validation/sph.md.
+// the static deflection gains the shear term q L²/(2κGA). Those are the references.
+// Runs at 10, 15 and 20 particles through the thickness, all on the example's total-Lagrangian
+// formulation (TL) unless named otherwise:
+//   tl           the example: quadratic-complete reference gradient, hourglass α = 0.1, run to
+//                0.3 s (2.5 periods) to see that it stays stable;
+//   tl_hg001, tl_hg1   α = 0.01 and 1: the period must not depend on the hourglass coefficient;
+//   tl_linear    the linear reference gradient (Bonet & Lok 1999) — drawn, not checked;
+//   ul           the updated-Lagrangian solver with the linear correction (the example before
+//                2026-12-02) — drawn, not checked (+5.3 / +2.7 / +9.5 % and unstable at 20, hand runs).
+// Static deflection (TL): gravity on, E = 100 MPa (δ/L = 0.27 %, strains 6e-4: the small-deflection
+// range of beam theory), Cundall damping 0.7, 0.15 s (4 periods of T = 0.0377 s);
+// δ = 0.5356 + 0.0061 = 0.5417 mm, measured as the mean tip displacement over the last period.
+// Why 0.7 and not the 0.3 of the runs before 2026-12-02: with 0.3 the tip creeps towards its rest
+// position for long after the oscillation has died, and at 0.15 s it is still 1.1 % short at 10
+// particles (0.5577 mm against 0.5640 mm at 0.4 s); with 0.7 it oscillates about the rest position
+// and the mean over the last period is within 0.05 % of it at 0.15 s.
+// Checks: the TL period within 3 % of Timoshenko at every resolution and converging (its error's
+// magnitude non-increasing with refinement); the amplitude of the second period within 5 % of the
+// first (stable: no growing mode; no dissipation in TL, so it should stay); changing α by a decade
+// either way moves the period by less than 0.5 %; the static deflection converging, within 3 % at
+// 15 and 20 particles. At 10 particles it is +4.1 % (hand run to 0.4 s): the 3 % is not
+// met there (the period's +2.35 % is a bending stiffness 4.6 % low, and the static deflection goes
+// with 1/EI; docs/validation/sph.md); checked against 5 % there, so that a regression shows.
+// The numbers go to docs/validation/sph.md.
 double first_period(const fs::path& series) {
   const auto t = csv_column(series, 0), u = csv_column(series, 11);
   std::vector<double> cross;
@@ -365,28 +374,47 @@ double first_period(const fs::path& series) {
   return cross.size() >= 2 ? cross[1] : (cross.size() == 1 ? 2.0 * cross[0] : 0.0);  // u = A sin ωt: T/2, T
 }
 
+/// Largest |tip displacement| for t in [t0, t1).
+double tip_amplitude(const fs::path& series, double t0, double t1) {
+  const auto t = csv_column(series, 0), u = csv_column(series, 11);
+  double a = 0.0;
+  for (std::size_t k = 0; k < t.size(); ++k)
+    if (t[k] >= t0 && t[k] < t1) a = std::max(a, std::abs(u[k]));
+  return a;
+}
+
 TEST(Validation, CantileverPeriodAndDeflectionConverge) {
   constexpr double kPeriod = 0.11911, kStatic = 5.417e-4, kStaticPeriod = 0.0377;
   std::map<std::string, std::vector<double>> err;  // period error per variant, n = 10, 15, 20
-  std::vector<double> static_err;
+  std::vector<double> static_err, growth;
   for (int n : {10, 15, 20}) {
     char dx[32];
     std::snprintf(dx, sizeof dx, "%.17g", 0.02 / n);
-    const std::string base = std::string(" --set numerics.spacing=") + dx + " --set run.end_time=0.14";
-    for (const auto& [variant, sets] : {std::pair<std::string, std::string>{"corrected", ""},
-                                        {"plain", " --set numerics.kernel_correction=off"},
-                                        {"corrected_as03", " --set numerics.artificial_stress=0.3"},
-                                        {"quadratic", " --set numerics.kernel_correction=quadratic"}}) {
+    const std::string base = std::string(" --set numerics.spacing=") + dx;
+    for (const auto& [variant, sets] : {std::pair<std::string, std::string>{"tl", " --set run.end_time=0.3"},
+                                        {"tl_hg001", " --set run.end_time=0.14 --set numerics.hourglass=0.01"},
+                                        {"tl_hg1", " --set run.end_time=0.14 --set numerics.hourglass=1"},
+                                        {"tl_linear", " --set run.end_time=0.14 --set numerics.kernel_correction=on"},
+                                        {"ul",
+                                         " --set run.end_time=0.14 --set numerics.formulation=updated_lagrangian"
+                                         " --set numerics.kernel_correction=auto"}}) {
       const std::string name = "cantilever_" + variant + "_n" + std::to_string(n);
       run_case(name, "cantilever.toml", base + sets);
       const double T = first_period(kWork / name / "series.csv");
       err[variant].push_back(T / kPeriod - 1.0);
       std::printf("%-30s T = %.5f s  error %+.2f %%\n", name.c_str(), T, 100.0 * (T / kPeriod - 1.0));
+      if (variant == "tl") {
+        const auto f = kWork / name / "series.csv";
+        const double a1 = tip_amplitude(f, 0.0, T), a2 = tip_amplitude(f, T, 2.0 * T);
+        growth.push_back(a2 / a1 - 1.0);
+        std::printf("%-30s amplitude first period %.4g mm, second %.4g mm (%+.2f %%)\n", name.c_str(), 1e3 * a1,
+                    1e3 * a2, 100.0 * (a2 / a1 - 1.0));
+      }
     }
     const std::string name = "cantilever_static_n" + std::to_string(n);
     run_case(name, "cantilever.toml",
-             std::string(" --set numerics.spacing=") + dx +
-                 " --set numerics.gravity=9.81 --set numerics.damping=0.3 --set initial_velocity.type=none"
+             base +
+                 " --set numerics.gravity=9.81 --set numerics.damping=0.7 --set initial_velocity.type=none"
                  " --set material[0].young=1e8 --set run.end_time=0.15");
     const auto ts = csv_column(kWork / name / "series.csv", 0), u = csv_column(kWork / name / "series.csv", 11);
     double sum = 0.0;
@@ -400,32 +428,35 @@ TEST(Validation, CantileverPeriodAndDeflectionConverge) {
     static_err.push_back(d / kStatic - 1.0);
     std::printf("%-30s tip deflection %.4f mm  error %+.2f %%\n", name.c_str(), 1e3 * d, 100.0 * (d / kStatic - 1.0));
   }
-  const auto& c = err["corrected"];
+  const auto& c = err["tl"];
   ASSERT_EQ(c.size(), 3u);
-  EXPECT_LT(std::abs(c[1]), std::abs(c[0])) << "corrected period converges 10 -> 15";
-  EXPECT_LT(std::abs(c[2]), std::abs(c[1])) << "corrected period converges 15 -> 20";
-  EXPECT_LT(std::abs(c[2]), 0.03) << "period within 3 % of Timoshenko at 20 particles through the thickness";
-  for (std::size_t k = 0; k < 3; ++k)
-    EXPECT_GT(std::abs(err["plain"][k]), std::abs(c[k])) << "the plain gradient is farther off";
-  EXPECT_LT(std::abs(static_err[2]), 0.03) << "static tip deflection within 3 % at 20 particles";
-  // Figure: period error (%) vs particles through the thickness: corrected (blue), plain (red),
-  // corrected with artificial stress 0.3 (green), static deflection error (black dots).
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_LT(std::abs(c[k]), 0.03) << "TL period within 3 % of Timoshenko, resolution " << k;
+    EXPECT_LT(std::abs(static_err[k]), k == 0 ? 0.05 : 0.03) << "TL static tip deflection, resolution " << k;
+    EXPECT_LT(std::abs(growth[k]), 0.05) << "TL amplitude steady over two periods, resolution " << k;
+    for (const char* v : {"tl_hg001", "tl_hg1"})
+      EXPECT_LT(std::abs(err[v][k] - c[k]), 0.005) << v << ": period independent of the hourglass coefficient";
+  }
+  EXPECT_LE(std::abs(c[1]), std::abs(c[0])) << "TL period converges 10 -> 15";
+  EXPECT_LE(std::abs(c[2]), std::abs(c[1])) << "TL period converges 15 -> 20";
+  EXPECT_LE(std::abs(static_err[1]), std::abs(static_err[0])) << "TL static deflection converges 10 -> 15";
+  EXPECT_LE(std::abs(static_err[2]), std::abs(static_err[1])) << "TL static deflection converges 15 -> 20";
+  // Figure: period error (%) vs particles through the thickness: TL (blue), TL with the linear
+  // gradient (green), UL with the linear correction (red), TL static deflection error (black dots).
   const std::vector<double> ns{10, 15, 20};
   auto pct = [](std::vector<double> v) {
     for (auto& x : v) x *= 100.0;
     return v;
   };
   plot(kFigures / "cantilever_period_convergence.png",
-       {{ns, pct(err["corrected"]), {30, 90, 200}, false},
-        {ns, pct(err["corrected"]), {30, 90, 200}, true},
-        {ns, pct(err["plain"]), {200, 40, 40}, false},
-        {ns, pct(err["plain"]), {200, 40, 40}, true},
-        {ns, pct(err["corrected_as03"]), {40, 160, 60}, false},
-        {ns, pct(err["corrected_as03"]), {40, 160, 60}, true},
-        {ns, pct(err["quadratic"]), {230, 140, 20}, false},
-        {ns, pct(err["quadratic"]), {230, 140, 20}, true},
+       {{ns, pct(err["tl"]), {30, 90, 200}, false},
+        {ns, pct(err["tl"]), {30, 90, 200}, true},
+        {ns, pct(err["tl_linear"]), {40, 160, 60}, false},
+        {ns, pct(err["tl_linear"]), {40, 160, 60}, true},
+        {ns, pct(err["ul"]), {200, 40, 40}, false},
+        {ns, pct(err["ul"]), {200, 40, 40}, true},
         {ns, pct(static_err), {0, 0, 0}, true}},
-       5.0, 25.0, -5.0, 40.0, 5.0, 5.0);
+       5.0, 25.0, -5.0, 15.0, 5.0, 5.0);
 }
 
 TEST(Validation, Figures) {

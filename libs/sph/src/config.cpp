@@ -215,6 +215,25 @@ void read_numerics(ConfigReader& r, RunConfig& c) {
                           (kc == "auto" && (d.kernel_correction || std::holds_alternative<LinearElastic>(c.model)));
     n.quadratic_correction = kc == "quadratic";
   }
+  {  // total_lagrangian: elastic bodies only (the solver checks the particles: no walls, no periodic axes)
+    const auto f = r.get_choice(
+        "numerics.formulation", "updated_lagrangian", {"updated_lagrangian", "total_lagrangian"},
+        {"",
+         "updated_lagrangian = the SPH solver for flow and failure (neighbours and gradients in the current "
+         "configuration); total_lagrangian = for elastic bodies in small-to-moderate deformation (beams, piles): "
+         "gradients in the configuration at the start of the main phase, St Venant-Kirchhoff stress, "
+         "hourglass control (docs/sph.md); needs model.constitutive = linear_elastic, no walls, no geostatic "
+         "phase"});
+    n.total_lagrangian = f == "total_lagrangian";
+    if (n.total_lagrangian && !std::holds_alternative<LinearElastic>(c.model))
+      throw InputError("total_lagrangian is only for elastic bodies: it needs model.constitutive = linear_elastic",
+                       r.source(), "numerics.formulation", f);
+  }
+  n.hourglass = r.get("numerics.hourglass", d.hourglass, Range::closed(0.0, 1.0),
+                      {"1",
+                       "hourglass-control coefficient alpha of the total-Lagrangian formulation (Ganzenmueller "
+                       "2015; 0: off; above ~1 its stiffness outgrows the P-wave time step, docs/sph.md); unused "
+                       "by updated_lagrangian"});
   n.neighbour_skin = r.get("numerics.neighbour_skin", d.neighbour_skin, Range::closed(0.0, 1.0),
                            {"1", "Verlet skin in units of h (0: rebuild the neighbour list every step)"});
 }
@@ -228,6 +247,11 @@ void read_geostatic_and_earthquake(ConfigReader& r, RunConfig& c) {
   c.geostatic_damping =
       r.get("geostatic.damping", 0.7, Range::closed_open(0.0, 1.0), {"1", "Cundall zeta while loading"});
   c.geostatic_elastic = r.get_bool("geostatic.elastic", true, {"", "linear-elastic soil while loading"});
+  if (c.geostatic && n.total_lagrangian)
+    throw InputError(
+        "total_lagrangian takes no geostatic phase (its reference configuration is the start of the "
+        "main phase): set geostatic.enabled = false and load with numerics.gravity and numerics.damping",
+        r.source(), "numerics.formulation", "total_lagrangian");
   c.rest_tolerance =
       r.get("geostatic.rest_tolerance", 0.01, Range::positive(), {"1", "at rest: max|v| < tol sqrt(g H)"});
 

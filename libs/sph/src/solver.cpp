@@ -244,6 +244,87 @@ struct MomentumPairTerm {
   }
 };
 
+/// A of one particle i (step 2, SphSolver::gradient_correction; docs there): the first Dim rows
+/// of B_i⁻¹ (quadratic) or [M_i⁻¹ 0] (linear), [I 0] where the moments are degenerate. `pairs(f)`
+/// calls f(V_j, x_ij, r) for every neighbour j within the support (x_ij = x_i − x_j, r = |x_ij| > 0).
+/// Shared by the updated-Lagrangian pass (current positions, every step) and the total-Lagrangian
+/// setup (reference positions, once).
+template <int Dim, int N, class Kernel, class Pairs>
+Eigen::Matrix<double, Dim, N> correction_matrix(const PairKernel<Kernel>& K, bool quadratic, Pairs&& pairs) {
+  constexpr double kMinMomentDet = Dim == 2 ? 0.2 * 0.2 : 0.2 * 0.2 * 0.2;
+  constexpr double kMinRcond = 1e-4;
+  using Basis = Eigen::Matrix<double, N, 1>;
+  using Moments = Eigen::Matrix<double, N, N>;
+  Eigen::Matrix<double, Dim, N> A = Eigen::Matrix<double, Dim, N>::Zero();
+  A.template leftCols<Dim>().setIdentity();
+  if (!quadratic) {  // the linear correction alone: C_i = M_i⁻¹ (Bonet & Lok 1999)
+    Mat<Dim> M = Mat<Dim>::Zero();
+    pairs([&](double Vj, const Vec<Dim>& xij, double r) {
+      const Vec<Dim> gw = xij * (K.sigma_h * Kernel::shape_derivative(r * K.inv_h) / r);
+      M.noalias() -= Vj * gw * xij.transpose();  // V_j ∇W_ij ⊗ (x_j − x_i)
+    });
+    if (M.determinant() >= kMinMomentDet) A.template leftCols<Dim>() = M.inverse();
+    return A;
+  }
+  Moments B = Moments::Zero();  // upper triangle only until the factorisation
+  pairs([&](double Vj, const Vec<Dim>& xij, double r) {
+    const double F = -K.sigma_h * Kernel::shape_derivative(r * K.inv_h) / r;  // |∇_i W_ij|/r
+    Basis p;                                                                  // [r; h m(r/h)], r = x_j − x_i
+    p.template head<Dim>() = -xij;
+    int c = Dim;
+    for (int a = 0; a < Dim; ++a)
+      for (int d = a; d < Dim; ++d) p[c++] = xij[a] * xij[d] * K.inv_h;
+    const double wgt = Vj * F;
+    for (int a = 0; a < N; ++a)  // V_j b_ij ⊗ p_ij = V_j F_ij p_ij ⊗ p_ij (symmetric)
+      for (int d = a; d < N; ++d) B(a, d) += wgt * p[a] * p[d];
+  });
+  Mat<Dim> M;
+  for (int a = 0; a < Dim; ++a)
+    for (int d = 0; d < Dim; ++d) M(a, d) = B(std::min(a, d), std::max(a, d));
+  if (!(M.determinant() >= kMinMomentDet)) return A;
+  // Cholesky B = L Lᵀ (B is symmetric positive semi-definite), in place in the lower triangle;
+  // (max L_kk / min L_kk)² estimates the condition number.
+  bool ok = true;
+  double dmin = std::numeric_limits<double>::infinity(), dmax = 0.0;
+  for (int c = 0; c < N && ok; ++c) {
+    double d = B(c, c);
+    for (int k = 0; k < c; ++k) d -= B(c, k) * B(c, k);
+    if (!(d > 0.0)) {
+      ok = false;
+      break;
+    }
+    d = std::sqrt(d);
+    B(c, c) = d;
+    dmin = std::min(dmin, d);
+    dmax = std::max(dmax, d);
+    for (int row = c + 1; row < N; ++row) {
+      double e = B(c, row);  // upper triangle holds the sums
+      for (int k = 0; k < c; ++k) e -= B(row, k) * B(c, k);
+      B(row, c) = e / d;
+    }
+  }
+  if (ok && dmax * dmax * kMinRcond <= dmin * dmin) {
+    // A_iᵀ = the first Dim columns of B⁻¹ (B symmetric): solve L Lᵀ X = [I; 0].
+    for (int col = 0; col < Dim; ++col) {
+      Basis y;
+      for (int row = 0; row < N; ++row) {
+        double e = row == col ? 1.0 : 0.0;
+        for (int k = 0; k < row; ++k) e -= B(row, k) * y[k];
+        y[row] = e / B(row, row);
+      }
+      for (int row = N - 1; row >= 0; --row) {
+        double e = y[row];
+        for (int k = row + 1; k < N; ++k) e -= B(k, row) * y[k];
+        y[row] = e / B(row, row);
+      }
+      A.row(col) = y.transpose();
+    }
+  } else {
+    A.template leftCols<Dim>() = M.inverse();
+  }
+  return A;
+}
+
 }  // namespace
 
 template <int Dim>
@@ -292,6 +373,25 @@ SphSolver<Dim>::SphSolver(SphStore<Dim> store, std::vector<MaterialParams> mater
       throw InputError("particle " + std::to_string(i) + " names material " + std::to_string(mat[i]) + " but only " +
                        std::to_string(materials_.size()) + " are defined");
   fill_missing_layer_normals(store_);
+  if (settings_.total_lagrangian) {
+    if (!std::holds_alternative<LinearElastic>(model_))
+      throw InputError(
+          "the total-Lagrangian formulation is for elastic bodies: it needs model.constitutive = "
+          "linear_elastic, not " +
+              std::visit([](const auto& m) { return std::string(std::decay_t<decltype(m)>::name); }, model_),
+          "", "numerics.formulation", "total_lagrangian");
+    const auto& kind = store_.template get<ParticleKind>();
+    if (std::any_of(kind.begin(), kind.end(), [](std::uint8_t k) { return k != kSoil; }))
+      throw InputError(
+          "the total-Lagrangian formulation takes no boundary (wall, pile) particles: support the "
+          "body with clamp.boxes",
+          "", "numerics.formulation", "total_lagrangian");
+    if (settings_.periodic.any())
+      throw InputError("the total-Lagrangian formulation takes no periodic axes", "", "numerics.formulation",
+                       "total_lagrangian");
+    if (!(settings_.hourglass >= 0.0 && settings_.hourglass <= 1.0))
+      throw InputError("must be in [0, 1]", "", "numerics.hourglass", std::to_string(settings_.hourglass));
+  }
   h_ = settings_.h_factor * settings_.spacing;
   damping_ = settings_.damping;
   set_model(model_);
@@ -333,11 +433,23 @@ double SphSolver<Dim>::bytes_per_particle() const {
          static_cast<double>(pair_acc_.size() * sizeof(Vec<Dim>) + pair_grad_.size() * sizeof(GradientReaction) +
                              pair_grad_corrected_.size() * sizeof(CorrectedGradientReaction)) /
              n +  // block buffers of the pair reactions (n (1 + W/B) slots each)
-         static_cast<double>(correction_.size() * sizeof(correction_[0])) / n;  // A_i (kernel_correction)
+         static_cast<double>(correction_.size() * sizeof(correction_[0])) / n +  // A_i (kernel_correction)
+         static_cast<double>(tl_X_.size() * sizeof(Vec<Dim>) + tl_V0_.size() * sizeof(double) +
+                             tl_F_.size() * sizeof(Mat<Dim>) + tl_off_.size() * 4 +
+                             tl_idx_.size() * (4 + 4 + sizeof(Vec<Dim>) + sizeof(double))) /
+             n;  // total-Lagrangian reference data (per pair: index, reverse slot, g⁰, hourglass weight)
 }
 
 template <int Dim>
 void SphSolver<Dim>::step() {
+  if (settings_.total_lagrangian) {  // linear_elastic only (constructor): no model dispatch
+    switch (settings_.kernel) {
+      case KernelChoice::CubicSpline:
+        return tl_step<CubicSpline<Dim>>();
+      case KernelChoice::WendlandC2:
+        return tl_step<WendlandC2<Dim>>();
+    }
+  }
   std::visit(
       [&](const auto& model) {
         switch (settings_.kernel) {  // no default: a kernel added to KernelChoice must be handled (-Wswitch)
@@ -422,6 +534,7 @@ void SphSolver<Dim>::choose_pair_blocks() {
 
 template <int Dim>
 void SphSolver<Dim>::resume(const SolverState& st) {
+  tl_ready_ = false;  // total-Lagrangian: the reference X = x − u is rebuilt at the next step
   time_ = st.time;
   step_ = st.step;
   dt_ = st.dt;
@@ -553,11 +666,7 @@ void SphSolver<Dim>::gather_reactions(const std::vector<T>& buffer, Add&& add, F
 template <int Dim>
 template <class Kernel>
 void SphSolver<Dim>::gradient_correction() {
-  constexpr double kMinMomentDet = Dim == 2 ? 0.2 * 0.2 : 0.2 * 0.2 * 0.2;
-  constexpr double kMinRcond = 1e-4;
   constexpr int N = kBasis;
-  using Basis = Eigen::Matrix<double, N, 1>;
-  using Moments = Eigen::Matrix<double, N, N>;
   const PairKernel<Kernel> K(h_);
   const MinimumImage<Dim> image(settings_.periodic);
   const std::int64_t n = static_cast<std::int64_t>(store_.size());
@@ -576,80 +685,18 @@ void SphSolver<Dim>::gradient_correction() {
       const Vec<Dim> xij = image(x[i], x[j]);
       const double r2 = xij.squaredNorm();
       if (r2 >= K.cutoff2 || r2 == 0.0) continue;
-      f(j, xij, std::sqrt(r2));
+      f(vol[j], xij, std::sqrt(r2));
     }
   };
 #pragma omp parallel for schedule(static) if (parallel_worth(n))
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
-    A[i].setZero();
-    A[i].template leftCols<Dim>().setIdentity();
-    if (kind[i] != kSoil) continue;
-    if (!quadratic) {  // the linear correction alone: C_i = M_i⁻¹ (Bonet & Lok 1999)
-      Mat<Dim> M = Mat<Dim>::Zero();
-      support_pairs(i, [&](std::uint32_t j, const Vec<Dim>& xij, double r) {
-        const Vec<Dim> gw = xij * (K.sigma_h * Kernel::shape_derivative(r * K.inv_h) / r);
-        M.noalias() -= vol[j] * gw * xij.transpose();  // V_j ∇W_ij ⊗ (x_j − x_i)
-      });
-      if (M.determinant() >= kMinMomentDet) A[i].template leftCols<Dim>() = M.inverse();
+    if (kind[i] != kSoil) {
+      A[i].setZero();
+      A[i].template leftCols<Dim>().setIdentity();
       continue;
     }
-    Moments B = Moments::Zero();  // upper triangle only until the factorisation
-    support_pairs(i, [&](std::uint32_t j, const Vec<Dim>& xij, double r) {
-      const double F = -K.sigma_h * Kernel::shape_derivative(r * K.inv_h) / r;  // |∇_i W_ij|/r
-      Basis p;                                                                  // [r; h m(r/h)], r = x_j − x_i
-      p.template head<Dim>() = -xij;
-      int c = Dim;
-      for (int a = 0; a < Dim; ++a)
-        for (int d = a; d < Dim; ++d) p[c++] = xij[a] * xij[d] * K.inv_h;
-      const double wgt = vol[j] * F;
-      for (int a = 0; a < N; ++a)  // V_j b_ij ⊗ p_ij = V_j F_ij p_ij ⊗ p_ij (symmetric)
-        for (int d = a; d < N; ++d) B(a, d) += wgt * p[a] * p[d];
-    });
-    Mat<Dim> M;
-    for (int a = 0; a < Dim; ++a)
-      for (int d = 0; d < Dim; ++d) M(a, d) = B(std::min(a, d), std::max(a, d));
-    if (!(M.determinant() >= kMinMomentDet)) continue;
-    // Cholesky B = L Lᵀ (B is symmetric positive semi-definite), in place in the lower triangle;
-    // (max L_kk / min L_kk)² estimates the condition number.
-    bool ok = true;
-    double dmin = std::numeric_limits<double>::infinity(), dmax = 0.0;
-    for (int c = 0; c < N && ok; ++c) {
-      double d = B(c, c);
-      for (int k = 0; k < c; ++k) d -= B(c, k) * B(c, k);
-      if (!(d > 0.0)) {
-        ok = false;
-        break;
-      }
-      d = std::sqrt(d);
-      B(c, c) = d;
-      dmin = std::min(dmin, d);
-      dmax = std::max(dmax, d);
-      for (int row = c + 1; row < N; ++row) {
-        double e = B(c, row);  // upper triangle holds the sums
-        for (int k = 0; k < c; ++k) e -= B(row, k) * B(c, k);
-        B(row, c) = e / d;
-      }
-    }
-    if (ok && dmax * dmax * kMinRcond <= dmin * dmin) {
-      // A_iᵀ = the first Dim columns of B⁻¹ (B symmetric): solve L Lᵀ X = [I; 0].
-      for (int col = 0; col < Dim; ++col) {
-        Basis y;
-        for (int row = 0; row < N; ++row) {
-          double e = row == col ? 1.0 : 0.0;
-          for (int k = 0; k < row; ++k) e -= B(row, k) * y[k];
-          y[row] = e / B(row, row);
-        }
-        for (int row = N - 1; row >= 0; --row) {
-          double e = y[row];
-          for (int k = row + 1; k < N; ++k) e -= B(k, row) * y[k];
-          y[row] = e / B(row, row);
-        }
-        A[i].row(col) = y.transpose();
-      }
-    } else {
-      A[i].template leftCols<Dim>() = M.inverse();
-    }
+    A[i] = correction_matrix<Dim, N, Kernel>(K, quadratic, [&](auto&& f) { support_pairs(i, f); });
   }
 }
 
@@ -1120,6 +1167,9 @@ void SphSolver<Dim>::update_dt() {
 template <int Dim>
 GeostaticReport SphSolver<Dim>::apply_gravity_gradually(double duration, double damping, bool elastic,
                                                         const std::function<void()>& on_step) {
+  if (settings_.total_lagrangian)  // its reference is the start of the main phase (docs/sph.md)
+    throw InputError("the total-Lagrangian formulation takes no geostatic phase", "", "numerics.formulation",
+                     "total_lagrangian");
   GeostaticReport rep;
   rep.duration = duration;
   const ConstitutiveModel saved = model_;
@@ -1149,6 +1199,196 @@ GeostaticReport SphSolver<Dim>::apply_gravity_gradually(double duration, double 
   reset_internal_variables(store_, std::type_identity<ConstitutiveModel>{});  // Σ Δλ of the loading is not failure
   time_ = 0.0;
   return rep;
+}
+
+// ---- Total-Lagrangian formulation (settings_.total_lagrangian; docs/sph.md) ----------------------
+//
+// For elastic bodies in small-to-moderate deformation (beams, piles, retaining structures). All
+// spatial derivatives are taken in the reference configuration X, fixed at the first step of the
+// main phase as X = x − u (u the Displacement field, zero at the start of a run; after a restart
+// the same X again), with the neighbour list of that configuration, built once and never rebuilt
+// (Vignjevic, Reveles & Campbell 2006; Ganzenmüller 2015):
+//   V⁰_i = m_i/ρ₀, g⁰_ij = A_i b⁰_ij, the corrected reference gradient (linear: C_i ∇W⁰_ij, Bonet & Lok
+//          1999; quadratic_correction: the quadratic-complete one of step 2), computed once;
+//   F_i = I + Σ_j V⁰_j (u_j − u_i) ⊗ g⁰_ij (exact for an affine u, surfaces included);
+//   E_i = ½ (F_iᵀ F_i − I), S_i = λ tr E_i I + 2μ E_i (St Venant–Kirchhoff; plane strain in 2D:
+//          E_zz = 0, S_zz = λ tr E), P_i = F_i S_i (first Piola–Kirchhoff);
+//   m_i a_i = Σ_j V⁰_i V⁰_j (P_i g⁰_ij − P_j g⁰_ji) + f^HG_i, then ḡ, damping, leap-frog as step 5
+//          (the pair term is −∂/∂x_i of Σ_k V⁰_k Ψ(F_k): antisymmetric, linear momentum conserved);
+//   f^HG_i = ½ α Σ_j (V⁰_i V⁰_j W⁰_ij/|X_ij|²) E (δ^i_ij + δ^j_ji) x_ij/|x_ij| (Ganzenmüller 2015),
+//          x_ij = x_i − x_j, X_ij = X_i − X_j, δ^i_ij = (F_i X_ij − x_ij)·x_ij/|x_ij|: the pair's
+//          length error against the one F_i predicts; zero for an affine motion;
+//   Cauchy σ_i = J⁻¹ P_i F_iᵀ (J = det F, σ_zz = S_zz/J in 2D) into Stress, ρ_i = ρ₀/J into Density.
+// No artificial viscosity, artificial stress or XSPH (the hourglass force is the stabilisation).
+// Every particle sums its own row (the reverse slot tl_rev_ gives g⁰_ji): the sums are the same on
+// any thread count, and the pair terms of (i, j) and (j, i) are bitwise negatives of each other.
+template <int Dim>
+template <class Kernel>
+void SphSolver<Dim>::tl_step() {
+  if (!tl_ready_) tl_setup<Kernel>();
+  const Vec<Dim> gbar = body_acceleration();
+  tl_stress();
+  tl_forces();
+  integrate(gbar);
+  time_ += dt_;
+  ++step_;
+  check_state();
+  update_dt();
+}
+
+template <int Dim>
+template <class Kernel>
+void SphSolver<Dim>::tl_setup() {
+  constexpr int N = kBasis;
+  const std::size_t n = store_.size();
+  const PairKernel<Kernel> K(h_);
+  const Vec<Dim>* x = field<Position<Dim>>();
+  const Vec<Dim>* u = field<Displacement<Dim>>();
+  const double* m = field<Mass>();
+  const std::int32_t* mat = field<MaterialId>();
+  tl_X_.resize(n);
+  tl_V0_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    tl_X_[i] = x[i] - u[i];
+    tl_V0_[i] = m[i] / materials_[mat[i]].density;
+  }
+  NeighbourList<Dim> list;
+  list.build(tl_X_, Kernel::support * h_);
+  const auto off = list.offsets();
+  const auto idx = list.indices();
+  tl_off_.assign(n + 1, 0);
+  tl_idx_.clear();
+  for (std::size_t i = 0; i < n; ++i) {  // the neighbours within the support, ascending
+    const std::size_t row = tl_idx_.size();
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+      const std::uint32_t j = idx[k];
+      const double r2 = (tl_X_[i] - tl_X_[j]).squaredNorm();
+      if (j != i && r2 < K.cutoff2 && r2 > 0.0) tl_idx_.push_back(j);
+    }
+    std::sort(tl_idx_.begin() + static_cast<std::ptrdiff_t>(row), tl_idx_.end());
+    tl_off_[i + 1] = static_cast<std::uint32_t>(tl_idx_.size());
+  }
+  const std::size_t np = tl_idx_.size();
+  tl_rev_.resize(np);
+  tl_g_.resize(np);
+  tl_hg_.resize(np);
+  const Vec<Dim>* X = tl_X_.data();
+  const double* V0 = tl_V0_.data();
+  const bool quadratic = settings_.kernel_correction && settings_.quadratic_correction;
+  const bool corrected = settings_.kernel_correction;
+  const std::int64_t ni = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(static) if (parallel_worth(ni))
+  for (std::int64_t ii = 0; ii < ni; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    const std::uint32_t b = tl_off_[i], e = tl_off_[i + 1];
+    const auto pairs = [&](auto&& f) {
+      for (std::uint32_t k = b; k < e; ++k) {
+        const std::uint32_t j = tl_idx_[k];
+        const Vec<Dim> xij = X[i] - X[j];
+        f(V0[j], xij, xij.norm());
+      }
+    };
+    Eigen::Matrix<double, Dim, N> A = Eigen::Matrix<double, Dim, N>::Zero();
+    A.template leftCols<Dim>().setIdentity();
+    if (corrected) A = correction_matrix<Dim, N, Kernel>(K, quadratic, pairs);
+    const double Ei = materials_[mat[i]].young;
+    for (std::uint32_t k = b; k < e; ++k) {
+      const std::uint32_t j = tl_idx_[k];
+      const Vec<Dim> xij = X[i] - X[j];
+      const double r = xij.norm(), q = r * K.inv_h;
+      const double F = -K.sigma_h * Kernel::shape_derivative(q) / r;  // |∇_i W_ij|/r
+      const Vec<Dim> gw = -F * xij;                                   // ∇_i W⁰_ij
+      tl_g_[k] = A * kernel_basis<Dim, N>(gw, F, xij, K.inv_h);
+      const double E = 0.5 * (Ei + materials_[mat[j]].young);  // symmetric in i, j
+      tl_hg_[k] = 0.5 * settings_.hourglass * E * (V0[i] * V0[j]) * K.sigma * Kernel::shape(q) / (r * r);
+      // the slot of (j, i) in j's sorted row
+      const auto* first = tl_idx_.data() + tl_off_[j];
+      const auto* last = tl_idx_.data() + tl_off_[j + 1];
+      tl_rev_[k] =
+          static_cast<std::uint32_t>(std::lower_bound(first, last, static_cast<std::uint32_t>(i)) - tl_idx_.data());
+    }
+  }
+  tl_F_.assign(n, Mat<Dim>::Identity());
+  tl_ready_ = true;
+}
+
+template <int Dim>
+void SphSolver<Dim>::tl_stress() {
+  const std::int64_t n = static_cast<std::int64_t>(store_.size());
+  const Vec<Dim>* u = field<Displacement<Dim>>();
+  const std::int32_t* mat = field<MaterialId>();
+  const MaterialParams* mats = materials_.data();
+  const double* V0 = tl_V0_.data();
+  const std::uint32_t* off = tl_off_.data();
+  const std::uint32_t* idx = tl_idx_.data();
+  const Vec<Dim>* g = tl_g_.data();
+  Mat<Dim>* Fs = tl_F_.data();
+  Mat<Dim>* P = field<PairStress<Dim>>();
+  Mat3* sig = field<Stress>();
+  double* rho = field<Density>();
+  double* vol = field<Volume>();
+  Mat<Dim>* L = field<VelocityGradient<Dim>>();
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    Mat<Dim> F = Mat<Dim>::Identity();
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k)
+      F.noalias() += (V0[idx[k]] * (u[idx[k]] - u[i])) * g[k].transpose();
+    Fs[i] = F;
+    const MaterialParams& p = mats[mat[i]];
+    const double mu = p.shear, lambda = p.bulk - 2.0 * p.shear / 3.0;
+    Mat<Dim> Eg = 0.5 * (F.transpose() * F - Mat<Dim>::Identity());
+    const double tr = Eg.trace();
+    Mat<Dim> S = 2.0 * mu * Eg;
+    S.diagonal().array() += lambda * tr;
+    P[i].noalias() = F * S;
+    const double J = F.determinant();
+    Mat3 s3 = Mat3::Zero();
+    s3.template topLeftCorner<Dim, Dim>() = (P[i] * F.transpose()) / J;
+    if constexpr (Dim == 2) s3(2, 2) = lambda * tr / J;
+    sig[i] = s3;
+    rho[i] = p.density / J;
+    vol[i] = V0[i];
+    L[i].setZero();
+  }
+}
+
+template <int Dim>
+void SphSolver<Dim>::tl_forces() {
+  const std::int64_t n = static_cast<std::int64_t>(store_.size());
+  const Vec<Dim>* x = field<Position<Dim>>();
+  const double* m = field<Mass>();
+  const double* V0 = tl_V0_.data();
+  const Vec<Dim>* X = tl_X_.data();
+  const std::uint32_t* off = tl_off_.data();
+  const std::uint32_t* idx = tl_idx_.data();
+  const std::uint32_t* rev = tl_rev_.data();
+  const Vec<Dim>* g = tl_g_.data();
+  const double* hg = tl_hg_.data();
+  const Mat<Dim>* Fs = tl_F_.data();
+  const Mat<Dim>* P = field<PairStress<Dim>>();
+  Vec<Dim>* acc = field<Acceleration<Dim>>();
+  const bool hourglass = settings_.hourglass > 0.0;
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    Vec<Dim> f = Vec<Dim>::Zero();
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+      const std::uint32_t j = idx[k];
+      const Vec<Dim> t = P[i] * g[k] - P[j] * g[rev[k]];
+      f.noalias() += (V0[i] * V0[j]) * t;
+      if (hourglass) {
+        const Vec<Dim> xij = x[i] - x[j];
+        const Vec<Dim> Xij = X[i] - X[j];
+        const double r = xij.norm();
+        const Vec<Dim> e = xij / r;
+        // δ^i_ij + δ^j_ji: (F_i X_ij − x_ij)·e + (F_j X_ji − x_ji)·(−e)
+        const double delta = (Fs[i] * Xij - xij).dot(e) + (Fs[j] * Xij - xij).dot(e);
+        f.noalias() += (hg[k] * delta) * e;
+      }
+    }
+    acc[i] = f / m[i];
+  }
 }
 
 template class SphSolver<2>;

@@ -39,6 +39,10 @@
 ///   6. check_state, update_dt: Δt = min(C_cfl h/(c + |v|max), C_f √(h/|a|max), the model's own
 ///      limit, Δt_max), c the model's wave speed (constitutive.hpp: P-wave speed of a solid; a
 ///      fluid's sound speed and its viscous limit 0.125 h²ρ/μ).
+/// With `total_lagrangian` (elastic bodies only) one step is instead: F_i from the displacements and
+/// the corrected gradients of the reference configuration (built once), St Venant–Kirchhoff stress,
+/// the pair force Σ_j V⁰_i V⁰_j (P_i g⁰_ij − P_j g⁰_ji) and the Ganzenmüller (2015) hourglass force,
+/// then steps 5 and 6 (solver.cpp, "Total-Lagrangian formulation"; docs/sph.md).
 /// The pair sums of steps 2 and 4 are grouped alike on any thread count, and SolverState + resume
 /// restart a run bit for bit (docs/sph.md, "Determinism: thread count and restart").
 /// Units: SI throughout (m, s, kg, Pa).
@@ -102,6 +106,17 @@ struct NumericalSettings {
   /// surfaces too: a bent beam's outer fibres; docs/sph.md) instead of the linear C_i = M_i⁻¹.
   /// sph-slope: `numerics.kernel_correction = "quadratic"`.
   bool quadratic_correction = false;
+  /// Total-Lagrangian formulation for elastic bodies (docs/sph.md, "Total-Lagrangian formulation"):
+  /// reference configuration X = x − u and neighbour list fixed at the first step, corrected
+  /// reference gradients (linear, or quadratic-complete with quadratic_correction), deformation
+  /// gradient F, St Venant–Kirchhoff stress, the Ganzenmüller (2015) hourglass force. Only for
+  /// linear_elastic soil without boundary particles, periodic axes or a geostatic phase (InputError
+  /// otherwise). false: the updated-Lagrangian solver of the numbered passes above.
+  bool total_lagrangian = false;
+  /// Ganzenmüller (2015) hourglass coefficient α (dimensionless) of the total-Lagrangian
+  /// formulation, in [0, 1]; 0 switches the hourglass force off. The time step does not include the
+  /// hourglass stiffness: at α = 10 the cantilever blows up within 0.03 s (docs/sph.md).
+  double hourglass = 0.1;
   EarthquakeLoading earthquake;  ///< applied in the main phase (time from 0 after the geostatic phase)
 };
 
@@ -210,6 +225,10 @@ class SphSolver {
   /// The loads of the last step, one per tracked structure (zero before the first step).
   const std::vector<StructureLoad<Dim>>& structure_loads() const noexcept { return structure_loads_; }
 
+  /// Total-Lagrangian formulation only: the deformation gradient F_i of the last step (empty before
+  /// the first step), in store order.
+  const std::vector<Mat<Dim>>& deformation_gradient() const noexcept { return tl_F_; }
+
   /// Number of neighbour-list builds so far.
   std::int64_t neighbour_builds() const noexcept { return nb_.builds(); }
   /// Memory actually held per particle (store + neighbour list), bytes.
@@ -241,6 +260,13 @@ class SphSolver {
   void integrate(const Vec<Dim>& gbar);  // 5
   void check_state() const;              // 6
   void update_dt();                      // 6
+  // The total-Lagrangian step (settings_.total_lagrangian; solver.cpp, "Total-Lagrangian formulation"):
+  template <class Kernel>
+  void tl_step();
+  template <class Kernel>
+  void tl_setup();   // reference configuration, list, corrected gradients (once)
+  void tl_stress();  // F, S, P (PairStress), σ (Stress), ρ
+  void tl_forces();  // stress divergence and hourglass → acceleration
   /// The raw array of a field of the store (the pair loops index it directly).
   template <class Tag>
   typename Tag::type* field() noexcept {
@@ -305,6 +331,17 @@ class SphSolver {
   // every particle, the first Dim rows of B_i⁻¹ (solver.cpp, step 2), so that the corrected
   // gradient vector is g_ij = A_i b_ij ([I 0] for boundary particles; empty when the correction is off).
   std::vector<Eigen::Matrix<double, Dim, kBasis>> correction_;
+  // Total-Lagrangian formulation: reference positions X and volumes V⁰ = m/ρ₀, the reference
+  // neighbour list (CSR: tl_off_, tl_idx_; tl_rev_[k] is the slot of the pair (j, i) in j's row),
+  // the corrected reference gradient g⁰_ij and the hourglass weight ½ α E V⁰_i V⁰_j W⁰_ij / |X_ij|²
+  // of every directed pair, and F_i of the last step. Built at the first step (tl_ready_).
+  bool tl_ready_ = false;
+  std::vector<Vec<Dim>> tl_X_;
+  std::vector<double> tl_V0_;
+  std::vector<std::uint32_t> tl_off_, tl_idx_, tl_rev_;
+  std::vector<Vec<Dim>> tl_g_;
+  std::vector<double> tl_hg_;
+  std::vector<Mat<Dim>> tl_F_;
   StepStats stats_;
 };
 
