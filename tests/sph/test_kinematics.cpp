@@ -11,16 +11,10 @@
 
 #include "geohaz/sph/scenario.hpp"
 #include "geohaz/sph/solver.hpp"
+#include "support.hpp"
 
 namespace geohaz::sph {
 namespace {
-
-// Small problems: one OpenMP thread (a second one only adds barrier waits; see test_physics.cpp).
-class OneThread : public ::testing::Environment {
- public:
-  void SetUp() override { omp_set_num_threads(1); }
-};
-const auto* const kOneThread = ::testing::AddGlobalTestEnvironment(new OneThread);
 
 template <int Dim>
 SphSolver<Dim> make_block(const Mat<Dim>& A, const Vec<Dim>& v0, KernelChoice kernel, double hf, bool corrected = false,
@@ -234,19 +228,9 @@ void check_free_block_momentum(bool quadratic) {
   Mat<2> A;
   A << 0.3, -0.7, 1.1, -0.2;
   auto solver = make_block<2>(A, Vec<2>(0.5, -0.2), KernelChoice::CubicSpline, 1.2, true, 1e-5, {}, quadratic);
-  auto momentum = [&] {
-    const auto& S = solver.store();
-    Vec<2> p = Vec<2>::Zero();
-    double scale = 0.0;
-    for (std::size_t i = 0; i < S.size(); ++i) {
-      p += S.get<Mass>()[i] * S.get<Velocity<2>>()[i];
-      scale += S.get<Mass>()[i] * S.get<Velocity<2>>()[i].norm();
-    }
-    return std::make_pair(p, scale);
-  };
-  const auto [p0, scale] = momentum();
+  const auto [p0, scale] = test_support::linear_momentum(solver.store());
   for (int k = 0; k < 50; ++k) solver.step();
-  const auto p1 = momentum().first;
+  const auto p1 = test_support::linear_momentum(solver.store()).first;
   double stress = 0.0;
   for (const auto& s : solver.store().get<Stress>()) stress = std::max(stress, s.norm());
   std::printf("momentum change %.3g of %.3g, max |stress| %.3g Pa\n", (p1 - p0).norm(), scale, stress);

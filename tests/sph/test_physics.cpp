@@ -11,6 +11,7 @@
 #include "geohaz/sph/diagnostics.hpp"
 #include "geohaz/sph/scenario.hpp"
 #include "geohaz/sph/solver.hpp"
+#include "support.hpp"
 
 namespace geohaz::sph {
 namespace {
@@ -46,14 +47,6 @@ double min_soil_distance(const SphStore<2>& S) {
       if (k[i] == 0 && k[j] == 0) dmin = std::min(dmin, (x[i] - x[j]).norm());
   return dmin;
 }
-
-// The problems here are a few hundred to a few thousand particles: one thread is as fast as two and
-// immune to oversubscription of a shared CI machine (OpenMP barriers of spinning threads).
-class OneThread : public ::testing::Environment {
- public:
-  void SetUp() override { omp_set_num_threads(1); }
-};
-const auto* const kOneThread = ::testing::AddGlobalTestEnvironment(new OneThread);
 
 // Compression-wave arrival in a laterally confined elastic column (periodic across its width, i.e.
 // an infinitely wide layer: uniaxial strain without side-wall effects, see docs/sph.md): the whole

@@ -32,6 +32,7 @@
 
 #include "geohaz/core/parallel.hpp"
 #include "geohaz/sph/solver.hpp"
+#include "support.hpp"
 
 namespace geohaz::sph {
 namespace {
@@ -45,12 +46,6 @@ struct Golden {
   double drho, rho, eps_p;
   std::array<double, 9> sigma;  // column-major 3×3
 };
-
-class OneThread : public ::testing::Environment {
- public:
-  void SetUp() override { omp_set_num_threads(1); }
-};
-const auto* const kOneThread = ::testing::AddGlobalTestEnvironment(new OneThread);
 
 bool print_mode() {
   return std::getenv("GEOHAZ_GOLDEN_PRINT") != nullptr;

@@ -15,15 +15,10 @@
 #include "geohaz/core/parallel.hpp"
 #include "geohaz/sph/scenario.hpp"
 #include "geohaz/sph/solver.hpp"
+#include "support.hpp"
 
 namespace geohaz::sph {
 namespace {
-
-class OneThread : public ::testing::Environment {
- public:
-  void SetUp() override { omp_set_num_threads(1); }
-};
-const auto* const kOneThread = ::testing::AddGlobalTestEnvironment(new OneThread);
 
 /// A 2D box of soil W wide and H high between two side walls on a fixed bottom. The soil particles
 /// sit at (i + ½)Δx, (k + ½)Δx: the column represents the height H = nz Δx, and each wall face lies

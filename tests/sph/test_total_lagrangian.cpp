@@ -16,15 +16,10 @@
 
 #include "geohaz/sph/scenario.hpp"
 #include "geohaz/sph/solver.hpp"
+#include "support.hpp"
 
 namespace geohaz::sph {
 namespace {
-
-class OneThread : public ::testing::Environment {
- public:
-  void SetUp() override { omp_set_num_threads(1); }
-};
-const auto* const kOneThread = ::testing::AddGlobalTestEnvironment(new OneThread);
 
 /// A free block of soil (no walls), side W, spacing dx, at reference positions X; then displaced by
 /// u(X) (positions X + u, Displacement u) and moving with v(X). The total-Lagrangian reference is
@@ -182,19 +177,9 @@ TEST(TotalLagrangian, FreeStressedBlockConservesLinearMomentum) {
     auto solver =
         tl_block<2>([](const Vec<2>& X) { return Vec<2>(1e-3 * X[0] * X[1] / 0.1, 2e-3 * X[0] * X[0] / 0.1); },
                     [&](const Vec<2>& X) { return Vec<2>(Vec<2>(0.5, -0.2) + A * X); }, quadratic, 0.1, 0.01, 1e-5);
-    auto momentum = [&] {
-      const auto& S = solver.store();
-      Vec<2> p = Vec<2>::Zero();
-      double scale = 0.0;
-      for (std::size_t i = 0; i < S.size(); ++i) {
-        p += S.get<Mass>()[i] * S.get<Velocity<2>>()[i];
-        scale += S.get<Mass>()[i] * S.get<Velocity<2>>()[i].norm();
-      }
-      return std::make_pair(p, scale);
-    };
-    const auto [p0, scale] = momentum();
+    const auto [p0, scale] = test_support::linear_momentum(solver.store());
     for (int k = 0; k < 50; ++k) solver.step();
-    const auto p1 = momentum().first;
+    const auto p1 = test_support::linear_momentum(solver.store()).first;
     double stress = 0.0;
     for (const auto& s : solver.store().get<Stress>()) stress = std::max(stress, s.norm());
     std::printf("momentum change %.3g of %.3g, max |stress| %.3g Pa\n", (p1 - p0).norm(), scale, stress);
