@@ -16,6 +16,7 @@
 
 #include "geohaz/dem/experiments.hpp"
 #include "rigid_body.hpp"
+#include "single_block.hpp"
 
 using namespace geohaz;
 using namespace geohaz::dem;
@@ -50,15 +51,7 @@ TEST(DemBlockSupport, BlocksWhoseSupportEndsShortOfMuHTumbleFromRelease) {
     a.terrain_friction = mu;
     a.terrain_restitution = 0.3;
     a.terrain_rolling_friction = 0.1;
-    const double t = std::tan(40 * kPi / 180), H0 = 100;
-    a.terrain = {Vec2(0, H0), Vec2(H0 / t, 0), Vec2(H0 / t + 1000, 0)};
-    const Vec2 o(10, H0 - 10 * t);
-    const Vec2 along = Vec2(1, -t).normalized(), up = Vec2(t, 1).normalized();
-    const double b = 4.0;
-    a.source = {o + 0.2 * up, o + b * along + 0.2 * up, o + b * along + (b + 0.2) * up, o + (b + 0.2) * up};
-    const Vec2 s0 = o + b * along + 0.7 * along;
-    a.support = {s0 - 2 * up, s0 + (b + 3) * up};
-    a.settle_time = 0.5;
+    const auto [H0, along, up] = block_scene::place_on_40_degree_slope(a);
     DemSolver s;
     // Support at the end of settling: the discs within 5 cm of the slope, their downhill extent
     // from the block's centre, and the centre's height above the slope.

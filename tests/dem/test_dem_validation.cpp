@@ -18,6 +18,7 @@
 #include "geohaz/dem/experiments.hpp"
 #include "geohaz/dem/output.hpp"
 #include "plot.hpp"
+#include "single_block.hpp"
 
 using namespace geohaz;
 using namespace geohaz::dem;
@@ -218,15 +219,7 @@ AvalancheSpec single_block(std::uint64_t seed, double mu_r) {
   a.material.bond.tensile_strength = a.material.bond.shear_strength = 200e6;
   a.material.bond.tensile_strength_std = a.material.bond.shear_strength_std = 0;
   a.strength_factor = 1.0;
-  const double t = std::tan(40 * std::numbers::pi / 180), H0 = 100;
-  a.terrain = {Vec2(0, H0), Vec2(H0 / t, 0), Vec2(H0 / t + 1000, 0)};
-  const Vec2 o(10, H0 - 10 * t);  // on the slope
-  const Vec2 along = Vec2(1, -t).normalized(), up = Vec2(t, 1).normalized();
-  const double b = 4.0;
-  a.source = {o + 0.2 * up, o + b * along + 0.2 * up, o + b * along + (b + 0.2) * up, o + (b + 0.2) * up};
-  const Vec2 s0 = o + b * along + 0.7 * along;
-  a.support = {s0 - 2 * up, s0 + (b + 3) * up};
-  a.settle_time = 0.5;
+  block_scene::place_on_40_degree_slope(a);
   return a;
 }
 
