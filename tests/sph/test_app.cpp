@@ -639,6 +639,13 @@ TEST(SphSlopeApp, BadFormulationExitsTwoNamingTheKey) {
     EXPECT_FALSE(fs::exists(out)) << sets;
   }
   fs::remove_all(out);
+  // A strong hourglass force with the quadratic-complete gradient (the example's): at most 1.
+  const auto hg = run(cfg + " --set numerics.hourglass=5", "bad_formulation_hourglass");
+  EXPECT_EQ(hg.code, 2) << hg.err;
+  EXPECT_NE(hg.err.find("numerics.hourglass"), std::string::npos) << hg.err;
+  EXPECT_NE(hg.err.find("cantilever.toml"), std::string::npos) << hg.err;
+  EXPECT_NE(hg.err.find("at most 1"), std::string::npos) << hg.err;
+  EXPECT_FALSE(fs::exists(out));
   const auto r = run("--config " + (kData / "slope_2d_granular.toml").string() + " --out " + out.string() +
                          " --set numerics.formulation=total_lagrangian --set model.constitutive=linear_elastic"
                          " --set geostatic.enabled=false",

@@ -229,11 +229,17 @@ void read_numerics(ConfigReader& r, RunConfig& c) {
       throw InputError("total_lagrangian is only for elastic bodies: it needs model.constitutive = linear_elastic",
                        r.source(), "numerics.formulation", f);
   }
-  n.hourglass = r.get("numerics.hourglass", d.hourglass, Range::closed(0.0, 1.0),
+  n.hourglass = r.get("numerics.hourglass", d.hourglass, Range::closed(0.0, 100.0),
                       {"1",
                        "hourglass-control coefficient alpha of the total-Lagrangian formulation (Ganzenmueller "
-                       "2015; 0: off; above ~1 its stiffness outgrows the P-wave time step, docs/sph.md); unused "
-                       "by updated_lagrangian"});
+                       "2015; 0: off; its stiffness is in the time step; at most 1 with kernel_correction = "
+                       "quadratic, where a larger one drives a growing mode, docs/sph.md); unused by "
+                       "updated_lagrangian"});
+  if (n.total_lagrangian && n.quadratic_correction && n.hourglass > 1.0)
+    throw InputError(
+        "must be at most 1 with numerics.kernel_correction = quadratic (a larger hourglass force "
+        "drives a growing mode with the quadratic-complete gradient, docs/sph.md)",
+        r.source(), "numerics.hourglass", std::to_string(n.hourglass));
   n.neighbour_skin = r.get("numerics.neighbour_skin", d.neighbour_skin, Range::closed(0.0, 1.0),
                            {"1", "Verlet skin in units of h (0: rebuild the neighbour list every step)"});
 }

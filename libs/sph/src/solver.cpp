@@ -389,8 +389,13 @@ SphSolver<Dim>::SphSolver(SphStore<Dim> store, std::vector<MaterialParams> mater
     if (settings_.periodic.any())
       throw InputError("the total-Lagrangian formulation takes no periodic axes", "", "numerics.formulation",
                        "total_lagrangian");
-    if (!(settings_.hourglass >= 0.0 && settings_.hourglass <= 1.0))
-      throw InputError("must be in [0, 1]", "", "numerics.hourglass", std::to_string(settings_.hourglass));
+    if (!(settings_.hourglass >= 0.0 && settings_.hourglass <= 100.0))
+      throw InputError("must be in [0, 100]", "", "numerics.hourglass", std::to_string(settings_.hourglass));
+    if (settings_.kernel_correction && settings_.quadratic_correction && settings_.hourglass > 1.0)
+      throw InputError(
+          "must be at most 1 with the quadratic-complete gradient (kernel_correction = quadratic): a larger "
+          "hourglass force drives a growing mode with it",
+          "", "numerics.hourglass", std::to_string(settings_.hourglass));
   }
   h_ = settings_.h_factor * settings_.spacing;
   damping_ = settings_.damping;
@@ -1149,7 +1154,8 @@ void SphSolver<Dim>::check_state() const {
 
 template <int Dim>
 void SphSolver<Dim>::update_dt() {
-  double dt = settings_.cfl * h_ / (max_wave_speed_ + stats_.max_speed);
+  const double c = settings_.total_lagrangian ? tl_wave_speed_ : max_wave_speed_;  // TL: hourglass included
+  double dt = settings_.cfl * h_ / (c + stats_.max_speed);
   if (stats_.max_acceleration > 0.0)
     dt = std::min(dt, settings_.force_factor * std::sqrt(h_ / stats_.max_acceleration));
   dt = std::min(dt, model_dt_limit_);
@@ -1308,6 +1314,19 @@ void SphSolver<Dim>::tl_setup() {
           static_cast<std::uint32_t>(std::lower_bound(first, last, static_cast<std::uint32_t>(i)) - tl_idx_.data());
     }
   }
+  // The hourglass force's stiffness in the time step: in the mode it resists (i and j moving apart
+  // by u each along e_ij, F unchanged) the pair pushes i back with 4 w_ij u (w_ij = tl_hg_), so
+  // ω_i² ≤ Σ_j 4 w_ij / m_i. It enters as a wave speed c_hg = ω h/2 added to the P-wave speed in
+  // quadrature, c² = c_p² + c_hg², so that Δt = C_cfl h/c ≤ 2 C_cfl/ω (the leap-frog bound 2/ω
+  // with the CFL number's margin). α = 0 leaves c_p.
+  double w2 = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    double k = 0.0;
+    for (std::uint32_t s = tl_off_[i]; s < tl_off_[i + 1]; ++s) k += 4.0 * tl_hg_[s];
+    w2 = std::max(w2, k / m[i]);
+  }
+  tl_wave_speed_ = std::sqrt(max_wave_speed_ * max_wave_speed_ + 0.25 * w2 * h_ * h_);
+  dt_ = std::min(dt_, settings_.cfl * h_ / tl_wave_speed_);
   tl_F_.assign(n, Mat<Dim>::Identity());
   tl_ready_ = true;
 }

@@ -114,8 +114,10 @@ struct NumericalSettings {
   /// otherwise). false: the updated-Lagrangian solver of the numbered passes above.
   bool total_lagrangian = false;
   /// Ganzenmüller (2015) hourglass coefficient α (dimensionless) of the total-Lagrangian
-  /// formulation, in [0, 1]; 0 switches the hourglass force off. The time step does not include the
-  /// hourglass stiffness: at α = 10 the cantilever blows up within 0.03 s (docs/sph.md).
+  /// formulation, in [0, 100], at most 1 with quadratic_correction; 0 switches the hourglass force
+  /// off. Its stiffness is in the time step (solver.cpp, tl_setup). Above 1 the force itself drives
+  /// a growing mode with the quadratic-complete gradient, whatever the step (test
+  /// HourglassControlStaysBoundedWithItsTimeStep).
   double hourglass = 0.1;
   EarthquakeLoading earthquake;  ///< applied in the main phase (time from 0 after the geostatic phase)
 };
@@ -342,6 +344,7 @@ class SphSolver {
   std::vector<Vec<Dim>> tl_g_;
   std::vector<double> tl_hg_;
   std::vector<Mat<Dim>> tl_F_;
+  double tl_wave_speed_ = 0.0;  ///< √(c_p² + c_hg²), the time step's wave speed with the hourglass stiffness (m/s)
   StepStats stats_;
 };
 
