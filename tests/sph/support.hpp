@@ -4,9 +4,12 @@
 #include <omp.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <utility>
+#include <vector>
 
 #include "geohaz/sph/fields.hpp"
+#include "geohaz/sph/scenario.hpp"
 
 namespace geohaz::sph::test_support {
 
@@ -30,6 +33,25 @@ std::pair<Vec<Dim>, double> linear_momentum(const SphStore<Dim>& S) {
     scale += S.template get<Mass>()[i] * S.template get<Velocity<Dim>>()[i].norm();
   }
   return {p, scale};
+}
+
+/// The soil particles of a free block W × W (2D; W × W × W in 3D) at spacing dx, smoothing factor
+/// h/dx = hf, density 2000 kg/m³ and no boundary particles at all (the profile builder's walls,
+/// including the 3D roller side walls, removed).
+template <int Dim>
+SphStore<Dim> free_block(double W, double dx, double hf) {
+  ProfileDomain d;
+  d.surface = {{0.0, W}, {W, W}};
+  d.x_left = 0.0;
+  d.x_right = W;
+  d.width = W;
+  d.periodic_width = false;
+  d.bottom = d.left = d.right = WallType::None;
+  auto sc = build_profile<Dim>(d, dx, {2000.0}, hf);
+  std::vector<std::uint8_t> rm(sc.store.size());
+  for (std::size_t i = 0; i < rm.size(); ++i) rm[i] = sc.store.template get<ParticleKind>()[i] != 0;
+  sc.store.remove_if(rm);
+  return std::move(sc.store);
 }
 
 }  // namespace geohaz::sph::test_support

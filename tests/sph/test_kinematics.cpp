@@ -20,21 +20,9 @@ template <int Dim>
 SphSolver<Dim> make_block(const Mat<Dim>& A, const Vec<Dim>& v0, KernelChoice kernel, double hf, bool corrected = false,
                           double dt_max = 1e-9, const std::function<Vec<Dim>(const Vec<Dim>&)>& extra = {},
                           bool quadratic = false) {
-  ProfileDomain d;
-  const double W = Dim == 2 ? 0.3 : 0.16;
-  d.surface = {{0.0, W}, {W, W}};
-  d.x_left = 0.0;
-  d.x_right = W;
-  d.width = W;
-  d.periodic_width = false;
-  d.bottom = d.left = d.right = WallType::None;
-  auto sc = build_profile<Dim>(d, 0.01, {2000.0}, hf);
-  // No walls at all for this test: drop the roller side walls of 3D.
-  std::vector<std::uint8_t> rm(sc.store.size());
-  for (std::size_t i = 0; i < rm.size(); ++i) rm[i] = sc.store.template get<ParticleKind>()[i] != 0;
-  sc.store.remove_if(rm);
-  auto& x = sc.store.template get<Position<Dim>>();
-  auto& v = sc.store.template get<Velocity<Dim>>();
+  SphStore<Dim> store = test_support::free_block<Dim>(Dim == 2 ? 0.3 : 0.16, 0.01, hf);
+  auto& x = store.template get<Position<Dim>>();
+  auto& v = store.template get<Velocity<Dim>>();
   for (std::size_t i = 0; i < x.size(); ++i) v[i] = v0 + A * x[i] + (extra ? extra(x[i]) : Vec<Dim>::Zero());
   MaterialParams m;
   m.density = 2000;
@@ -49,7 +37,7 @@ SphSolver<Dim> make_block(const Mat<Dim>& A, const Vec<Dim>& v0, KernelChoice ke
   s.artificial_stress = 0.0;
   s.kernel_correction = corrected;
   s.quadratic_correction = quadratic;
-  return SphSolver<Dim>(std::move(sc.store), {m}, LinearElastic{}, s);
+  return SphSolver<Dim>(std::move(store), {m}, LinearElastic{}, s);
 }
 
 template <int Dim>

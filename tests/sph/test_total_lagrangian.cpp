@@ -29,21 +29,10 @@ template <int Dim>
 SphSolver<Dim> tl_block(const std::function<Vec<Dim>(const Vec<Dim>&)>& u,
                         const std::function<Vec<Dim>(const Vec<Dim>&)>& v, bool quadratic, double hourglass = 0.1,
                         double dx = 0.01, double dt_max = 1e-9) {
-  ProfileDomain d;
-  const double W = Dim == 2 ? 0.1 : 0.06;
-  d.surface = {{0.0, W}, {W, W}};
-  d.x_left = 0.0;
-  d.x_right = W;
-  d.width = W;
-  d.periodic_width = false;
-  d.bottom = d.left = d.right = WallType::None;
-  auto sc = build_profile<Dim>(d, dx, {2000.0}, 1.2);
-  std::vector<std::uint8_t> rm(sc.store.size());
-  for (std::size_t i = 0; i < rm.size(); ++i) rm[i] = sc.store.template get<ParticleKind>()[i] != 0;
-  sc.store.remove_if(rm);
-  auto& x = sc.store.template get<Position<Dim>>();
-  auto& vel = sc.store.template get<Velocity<Dim>>();
-  auto& disp = sc.store.template get<Displacement<Dim>>();
+  SphStore<Dim> store = test_support::free_block<Dim>(Dim == 2 ? 0.1 : 0.06, dx, 1.2);
+  auto& x = store.template get<Position<Dim>>();
+  auto& vel = store.template get<Velocity<Dim>>();
+  auto& disp = store.template get<Displacement<Dim>>();
   for (std::size_t i = 0; i < x.size(); ++i) {
     const Vec<Dim> X = x[i];
     disp[i] = u ? u(X) : Vec<Dim>::Zero();
@@ -63,7 +52,7 @@ SphSolver<Dim> tl_block(const std::function<Vec<Dim>(const Vec<Dim>&)>& u,
   s.quadratic_correction = quadratic;
   s.total_lagrangian = true;
   s.hourglass = hourglass;
-  return SphSolver<Dim>(std::move(sc.store), {m}, LinearElastic{}, s);
+  return SphSolver<Dim>(std::move(store), {m}, LinearElastic{}, s);
 }
 
 template <int Dim>
