@@ -48,6 +48,23 @@ inline double rolling_inertia(double Ii, double mi, double Ri, double Ij, double
   return 1.0 / (1.0 / (Ii + mi * Ri * Ri) + 1.0 / (Ij + mj * Rj * Rj));
 }
 
+/// Whether terrain segment k owns the contact of a disc at x. A vertex shared by two segments of a
+/// polyline is one contact, not two: a segment whose closest point is its start skips it (the
+/// previous segment owns the vertex), and one whose closest point is its end keeps it only if the
+/// disc is past the start of the next segment too (convex vertex). Interior points of both
+/// (concave vertex) both count.
+bool owns_contact(const TerrainSegments& terrain, std::size_t k, const Vec2& x) {
+  const WallSegment& s = terrain.segment(k);
+  if (!s.joined_prev && !s.joined_next) return true;
+  const double u = segment_parameter(s.a, s.b, x);
+  if (u <= 0.0 && s.joined_prev) return false;
+  if (u >= 1.0 && s.joined_next) {
+    const WallSegment& nx = terrain.segment(k + 1);
+    if (segment_parameter(nx.a, nx.b, x) > 0.0) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::size_t add_disc(DiscStore& s, const Vec2& x, double r, double rho, std::int64_t id) {
@@ -516,14 +533,7 @@ void DemSolver::wall_forces(const Law& law) {
         const double r = std::sqrt(r2);
         const Vec2 nrm = d / r;
         const Vec2 t = perp(nrm);
-        // Dashpot mass: the disc's, or its bonded fragment's effective mass at the contact point.
-        double md = m[i];
-        if (frag_mass) {
-          const std::uint32_t q = frag_of_[i];
-          const Vec2 rc = p - frag_centre_[q];
-          const double rn = rc.x() * nrm.y() - rc.y() * nrm.x();
-          md = std::max(m[i], 1.0 / (1.0 / frag_mass_[q] + rn * rn / frag_inertia_[q]));
-        }
+        const double md = frag_mass ? fragment_dashpot_mass(i, m[i], p, nrm) : m[i];
         const ContactResponse c = law.evaluate(Ri - r, md, Ri, 2.0 * Ri, zeta);
         const Vec2 vrel = v[i] - s.velocity - w[i] * Ri * t;
         // A wall never pulls a disc: the dashpot cannot make the normal force tensile (ζ is
@@ -586,20 +596,7 @@ void DemSolver::wall_forces(const Law& law) {
       if (terrain.size() > 0) {
         auto [b, e] = terrain.candidates(xi.x());
         for (auto p = b; p != e; ++p) {
-          const WallSegment& s = terrain.segment(*p);
-          // A vertex shared by two segments of a polyline is one contact, not two: a segment
-          // whose closest point is its start skips it (the previous segment owns the vertex), and
-          // one whose closest point is its end keeps it only if the disc is past the start of the
-          // next segment too (convex vertex). Interior points of both (concave vertex) both count.
-          if (s.joined_prev || s.joined_next) {
-            const double u = segment_parameter(s.a, s.b, xi);
-            if (u <= 0.0 && s.joined_prev) continue;
-            if (u >= 1.0 && s.joined_next) {
-              const WallSegment& nx = terrain.segment(*p + 1);
-              if (segment_parameter(nx.a, nx.b, xi) > 0.0) continue;
-            }
-          }
-          touch(s, nw + *p, SIZE_MAX, terrain_damping_[*p]);
+          if (owns_contact(terrain, *p, xi)) touch(terrain.segment(*p), nw + *p, SIZE_MAX, terrain_damping_[*p]);
         }
       }
       if (used == 0 && !had) continue;  // no wall contact before or now: nothing to write
@@ -622,6 +619,13 @@ void DemSolver::compute_forces(const Law& law) {
   pair_forces(law);
   bond_forces();
   wall_forces(law);
+}
+
+double DemSolver::fragment_dashpot_mass(std::size_t i, double mi, const Vec2& p, const Vec2& n) const {
+  const std::uint32_t q = frag_of_[i];
+  const Vec2 rc = p - frag_centre_[q];
+  const double rn = rc.x() * n.y() - rc.y() * n.x();
+  return std::max(mi, 1.0 / (1.0 / frag_mass_[q] + rn * rn / frag_inertia_[q]));
 }
 
 void DemSolver::update_fragments() {

@@ -142,6 +142,9 @@ class DemSolver {
   // Bonded fragments for contact.fragment_damping_mass (recomputed every step; buffers reused):
   // per disc its fragment (union–find over intact bonds), per fragment mass, centre, inertia.
   void update_fragments();
+  /// Mass of disc i's wall and terrain dashpots at contact point p with normal n: its bonded
+  /// fragment's effective mass there, 1/(1/M + (r × n)²/I), at least the disc's own mass mi.
+  double fragment_dashpot_mass(std::size_t i, double mi, const Vec2& p, const Vec2& n) const;
   std::vector<std::uint32_t> frag_of_;
   std::vector<double> frag_mass_, frag_inertia_;
   std::vector<Vec2> frag_centre_;
