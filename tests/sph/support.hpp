@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <utility>
 #include <vector>
 
@@ -33,6 +35,21 @@ std::pair<Vec<Dim>, double> linear_momentum(const SphStore<Dim>& S) {
     scale += S.template get<Mass>()[i] * S.template get<Velocity<Dim>>()[i].norm();
   }
   return {p, scale};
+}
+
+/// Runs `solver` 50 steps and checks that Σ m v stays at its start value to 1e-12 of Σ m |v| (pair
+/// terms that cancel pairwise), with the stress above `min_stress` (Pa) so that the check means
+/// something.
+template <class Solver>
+void expect_fifty_steps_conserve_momentum(Solver& solver, double min_stress) {
+  const auto [p0, scale] = linear_momentum(solver.store());
+  for (int k = 0; k < 50; ++k) solver.step();
+  const auto p1 = linear_momentum(solver.store()).first;
+  double stress = 0.0;
+  for (const auto& s : solver.store().template get<Stress>()) stress = std::max(stress, s.norm());
+  std::printf("momentum change %.3g of %.3g, max |stress| %.3g Pa\n", (p1 - p0).norm(), scale, stress);
+  EXPECT_GT(stress, min_stress) << "the block must be stressed for the test to mean anything";
+  EXPECT_LT((p1 - p0).norm(), 1e-12 * scale);
 }
 
 /// The soil particles of a free block W × W (2D; W × W × W in 3D) at spacing dx, smoothing factor
