@@ -115,6 +115,8 @@ int avalanche(std::size_t n, double runout_s, int threads) {
   a.record_interval = 0.5;
   a.terrain_friction = 0.5;
   a.terrain_restitution = 0.3;
+  a.terrain_rolling_friction = 0.65;
+  a.material.contact.fragment_rolling = true;  // material.terrain_rolling = "fragment"
   a.runout_time = runout_s;
   // 3 km profile: 35° slope from (0, 1000) to (1428, 0), floor to x = 3000 m.
   const double t = std::tan(35.0 * std::acos(-1.0) / 180.0), top = 1000.0;

@@ -4,7 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <numbers>
+#include <utility>
+#include <vector>
 
 #include "geohaz/dem/solver.hpp"
 
@@ -361,28 +364,112 @@ TEST(DemContact, DiscRollingOnTerrainDeceleratesWithTheTerrainRollingResistance)
   // of rock on debris that data/dem/avalanche.toml takes from STONE (Guzzetti et al. 2002). Also:
   // after stopping on flat terrain the disc stays at rest (the rolling spring holds it).
   // Start speeds keep each disc rolling through the measuring window [0.2 s, 1.2 s].
+  // The same with the rolling moment on the fragment (material.terrain_rolling = fragment): a lone
+  // disc is its own fragment, so the two must agree to round-off.
   for (const auto& [mu_r, v0] : {std::pair{0.2, 4.0}, std::pair{0.65, 7.0}}) {
-    const double R = 0.5, g = 9.81, kn = 1e9;
-    DemSolver s;
-    s.law = LinearSpringCoulomb{kn, 0.4 * kn};
-    s.contact.rolling_friction = 0.0;
-    add_disc(s.discs, Vec2(0, R - 2650 * kPi * R * R * g / kn), R, 2650);
-    s.discs.get<Velocity<2>>()[0] = Vec2(v0, 0);
-    s.discs.get<AngularVelocity>()[0] = -v0 / R;
-    s.terrain.add_polyline({Vec2(-10, 0), Vec2(100, 0)}, 0.5, 0.3, mu_r);
-    s.initialise();
-    s.run_until(0.2);
-    const double t1 = s.time(), v1 = s.discs.get<Velocity<2>>()[0].x(), x1 = s.discs.get<Position<2>>()[0].x();
-    s.run_until(1.2);
-    const double a = (v1 - s.discs.get<Velocity<2>>()[0].x()) / (s.time() - t1);
-    EXPECT_NEAR(a, 2.0 / 3.0 * mu_r * g, 0.02 * 2.0 / 3.0 * mu_r * g) << "mu_r = " << mu_r;
-    // Energy line: from x1 the disc (kinetic energy ¾ m v1², rolling without slip) travels
-    // ¾ v1² / (μ_r g) before it stops: μ_r m g per metre.
-    s.run_until(1.2 + 1.5 * v1 / (2.0 / 3.0 * mu_r * g));
-    const double travel = s.discs.get<Position<2>>()[0].x() - x1;
-    EXPECT_NEAR(travel, 0.75 * v1 * v1 / (mu_r * g), 0.02 * 0.75 * v1 * v1 / (mu_r * g)) << "mu_r = " << mu_r;
-    EXPECT_LT(std::abs(s.discs.get<Velocity<2>>()[0].x()), 1e-3) << "mu_r = " << mu_r;
+    double end_x[2] = {0, 0};
+    for (const bool fragment : {false, true}) {
+      const double R = 0.5, g = 9.81, kn = 1e9;
+      DemSolver s;
+      s.law = LinearSpringCoulomb{kn, 0.4 * kn};
+      s.contact.rolling_friction = 0.0;
+      s.contact.fragment_rolling = fragment;
+      add_disc(s.discs, Vec2(0, R - 2650 * kPi * R * R * g / kn), R, 2650);
+      s.discs.get<Velocity<2>>()[0] = Vec2(v0, 0);
+      s.discs.get<AngularVelocity>()[0] = -v0 / R;
+      s.terrain.add_polyline({Vec2(-10, 0), Vec2(100, 0)}, 0.5, 0.3, mu_r);
+      s.initialise();
+      s.run_until(0.2);
+      const double t1 = s.time(), v1 = s.discs.get<Velocity<2>>()[0].x(), x1 = s.discs.get<Position<2>>()[0].x();
+      s.run_until(1.2);
+      const double a = (v1 - s.discs.get<Velocity<2>>()[0].x()) / (s.time() - t1);
+      EXPECT_NEAR(a, 2.0 / 3.0 * mu_r * g, 0.02 * 2.0 / 3.0 * mu_r * g) << "mu_r = " << mu_r;
+      // Energy line: from x1 the disc (kinetic energy ¾ m v1², rolling without slip) travels
+      // ¾ v1² / (μ_r g) before it stops: μ_r m g per metre.
+      s.run_until(1.2 + 1.5 * v1 / (2.0 / 3.0 * mu_r * g));
+      const double travel = s.discs.get<Position<2>>()[0].x() - x1;
+      EXPECT_NEAR(travel, 0.75 * v1 * v1 / (mu_r * g), 0.02 * 0.75 * v1 * v1 / (mu_r * g)) << "mu_r = " << mu_r;
+      EXPECT_LT(std::abs(s.discs.get<Velocity<2>>()[0].x()), 1e-3) << "mu_r = " << mu_r;
+      end_x[fragment] = s.discs.get<Position<2>>()[0].x();
+    }
+    EXPECT_NEAR(end_x[1], end_x[0], 1e-9 * std::abs(end_x[0])) << "mu_r = " << mu_r;
   }
+}
+
+TEST(DemContact, FragmentRollingMomentHasTheFragmentsLeverArmAndTurnsItRigidly) {
+  // A T-shaped fragment of five bonded discs (R = 0.4 m: a column of three, the bottom one on
+  // flat terrain with overlap δ, and one on each side of the top disc), spinning rigidly about its
+  // centre (so the contact moves tangentially, keeping F_n the same in both runs) fast enough that
+  // the terrain rolling spring reaches its plastic limit in the first step. With the moment on
+  // the disc (disc) it is μ_r R F_n on the bottom disc; on the fragment (fragment) μ_r h F_n with
+  // h = (G − p)·n = 3.8R − δ the height of the fragment's centre G above the contact point p, and
+  // it is applied as a rigid rotation: disc j gets m_j α ẑ × (x_j − G) and I_j α, α = M/I_f. The
+  // two runs have identical states up to the forces, so the differences of their force and
+  // moment arrays after one step are exactly these loads.
+  const double R = 0.4, rho = 2650, delta = 1e-5, mu_r = 0.5, omega = -20.0;
+  const std::vector<Vec2> p = {Vec2(0, R - delta), Vec2(0, 3 * R - delta), Vec2(0, 5 * R - delta),
+                               Vec2(-2 * R, 5 * R - delta), Vec2(2 * R, 5 * R - delta)};
+  auto run = [&](bool fragment) {
+    auto s = std::make_unique<DemSolver>();
+    s->law = LinearSpringCoulomb{1e9, 4e8};
+    s->contact.rolling_friction = mu_r;
+    s->contact.rolling_damping = 0.0;
+    s->contact.fragment_rolling = fragment;
+    s->settings.fixed_time_step = 1e-5;
+    s->settings.reorder_every = 0;
+    for (const Vec2& q : p) add_disc(s->discs, q, R, rho);
+    const Vec2 centre = (p[0] + p[1] + p[2] + p[3] + p[4]) / 5;  // equal masses
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      s->discs.get<AngularVelocity>()[i] = omega;
+      s->discs.get<Velocity<2>>()[i] = omega * Vec2(-(p[i] - centre).y(), (p[i] - centre).x());
+    }
+    const double kn = 2e10 / (2 * R);
+    for (auto [a, b] : {std::pair{0, 1}, std::pair{1, 2}, std::pair{2, 3}, std::pair{2, 4}})
+      s->bonds.add(a, b, R, 2 * R, kn, kn / 2.5, 200e6, 200e6);
+    s->terrain.add_polyline({Vec2(-10, 0), Vec2(10, 0)}, 0.5, 0.3, mu_r);
+    s->initialise();
+    s->step();
+    return s;
+  };
+  const auto off = run(false), on = run(true);
+  auto roll_moment = [](const DemSolver& s) {
+    const auto& wc = s.discs.get<WallContacts>()[s.index_of(0)];
+    EXPECT_GE(wc(0, 0), 0.0);
+    return wc(2, 0);
+  };
+  const double m_off = roll_moment(*off), m_on = roll_moment(*on);
+  // Centre and inertia of the fragment where the forces were computed (after the first drift).
+  const auto& x = on->discs.get<Position<2>>();
+  const auto& m = on->discs.get<Mass>();
+  const auto& I = on->discs.get<Inertia>();
+  Vec2 G = Vec2::Zero();
+  double M = 0, If = 0;
+  for (std::size_t j = 0; j < p.size(); ++j) {
+    G += m[j] * x[j];
+    M += m[j];
+  }
+  G /= M;
+  for (std::size_t j = 0; j < p.size(); ++j) If += I[j] + m[j] * (x[j] - G).squaredNorm();
+  const std::size_t bottom = on->index_of(0);
+  const double h = G.y();  // terrain y = 0, normal +y
+  EXPECT_NEAR(h, 3.8 * R - delta, 1e-3);
+  EXPECT_GT(m_off, 0.0);                           // spinning clockwise: the resistance turns it back (+)
+  EXPECT_NEAR(m_on / m_off, h / R, 1e-9 * h / R);  // both at μ_r arm F_n, same F_n
+  const double alpha = m_on / If;
+  const auto &F_on = on->discs.get<Force>(), &F_off = off->discs.get<Force>();
+  const auto &T_on = on->discs.get<Torque>(), &T_off = off->discs.get<Torque>();
+  Vec2 net = Vec2::Zero();
+  for (std::size_t j = 0; j < p.size(); ++j) {
+    const Vec2 r = x[j] - G;
+    const Vec2 dF = F_on[j] - F_off[j];
+    const double dT = T_on[j] - T_off[j];
+    const Vec2 expected = m[j] * alpha * Vec2(-r.y(), r.x());
+    EXPECT_NEAR(dF.x(), expected.x(), 1e-9 * m_on / R) << "disc " << j;
+    EXPECT_NEAR(dF.y(), expected.y(), 1e-9 * m_on / R) << "disc " << j;
+    EXPECT_NEAR(dT, I[j] * alpha - (j == bottom ? m_off : 0.0), 1e-9 * m_on) << "disc " << j;
+    net += dF;
+  }
+  EXPECT_LT(net.norm(), 1e-9 * m_on / R);  // a pure moment: no net force
 }
 
 TEST(DemContact, EveryLawStoresTheWorkOfItsNormalForce) {

@@ -453,7 +453,8 @@ TEST(DemApp, BadInputExitsWithCode2AndWritesNothing) {
         "avalanche.terrain_restitution=0", "material.restitution=0", "material.restitution=1.5",
         "material.rolling_friction=-0.1", "avalanche.terrain_rolling_friction=-0.2",
         "avalanche.stop_kinetic_fraction=-0.5", "avalanche.stop_speed=-1", "material.rolling_damping=1.5",
-        "material.tangential_damping=1.5", "material.tangential_damping=-0.1", "material.terrain_damping_mass=wheel"}) {
+        "material.tangential_damping=1.5", "material.tangential_damping=-0.1", "material.terrain_damping_mass=wheel",
+        "material.terrain_rolling=wheel", "material.rolling_friction=2.5", "avalanche.terrain_rolling_friction=3"}) {
     const auto r = geohaz::testing::run_command(kApp.string() + " --config " + (kData / "avalanche.toml").string() +
                                                 " --set " + set + " --out " + out.string());
     EXPECT_EQ(r.code, 2) << set;

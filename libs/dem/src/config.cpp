@@ -106,8 +106,10 @@ void read_material(ConfigReader& r, RunConfig& c) {
   m.contact.friction = r.get("material.friction", 0.5, Range::non_negative(), {"1", "contact friction coefficient mu"});
   m.contact.restitution =
       r.get("material.restitution", 0.5, Range::open_closed(0.0, 1.0), {"1", "normal restitution coefficient e"});
-  m.contact.rolling_friction = r.get("material.rolling_friction", 0.0, Range::non_negative(),
-                                     {"1", "rolling-resistance coefficient mu_r (Ai et al. 2011, model C)"});
+  // μ_r is the tangent of a rolling angle: 1 is a square resting on a face (tan 45°), STONE's
+  // largest tan β is 0.80; above 2 the rolling stiffness 2.25 μ_r² k_n R² makes the time step collapse.
+  m.contact.rolling_friction = r.get("material.rolling_friction", 0.0, Range::closed(0.0, 2.0),
+                                     {"1", "rolling-resistance coefficient mu_r (Ai et al. 2011, model C), 0 to 2"});
   m.contact.rolling_damping =
       r.get("material.rolling_damping", 0.3, Range::closed(0.0, 1.0), {"1", "rolling viscous damping ratio eta_r"});
   m.contact.tangential_damping =
@@ -120,6 +122,13 @@ void read_material(ConfigReader& r, RunConfig& c) {
                    {"",
                     "mass of the disc-terrain and disc-wall dashpots: disc = the disc's own; fragment = the "
                     "effective mass of its bonded fragment at the contact point, 1/(1/M + (r x n)^2/I)"}) == "fragment";
+  m.contact.fragment_rolling =
+      r.get_choice("material.terrain_rolling", "disc", {"disc", "fragment"},
+                   {"",
+                    "lever arm of the disc-terrain rolling resistance: disc = the disc radius, moment on "
+                    "the disc; fragment = the height of its bonded fragment's centre above the contact, moment on the "
+                    "whole fragment (a rolling fragment loses mu_r N per metre, as a lumped rockfall block)"}) ==
+      "fragment";
   // [bond]
   ParallelBondProperties& b = m.bond;  // defaults: the struct's (bonds.hpp)
   b.radius_multiplier = r.get("bond.radius_multiplier", b.radius_multiplier, Range::open_closed(0.0, 1.0),
@@ -286,8 +295,10 @@ void read_avalanche(ConfigReader& r, RunConfig& c, bool describe) {
   a.terrain_restitution = r.get("avalanche.terrain_restitution", a.terrain_restitution, Range::open_closed(0.0, 1.0),
                                 {"1", "restitution of disc-terrain contacts"});
   a.terrain_rolling_friction =
-      r.get("avalanche.terrain_rolling_friction", m.contact.rolling_friction, Range::non_negative(),
-            {"1", "rolling-resistance coefficient mu_r of disc-terrain contacts (default: material.rolling_friction)"});
+      r.get("avalanche.terrain_rolling_friction", m.contact.rolling_friction, Range::closed(0.0, 2.0),
+            {"1",
+             "rolling-resistance coefficient mu_r of disc-terrain contacts, 0 to 2 (default: "
+             "material.rolling_friction)"});
   a.settle_time = r.get("avalanche.settle_time", a.settle_time, Range::non_negative(),
                         {"s", "settling under gravity before release"});
   a.settle_damping = r.get("avalanche.settle_damping", a.settle_damping, Range::closed_open(0.0, 1.0),

@@ -214,6 +214,7 @@ void DemSolver::update_neighbours(double max_drift) {
 }
 
 void DemSolver::reorder(std::span<const std::uint32_t> order) {
+  ++reorders_;  // the fragment labels (update_fragments) are per index
   perm_scratch_.assign(order.begin(), order.end());
   discs.reorder(perm_scratch_);
   // Move each disc's history segment with it.
@@ -493,8 +494,9 @@ void DemSolver::wall_forces(const Law& law) {
   const Vec2 gravity = settings.gravity;
   const std::int64_t n = static_cast<std::int64_t>(discs.size());
   update_wall_damping(law);
-  const bool frag_mass = contact.fragment_damping_mass;
-  if (frag_mass) update_fragments();
+  const bool frag_mass = contact.fragment_damping_mass, frag_roll = contact.fragment_rolling;
+  if (frag_mass || frag_roll) update_fragments();
+  if (frag_roll) roll_moment_.assign(discs.size(), 0.0);
   // Bounding boxes of the walls grown by the largest radius: a cheap reject before the distance.
   std::vector<Vec2> box_lo(nw), box_hi(nw);
   for (std::size_t k = 0; k < nw; ++k) {
@@ -562,15 +564,32 @@ void DemSolver::wall_forces(const Law& law) {
         const double mu_rw = s.rolling_friction >= 0.0 ? s.rolling_friction : mu_r;  // the wall's own, if set
         // Tangential dashpot: the wall's normal damping ratio (× f_t) on the tangential spring.
         const double ct = f_t > 0.0 ? f_t * c.cn * std::sqrt(c.kt / c.kn) : 0.0;
+        // Rolling resistance on the disc (lever arm R_i, the disc's spin, I_r about the contact
+        // point) or, on terrain with contact.fragment_rolling, on its fragment (lever arm h, the
+        // fragment's spin, I_f + M_f max(|G − p|, R_i)²).
+        // Walls (platens, the avalanche's support) always act on the disc.
+        const bool on_fragment = frag_roll && wall_index == SIZE_MAX;
+        const std::uint32_t q = on_fragment ? frag_of_[i] : 0;
+        const double arm = on_fragment ? std::max(Ri, (frag_centre_[q] - p).dot(nrm)) : Ri;
         const auto fr = CoulombFrictionRolling::update(
-            fs, mr, c.kt, c.kn, vrel.dot(t), fn, Ri, w[i], s.friction, mu_rw, eta_r, dt,
-            [&] { return I[i] + m[i] * Ri * Ri; }, ct);
+            fs, mr, c.kt, c.kn, vrel.dot(t), fn, arm, on_fragment ? frag_spin_[q] : w[i], s.friction, mu_rw, eta_r, dt,
+            [&] {
+              if (!on_fragment) return I[i] + m[i] * Ri * Ri;
+              return frag_inertia_[q] + frag_mass_[q] * std::max((frag_centre_[q] - p).squaredNorm(), Ri * Ri);
+            },
+            ct);
         fs = fr.shear;
         mr = fr.roll;
-        const double kr = fr.kr;
+        // The rolling spring acts on the fragment's inertia: on disc i's share I_i/I_f of it.
+        const double kr = on_fragment ? fr.kr * I[i] / frag_inertia_[q] : fr.kr;
         const Vec2 fc = fn * nrm + (fs + fr.shear_damping) * t;
         f += fc;
-        tq += -Ri * (fs + fr.shear_damping) + mr + fr.roll_damping;
+        if (on_fragment) {
+          tq += -Ri * (fs + fr.shear_damping);
+          roll_moment_[i] += mr + fr.roll_damping;
+        } else {
+          tq += -Ri * (fs + fr.shear_damping) + mr + fr.roll_damping;  // one expression: bit-identical to before
+        }
         // Time step: a dashpot of ratio ζ lowers the critical step of the explicit scheme to
         // (2/ω)(√(1+ζ²) − ζ) (Belytschko et al. 2000, §6.3), i.e. k acts as k (ζ + √(1+ζ²))².
         // Without it a strongly damped contact (e = 0.1, ζ = 1.24) changes v by 57 % per step
@@ -612,6 +631,39 @@ void DemSolver::wall_forces(const Law& law) {
       walls[k].contacts += wn[k];
     }
   }
+  if (frag_roll) apply_fragment_rolling();
+}
+
+void DemSolver::apply_fragment_rolling() {
+  const std::size_t n = discs.size();
+  const auto& x = discs.get<Position<2>>();
+  const auto& m = discs.get<Mass>();
+  const auto& I = discs.get<Inertia>();
+  auto& F = discs.get<Force>();
+  auto& T = discs.get<Torque>();
+  // Sum per fragment (indexed by its root disc, as update_fragments), then the angular
+  // acceleration α = M/I_f of a rigid body: disc j gets the force m_j α ẑ × (x_j − G) and the
+  // moment I_j α, which sum to no force and to M about G. Lone discs: T_i += M_i.
+  std::vector<double>& moment = roll_moment_;
+  const std::int64_t nf = static_cast<std::int64_t>(frag_roots_.size());
+#pragma omp parallel for schedule(dynamic, 256) if (parallel_worth(n))
+  for (std::int64_t k = 0; k < nf; ++k) {
+    const std::size_t a = frag_start_[static_cast<std::size_t>(k)], b = frag_start_[static_cast<std::size_t>(k) + 1];
+    const std::uint32_t q = frag_members_[a];  // the root, first in index order
+    for (std::size_t p = a + 1; p < b; ++p) {
+      moment[q] += moment[frag_members_[p]];
+      moment[frag_members_[p]] = 0.0;
+    }
+  }
+#pragma omp parallel for schedule(static) if (parallel_worth(n))
+  for (std::int64_t jj = 0; jj < static_cast<std::int64_t>(n); ++jj) {
+    const auto j = static_cast<std::size_t>(jj);
+    const std::uint32_t q = frag_of_[j];
+    if (moment[q] == 0.0) continue;
+    const double alpha = moment[q] / frag_inertia_[q];
+    F[j] += m[j] * alpha * perp(x[j] - frag_centre_[q]);
+    T[j] += I[j] * alpha;
+  }
 }
 
 template <class Law>
@@ -630,33 +682,80 @@ double DemSolver::fragment_dashpot_mass(std::size_t i, double mi, const Vec2& p,
 
 void DemSolver::update_fragments() {
   const std::size_t n = discs.size();
+  // The fragments change only when a bond breaks (or bonds or discs are added, or the discs are
+  // reordered): relabel then, with union–find over the intact bonds and a list of each fragment's
+  // discs in index order.
+  std::size_t intact = 0;
+  for (const BondState st : bonds.state) intact += st == BondState::Intact;
+  const std::array<std::size_t, 4> key{n, bonds.size(), intact, static_cast<std::size_t>(reorders_)};
+  if (key != frag_key_) {
+    frag_key_ = key;
+    frag_of_.resize(n);
+    std::iota(frag_of_.begin(), frag_of_.end(), 0u);
+    auto find = [&](std::uint32_t a) {
+      while (frag_of_[a] != a) a = frag_of_[a] = frag_of_[frag_of_[a]];
+      return a;
+    };
+    for (std::size_t b = 0; b < bonds.size(); ++b) {
+      if (bonds.state[b] != BondState::Intact) continue;
+      const std::uint32_t a = find(index_of(bonds.id_a[b])), c = find(index_of(bonds.id_b[b]));
+      if (a != c) frag_of_[std::max(a, c)] = std::min(a, c);
+    }
+    for (std::size_t i = 0; i < n; ++i) frag_of_[i] = find(static_cast<std::uint32_t>(i));
+    // Each root is its fragment's smallest index; members listed by fragment, in index order.
+    frag_roots_.clear();
+    std::vector<std::uint32_t> count(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (frag_of_[i] == i) frag_roots_.push_back(static_cast<std::uint32_t>(i));
+      ++count[frag_of_[i]];
+    }
+    frag_start_.assign(frag_roots_.size() + 1, 0);
+    std::vector<std::uint32_t> slot(n, 0);
+    for (std::size_t k = 0; k < frag_roots_.size(); ++k) {
+      frag_start_[k + 1] = frag_start_[k] + count[frag_roots_[k]];
+      slot[frag_roots_[k]] = frag_start_[k];
+    }
+    frag_members_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) frag_members_[slot[frag_of_[i]]++] = static_cast<std::uint32_t>(i);
+    frag_mass_.assign(n, 0.0);  // per root disc; the entries of other discs are not used
+    frag_inertia_.assign(n, 0.0);
+    frag_spin_.assign(n, 0.0);
+    frag_centre_.assign(n, Vec2::Zero());
+    frag_momentum_.assign(n, Vec2::Zero());
+  }
+  // Mass, centre, momentum, inertia about the centre and spin (angular momentum about the centre /
+  // inertia) of every fragment, each summed over its discs in index order.
   const auto& x = discs.get<Position<2>>();
+  const auto& v = discs.get<Velocity<2>>();
+  const auto& w = discs.get<AngularVelocity>();
   const auto& m = discs.get<Mass>();
   const auto& I = discs.get<Inertia>();
-  frag_of_.resize(n);
-  std::iota(frag_of_.begin(), frag_of_.end(), 0u);
-  auto find = [&](std::uint32_t a) {
-    while (frag_of_[a] != a) a = frag_of_[a] = frag_of_[frag_of_[a]];
-    return a;
-  };
-  for (std::size_t b = 0; b < bonds.size(); ++b) {
-    if (bonds.state[b] != BondState::Intact) continue;
-    const std::uint32_t a = find(index_of(bonds.id_a[b])), c = find(index_of(bonds.id_b[b]));
-    if (a != c) frag_of_[std::max(a, c)] = std::min(a, c);
+  const std::int64_t nf = static_cast<std::int64_t>(frag_roots_.size());
+#pragma omp parallel for schedule(dynamic, 256) if (parallel_worth(n))
+  for (std::int64_t k = 0; k < nf; ++k) {
+    const std::uint32_t q = frag_roots_[static_cast<std::size_t>(k)];
+    const std::uint32_t* b = frag_members_.data() + frag_start_[static_cast<std::size_t>(k)];
+    const std::uint32_t* e = frag_members_.data() + frag_start_[static_cast<std::size_t>(k) + 1];
+    double mass = 0;
+    Vec2 centre = Vec2::Zero(), momentum = Vec2::Zero();
+    for (const std::uint32_t* p = b; p != e; ++p) {
+      mass += m[*p];
+      centre += m[*p] * x[*p];
+    }
+    centre /= mass;
+    for (const std::uint32_t* p = b; p != e; ++p) momentum += m[*p] * v[*p];
+    double inertia = 0, spin = 0;
+    for (const std::uint32_t* p = b; p != e; ++p) {
+      const Vec2 d = x[*p] - centre, u = v[*p] - momentum / mass;
+      inertia += I[*p] + m[*p] * d.squaredNorm();
+      spin += I[*p] * w[*p] + m[*p] * (d.x() * u.y() - d.y() * u.x());
+    }
+    frag_mass_[q] = mass;
+    frag_centre_[q] = centre;
+    frag_momentum_[q] = momentum;
+    frag_inertia_[q] = inertia;
+    frag_spin_[q] = spin / inertia;
   }
-  for (std::size_t i = 0; i < n; ++i) frag_of_[i] = find(static_cast<std::uint32_t>(i));
-  // Fragments indexed by their root disc (no renumbering: the arrays are per disc, most unused).
-  frag_mass_.assign(n, 0.0);
-  frag_inertia_.assign(n, 0.0);
-  frag_centre_.assign(n, Vec2::Zero());
-  for (std::size_t i = 0; i < n; ++i) {
-    frag_mass_[frag_of_[i]] += m[i];
-    frag_centre_[frag_of_[i]] += m[i] * x[i];
-  }
-  for (std::size_t i = 0; i < n; ++i)
-    if (frag_of_[i] == i) frag_centre_[i] /= frag_mass_[i];
-  for (std::size_t i = 0; i < n; ++i)
-    frag_inertia_[frag_of_[i]] += I[i] + m[i] * (x[i] - frag_centre_[frag_of_[i]]).squaredNorm();
 }
 
 void DemSolver::update_time_step() {

@@ -213,6 +213,14 @@ struct ContactProperties {
   /// r from that centre to the contact; Stronge 2000), so a bonded block hitting the terrain
   /// rebounds with the configured e instead of a disc's dashpot on a block's mass.
   bool fragment_damping_mass = false;
+  /// Lever arm of the disc–terrain rolling resistance: false (default) the disc's radius, the
+  /// moment acting on the disc (model C as for disc–disc and disc–wall contacts); true the height
+  /// h = (G − p)·n of its bonded fragment's centre G above the contact point p (at least the disc
+  /// radius), the spring turning with the fragment's spin and its moment μ_r h F_n applied to the
+  /// fragment as a rigid body (every disc j gets m_j α × r_j and I_j α, α = M/I_f), so a fragment
+  /// rolling on the terrain loses μ_r N per metre as a lumped rockfall block does (STONE, Guzzetti
+  /// et al. 2002) instead of μ_r N R_disc/h. A lone disc is unchanged.
+  bool fragment_rolling = false;
 };
 
 /// Combined rolling stiffness per Ai et al. (2011), eq. (9).

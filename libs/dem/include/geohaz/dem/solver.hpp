@@ -15,6 +15,7 @@
 /// out like the neighbour list and rebuilt every step from the previous step's table: lookups go
 /// by partner id, so the history survives sorting and list rebuilds.
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -139,15 +140,26 @@ class DemSolver {
   // (Law::wall_damping), cached: recomputed when a wall's e or the law changes, and on initialise().
   std::vector<double> wall_damping_, wall_damping_e_, terrain_damping_;
   std::size_t damping_law_ = SIZE_MAX;  ///< law.index() the caches were computed for
-  // Bonded fragments for contact.fragment_damping_mass (recomputed every step; buffers reused):
-  // per disc its fragment (union–find over intact bonds), per fragment mass, centre, inertia.
+  // Bonded fragments for contact.fragment_damping_mass and contact.fragment_rolling (recomputed
+  // every step; buffers reused): per disc its fragment (union–find over intact bonds), per
+  // fragment mass, centre, inertia about the centre and spin (angular momentum / inertia).
   void update_fragments();
   /// Mass of disc i's wall and terrain dashpots at contact point p with normal n: its bonded
   /// fragment's effective mass there, 1/(1/M + (r × n)²/I), at least the disc's own mass mi.
   double fragment_dashpot_mass(std::size_t i, double mi, const Vec2& p, const Vec2& n) const;
+  /// Loads of the rolling moments of fragments (contact.fragment_rolling): the summed
+  /// terrain rolling moment of each fragment spread over its discs as a rigid-body rotation.
+  void apply_fragment_rolling();
   std::vector<std::uint32_t> frag_of_;
-  std::vector<double> frag_mass_, frag_inertia_;
-  std::vector<Vec2> frag_centre_;
+  std::vector<double> frag_mass_, frag_inertia_, frag_spin_;
+  std::vector<Vec2> frag_centre_, frag_momentum_;
+  std::vector<std::uint32_t> frag_roots_;    ///< each fragment's root disc (its smallest index)
+  std::vector<std::uint32_t> frag_start_;    ///< per fragment: CSR into frag_members_
+  std::vector<std::uint32_t> frag_members_;  ///< discs by fragment, in index order
+  /// Discs, bonds, intact bonds and reorders when the labels were made: relabel when it changes.
+  std::array<std::size_t, 4> frag_key_{};
+  std::int64_t reorders_ = 0;
+  std::vector<double> roll_moment_;  ///< per disc: its terrain rolling moments of this step (N·m/m)
   /// Largest dashpot time-step factor (ζ + √(1+ζ²))² of the walls and terrain: the reference
   /// stiffness of a disc without contacts is scaled by it, so the step in which a free disc first
   /// touches a strongly damped wall is already short enough.
