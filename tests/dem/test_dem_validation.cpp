@@ -234,6 +234,44 @@ AvalancheSpec single_block(std::uint64_t seed, double mu_r, bool example_terrain
   return a;
 }
 
+/// One run of a single block: the result, the travel angles of its farthest point and of its
+/// centre of mass (deg), and its rotation since release in turns (mean over its discs, which turn
+/// with the block while it stays whole; + is counter-clockwise, so a block rolling downhill in +x
+/// turns negatively: a block that slides turns little, one that rolls ≈ L/(2π r)).
+struct BlockRun {
+  AvalancheResult r;
+  double angle = 0, angle_com = 0, turns = 0;
+  const RunoutQuantile& farthest() const { return r.quantiles.back(); }
+  nlohmann::json json() const {
+    return {{"discs", r.discs},
+            {"fragments", r.fragment_sizes.size()},
+            {"largest_fragment", r.fragment_sizes.front()},
+            {"at_rest", r.at_rest},
+            {"duration_s", r.duration},
+            {"L_farthest", farthest().runout},
+            {"fahrboeschung_deg", angle},
+            {"com_travel_angle_deg", angle_com},
+            {"turns", turns}};
+  }
+};
+
+BlockRun run_block(const AvalancheSpec& a, DemSolver& s) {
+  BlockRun b{run_avalanche(a, s)};
+  b.angle = std::atan(b.farthest().h_over_l) * 180 / std::numbers::pi;
+  b.angle_com = std::atan(b.r.com_h_over_l) * 180 / std::numbers::pi;
+  for (const double phi : s.discs.get<Rotation>()) b.turns += phi;
+  b.turns /= 2 * std::numbers::pi * static_cast<double>(s.discs.size());
+  return b;
+}
+
+/// Mean and sample standard deviation.
+std::pair<double, double> mean_and_sd(const std::vector<double>& x) {
+  double mean = 0, var = 0;
+  for (const double v : x) mean += v / static_cast<double>(x.size());
+  for (const double v : x) var += (v - mean) * (v - mean) / static_cast<double>(x.size() - 1);
+  return {mean, std::sqrt(var)};
+}
+
 }  // namespace
 
 TEST(DemValidation, SingleBlockTravelAngle) {
@@ -241,56 +279,41 @@ TEST(DemValidation, SingleBlockTravelAngle) {
   // example's, so it stays whole) released on a 40° slope 100 m high onto a flat floor, with the
   // shipped example's laws: μ = 0.5, e = 0.3, disc–disc μ_r = 0.1, the terrain rolling
   // resistance of rock on debris (tan β = 0.65, STONE) acting on the block as a whole
-  // (material.terrain_rolling = "fragment"). Rockfall practice: single blocks stop within
-  // a Fahrböschung (crown to farthest point) of about 28–35° (Evans & Hungr 1993: minimum shadow angle 27.5°; Heim 1932
-  // about 32°). One packing is one sample (the travel of a block depends on its outline), so ten packings, and the
-  // check is on their mean. Also: the block slides rather than rolling over its rounded outline
-  // (docs/validation/dem.md: with the moment on the contact disc it rolled 6–21 turns).
+  // (material.terrain_rolling = "fragment"). Rockfall practice: single blocks stop within a
+  // Fahrböschung (crown to farthest point) of about 28–35° (Evans & Hungr 1993: minimum shadow
+  // angle 27.5°; Heim 1932 about 32°). One packing is one sample (the travel of a block depends on
+  // its outline), so ten packings, and the check is on their mean. Also: the block slides rather
+  // than rolling over its rounded outline (docs/validation/dem.md: with the moment on the contact
+  // disc it rolled 6–21 turns).
   nlohmann::json j = nlohmann::json::array();
   std::vector<double> angles;
   double turns_sum = 0;
   for (std::uint64_t seed = 1; seed <= 10; ++seed) {
     const AvalancheSpec a = single_block(seed, 0.1, true);
     DemSolver s;
-    const auto r = run_avalanche(a, s);
-    const RunoutQuantile& far = r.quantiles.back();
-    const double angle = std::atan(far.h_over_l) * 180 / std::numbers::pi;
-    const double angle_com = std::atan(r.com_h_over_l) * 180 / std::numbers::pi;
-    double turns = 0;
-    for (const double phi : s.discs.get<Rotation>()) turns += phi;
-    turns /= 2 * std::numbers::pi * static_cast<double>(s.discs.size());
+    const BlockRun b = run_block(a, s);
     std::printf(
         "single block, seed %d: %zu discs, %zu fragments (largest %zu), at rest %d after %.1f s; farthest point "
         "L = %.1f m, H = %.1f m, Fahrboeschung %.1f deg; centre of mass %.1f deg; %.1f turns\n",
-        static_cast<int>(seed), r.discs, r.fragment_sizes.size(), r.fragment_sizes.front(), r.at_rest, r.duration,
-        far.runout, far.fall_height, angle, angle_com, turns);
+        static_cast<int>(seed), b.r.discs, b.r.fragment_sizes.size(), b.r.fragment_sizes.front(), b.r.at_rest,
+        b.r.duration, b.farthest().runout, b.farthest().fall_height, b.angle, b.angle_com, b.turns);
     std::fflush(stdout);
-    j.push_back({{"seed", seed},
-                 {"discs", r.discs},
-                 {"fragments", r.fragment_sizes.size()},
-                 {"largest_fragment", r.fragment_sizes.front()},
-                 {"at_rest", r.at_rest},
-                 {"duration_s", r.duration},
-                 {"L_farthest", far.runout},
-                 {"H_farthest", far.fall_height},
-                 {"fahrboeschung_deg", angle},
-                 {"com_travel_angle_deg", angle_com},
-                 {"turns", turns}});
+    j.push_back(b.json());
+    j.back()["seed"] = seed;
+    j.back()["H_farthest"] = b.farthest().fall_height;
     write_avalanche_png(out_dir() / ("single_block_seed" + std::to_string(seed) + ".png"), s, a.terrain, a.source);
-    angles.push_back(angle);
-    turns_sum += std::abs(turns);
-    EXPECT_TRUE(r.at_rest);
-    EXPECT_GE(10 * r.fragment_sizes.front(), 9 * r.discs) << "seed " << seed;  // the block stays whole
+    angles.push_back(b.angle);
+    turns_sum += std::abs(b.turns);
+    EXPECT_TRUE(b.r.at_rest);
+    EXPECT_GE(10 * b.r.fragment_sizes.front(), 9 * b.r.discs) << "seed " << seed;  // the block stays whole
   }
   std::ofstream(out_dir() / "single_block.json") << j.dump(2) << "\n";
-  double mean = 0, var = 0;
-  for (const double x : angles) mean += x / static_cast<double>(angles.size());
-  for (const double x : angles) var += (x - mean) * (x - mean) / static_cast<double>(angles.size() - 1);
-  const double se = std::sqrt(var / static_cast<double>(angles.size()));
+  const auto [mean, sd] = mean_and_sd(angles);
+  const double se = sd / std::sqrt(static_cast<double>(angles.size()));
   std::printf(
       "single block: 10 packings, Fahrboeschung mean %.1f deg +- %.1f (standard error), standard deviation %.1f deg, "
       "mean |turns| %.1f\n",
-      mean, se, std::sqrt(var), turns_sum / 10);
+      mean, se, sd, turns_sum / 10);
   // The mean over ten packings is known to ± se: the check is that the practice range "about 28–35°"
   // is not rejected at two standard errors (docs/validation/dem.md gives the plain numbers).
   EXPECT_GE(mean + 2 * se, 28.0);
@@ -299,7 +322,7 @@ TEST(DemValidation, SingleBlockTravelAngle) {
 }
 
 /// Outline resolution study of the single block (docs/validation/dem.md): the same 4 m × 4 m
-/// block, slope, laws and coefficients as SingleBlockTravelAngle at μ_r = 0.1, built of discs of
+/// block, slope, laws and coefficients as single_block() at μ_r = 0.1 (on the disc), built of discs of
 /// mean radius R (radii R ± 25 %, so R = 0.4 is the 0.3–0.5 m of the original), several packings
 /// (seeds) each. A travel angle that means something must converge as R → 0 (the outline tends to
 /// the square). Each (R, seeds) case is its own test so they can run in separate processes; each
@@ -337,50 +360,31 @@ TEST_P(SingleBlockOutlineResolution, TravelAngleOfSeveralPackings) {
     a.terrain_rolling_friction = GetParam().terrain_rolling;
     a.material.contact.fragment_rolling = GetParam().fragment_rolling;
     DemSolver s;
-    const auto r = run_avalanche(a, s);
-    const RunoutQuantile& far = r.quantiles.back();
-    const double angle = std::atan(far.h_over_l) * 180 / std::numbers::pi;
-    const double angle_com = std::atan(r.com_h_over_l) * 180 / std::numbers::pi;
-    // How the block moved: its rotation since release in turns (mean over its discs, which turn
-    // with the block while it stays whole; + is counter-clockwise, so a block rolling downhill in
-    // +x turns negatively). A block that slides turns little; one that rolls turns ≈ L/(2π r).
-    double turns = 0;
-    for (const double phi : s.discs.get<Rotation>()) turns += phi;
-    turns /= 2 * std::numbers::pi * static_cast<double>(s.discs.size());
+    const BlockRun b = run_block(a, s);
     std::printf(
         "single block, R = %.3f m, seed %d: %zu discs, %zu fragments (largest %zu), at rest %d after %.1f s; "
         "farthest point L = %.1f m, Fahrboeschung %.2f deg; centre of mass %.2f deg; %.1f turns\n",
-        R, seed, r.discs, r.fragment_sizes.size(), r.fragment_sizes.front(), r.at_rest, r.duration, far.runout, angle,
-        angle_com, turns);
+        R, seed, b.r.discs, b.r.fragment_sizes.size(), b.r.fragment_sizes.front(), b.r.at_rest, b.r.duration,
+        b.farthest().runout, b.angle, b.angle_com, b.turns);
     std::fflush(stdout);
-    j.push_back({{"radius", R},
-                 {"seed", seed},
-                 {"discs", r.discs},
-                 {"fragments", r.fragment_sizes.size()},
-                 {"largest_fragment", r.fragment_sizes.front()},
-                 {"at_rest", r.at_rest},
-                 {"duration_s", r.duration},
-                 {"L_farthest", far.runout},
-                 {"fahrboeschung_deg", angle},
-                 {"com_travel_angle_deg", angle_com},
-                 {"turns", turns}});
+    j.push_back(b.json());
+    j.back()["radius"] = R;
+    j.back()["seed"] = seed;
     char name[96];
     std::snprintf(name, sizeof name, "single_block_R%.3f_seed%d_damped%d_E%.0e_rolling%.2f%s.png", R, seed,
                   static_cast<int>(GetParam().fragment_damping), GetParam().bond_modulus, GetParam().terrain_rolling,
                   GetParam().fragment_rolling ? "_fragment" : "");
     write_avalanche_png(out_dir() / name, s, a.terrain, a.source);
-    angles.push_back(angle);
-    EXPECT_TRUE(r.at_rest);
-    EXPECT_GT(angle, 5.0);
-    EXPECT_LT(angle, 60.0);
+    angles.push_back(b.angle);
+    EXPECT_TRUE(b.r.at_rest);
+    EXPECT_GT(b.angle, 5.0);
+    EXPECT_LT(b.angle, 60.0);
     // The study is of a block: bonds 200 MPa keep it whole (at most one loose disc in ten).
-    EXPECT_GE(10 * r.fragment_sizes.front(), 9 * r.discs) << "seed " << seed;
+    EXPECT_GE(10 * b.r.fragment_sizes.front(), 9 * b.r.discs) << "seed " << seed;
   }
-  double mean = 0, var = 0;
-  for (const double x : angles) mean += x / static_cast<double>(angles.size());
-  for (const double x : angles) var += (x - mean) * (x - mean) / static_cast<double>(angles.size() - 1);
+  const auto [mean, sd] = mean_and_sd(angles);
   std::printf("single block, R = %.3f m: %zu packings, Fahrboeschung mean %.1f deg, standard deviation %.1f deg\n", R,
-              angles.size(), mean, std::sqrt(var));
+              angles.size(), mean, sd);
   char name[96];
   if (GetParam().terrain_rolling != 0.1 || GetParam().fragment_rolling)
     std::snprintf(name, sizeof name, "single_block_rolling%.2f_%s_damped%d_E%.0e_R%.3f_seeds%d-%d.json",
