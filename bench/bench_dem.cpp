@@ -114,7 +114,7 @@ int avalanche(std::size_t n, double runout_s, int threads) {
   a.strength_factor = 0.5;
   a.record_interval = 0.5;
   a.terrain_friction = 0.5;
-  a.terrain_restitution = 0.3;
+  a.terrain_restitution = 0.35;
   a.terrain_rolling_friction = 0.65;
   a.material.contact.fragment_rolling = true;  // material.terrain_rolling = "fragment"
   a.runout_time = runout_s;

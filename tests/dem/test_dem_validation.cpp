@@ -189,7 +189,7 @@ AvalancheSpec example_avalanche() {
   a.runout_time = 300;
   a.record_interval = 0.25;
   a.terrain_friction = 0.5;
-  a.terrain_restitution = 0.3;
+  a.terrain_restitution = 0.35;
   // Rolling friction coefficient tan β of a rock rolling on landslide debris, STONE (Guzzetti et
   // al. 2002; lithological table of Alvioli et al. 2021): docs/dem.md, "Rolling resistance of rock on
   // terrain".
@@ -213,9 +213,9 @@ namespace {
 
 /// The single block of the SingleBlock* studies: a bonded 4 m block (R 0.3–0.5 m, bonds 200 MPa,
 /// no joints) held on a 40° slope 100 m high that runs onto a 1 km floor. With `example_terrain`
-/// the example's terrain law (terrain μ_r = 0.65 on the fragment's lever arm) and disc–disc
-/// μ_r = mu_r; without, that of the studies before it: disc and terrain μ_r = mu_r (varied
-/// together: their tables), acting on the disc.
+/// the example's terrain laws (terrain μ_r = 0.65 on the fragment's lever arm, e = 0.35) and
+/// disc–disc μ_r = mu_r; without, those of the studies before them: disc and terrain μ_r = mu_r
+/// (varied together: their tables), acting on the disc, terrain e = 0.3.
 AvalancheSpec single_block(std::uint64_t seed, double mu_r, bool example_terrain = false) {
   AvalancheSpec a = example_avalanche();
   a.packing.seed = seed;
@@ -224,6 +224,7 @@ AvalancheSpec single_block(std::uint64_t seed, double mu_r, bool example_terrain
   a.material.contact.rolling_friction = mu_r;
   if (!example_terrain) {
     a.terrain_rolling_friction = mu_r;
+    a.terrain_restitution = 0.3;  // the example's before the sourced 0.35
     a.material.contact.fragment_rolling = false;
   }
   a.material.joint_sets.clear();
@@ -277,9 +278,9 @@ std::pair<double, double> mean_and_sd(const std::vector<double>& x) {
 TEST(DemValidation, SingleBlockTravelAngle) {
   // One bonded block (≈ 4 m × 4 m of discs with R = 0.3–0.5 m, bonds 100× stronger than the
   // example's, so it stays whole) released on a 40° slope 100 m high onto a flat floor, with the
-  // shipped example's laws: μ = 0.5, e = 0.3, disc–disc μ_r = 0.1, the terrain rolling
-  // resistance of rock on debris (tan β = 0.65, STONE) acting on the block as a whole
-  // (material.terrain_rolling = "fragment"). Rockfall practice: single blocks stop within a
+  // shipped example's laws: μ = 0.5, disc–disc e = 0.3 and μ_r = 0.1, and the terrain restitution
+  // and rolling resistance of rock on debris (e = 0.35, tan β = 0.65, STONE), the latter acting on
+  // the block as a whole (material.terrain_rolling = "fragment"). Rockfall practice: single blocks stop within a
   // Fahrböschung (crown to farthest point) of about 28–35° (Evans & Hungr 1993: minimum shadow
   // angle 27.5°; Heim 1932 about 32°). One packing is one sample (the travel of a block depends on
   // its outline), so ten packings, and the check is on their mean. Also: the block slides rather
@@ -340,6 +341,7 @@ struct BlockResolutionCase {
   // (material.terrain_rolling: false the disc radius, true the fragment's centre height).
   double terrain_rolling = 0.1;
   bool fragment_rolling = false;
+  double terrain_restitution = 0.3;  ///< 0.35: STONE's value for landslide debris, with μ_r 0.65
 };
 
 class SingleBlockOutlineResolution : public ::testing::TestWithParam<BlockResolutionCase> {};
@@ -358,6 +360,7 @@ TEST_P(SingleBlockOutlineResolution, TravelAngleOfSeveralPackings) {
     }
     if (GetParam().bond_modulus > 0) a.material.bond.modulus = GetParam().bond_modulus;
     a.terrain_rolling_friction = GetParam().terrain_rolling;
+    a.terrain_restitution = GetParam().terrain_restitution;
     a.material.contact.fragment_rolling = GetParam().fragment_rolling;
     DemSolver s;
     const BlockRun b = run_block(a, s);
@@ -411,11 +414,11 @@ INSTANTIATE_TEST_SUITE_P(DemValidation, SingleBlockOutlineResolution,
                                            BlockResolutionCase{0.4, 1, 10, true},
                                            BlockResolutionCase{0.4, 1, 10, true, 2e10},
                                            BlockResolutionCase{0.4, 1, 10, false, 2e10},
-                                           BlockResolutionCase{0.4, 1, 10, false, 0, 0.65, false},
-                                           BlockResolutionCase{0.2, 1, 10, false, 0, 0.65, true},
-                                           BlockResolutionCase{0.4, 1, 10, true, 0, 0.65, true},
-                                           BlockResolutionCase{0.4, 1, 10, true, 2e10, 0.65, true},
-                                           BlockResolutionCase{0.2, 1, 10, true, 0, 0.65, true}));
+                                           BlockResolutionCase{0.4, 1, 10, false, 0, 0.65, false, 0.35},
+                                           BlockResolutionCase{0.2, 1, 10, false, 0, 0.65, true, 0.35},
+                                           BlockResolutionCase{0.4, 1, 10, true, 0, 0.65, true, 0.35},
+                                           BlockResolutionCase{0.4, 1, 10, true, 2e10, 0.65, true, 0.35},
+                                           BlockResolutionCase{0.2, 1, 10, true, 0, 0.65, true, 0.35}));
 
 TEST(DemValidation, SingleBlockOutlineResolutionFigure) {
   // Collects the JSON files of SingleBlockOutlineResolution (run those first; skipped when none
