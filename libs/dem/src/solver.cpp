@@ -564,27 +564,19 @@ void DemSolver::wall_forces(const Law& law) {
         const double mu_rw = s.rolling_friction >= 0.0 ? s.rolling_friction : mu_r;  // the wall's own, if set
         // Tangential dashpot: the wall's normal damping ratio (× f_t) on the tangential spring.
         const double ct = f_t > 0.0 ? f_t * c.cn * std::sqrt(c.kt / c.kn) : 0.0;
-        // Rolling resistance on the disc (lever arm R_i, the disc's spin, I_r about the contact
-        // point) or, on terrain with contact.fragment_rolling, on its fragment (lever arm h, the
-        // fragment's spin, I_f + M_f max(|G − p|, R_i)²).
-        // Walls (platens, the avalanche's support) always act on the disc.
-        const bool on_fragment = frag_roll && wall_index == SIZE_MAX;
-        const std::uint32_t q = on_fragment ? frag_of_[i] : 0;
-        const double arm = on_fragment ? std::max(Ri, (frag_centre_[q] - p).dot(nrm)) : Ri;
+        // Rolling resistance on the disc, or on terrain with contact.fragment_rolling on its
+        // fragment; walls (platens, the avalanche's support) always act on the disc.
+        const RollingBody rb = rolling_body(i, p, nrm, frag_roll && wall_index == SIZE_MAX);
         const auto fr = CoulombFrictionRolling::update(
-            fs, mr, c.kt, c.kn, vrel.dot(t), fn, arm, on_fragment ? frag_spin_[q] : w[i], s.friction, mu_rw, eta_r, dt,
-            [&] {
-              if (!on_fragment) return I[i] + m[i] * Ri * Ri;
-              return frag_inertia_[q] + frag_mass_[q] * std::max((frag_centre_[q] - p).squaredNorm(), Ri * Ri);
-            },
-            ct);
+            fs, mr, c.kt, c.kn, vrel.dot(t), fn, rb.arm, rb.spin, s.friction, mu_rw, eta_r, dt,
+            [&] { return rb.inertia_at_contact; }, ct);
         fs = fr.shear;
         mr = fr.roll;
         // The rolling spring acts on the fragment's inertia: on disc i's share I_i/I_f of it.
-        const double kr = on_fragment ? fr.kr * I[i] / frag_inertia_[q] : fr.kr;
+        const double kr = rb.on_fragment ? fr.kr * I[i] / rb.fragment_inertia : fr.kr;
         const Vec2 fc = fn * nrm + (fs + fr.shear_damping) * t;
         f += fc;
-        if (on_fragment) {
+        if (rb.on_fragment) {
           tq += -Ri * (fs + fr.shear_damping);
           roll_moment_[i] += mr + fr.roll_damping;
         } else {
@@ -671,6 +663,19 @@ void DemSolver::compute_forces(const Law& law) {
   pair_forces(law);
   bond_forces();
   wall_forces(law);
+}
+
+DemSolver::RollingBody DemSolver::rolling_body(std::size_t i, const Vec2& p, const Vec2& n, bool on_fragment) const {
+  const double Ri = discs.get<Radius>()[i];
+  if (!on_fragment) {
+    const auto& I = discs.get<Inertia>();
+    const auto& m = discs.get<Mass>();
+    return {false, Ri, discs.get<AngularVelocity>()[i], I[i] + m[i] * Ri * Ri, I[i]};
+  }
+  const std::uint32_t q = frag_of_[i];
+  const Vec2 r = frag_centre_[q] - p;
+  return {true, std::max(Ri, r.dot(n)), frag_spin_[q],
+          frag_inertia_[q] + frag_mass_[q] * std::max(r.squaredNorm(), Ri * Ri), frag_inertia_[q]};
 }
 
 double DemSolver::fragment_dashpot_mass(std::size_t i, double mi, const Vec2& p, const Vec2& n) const {

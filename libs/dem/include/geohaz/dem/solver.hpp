@@ -147,6 +147,15 @@ class DemSolver {
   /// Mass of disc i's wall and terrain dashpots at contact point p with normal n: its bonded
   /// fragment's effective mass there, 1/(1/M + (r × n)²/I), at least the disc's own mass mi.
   double fragment_dashpot_mass(std::size_t i, double mi, const Vec2& p, const Vec2& n) const;
+  /// What the rolling resistance of disc i's wall or terrain contact at p (normal n) acts on: the
+  /// disc (lever arm R_i, its spin, I_r = I_i + m_i R_i² about the contact) or, if on_fragment, its
+  /// bonded fragment (lever arm h = max(R_i, (G − p)·n), the fragment's spin, I_f + M_f
+  /// max(|G − p|, R_i)²); fragment_inertia is I_f (I_i for the disc).
+  struct RollingBody {
+    bool on_fragment;
+    double arm, spin, inertia_at_contact, fragment_inertia;
+  };
+  RollingBody rolling_body(std::size_t i, const Vec2& p, const Vec2& n, bool on_fragment) const;
   /// Loads of the rolling moments of fragments (contact.fragment_rolling): the summed
   /// terrain rolling moment of each fragment spread over its discs as a rigid-body rotation.
   void apply_fragment_rolling();
