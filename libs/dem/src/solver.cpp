@@ -637,7 +637,7 @@ void DemSolver::apply_fragment_rolling() {
   // acceleration α = M/I_f of a rigid body: disc j gets the force m_j α ẑ × (x_j − G) and the
   // moment I_j α, which sum to no force and to M about G. Lone discs: T_i += M_i.
   std::vector<double>& moment = roll_moment_;
-  const std::int64_t nf = static_cast<std::int64_t>(frag_roots_.size());
+  const std::int64_t nf = static_cast<std::int64_t>(frag_start_.size()) - 1;
 #pragma omp parallel for schedule(dynamic, 256) if (parallel_worth(n))
   for (std::int64_t k = 0; k < nf; ++k) {
     const std::size_t a = frag_start_[static_cast<std::size_t>(k)], b = frag_start_[static_cast<std::size_t>(k) + 1];
@@ -708,17 +708,16 @@ void DemSolver::update_fragments() {
     }
     for (std::size_t i = 0; i < n; ++i) frag_of_[i] = find(static_cast<std::uint32_t>(i));
     // Each root is its fragment's smallest index; members listed by fragment, in index order.
-    frag_roots_.clear();
-    std::vector<std::uint32_t> count(n, 0);
+    std::vector<std::uint32_t> roots, count(n, 0);
     for (std::size_t i = 0; i < n; ++i) {
-      if (frag_of_[i] == i) frag_roots_.push_back(static_cast<std::uint32_t>(i));
+      if (frag_of_[i] == i) roots.push_back(static_cast<std::uint32_t>(i));
       ++count[frag_of_[i]];
     }
-    frag_start_.assign(frag_roots_.size() + 1, 0);
+    frag_start_.assign(roots.size() + 1, 0);
     std::vector<std::uint32_t> slot(n, 0);
-    for (std::size_t k = 0; k < frag_roots_.size(); ++k) {
-      frag_start_[k + 1] = frag_start_[k] + count[frag_roots_[k]];
-      slot[frag_roots_[k]] = frag_start_[k];
+    for (std::size_t k = 0; k < roots.size(); ++k) {
+      frag_start_[k + 1] = frag_start_[k] + count[roots[k]];
+      slot[roots[k]] = frag_start_[k];
     }
     frag_members_.resize(n);
     for (std::size_t i = 0; i < n; ++i) frag_members_[slot[frag_of_[i]]++] = static_cast<std::uint32_t>(i);
@@ -726,7 +725,6 @@ void DemSolver::update_fragments() {
     frag_inertia_.assign(n, 0.0);
     frag_spin_.assign(n, 0.0);
     frag_centre_.assign(n, Vec2::Zero());
-    frag_momentum_.assign(n, Vec2::Zero());
   }
   // Mass, centre, momentum, inertia about the centre and spin (angular momentum about the centre /
   // inertia) of every fragment, each summed over its discs in index order.
@@ -735,12 +733,12 @@ void DemSolver::update_fragments() {
   const auto& w = discs.get<AngularVelocity>();
   const auto& m = discs.get<Mass>();
   const auto& I = discs.get<Inertia>();
-  const std::int64_t nf = static_cast<std::int64_t>(frag_roots_.size());
+  const std::int64_t nf = static_cast<std::int64_t>(frag_start_.size()) - 1;
 #pragma omp parallel for schedule(dynamic, 256) if (parallel_worth(n))
   for (std::int64_t k = 0; k < nf; ++k) {
-    const std::uint32_t q = frag_roots_[static_cast<std::size_t>(k)];
     const std::uint32_t* b = frag_members_.data() + frag_start_[static_cast<std::size_t>(k)];
     const std::uint32_t* e = frag_members_.data() + frag_start_[static_cast<std::size_t>(k) + 1];
+    const std::uint32_t q = *b;  // the root, first in index order
     double mass = 0;
     Vec2 centre = Vec2::Zero(), momentum = Vec2::Zero();
     for (const std::uint32_t* p = b; p != e; ++p) {
@@ -757,7 +755,6 @@ void DemSolver::update_fragments() {
     }
     frag_mass_[q] = mass;
     frag_centre_[q] = centre;
-    frag_momentum_[q] = momentum;
     frag_inertia_[q] = inertia;
     frag_spin_[q] = spin / inertia;
   }

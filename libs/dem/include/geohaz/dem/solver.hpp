@@ -161,10 +161,9 @@ class DemSolver {
   void apply_fragment_rolling();
   std::vector<std::uint32_t> frag_of_;
   std::vector<double> frag_mass_, frag_inertia_, frag_spin_;
-  std::vector<Vec2> frag_centre_, frag_momentum_;
-  std::vector<std::uint32_t> frag_roots_;    ///< each fragment's root disc (its smallest index)
+  std::vector<Vec2> frag_centre_;
   std::vector<std::uint32_t> frag_start_;    ///< per fragment: CSR into frag_members_
-  std::vector<std::uint32_t> frag_members_;  ///< discs by fragment, in index order
+  std::vector<std::uint32_t> frag_members_;  ///< discs by fragment in index order, its root (smallest index) first
   /// Discs, bonds, intact bonds and reorders when the labels were made: relabel when it changes.
   std::array<std::size_t, 4> frag_key_{};
   std::int64_t reorders_ = 0;
