@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "geohaz/core/errors.hpp"
@@ -35,20 +36,91 @@ int SlopeSection::material_at(double z) const noexcept {
   return layer_materials.back();
 }
 
+double PoreWater::level_at(double x) const noexcept {
+  if (x <= phreatic.front()[0]) return phreatic.front()[1];
+  if (x >= phreatic.back()[0]) return phreatic.back()[1];
+  const auto it = std::upper_bound(phreatic.begin(), phreatic.end(), x,
+                                   [](double v, const std::array<double, 2>& p) { return v < p[0]; });
+  const auto& a = *(it - 1);
+  const auto& b = *it;
+  return b[0] > a[0] ? a[1] + (b[1] - a[1]) * (x - a[0]) / (b[0] - a[0]) : b[1];
+}
+
+double PoreWater::pressure_at(double x, double z) const noexcept {
+  const double h = level_at(x) - z;
+  if (!(h > 0.0)) return 0.0;
+  double cos2 = 1.0;
+  if (head_loss_correction && phreatic.size() > 1 && x > phreatic.front()[0] && x < phreatic.back()[0]) {
+    // Inclination of the segment under x (a vertex takes the segment to its right).
+    const auto it = std::upper_bound(phreatic.begin(), phreatic.end(), x,
+                                     [](double v, const std::array<double, 2>& p) { return v < p[0]; });
+    const double dx = (*it)[0] - (*(it - 1))[0], dz = (*it)[1] - (*(it - 1))[1];
+    cos2 = dx > 0.0 ? dx * dx / (dx * dx + dz * dz) : 0.0;
+  }
+  return unit_weight * h * cos2;
+}
+
+void SlopeSection::validate_water(const std::string& prefix) const {
+  if (!(water.ru >= 0.0 && water.ru < 1.0))
+    throw InputError("r_u must lie in [0, 1)", "", prefix + "ru", std::to_string(water.ru));
+  if (!(water.unit_weight > 0.0))
+    throw InputError("the unit weight of water must be positive", "", prefix + "unit_weight",
+                     std::to_string(water.unit_weight));
+  if (!water.phreatic.empty()) {
+    if (water.ru > 0.0)
+      throw InputError("give either a phreatic surface or r_u, not both", "", prefix + "ru", std::to_string(water.ru));
+    for (std::size_t i = 1; i < water.phreatic.size(); ++i)
+      if (water.phreatic[i][0] < water.phreatic[i - 1][0])
+        throw InputError("the phreatic surface's x must not decrease", "", prefix + "phreatic",
+                         std::to_string(water.phreatic[i][0]));
+    // Above the ground everywhere: the section would be a lake bed, not a slope with a water table.
+    bool below_somewhere = false;
+    const int n = 400;
+    for (int k = 0; k <= n && !below_somewhere; ++k) {
+      const double x = x_left + (x_right - x_left) * k / n;
+      below_somewhere = water.level_at(x) < surface_at(surface, x);
+    }
+    if (!below_somewhere)
+      throw InputError("the phreatic surface lies above the ground over the whole section", "", prefix + "phreatic");
+  }
+  for (std::size_t m = 0; m < soils.size(); ++m) {
+    const auto& q = soils[m];
+    if (q.saturated_unit_weight > 0.0 && q.saturated_unit_weight < q.unit_weight)
+      throw InputError(
+          "material " + std::to_string(m) + ": the saturated unit weight must not be below the moist unit weight", "",
+          prefix + "saturated_unit_weight", std::to_string(q.saturated_unit_weight));
+  }
+}
+
 namespace {
 
-/// ∫ γ(z) dz over [z0, z1] with γ piecewise constant between the layer tops (N/m²).
-double weight_of_column(const SlopeSection& s, double z0, double z1) {
-  if (!(z1 > z0)) return 0.0;
-  if (s.layer_materials.empty()) return s.soils[0].unit_weight * (z1 - z0);
-  double w = 0.0, lo = -1e300;
+/// Weight per width ∫ γ dz over [z0, z1] (N/m²) and its first moment ∫ γ z dz (N/m), γ piecewise
+/// constant between the layer tops and, below the phreatic surface z_w, saturated.
+struct Column {
+  double w = 0.0, wz = 0.0;
+};
+
+Column column_of(const SlopeSection& s, double z0, double z1, double zw) {
+  Column c;
+  if (!(z1 > z0)) return c;
+  auto add = [&](const LimitEquilibriumSoil& soil, double a, double b) {  // a < b within one soil
+    const double mid = std::clamp(zw, a, b);
+    const double ws = soil.unit_weight_below_water() * (mid - a), wm = soil.unit_weight * (b - mid);
+    c.w += ws + wm;
+    c.wz += ws * 0.5 * (a + mid) + wm * 0.5 * (mid + b);
+  };
+  if (s.layer_materials.empty()) {
+    add(s.soils[0], z0, z1);
+    return c;
+  }
+  double lo = -1e300;
   for (std::size_t k = 0; k <= s.layer_tops.size(); ++k) {
     const double hi = k < s.layer_tops.size() ? s.layer_tops[k] : 1e300;
     const double a = std::max(lo, z0), b = std::min(hi, z1);
-    if (b > a) w += s.soils[static_cast<std::size_t>(s.layer_materials[k])].unit_weight * (b - a);
+    if (b > a) add(s.soils[static_cast<std::size_t>(s.layer_materials[k])], a, b);
     lo = hi;
   }
-  return w;
+  return c;
 }
 
 double arc_at(const SlipCircle& c, double x) {
@@ -66,17 +138,28 @@ BishopResult bishop_mass(const SlopeSection& s, const SlipCircle& c, double x0, 
   r.x_exit = x1;
   if (arc_at(c, std::clamp(c.xc, x0, x1)) < s.z_bottom - 1e-9 * c.radius) return r;  // through the rigid bottom
   const double b = (x1 - x0) / slices;
+  const bool phreatic = !s.water.phreatic.empty();
+  const double kh = s.seismic.kh, kv = s.seismic.kv, gw = s.water.unit_weight;
   struct Slice {
-    double w, sin_a, cos_a, cb, tan_phi;
+    double v;        // vertical load (1 − k_v) W + W_w (N/m)
+    double sin_a;    // (x_c − x)/R
+    double cos_a;    // cos α
+    double cb;       // c′ ℓ cos α (N/m)
+    double ub;       // u ℓ cos α (N/m)
+    double tan_phi;  // tan φ′
   };
   std::vector<Slice> sl;
   sl.reserve(static_cast<std::size_t>(slices));
-  double moment = 0.0;
+  double moment = 0.0;   // Σ V (x_c − x)/R, signed
+  double seismic = 0.0;  // Σ W (z_c − z_g)/R: the horizontal force's arm per unit k_h
   for (int i = 0; i < slices; ++i) {
     const double x = x0 + (i + 0.5) * b;
     const double zb = arc_at(c, x), zt = surface_at(s.surface, x);
     if (!(zt > zb)) continue;
-    const double w = b * weight_of_column(s, zb, zt);
+    const double zw = phreatic ? s.water.level_at(x) : -1e300;
+    const Column col = column_of(s, zb, zt, zw);
+    const double w = b * col.w;
+    const double ww = zw > zt ? b * gw * (zw - zt) : 0.0;  // ponded water on the slice
     const auto& soil = s.soils[static_cast<std::size_t>(s.material_at(zb))];
     const double sa = (c.xc - x) / c.radius;
     const double ca = std::sqrt(std::max(0.0, 1.0 - sa * sa));
@@ -84,31 +167,73 @@ BishopResult bishop_mass(const SlopeSection& s, const SlipCircle& c, double x0, 
     // steep base's length where the arc turns vertical.
     const double arc = c.radius * std::abs(std::asin(std::clamp((x + 0.5 * b - c.xc) / c.radius, -1.0, 1.0)) -
                                            std::asin(std::clamp((x - 0.5 * b - c.xc) / c.radius, -1.0, 1.0)));
-    sl.push_back({w, sa, ca, soil.cohesion * arc * ca, std::tan(soil.friction)});
-    moment += w * sa;
+    double u = 0.0;
+    if (phreatic)
+      u = s.water.pressure_at(x, zb);
+    else if (s.water.ru > 0.0)
+      u = s.water.ru * col.w;  // r_u = u / (γ h), γ h the soil column's weight per area
+    const double v = (1.0 - kv) * w + ww;
+    sl.push_back({v, sa, ca, soil.cohesion * arc * ca, u * arc * ca, std::tan(soil.friction)});
+    moment += v * sa;
+    seismic += w * (c.zc - col.wz / col.w) / c.radius;
     r.weight += w;
   }
   if (sl.empty() || moment == 0.0) return r;
-  const double sign = moment > 0.0 ? 1.0 : -1.0;  // the mass moves down the slope
-  const double driving = std::abs(moment);
-  double F = 1.0;
-  for (int it = 1; it <= 200; ++it) {
-    double resisting = 0.0;
+  const int sign = moment > 0.0 ? 1 : -1;  // the mass moves down the slope
+  r.direction = sign;
+  // Ponded water: the hydrostatic thrusts on the vertical faces of the water above the mass at its
+  // ends (with the water's weight on the slices, the water's whole load on the ground), d²γ_w/2 at
+  // d/3 above the ground, pushing towards the mass; their moment about the centre per R, in the
+  // direction of sliding.
+  double water_moment = 0.0;
+  if (phreatic)
+    for (const auto& [xe, push] : {std::pair{x0, 1.0}, std::pair{x1, -1.0}}) {
+      const double zg = surface_at(s.surface, xe), d = s.water.level_at(xe) - zg;
+      if (d > 0.0) water_moment += sign * push * 0.5 * gw * d * d * (c.zc - (zg + d / 3.0)) / c.radius;
+    }
+  const double driving_static = std::abs(moment) + water_moment;
+  const double driving = driving_static + kh * seismic;
+  // Σ [c′b + (V − ub) tan φ′]/m_α at F, and the smallest m_α of the slices whose base rises in the
+  // direction of sliding (+∞ if none).
+  auto resisting_at = [&](double F, double& min_ma) {
+    double res = 0.0;
+    min_ma = std::numeric_limits<double>::infinity();
     for (const auto& q : sl) {
       const double sa = sign * q.sin_a;
       const double ma = q.cos_a + sa * q.tan_phi / F;
-      if (sa < 0.0 && ma < kMinMAlpha) return r;
-      resisting += (q.cb + q.w * q.tan_phi) / ma;
+      if (sa < 0.0) min_ma = std::min(min_ma, ma);
+      // Effective normal force never negative: a slice whose pore pressure exceeds its load carries
+      // no friction (its base is open), not a negative one.
+      res += (q.cb + std::max(q.v - q.ub, 0.0) * q.tan_phi) / ma;
     }
-    const double Fn = resisting / driving;
+    return res;
+  };
+  if (!(driving > 0.0)) return r;
+  double min_ma = 0.0;
+  double F = 1.0;
+  for (int it = 1; it <= 200; ++it) {
+    const double res = resisting_at(F, min_ma);
     r.iterations = it;
-    if (std::abs(Fn - F) < 1e-9 * Fn) {
-      r.factor = Fn;
-      return r;
+    if (min_ma < 0.05) {  // the iterate is far below the factor: m_α near 0 or negative; try higher
+      F *= 2.0;
+      if (F > 1e6) return r;
+      continue;
     }
-    F = Fn;
+    const double Fn = res / driving;
+    if (std::abs(Fn - F) < 1e-9 * Fn) {
+      F = Fn;
+      break;
+    }
+    F = Fn;  // after 200 iterations the last iterate (never seen in the tests)
   }
-  r.factor = F;  // not converged to 1e-9 in 200 iterations: the last iterate (never seen in the tests)
+  // Whitman & Bailey's limit at the factor found (not at the iterates on the way).
+  (void)resisting_at(F, min_ma);
+  if (min_ma < kMinMAlpha) return r;
+  r.factor = F;
+  // Yield coefficient: F = 1 ⇔ k_h Σ W (z_c − z_g)/R = resisting(1) − static driving.
+  // Not determined (+∞) where a toe slice's m_α falls below the limit at F = 1.
+  const double res1 = resisting_at(1.0, min_ma);
+  if (min_ma >= kMinMAlpha && seismic > 0.0) r.yield_coefficient = std::max(0.0, (res1 - driving_static) / seismic);
   return r;
 }
 
@@ -143,8 +268,11 @@ BishopResult bishop_factor(const SlopeSection& s, const SlipCircle& c, int slice
     const bool inside = k < m && depth(0.5 * (xs(k) + xs(k + 1))) > 0.0;
     if (inside && first < 0) first = k;
     if (!inside && first >= 0) {
-      const double x0 = refine(xs(first), 0.5 * (xs(first) + xs(first + 1)));
-      const double x1 = refine(xs(k), 0.5 * (xs(k - 1) + xs(k)));
+      // The crossings lie between the mid-points sampled outside and inside (the ends xa, xb are
+      // outside: checked above).
+      auto mid = [&](int j) { return 0.5 * (xs(j) + xs(j + 1)); };
+      const double x0 = refine(first > 0 ? mid(first - 1) : xa, mid(first));
+      const double x1 = refine(k < m ? mid(k) : xb, mid(k - 1));
       const auto q = bishop_mass(s, c, x0, x1, slices);
       if (q.factor < best.factor) best = q;
       first = -1;
@@ -159,6 +287,11 @@ BishopResult bishop_critical_circle(const SlopeSection& s, const BishopSearchSet
   const double height = ztop - s.z_bottom, length = s.x_right - s.x_left;
   const double zc_hi = ztop + std::max(2.0 * height, 0.5 * length);
   // A circle as (x_c, z_c, bottom elevation z_c − R).
+  // The objective: the factor of safety, or the yield coefficient (+∞ where not determined).
+  auto key = [&](const BishopResult& r) {
+    if (!set.minimise_yield_coefficient || !r.admissible()) return r.factor;
+    return r.yield_coefficient;
+  };
   auto eval = [&](double xc, double zc, double zlow) {
     BishopResult r;
     if (!(zlow >= s.z_bottom - height) || !(zc > zlow)) return r;
@@ -182,9 +315,13 @@ BishopResult bishop_critical_circle(const SlopeSection& s, const BishopSearchSet
         const double zc = ztop + (zc_hi - ztop) * (j + 0.5) / n;
         const double zlow = s.z_bottom - height + 2.0 * height * k / n;
         const auto r = eval(xc, zc, zlow);
-        if (r.admissible()) found.push_back({r.factor, {xc, zc, zlow}});
+        if (r.admissible() && key(r) < std::numeric_limits<double>::infinity())
+          found.push_back({key(r), {xc, zc, zlow}});
       }
-  if (found.empty()) throw InputError("the limit-equilibrium search found no admissible slip circle");
+  if (found.empty())
+    throw InputError(set.minimise_yield_coefficient
+                         ? "the limit-equilibrium search found no slip circle with a yield coefficient"
+                         : "the limit-equilibrium search found no admissible slip circle");
   std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   BishopResult best;
   const std::array<double, 3> step0{length / n, (zc_hi - ztop) / n, height / n};
@@ -200,7 +337,7 @@ BishopResult bishop_critical_circle(const SlopeSection& s, const BishopSearchSet
           auto q = p;
           q[static_cast<std::size_t>(a)] += sgn * step[static_cast<std::size_t>(a)];
           const auto r = eval(q[0], q[1], q[2]);
-          if (r.factor < cur.factor) {
+          if (key(r) < key(cur)) {
             cur = r;
             p = q;
             moved = true;
@@ -209,7 +346,7 @@ BishopResult bishop_critical_circle(const SlopeSection& s, const BishopSearchSet
       if (!moved)
         for (auto& d : step) d *= 0.5;
     }
-    if (cur.factor < best.factor) best = cur;
+    if (key(cur) < key(best)) best = cur;
   }
   return best;
 }

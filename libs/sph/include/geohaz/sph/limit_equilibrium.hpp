@@ -24,10 +24,23 @@
 /// (Whitman & Bailey 1967: there a small m_α makes Bishop's base normal force unreliably large).
 /// Where α > 0, m_α ≥ cos α and a small m_α only means a steep base whose length b/cos α the
 /// cohesion term measures correctly (vertical cuts, φ = 0), so no limit applies.
+///
+/// Pore pressure and seismic coefficients (docs/sph.md, "Pore pressure and seismic coefficients").
+/// With a pore pressure u on the slice base (from a phreatic surface, u = γ_w h_w, or from
+/// r_u = u / (γ h)), a vertical seismic coefficient k_v (positive upward: the slice carries
+/// V = (1 − k_v) W + W_w, W_w the weight of ponded water above it) and a horizontal one k_h (a force
+/// k_h W at the slice's centre of gravity z_g, in the direction of sliding), the slice's vertical
+/// equilibrium and the moment equilibrium about the centre give
+///     F = Σ [c′ b + (V − u b) tan φ′] / m_α  /  Σ [V sin α + k_h W (z_c − z_g)/R] + M_w/R,
+/// with b = ℓ cos α (ℓ the slice's arc length) and M_w the moment of the horizontal water thrusts
+/// at the ends of any ponded water. The horizontal force enters only the driving moment, so the
+/// k_h that makes F = 1 on a given circle (its yield coefficient k_y) is explicit:
+///     k_y = (Σ [c′ b + (V − u b) tan φ′] / m_α(F = 1) − Σ V sin α − M_w/R) / Σ W (z_c − z_g)/R.
 /// Units SI (m, Pa, N/m³, radians).
 
 #include <array>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "geohaz/sph/scenario.hpp"
@@ -36,9 +49,38 @@ namespace geohaz::sph {
 
 /// Strength and unit weight of one soil for the limit-equilibrium analysis.
 struct LimitEquilibriumSoil {
-  double unit_weight = 18e3;  ///< γ, N/m³
+  double unit_weight = 18e3;  ///< γ, N/m³ (moist: above the phreatic surface)
   double cohesion = 0.0;      ///< c′, Pa
   double friction = 0.5;      ///< φ′, rad
+  /// γ_sat below the phreatic surface, N/m³; 0: the same as unit_weight.
+  double saturated_unit_weight = 0.0;
+  double unit_weight_below_water() const noexcept {
+    return saturated_unit_weight > 0.0 ? saturated_unit_weight : unit_weight;
+  }
+};
+
+/// Pore water of a section: a phreatic surface, or a pore-pressure ratio r_u, or neither (dry).
+struct PoreWater {
+  /// Phreatic surface (x, z), non-decreasing x (m), held constant beyond its ends; empty: none.
+  /// Where it lies above the ground the water is ponded on the slope.
+  std::vector<std::array<double, 2>> phreatic;
+  /// true: u = γ_w h_w cos²θ (θ the phreatic surface's inclination: straight equipotentials normal
+  /// to a straight phreatic line, steady seepage); false: u = γ_w h_w (hydrostatic below the line).
+  bool head_loss_correction = false;
+  double ru = 0.0;              ///< r_u = u / (γ h) on the slice base, [0, 1); 0 with a phreatic surface
+  double unit_weight = 9.81e3;  ///< γ_w, N/m³
+  bool active() const noexcept { return !phreatic.empty() || ru > 0.0; }
+  /// Elevation of the phreatic surface at x (m); requires a phreatic surface.
+  double level_at(double x) const noexcept;
+  /// Pore pressure (Pa) at (x, z) from the phreatic surface (0 above it); requires one.
+  double pressure_at(double x, double z) const noexcept;
+};
+
+/// Pseudo-static seismic coefficients: forces k_h W horizontally in the direction of sliding and
+/// k_v W vertically (positive upward) on every slice, W its weight.
+struct SeismicCoefficients {
+  double kh = 0.0;  ///< horizontal, 1 (fraction of g)
+  double kv = 0.0;  ///< vertical, positive upward, 1
 };
 
 /// A 2D slope section: the profile domain of the SPH scenario (surface, extent, rigid bottom,
@@ -50,6 +92,8 @@ struct SlopeSection {
   std::vector<double> layer_tops;              ///< as ProfileDomain: layer k holds z < layer_tops[k]
   std::vector<int> layer_materials;            ///< size layer_tops.size() + 1, or empty (all 0)
   std::vector<LimitEquilibriumSoil> soils;     ///< by material index
+  PoreWater water;                             ///< pore pressure (default: dry)
+  SeismicCoefficients seismic;                 ///< pseudo-static coefficients (default: none)
 
   /// The section of a profile domain. Throws InputError for what it cannot represent (a surface
   /// layer by depth, bedrock following the surface, a terrain across the width) or a material index
@@ -57,6 +101,10 @@ struct SlopeSection {
   static SlopeSection from_profile(const ProfileDomain& d, std::vector<LimitEquilibriumSoil> soils);
   /// Material index at elevation z.
   int material_at(double z) const noexcept;
+  /// Checks what the per-key ranges cannot: r_u in [0, 1) and not with a phreatic surface, the
+  /// phreatic surface's x non-decreasing and below the ground somewhere, γ_sat ≥ γ ≥ 0.
+  /// Throws InputError naming `key_prefix` + the key ("water.phreatic", "water.ru", ...).
+  void validate_water(const std::string& key_prefix = "") const;
 };
 
 /// A circular slip surface (m).
@@ -71,6 +119,10 @@ struct BishopResult {
   double x_entry = 0.0, x_exit = 0.0;  ///< ends of the sliding mass on the surface (m)
   double weight = 0.0;                 ///< weight of the sliding mass per metre (N/m)
   int iterations = 0;                  ///< fixed-point iterations
+  /// Yield coefficient of this circle: the k_h (with the section's k_v and water) that makes F = 1;
+  /// 0 if F ≤ 1 without it; +∞ if not determined (a toe slice's m_α below the limit at F = 1).
+  double yield_coefficient = std::numeric_limits<double>::infinity();
+  int direction = 1;  ///< +1: the mass slides towards +x, −1 towards −x
   bool admissible() const noexcept { return factor < std::numeric_limits<double>::infinity(); }
 };
 
@@ -84,13 +136,16 @@ struct BishopSearchSettings {
   int slices = 200;        ///< slices per circle
   int refine_starts = 4;   ///< best grid circles refined by the pattern search
   double min_depth = 0.0;  ///< m: circles whose mass is shallower than this are skipped (0: none)
+  /// false: the circle of the smallest factor of safety; true: the circle of the smallest yield
+  /// coefficient k_y (the surface a Newmark analysis slides on; it may differ from the former).
+  bool minimise_yield_coefficient = false;
 };
 
 /// The circle of the smallest Bishop factor. The grid spans centres over the section's extent from
 /// the highest surface point up to the larger of twice the section's height and half its length
 /// above it, and circle bottoms (the lowest point of the whole circle, which may lie beyond the
 /// mass) from one section height below z_bottom to the highest surface point. Throws InputError if
-/// no admissible circle exists.
+/// no admissible circle exists (with minimise_yield_coefficient: none with a determined k_y).
 BishopResult bishop_critical_circle(const SlopeSection& s, const BishopSearchSettings& settings = {});
 
 }  // namespace geohaz::sph
