@@ -42,13 +42,17 @@ void read_run(ConfigReader& r, RunConfig& c) {
                : sc == "biaxial" ? ScenarioType::Biaxial
                : sc == "block"   ? ScenarioType::Block
                                  : ScenarioType::Section;
-  c.analysis = r.get_choice("run.analysis", "dynamic", {"dynamic", "strength_reduction"},
-                            {"",
-                             "dynamic: the main phase in time; strength_reduction: the factor of safety by "
-                             "strength reduction from the geostatic state, with Bishop's factor beside it "
-                             "([strength_reduction])"}) == "dynamic"
-                   ? Analysis::Dynamic
-                   : Analysis::StrengthReduction;
+  const auto analysis =
+      r.get_choice("run.analysis", "dynamic", {"dynamic", "strength_reduction", "limit_equilibrium"},
+                   {"",
+                    "dynamic: the main phase in time; strength_reduction: the factor of safety by "
+                    "strength reduction from the geostatic state, with Bishop's factor beside it "
+                    "([strength_reduction]); limit_equilibrium: Bishop's method only (2D slope), with "
+                    "[water] and [seismic], the yield coefficient k_y and, with an [earthquake], the Newmark "
+                    "displacement"});
+  c.analysis = analysis == "dynamic"              ? Analysis::Dynamic
+               : analysis == "strength_reduction" ? Analysis::StrengthReduction
+                                                  : Analysis::LimitEquilibrium;
   {  // read whatever the analysis, so that --set run.analysis=... works on any config
     const StrengthReductionSettings d;
     auto& q = c.srm;
@@ -149,6 +153,14 @@ void read_model_and_materials(ConfigReader& r, RunConfig& c) {
           "residual friction must not exceed the peak friction angle (" + std::to_string(p.friction / kDeg) + " deg)",
           r.source(), "material.residual_friction", std::to_string(p.residual_friction / kDeg));
     p.fit = dpfit;
+    const double sat = m.get("saturated_density", 0.0, Range::closed(0.0, 30000.0),
+                             {"kg/m^3",
+                              "density below the phreatic surface ([water]; 0: density); at least density "
+                              "(limit-equilibrium analysis)"});
+    if (sat > 0.0 && sat < p.density)
+      throw InputError("must not be below the material's density (" + std::to_string(p.density) + " kg/m^3)",
+                       r.source(), "material.saturated_density", std::to_string(sat));
+    c.saturated_densities.push_back(sat);
     if (p.dilatancy > p.friction + 1e-12)
       throw InputError("dilatancy must not exceed the friction angle", r.source(), "material.dilatancy",
                        std::to_string(p.dilatancy / kDeg));
@@ -286,6 +298,36 @@ void read_geostatic_and_earthquake(ConfigReader& r, RunConfig& c) {
 }
 
 /// [output].
+/// [water] and [seismic]: the pore water and the pseudo-static coefficients of the limit-equilibrium
+/// analysis (docs/sph.md, "Pore pressure and seismic coefficients").
+void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
+  auto& w = c.water;
+  const auto line = r.get_array("water.phreatic", {}, {},
+                                {"m",
+                                 "phreatic surface x0, z0, x1, z1, ... (x non-decreasing, level beyond the ends); "
+                                 "u = water density g h_w below it; empty: none"});
+  if (line.size() % 2 || line.size() == 2)
+    throw InputError("needs pairs x, z of at least two points", r.source(), "water.phreatic",
+                     std::to_string(line.size()) + " numbers");
+  for (std::size_t k = 0; k + 1 < line.size(); k += 2) w.phreatic.push_back({line[k], line[k + 1]});
+  w.ru = r.get("water.ru", 0.0, Range::closed_open(0.0, 1.0),
+               {"1", "pore-pressure ratio r_u = u / (gamma h) on the slice bases (not with water.phreatic)"});
+  const double rho_w = r.get("water.density", 1000.0, Range::closed(900.0, 1300.0), {"kg/m^3", "density of water"});
+  w.unit_weight = rho_w * c.numerics.gravity;
+  w.head_loss_correction =
+      r.get_choice("water.pore_pressure", "vertical_head", {"vertical_head", "head_loss_corrected"},
+                   {"",
+                    "vertical_head: u = gamma_w h_w (h_w the depth below the phreatic surface, hydrostatic); "
+                    "head_loss_corrected: u = gamma_w h_w cos^2(theta), theta the phreatic surface's inclination "
+                    "(steady seepage parallel to it; Slide's automatic H_u)"}) == "head_loss_corrected";
+  c.seismic.kh = r.get("seismic.kh", 0.0, Range::closed_open(0.0, 1.0),
+                       {"1",
+                        "horizontal pseudo-static coefficient: a force k_h W in the direction of sliding "
+                        "(limit-equilibrium analysis and strength-reduction trials)"});
+  c.seismic.kv = r.get("seismic.kv", 0.0, Range::closed(-0.5, 0.5),
+                       {"1", "vertical pseudo-static coefficient, positive upward: the weight becomes (1 - k_v) W"});
+}
+
 void read_output(ConfigReader& r, RunConfig& c) {
   // [output]
   c.failed_threshold = r.get("output.failed_threshold", 0.01, Range::positive(),
@@ -483,6 +525,7 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   read_model_and_materials(r, c);
   read_numerics(r, c);
   read_geostatic_and_earthquake(r, c);
+  read_water_and_seismic(r, c);
   read_output(r, c);
   read_geometry(r, c, describe);
   read_walls_clamp_and_initial_velocity(r, c, describe);

@@ -19,6 +19,7 @@
 #include "geohaz/core/snapshot.hpp"
 #include "geohaz/sph/diagnostics.hpp"
 #include "geohaz/sph/limit_equilibrium.hpp"
+#include "simulation_model.hpp"
 
 namespace geohaz::sph {
 
@@ -639,17 +640,9 @@ struct SrmTrial {
 /// scenarios).
 BishopResult bishop_of(const RunConfig& c) {
   if (c.scenario != ScenarioType::Slope || c.dimension != 2) return {};
-  ProfileDomain d = c.slope.profile();
-  if (!c.layer_materials.empty()) {
-    d.layer_tops = c.layer_tops;
-    d.layer_materials = c.layer_materials;
-  } else {
-    d.layer_tops.clear();
-    d.layer_materials.clear();
-  }
-  std::vector<LimitEquilibriumSoil> soils;
-  for (const auto& m : c.materials) soils.push_back({m.density * c.numerics.gravity, m.cohesion, m.friction});
-  return bishop_critical_circle(SlopeSection::from_profile(d, soils));
+  auto s = limit_equilibrium_section(c, false);
+  s.seismic = c.seismic;  // the strength reduction's pseudo-static coefficients, if any
+  return bishop_critical_circle(s);
 }
 
 /// The table of a list of (x, z) points ("x_m,z_m": a surface or a circle).
@@ -697,29 +690,6 @@ nlohmann::json summary_header(const RunConfig& c, const SphSolver<Dim>& solver, 
 }
 
 }  // namespace
-
-/// What a simulation is, whatever its dimension and analysis: the dynamic run or the strength
-/// reduction, in 2D or 3D. Called once per phase or output, never per particle.
-class SimulationModel {
- public:
-  virtual ~SimulationModel() = default;
-  virtual void run(const SphSimulation& self, RunObserver* obs) = 0;
-  virtual double time() const = 0;
-  virtual std::int64_t step_count() const = 0;
-  virtual std::size_t particle_count() const = 0;
-  virtual bool main_phase_started() const = 0;
-  virtual nlohmann::json summary() const = 0;
-  virtual std::vector<NamedTable> tables() const = 0;
-  virtual ParticleFields particles() const = 0;
-  /// The state a snapshot shows now (SphRunFiles: at the start, at snapshot times, at the end).
-  virtual void write_snapshot(SnapshotWriter& w) const = 0;
-  /// Quick-look PNGs whose time has come (before a main-phase step).
-  virtual void draw_due_pngs(const std::filesystem::path& out) = 0;
-  /// Every output of a finished run into `out`; a line on stderr unless quiet.
-  virtual void write_outputs(const std::filesystem::path& out) const = 0;
-  /// After a SimulationError in the main phase: the series so far.
-  virtual void write_partial(const std::filesystem::path& out) const = 0;
-};
 
 struct SphSimulation::Impl {
   std::unique_ptr<SimulationModel> model;
@@ -1227,6 +1197,15 @@ nlohmann::json DynamicRun<Dim>::summary_with(const ReleaseOutput& rel) const {
       s["release"]["volume_on_raster_m3"] = rel.binned;
     }
   }
+  if (Dim == 2 && c_.scenario == ScenarioType::Slope && c_.numerics.earthquake.active()) {
+    // Beside the SPH run: Newmark's rigid block on the circle of the smallest yield coefficient.
+    try {
+      s["newmark"] = newmark_report(c_);
+      s["newmark"]["sph_max_displacement_m"] = umax;
+    } catch (const InputError& e) {
+      s["newmark_note"] = e.reason();
+    }
+  }
   s["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
   return s;
 }
@@ -1237,6 +1216,13 @@ template <int Dim>
 SolverSettings<Dim> trial_settings(const RunConfig& c, const Scenario<Dim>& sc) {
   auto s = settings_for<Dim>(c, sc);
   s.earthquake = EarthquakeLoading{};
+  if (c.seismic.kh != 0.0 || c.seismic.kv != 0.0) {
+    // Pseudo-static coefficients: a constant body acceleration k_h g towards +x (the slope scenario's
+    // face descends towards +x, SlopeGeometry) and k_v g upward, in the trials only (the geostatic
+    // phase turns the earthquake off), as Bishop's k_h W and k_v W.
+    const double g = c.numerics.gravity, ah = c.seismic.kh * g, av = c.seismic.kv * g;
+    s.earthquake = EarthquakeLoading::record({0.0, 1e12}, {ah, ah}, {av, av});
+  }
   s.damping = c.srm.damping;
   return s;
 }
@@ -1525,7 +1511,9 @@ nlohmann::json StrengthReductionRun<Dim>::summary() const {
     const auto& C = bishop_.circle;
     s["bishop"] = {{"factor", bishop_.factor}, {"centre_x_m", C.xc},           {"centre_z_m", C.zc},
                    {"radius_m", C.radius},     {"entry_x_m", bishop_.x_entry}, {"exit_x_m", bishop_.x_exit}};
+    if (std::isfinite(bishop_.yield_coefficient)) s["bishop"]["yield_coefficient"] = bishop_.yield_coefficient;
   }
+  s["seismic"] = {{"kh", c_.seismic.kh}, {"kv", c_.seismic.kv}};
   s["outcome"] = outcome_;
   s["factor_of_safety"] = outcome_ == "bracketed" ? nlohmann::json(lo_) : nlohmann::json();
   s["bracket"] = {lo_, hi_};
@@ -1663,6 +1651,8 @@ void validate(const RunConfig& c) {
       throw InputError("strength reduction needs a slope, column or section scenario (gravity-loaded)", c.config_source,
                        "run.analysis", "strength_reduction");
   }
+  validate_water_and_seismic(c);
+  if (c.analysis == Analysis::LimitEquilibrium) return;  // no particles to build
   if (c.initial_velocity.type == InitialVelocity::Type::Uniform &&
       c.initial_velocity.value.size() != static_cast<std::size_t>(c.dimension))
     throw InputError(
@@ -1698,7 +1688,9 @@ std::string Table::csv() const {
 
 SphSimulation::SphSimulation(const RunConfig& cfg, bool quiet) : cfg_(cfg), impl_(std::make_unique<Impl>()) {
   const bool srm = cfg.analysis == Analysis::StrengthReduction;
-  if (cfg.dimension == 2)
+  if (cfg.analysis == Analysis::LimitEquilibrium)
+    impl_->model = make_limit_equilibrium_run(cfg, quiet);
+  else if (cfg.dimension == 2)
     impl_->model = srm ? std::unique_ptr<SimulationModel>(std::make_unique<StrengthReductionRun<2>>(cfg, quiet))
                        : std::make_unique<DynamicRun<2>>(cfg, quiet);
   else
@@ -1742,6 +1734,7 @@ class SphRunFiles final : public RunObserver {
     if (out_.empty()) return;
     make_output_dir(out_);
     write_text_file(out_ / "config.resolved.toml", cfg_.resolved_config);
+    if (cfg_.analysis == Analysis::LimitEquilibrium) return;  // no particles
     snaps_ = std::make_unique<SnapshotWriter>(out_ / "snapshots.h5", "sph-slope", cfg_.dimension, cfg_.resolved_config);
     snaps_->set_attribute("scenario", scenario_name(cfg_.scenario));
     snaps_->set_attribute("units", "SI: m, s, kg, Pa");

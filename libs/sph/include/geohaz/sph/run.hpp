@@ -24,6 +24,7 @@
 
 #include "geohaz/core/raster.hpp"
 #include "geohaz/sph/constitutive.hpp"
+#include "geohaz/sph/limit_equilibrium.hpp"
 #include "geohaz/sph/loading.hpp"
 #include "geohaz/sph/scenario.hpp"
 #include "geohaz/sph/solver.hpp"
@@ -77,8 +78,12 @@ struct SectionInput {
 
 /// What a run computes.
 enum class Analysis {
-  Dynamic,           ///< the main phase in time (failure, run-out, shaking)
-  StrengthReduction  ///< the factor of safety by strength reduction (docs/sph.md, "Factor of safety")
+  Dynamic,            ///< the main phase in time (failure, run-out, shaking)
+  StrengthReduction,  ///< the factor of safety by strength reduction (docs/sph.md, "Factor of safety")
+  /// Bishop's method only (2D slope): the critical circle with pore water and seismic coefficients,
+  /// the yield coefficient k_y and, with an earthquake, the Newmark displacement (docs/sph.md,
+  /// "Pore pressure and seismic coefficients"); no particles.
+  LimitEquilibrium
 };
 
 /// Strength reduction (Dawson et al. 1999; Griffiths & Lane 1999): from the geostatic state, trials
@@ -131,6 +136,13 @@ struct RunConfig {
   double rest_tolerance = 0.01;  ///< at rest: max |v| < tol·√(g H)
   Analysis analysis = Analysis::Dynamic;
   StrengthReductionSettings srm;
+  /// Pore water of the section ([water]; PoreWater::unit_weight = water density × gravity). Read by
+  /// the limit-equilibrium analysis only: the SPH solver has no pore pressure yet (validate()).
+  PoreWater water;
+  /// Saturated density per material (kg/m³; 0: the material's density), below the phreatic surface.
+  std::vector<double> saturated_densities;
+  /// Pseudo-static coefficients ([seismic]): in Bishop's method and in the strength-reduction trials.
+  SeismicCoefficients seismic;
   // Main phase.
   double end_time = 1.0;                   ///< s
   double output_interval = 0.01;           ///< s (time series)

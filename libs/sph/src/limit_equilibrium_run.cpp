@@ -1,0 +1,211 @@
+// run.analysis = limit_equilibrium and the limit-equilibrium parts of the other analyses: the
+// section of a 2D slope with its pore water and seismic coefficients, the checks of [water] and
+// [seismic], the Newmark report (docs/sph.md, "Pore pressure and seismic coefficients").
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+
+#include "geohaz/core/errors.hpp"
+#include "geohaz/core/output.hpp"
+#include "geohaz/sph/newmark.hpp"
+#include "simulation_model.hpp"
+
+namespace geohaz::sph {
+
+SlopeSection limit_equilibrium_section(const RunConfig& c, bool with_water_and_seismic) {
+  if (c.scenario != ScenarioType::Slope || c.dimension != 2)
+    throw InputError("the limit-equilibrium analysis needs the 2D slope scenario", c.config_source, "run.scenario");
+  ProfileDomain d = c.slope.profile();
+  if (!c.layer_materials.empty()) {
+    d.layer_tops = c.layer_tops;
+    d.layer_materials = c.layer_materials;
+  } else {
+    d.layer_tops.clear();
+    d.layer_materials.clear();
+  }
+  const double g = c.numerics.gravity;
+  std::vector<LimitEquilibriumSoil> soils;
+  for (std::size_t m = 0; m < c.materials.size(); ++m) {
+    const auto& p = c.materials[m];
+    const double sat = m < c.saturated_densities.size() ? c.saturated_densities[m] : 0.0;
+    soils.push_back({p.density * g, p.cohesion, p.friction, with_water_and_seismic ? sat * g : 0.0});
+  }
+  auto s = SlopeSection::from_profile(d, soils);
+  if (with_water_and_seismic) {
+    s.water = c.water;
+    s.seismic = c.seismic;
+  }
+  return s;
+}
+
+void validate_water_and_seismic(const RunConfig& c) {
+  const bool water = c.water.active();
+  const bool le = c.analysis == Analysis::LimitEquilibrium;
+  if (water && !le)
+    throw InputError(
+        "pore water is read by run.analysis = limit_equilibrium only: the SPH solver has no pore pressure yet",
+        c.config_source, c.water.phreatic.empty() ? "water.ru" : "water.phreatic");
+  if (c.analysis == Analysis::Dynamic && (c.seismic.kh != 0.0 || c.seismic.kv != 0.0))
+    throw InputError(
+        "the pseudo-static coefficients are for the limit-equilibrium analysis and the strength reduction; a "
+        "dynamic run takes an [earthquake]",
+        c.config_source, c.seismic.kh != 0.0 ? "seismic.kh" : "seismic.kv");
+  if (c.analysis == Analysis::StrengthReduction && (c.seismic.kh != 0.0 || c.seismic.kv != 0.0) &&
+      (c.scenario != ScenarioType::Slope || c.dimension != 2))
+    throw InputError("a strength reduction with seismic coefficients needs the 2D slope scenario", c.config_source,
+                     "seismic.kh");
+  if (!le) return;
+  const auto s = limit_equilibrium_section(c, true);  // InputError naming run.scenario for other scenarios
+  try {
+    s.validate_water("water.");
+  } catch (const InputError& e) {
+    // The saturated unit weight is a material key in the config.
+    const std::string key = e.key() == "water.saturated_unit_weight" ? "material.saturated_density" : e.key();
+    throw InputError(e.reason(), c.config_source, key, e.value());
+  }
+}
+
+namespace {
+
+/// The points of a circle's arc between two x (m), for bishop_circle.csv.
+Table circle_table(const BishopResult& r) {
+  Table t{{"x_m", "z_m"}, {}, {}};
+  const auto& C = r.circle;
+  for (int k = 0; k <= 100; ++k) {
+    const double x = r.x_entry + (r.x_exit - r.x_entry) * k / 100.0;
+    t.rows.push_back({x, C.zc - std::sqrt(std::max(0.0, C.radius * C.radius - (x - C.xc) * (x - C.xc)))});
+  }
+  return t;
+}
+
+nlohmann::json circle_json(const BishopResult& r) {
+  const auto& C = r.circle;
+  nlohmann::json j = {{"factor", r.factor},         {"centre_x_m", C.xc},      {"centre_z_m", C.zc},
+                      {"radius_m", C.radius},       {"entry_x_m", r.x_entry},  {"exit_x_m", r.x_exit},
+                      {"weight_N_per_m", r.weight}, {"direction", r.direction}};
+  j["yield_coefficient"] = std::isfinite(r.yield_coefficient) ? nlohmann::json(r.yield_coefficient) : nlohmann::json();
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json newmark_report(const RunConfig& c) {
+  const auto& quake = c.numerics.earthquake;
+  if (!quake.active()) return nullptr;
+  auto s = limit_equilibrium_section(c, c.analysis == Analysis::LimitEquilibrium);
+  s.seismic = {};  // the yield coefficient of the static section (k_v of the record is not used)
+  BishopSearchSettings set;
+  set.minimise_yield_coefficient = true;
+  const auto r = bishop_critical_circle(s, set);
+  const double g = c.numerics.gravity, ay = r.yield_coefficient * g;
+  // The record is the acceleration applied to every particle (loading.hpp): it drives the block in the
+  // direction of sliding where direction · a_h > a_y. Integrated past the record's end until the
+  // block has stopped (it decelerates at a_y: at most v_max / a_y later).
+  const double dt = 1e-3, t_end = quake.end_time() + 1.0;
+  auto run = [&](int direction) {
+    auto n = newmark_displacement(quake, ay, direction, t_end, dt);
+    if (ay > 0.0 && n.max_velocity > 0.0)
+      n = newmark_displacement(quake, ay, direction, t_end + n.max_velocity / ay, dt);
+    return n;
+  };
+  const auto along = run(r.direction), against = run(-r.direction);
+  nlohmann::json j = circle_json(r);
+  j["yield_acceleration_m_per_s2"] = ay;
+  j["displacement_m"] = along.displacement;
+  j["max_velocity_m_per_s"] = along.max_velocity;
+  j["sliding_time_s"] = along.sliding_time;
+  j["episodes"] = along.episodes;
+  j["displacement_reversed_record_m"] = against.displacement;
+  j["time_step_s"] = dt;
+  j["note"] =
+      "Newmark (1965) rigid block on the circle of the smallest yield coefficient k_y (Bishop, static); the record "
+      "drives it in the direction of sliding as the SPH run applies it to the particles; displacement along the "
+      "slip surface's direction of sliding";
+  return j;
+}
+
+namespace {
+
+/// run.analysis = limit_equilibrium: Bishop's critical circle with the pore water and the
+/// seismic coefficients, the yield coefficient of the static section and, with an earthquake, the
+/// Newmark displacement.
+class LimitEquilibriumRun final : public SimulationModel {
+ public:
+  LimitEquilibriumRun(const RunConfig& c, bool quiet) : c_(c), quiet_(quiet) {}
+  void run(const SphSimulation& self, RunObserver* obs) override {
+    if (obs) obs->started(self);
+    const auto s = limit_equilibrium_section(c_, true);
+    critical_ = bishop_critical_circle(s);
+    newmark_ = newmark_report(c_);
+    if (newmark_.is_null()) {  // the yield coefficient of the static section all the same
+      auto st = s;
+      st.seismic = {};
+      BishopSearchSettings set;
+      set.minimise_yield_coefficient = true;
+      try {
+        yield_ = bishop_critical_circle(st, set);
+      } catch (const InputError&) {  // no circle with a determined k_y: reported as null
+      }
+    }
+    if (obs) obs->finished(self);
+  }
+  double time() const override { return 0.0; }
+  std::int64_t step_count() const override { return 0; }
+  std::size_t particle_count() const override { return 0; }
+  bool main_phase_started() const override { return false; }
+  nlohmann::json summary() const override {
+    nlohmann::json s;
+    s["scenario"] = "slope";
+    s["dimension"] = 2;
+    s["config"] = c_.config_source;
+    s["analysis"] = "limit_equilibrium";
+    s["bishop"] = circle_json(critical_);
+    s["factor_of_safety"] = critical_.factor;
+    s["seismic"] = {{"kh", c_.seismic.kh}, {"kv", c_.seismic.kv}};
+    const auto& w = c_.water;
+    s["water"] = {{"phreatic_surface", w.phreatic.empty() ? nlohmann::json() : nlohmann::json(w.phreatic)},
+                  {"ru", w.ru},
+                  {"unit_weight_N_per_m3", w.unit_weight},
+                  {"pore_pressure", w.head_loss_correction ? "head_loss_corrected" : "vertical_head"}};
+    if (!newmark_.is_null())
+      s["newmark"] = newmark_;
+    else
+      s["yield"] = yield_.admissible() ? circle_json(yield_) : nlohmann::json();
+    return s;
+  }
+  std::vector<NamedTable> tables() const override {
+    std::vector<NamedTable> t;
+    if (critical_.admissible()) t.push_back({"bishop_circle", circle_table(critical_)});
+    return t;
+  }
+  ParticleFields particles() const override { return {}; }
+  void write_snapshot(SnapshotWriter&) const override {}
+  void draw_due_pngs(const std::filesystem::path&) override {}
+  void write_outputs(const std::filesystem::path& out) const override {
+    for (const auto& [name, table] : tables()) write_text_file(out / (name + ".csv"), table.csv());
+    write_text_file(out / "summary.json", summary().dump(2) + "\n");
+    if (!quiet_) {
+      std::fprintf(stderr, "sph-slope: Bishop factor of safety %.4g", critical_.factor);
+      if (!newmark_.is_null())
+        std::fprintf(stderr, ", k_y %.4g, Newmark displacement %.4g m", newmark_["yield_coefficient"].get<double>(),
+                     newmark_["displacement_m"].get<double>());
+      std::fprintf(stderr, "; outputs in %s\n", out.string().c_str());
+    }
+  }
+  void write_partial(const std::filesystem::path&) const override {}
+
+ private:
+  const RunConfig& c_;
+  bool quiet_;
+  BishopResult critical_, yield_;
+  nlohmann::json newmark_;
+};
+
+}  // namespace
+
+std::unique_ptr<SimulationModel> make_limit_equilibrium_run(const RunConfig& c, bool quiet) {
+  return std::make_unique<LimitEquilibriumRun>(c, quiet);
+}
+
+}  // namespace geohaz::sph

@@ -1,0 +1,59 @@
+#pragma once
+// Private to libs/sph/src: the interface every sph-slope analysis implements (run.cpp: the dynamic
+// run and the strength reduction; limit_equilibrium_run.cpp: Bishop's method with water and
+// seismic coefficients), and the limit-equilibrium helpers run.cpp shares.
+
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "geohaz/core/snapshot.hpp"
+#include "geohaz/sph/limit_equilibrium.hpp"
+#include "geohaz/sph/run.hpp"
+
+namespace geohaz::sph {
+
+/// What a simulation is, whatever its dimension and analysis: the dynamic run or the strength
+/// reduction, in 2D or 3D. Called once per phase or output, never per particle.
+class SimulationModel {
+ public:
+  virtual ~SimulationModel() = default;
+  virtual void run(const SphSimulation& self, RunObserver* obs) = 0;
+  virtual double time() const = 0;
+  virtual std::int64_t step_count() const = 0;
+  virtual std::size_t particle_count() const = 0;
+  virtual bool main_phase_started() const = 0;
+  virtual nlohmann::json summary() const = 0;
+  virtual std::vector<NamedTable> tables() const = 0;
+  virtual ParticleFields particles() const = 0;
+  /// The state a snapshot shows now (SphRunFiles: at the start, at snapshot times, at the end).
+  virtual void write_snapshot(SnapshotWriter& w) const = 0;
+  /// Quick-look PNGs whose time has come (before a main-phase step).
+  virtual void draw_due_pngs(const std::filesystem::path& out) = 0;
+  /// Every output of a finished run into `out`; a line on stderr unless quiet.
+  virtual void write_outputs(const std::filesystem::path& out) const = 0;
+  /// After a SimulationError in the main phase: the series so far.
+  virtual void write_partial(const std::filesystem::path& out) const = 0;
+};
+
+/// The limit-equilibrium section of a 2D slope scenario: its profile, layers, soils (γ = ρ g, γ_sat
+/// = ρ_sat g), the config's pore water and seismic coefficients (`with_water_and_seismic`). Throws
+/// InputError for other scenarios or what the section cannot represent.
+SlopeSection limit_equilibrium_section(const RunConfig& c, bool with_water_and_seismic);
+
+/// The cross-field checks of [water] and [seismic] (InputError naming the key): water only with
+/// run.analysis = limit_equilibrium on a 2D slope (the SPH solver has no pore pressure yet), k_h and
+/// k_v not in a dynamic run (its earthquake is the record), the water's own checks
+/// (SlopeSection::validate_water).
+void validate_water_and_seismic(const RunConfig& c);
+
+/// The Newmark report of a 2D slope under the config's earthquake: the circle of the smallest yield
+/// coefficient (static: no k_h), k_y, and the rigid-block displacement for the record applied in the
+/// direction of sliding, as the SPH run applies it (and the other way). Null if no earthquake.
+nlohmann::json newmark_report(const RunConfig& c);
+
+/// The analysis run.analysis = limit_equilibrium.
+std::unique_ptr<SimulationModel> make_limit_equilibrium_run(const RunConfig& c, bool quiet);
+
+}  // namespace geohaz::sph

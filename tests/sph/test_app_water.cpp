@@ -1,0 +1,149 @@
+// Regression tests of sph-slope's pore water and seismic coefficients (label: regression; docs/sph.md,
+// "Pore pressure and seismic coefficients"): run.analysis = limit_equilibrium with [water], [seismic]
+// and an [earthquake] (Newmark), the Newmark report beside a dynamic SPH run, the strength reduction
+// with a horizontal seismic coefficient against Bishop, and bad water input exiting with 2 naming the
+// key and writing nothing.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "geohaz/sph/loading.hpp"
+#include "geohaz/sph/newmark.hpp"
+#include "run_command.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kApp = fs::path(GEOHAZ_BINARY_DIR) / "apps/sph-slope/sph-slope";
+const fs::path kData = fs::path(GEOHAZ_SOURCE_DIR) / "data/sph";
+const fs::path kWork = fs::path(GEOHAZ_BINARY_DIR) / "tests/sph/app_water_runs";
+
+struct Result {
+  int code;
+  std::string err;
+};
+
+Result run(const std::string& args, const std::string& name) {
+  fs::create_directories(kWork);
+  const auto r = geohaz::testing::run_command(kApp.string() + " " + args + " --threads 1");
+  std::ofstream(kWork / (name + ".log")) << r.output;  // kept for inspection after a failure
+  return {r.code, r.output};
+}
+
+nlohmann::json summary(const fs::path& dir) {
+  std::ifstream in(dir / "summary.json");
+  return nlohmann::json::parse(in);
+}
+
+const std::string kAcads = (kData / "acads_1a_srm.toml").string();
+const std::string kWater = (kData / "slope_water_newmark.toml").string();
+
+// ACADS 1(a) by limit equilibrium alone: Bishop's 0.985 (the unit tests' value, the same section), no
+// particles (no snapshots); r_u = 0.25 and a water table lower it, k_h = 0.1 lowers it more.
+TEST(SphSlopeWater, LimitEquilibriumAnalysisOfAcadsWithWaterAndSeismicCoefficient) {
+  const fs::path out = kWork / "le_acads";
+  auto factor = [&](const std::string& sets) {
+    fs::remove_all(out);
+    const auto r = run(
+        "--config " + kAcads + " --out " + out.string() + " --set run.analysis=limit_equilibrium " + sets + " --quiet",
+        "le_acads");
+    EXPECT_EQ(r.code, 0) << r.err;
+    return summary(out)["factor_of_safety"].get<double>();
+  };
+  const double dry = factor("");
+  EXPECT_NEAR(dry, 0.985, 0.002);
+  for (const char* f : {"summary.json", "bishop_circle.csv", "config.resolved.toml"}) EXPECT_TRUE(fs::exists(out / f));
+  EXPECT_FALSE(fs::exists(out / "snapshots.h5"));
+  const double ru = factor("--set water.ru=0.25");
+  const double table = factor("--set water.phreatic=[0,12,25,11,45,5,65,5]");
+  const double kh = factor("--set seismic.kh=0.1");
+  EXPECT_LT(ru, dry);
+  EXPECT_LT(table, dry);
+  EXPECT_LT(kh, dry);
+}
+
+// The example with a water table and a sine: F > 1, a yield coefficient in (0, 1), and the Newmark
+// displacement of the report equal to the library's for the reported k_y and the same record (the
+// plumbing; the closed forms are in test_newmark.cpp).
+TEST(SphSlopeWater, ExampleReportsYieldCoefficientAndNewmarkDisplacement) {
+  const fs::path out = kWork / "le_example";
+  fs::remove_all(out);
+  const auto r = run("--config " + kWater + " --out " + out.string() + " --quiet", "le_example");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto s = summary(out);
+  EXPECT_GT(s["factor_of_safety"].get<double>(), 1.0);
+  const auto& n = s["newmark"];
+  const double ky = n["yield_coefficient"].get<double>();
+  EXPECT_GT(ky, 0.0);
+  EXPECT_LT(ky, 3.0 / 9.81);  // the sine's peak exceeds the yield acceleration: the block slides
+  EXPECT_LE(ky, s["bishop"]["yield_coefficient"].get<double>() + 1e-9);  // the smallest k_y
+  const auto quake = geohaz::sph::EarthquakeLoading::sine(3.0, 1.0, 0.0, 3.0, 0.0);
+  const auto lib = geohaz::sph::newmark_displacement(quake, ky * 9.81, n["direction"].get<int>(), 6.0, 1e-3);
+  EXPECT_GT(lib.displacement, 0.0);
+  EXPECT_NEAR(n["displacement_m"].get<double>(), lib.displacement, 1e-9);
+  EXPECT_EQ(n["episodes"].get<int>(), 3);
+}
+
+// A dynamic SPH run with an earthquake on a 2D slope reports the Newmark block beside it.
+TEST(SphSlopeWater, DynamicRunWithEarthquakeReportsNewmarkBesideSph) {
+  const fs::path out = kWork / "dynamic_newmark";
+  fs::remove_all(out);
+  const auto r = run("--config " + (kData / "slope_2d_granular.toml").string() + " --out " + out.string() +
+                         " --set numerics.spacing=0.025 --set run.end_time=0.1 --set earthquake.type=sine"
+                         " --set earthquake.amplitude=5 --set earthquake.duration=0.1 --set earthquake.ramp=0"
+                         " --quiet",
+                     "dynamic_newmark");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto s = summary(out);
+  ASSERT_TRUE(s.contains("newmark")) << s.dump(2);
+  EXPECT_GE(s["newmark"]["displacement_m"].get<double>(), 0.0);
+  EXPECT_EQ(s["newmark"]["sph_max_displacement_m"].get<double>(), s["max_displacement_m"].get<double>());
+}
+
+// Strength reduction with k_h = 0.1 on ACADS 1(a) at Δx = 1 m, bracket [0.6, 1.0], ΔF = 0.04: within
+// 5 % of Bishop with the same k_h (0.790). About 10 s on one thread.
+TEST(SphSlopeWater, StrengthReductionWithSeismicCoefficientAgreesWithBishop) {
+  const fs::path out = kWork / "srm_kh";
+  fs::remove_all(out);
+  const auto r = run("--config " + kAcads + " --out " + out.string() +
+                         " --set numerics.spacing=1.0 --set strength_reduction.f_min=0.6"
+                         " --set strength_reduction.f_max=1.0 --set strength_reduction.tolerance=0.04"
+                         " --set seismic.kh=0.1 --quiet",
+                     "srm_kh");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto s = summary(out);
+  EXPECT_EQ(s["outcome"], "bracketed");
+  const double F = s["factor_of_safety"].get<double>(), Fb = s["bishop"]["factor"].get<double>();
+  EXPECT_NEAR(Fb, 0.790, 0.005);
+  EXPECT_NEAR(F, Fb, 0.05 * Fb);
+  EXPECT_EQ(s["seismic"]["kh"].get<double>(), 0.1);
+}
+
+// Bad water input: exit 2 naming the key, nothing written.
+TEST(SphSlopeWater, BadWaterInputExitsTwoNamingTheKey) {
+  const fs::path out = kWork / "bad_water";
+  for (const auto& [sets, key] : std::vector<std::pair<std::string, std::string>>{
+           {"water.ru=1.0", "water.ru"},
+           {"water.ru=-0.1", "water.ru"},
+           {"water.phreatic=[0,20,65,20]", "water.phreatic"},                     // above the ground everywhere
+           {"water.phreatic=[0,12,25]", "water.phreatic"},                        // not pairs
+           {"water.phreatic=[30,12,25,11]", "water.phreatic"},                    // x decreasing
+           {"material[0].saturated_density=1900", "material.saturated_density"},  // below the density
+           {"water.ru=0.2 --set water.phreatic=[0,12,65,5]", "water.ru"},         // both
+           {"run.analysis=dynamic", "water.phreatic"},  // no pore pressure in the SPH solver yet
+           {"run.analysis=dynamic --set water.phreatic=[] --set seismic.kh=0.1", "seismic.kh"}}) {
+    fs::remove_all(out);
+    const auto r = run("--config " + kWater + " --out " + out.string() + " --set " + sets, "bad_water");
+    EXPECT_EQ(r.code, 2) << sets << ": " << r.err;
+    EXPECT_NE(r.err.find(key), std::string::npos) << sets << ": " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << sets;
+  }
+}
+
+}  // namespace
