@@ -136,7 +136,8 @@ TEST(SphSlopeWater, BadWaterInputExitsTwoNamingTheKey) {
            {"water.phreatic=[30,12,25,11]", "water.phreatic"},                    // x decreasing
            {"material[0].saturated_density=1900", "material.saturated_density"},  // below the density
            {"water.ru=0.2 --set water.phreatic=[0,12,65,5]", "water.ru"},         // both
-           {"run.analysis=dynamic", "water.phreatic"},  // no pore pressure in the SPH solver yet
+           {"run.analysis=dynamic --set water.phreatic=[] --set water.ru=0.2", "water.ru"},  // SPH: a table
+           {"water.history_times=[0,5]", "water.history_offsets"},                           // lengths differ
            {"run.analysis=dynamic --set water.phreatic=[] --set seismic.kh=0.1", "seismic.kh"}}) {
     fs::remove_all(out);
     const auto r = run("--config " + kWater + " --out " + out.string() + " --set " + sets, "bad_water");

@@ -320,6 +320,12 @@ void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
                     "vertical_head: u = gamma_w h_w (h_w the depth below the phreatic surface, hydrostatic); "
                     "head_loss_corrected: u = gamma_w h_w cos^2(theta), theta the phreatic surface's inclination "
                     "(steady seepage parallel to it; Slide's automatic H_u)"}) == "head_loss_corrected";
+  c.water_history_times =
+      r.get_array("water.history_times", {}, Range::non_negative(),
+                  {"s", "main-phase times of the water-table history (increasing; SPH runs with water.phreatic)"});
+  c.water_history_offsets =
+      r.get_array("water.history_offsets", {}, {},
+                  {"m", "rise of the phreatic surface at those times (linear between, held after; + up)"});
   c.seismic.kh = r.get("seismic.kh", 0.0, Range::closed_open(0.0, 1.0),
                        {"1",
                         "horizontal pseudo-static coefficient: a force k_h W in the direction of sliding "

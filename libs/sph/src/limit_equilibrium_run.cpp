@@ -34,18 +34,57 @@ SlopeSection limit_equilibrium_section(const RunConfig& c, bool with_water_and_s
   auto s = SlopeSection::from_profile(d, soils);
   if (with_water_and_seismic) {
     s.water = c.water;
+    // Beside an SPH run, the SPH's water table: clipped to the ground (no ponded water).
+    if (c.analysis != Analysis::LimitEquilibrium && !c.water.phreatic.empty())
+      s.water.phreatic = clipped_phreatic_surface(c);
     s.seismic = c.seismic;
   }
   return s;
 }
 
+std::vector<std::array<double, 2>> clipped_phreatic_surface(const RunConfig& c) {
+  const auto ground = c.slope.profile();
+  PoreWater w = c.water;
+  std::vector<std::array<double, 2>> out;
+  const int n = 4000;
+  for (int k = 0; k <= n; ++k) {
+    const double x = ground.x_left + (ground.x_right - ground.x_left) * k / n;
+    out.push_back({x, std::min(w.level_at(x), surface_at(ground.surface, x))});
+  }
+  return out;
+}
+
+PoreWaterSettings pore_water_settings(const RunConfig& c) {
+  PoreWaterSettings pw;
+  if (c.water.phreatic.empty() || c.scenario != ScenarioType::Slope || c.dimension != 2) return pw;
+  pw.phreatic = c.water.phreatic;
+  pw.ground = c.slope.profile().surface;
+  pw.density = c.numerics.gravity > 0.0 ? c.water.unit_weight / c.numerics.gravity : 1000.0;
+  pw.history_times = c.water_history_times;
+  pw.history_offsets = c.water_history_offsets;
+  return pw;
+}
+
 void validate_water_and_seismic(const RunConfig& c) {
   const bool water = c.water.active();
   const bool le = c.analysis == Analysis::LimitEquilibrium;
-  if (water && !le)
+  if (water && (c.scenario != ScenarioType::Slope || c.dimension != 2))
+    throw InputError("pore water needs the 2D slope scenario", c.config_source,
+                     c.water.phreatic.empty() ? "water.ru" : "water.phreatic");
+  if (!le && c.water.ru > 0.0)
     throw InputError(
-        "pore water is read by run.analysis = limit_equilibrium only: the SPH solver has no pore pressure yet",
-        c.config_source, c.water.phreatic.empty() ? "water.ru" : "water.phreatic");
+        "the SPH solver takes a phreatic surface (water.phreatic); r_u is for run.analysis = "
+        "limit_equilibrium",
+        c.config_source, "water.ru", std::to_string(c.water.ru));
+  const auto& ht = c.water_history_times;
+  if (ht.size() != c.water_history_offsets.size())
+    throw InputError("needs as many offsets as water.history_times (" + std::to_string(ht.size()) + ")",
+                     c.config_source, "water.history_offsets");
+  for (std::size_t k = 1; k < ht.size(); ++k)
+    if (!(ht[k] > ht[k - 1]))
+      throw InputError("must increase", c.config_source, "water.history_times", std::to_string(ht[k]));
+  if (!ht.empty() && c.water.phreatic.empty())
+    throw InputError("a water-table history needs water.phreatic", c.config_source, "water.history_times");
   if (c.analysis == Analysis::Dynamic && (c.seismic.kh != 0.0 || c.seismic.kv != 0.0))
     throw InputError(
         "the pseudo-static coefficients are for the limit-equilibrium analysis and the strength reduction; a "
@@ -55,8 +94,9 @@ void validate_water_and_seismic(const RunConfig& c) {
       (c.scenario != ScenarioType::Slope || c.dimension != 2))
     throw InputError("a strength reduction with seismic coefficients needs the 2D slope scenario", c.config_source,
                      "seismic.kh");
-  if (!le) return;
-  const auto s = limit_equilibrium_section(c, true);  // InputError naming run.scenario for other scenarios
+  if (!water && !le) return;
+  auto s = limit_equilibrium_section(c, true);  // InputError naming run.scenario for other scenarios
+  s.water.phreatic = c.water.phreatic;          // the table as given (above the ground everywhere?)
   try {
     s.validate_water("water.");
   } catch (const InputError& e) {
@@ -93,7 +133,7 @@ nlohmann::json circle_json(const BishopResult& r) {
 nlohmann::json newmark_report(const RunConfig& c) {
   const auto& quake = c.numerics.earthquake;
   if (!quake.active()) return nullptr;
-  auto s = limit_equilibrium_section(c, c.analysis == Analysis::LimitEquilibrium);
+  auto s = limit_equilibrium_section(c, true);
   s.seismic = {};  // the yield coefficient of the static section (k_v of the record is not used)
   BishopSearchSettings set;
   set.minimise_yield_coefficient = true;

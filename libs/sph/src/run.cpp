@@ -264,6 +264,7 @@ Built<Dim> build(const RunConfig& c) {
   b.frame.spacing = dx;
   b.frame.front_thickness = c.front_thickness;
   clamp_regions<Dim>(c, b.sc.store);
+  saturate_below_water_table<Dim>(c, b.sc.store);
   return b;
 }
 
@@ -275,6 +276,7 @@ SolverSettings<Dim> settings_for(const RunConfig& c, const Scenario<Dim>& sc) {
   s.periodic = sc.periodic;
   s.domain_lo = sc.domain_lo;
   s.domain_hi = sc.domain_hi;
+  s.pore_water = pore_water_settings(c);
   return s;
 }
 
@@ -640,9 +642,8 @@ struct SrmTrial {
 /// scenarios).
 BishopResult bishop_of(const RunConfig& c) {
   if (c.scenario != ScenarioType::Slope || c.dimension != 2) return {};
-  auto s = limit_equilibrium_section(c, false);
-  s.seismic = c.seismic;  // the strength reduction's pseudo-static coefficients, if any
-  return bishop_critical_circle(s);
+  // The strength reduction's water (clipped to the ground as the SPH's) and seismic coefficients.
+  return bishop_critical_circle(limit_equilibrium_section(c, true));
 }
 
 /// The table of a list of (x, z) points ("x_m,z_m": a surface or a circle).

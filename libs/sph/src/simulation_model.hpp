@@ -3,6 +3,7 @@
 // run and the strength reduction; limit_equilibrium_run.cpp: Bishop's method with water and
 // seismic coefficients), and the limit-equilibrium helpers run.cpp shares.
 
+#include <array>
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -42,11 +43,41 @@ class SimulationModel {
 /// InputError for other scenarios or what the section cannot represent.
 SlopeSection limit_equilibrium_section(const RunConfig& c, bool with_water_and_seismic);
 
-/// The cross-field checks of [water] and [seismic] (InputError naming the key): water only with
-/// run.analysis = limit_equilibrium on a 2D slope (the SPH solver has no pore pressure yet), k_h and
-/// k_v not in a dynamic run (its earthquake is the record), the water's own checks
-/// (SlopeSection::validate_water).
+/// The cross-field checks of [water] and [seismic] (InputError naming the key): water only on a 2D
+/// slope, r_u only in the limit-equilibrium analysis (the SPH solver takes a phreatic surface), the
+/// history's arrays, k_h and k_v not in a dynamic run (its earthquake is the record), the water's own
+/// checks (SlopeSection::validate_water).
 void validate_water_and_seismic(const RunConfig& c);
+
+/// The phreatic surface clipped to the ground of the 2D slope (sampled finely): what the SPH solver
+/// and the Bishop check beside it use (no ponded water, the ground a seepage face).
+std::vector<std::array<double, 2>> clipped_phreatic_surface(const RunConfig& c);
+
+/// The solver's pore water of a config (dry unless [water] has a phreatic surface).
+PoreWaterSettings pore_water_settings(const RunConfig& c);
+
+/// Saturated density below the water table at the start: each soil particle of a material with a
+/// saturated density whose position lies below the clipped table takes ρ_sat (mass and density
+/// scaled by ρ_sat/ρ).
+template <int Dim>
+void saturate_below_water_table(const RunConfig& c, SphStore<Dim>& s) {
+  const auto pw = pore_water_settings(c);
+  if (!pw.active()) return;
+  const auto& x = s.template get<Position<Dim>>();
+  const auto& kind = s.template get<ParticleKind>();
+  const auto& mat = s.template get<MaterialId>();
+  auto& m = s.template get<Mass>();
+  auto& rho = s.template get<Density>();
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (kind[i] != static_cast<std::uint8_t>(Kind::Soil)) continue;
+    const auto k = static_cast<std::size_t>(mat[i]);
+    const double sat = k < c.saturated_densities.size() ? c.saturated_densities[k] : 0.0;
+    if (!(sat > 0.0) || x[i][Dim - 1] >= pw.level(x[i][0], 0.0)) continue;
+    const double f = sat / c.materials[k].density;
+    m[i] *= f;
+    rho[i] *= f;
+  }
+}
 
 /// The Newmark report of a 2D slope under the config's earthquake: the circle of the smallest yield
 /// coefficient (static: no k_h), k_y, and the rigid-block displacement for the record applied in the

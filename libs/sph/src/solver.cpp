@@ -467,6 +467,36 @@ void SphSolver<Dim>::step() {
       model_);
 }
 
+namespace {
+
+/// z of a polyline (x, z) at x, held constant beyond its ends (x non-decreasing).
+double polyline_at(const std::vector<std::array<double, 2>>& p, double x) noexcept {
+  if (x <= p.front()[0]) return p.front()[1];
+  if (x >= p.back()[0]) return p.back()[1];
+  const auto it =
+      std::upper_bound(p.begin(), p.end(), x, [](double v, const std::array<double, 2>& q) { return v < q[0]; });
+  const auto& a = *(it - 1);
+  const auto& b = *it;
+  return b[0] > a[0] ? a[1] + (b[1] - a[1]) * (x - a[0]) / (b[0] - a[0]) : b[1];
+}
+
+}  // namespace
+
+double PoreWaterSettings::offset(double t) const noexcept {
+  if (history_times.empty()) return 0.0;
+  if (t <= history_times.front()) return history_offsets.front();
+  if (t >= history_times.back()) return history_offsets.back();
+  const auto it = std::upper_bound(history_times.begin(), history_times.end(), t);
+  const auto k = static_cast<std::size_t>(it - history_times.begin());
+  const double w = (t - history_times[k - 1]) / (history_times[k] - history_times[k - 1]);
+  return (1.0 - w) * history_offsets[k - 1] + w * history_offsets[k];
+}
+
+double PoreWaterSettings::level(double x, double dz) const noexcept {
+  const double zw = polyline_at(phreatic, x) + dz;
+  return ground.empty() ? zw : std::min(zw, polyline_at(ground, x));
+}
+
 // ---- One step: the passes of the numbered list in solver.hpp -------------------------------------
 
 template <int Dim>
@@ -871,6 +901,14 @@ void SphSolver<Dim>::update_stress(const Model& /*model*/) {
   Mat<Dim>* R = field<ArtificialStress<Dim>>();
   Mat<Dim>* ps = field<PairStress<Dim>>();
   const MaterialParams* mats = materials_.data();
+  // Prescribed pore water (PoreWaterSettings): u from the water table of this step; the pair stress
+  // of step 4 is the total stress σ′ − u I.
+  const PoreWaterSettings& pw = settings_.pore_water;
+  const bool water = pw.active();
+  const double pw_dz = water && earthquake_on_ ? pw.offset(time_) : (water ? pw.offset(0.0) : 0.0);
+  const double pw_gamma = pw.density * settings_.gravity * gravity_factor_;
+  const Vec<Dim>* xpos = field<Position<Dim>>();
+  double* upore = field<PorePressure>();
   // The model's internal variables (fields of the store), passed per particle to its update.
   const auto iv = field_arrays(typename Model::InternalVariables{});
   has_as_.resize(static_cast<std::size_t>(n));
@@ -909,6 +947,11 @@ void SphSolver<Dim>::update_stress(const Model& /*model*/) {
         has_as[i] = R[i].squaredNorm() > 0.0;
       }
       ps[i] = sig[i].template topLeftCorner<Dim, Dim>();
+      if (water) {
+        const double u = pw_gamma * std::max(pw.level(xpos[i][0], pw_dz) - xpos[i][Dim - 1], 0.0);
+        upore[i] = u;
+        ps[i].diagonal().array() -= u;
+      }
     }
     block_sums_[b] = plastic;
   }

@@ -161,13 +161,22 @@ struct Clamped {
 template <class... Tags>
 struct FieldList {};
 
+/// Pore pressure u of a soil particle (prescribed from the phreatic surface, solver.hpp
+/// PoreWaterSettings; 0 when dry), Pa, positive in compression of the pore water: the stress field is
+/// the effective stress σ′ and the momentum equation takes the total stress σ′ − u I.
+struct PorePressure {
+  using type = double;
+  static constexpr const char* label = "pore_pressure";
+  static constexpr const char* unit = "Pa";
+};
+
 /// The store of the SPH model.
 template <int Dim>
 using SphStore =
     ParticleStore<Position<Dim>, Velocity<Dim>, Acceleration<Dim>, Displacement<Dim>, Stress, VelocityGradient<Dim>,
                   Density, DensityRate, Mass, MaterialId, ParticleKind, WallNormal<Dim>, LayerNormal<Dim>,
                   PlasticStrain, StressFree, SummationDensity, XsphCorrection<Dim>, ArtificialStress<Dim>,
-                  PairStress<Dim>, Volume, PositionAtBuild<Dim>, StructureId, ParticleId, Clamped>;
+                  PairStress<Dim>, Volume, PositionAtBuild<Dim>, StructureId, ParticleId, Clamped, PorePressure>;
 
 /// Boundary particles without a layering normal (stores built by hand, snapshots written before the
 /// field existed) take the vertical one, the flat-lying-soil default of the scenario builders.

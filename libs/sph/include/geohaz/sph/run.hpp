@@ -136,9 +136,12 @@ struct RunConfig {
   double rest_tolerance = 0.01;  ///< at rest: max |v| < tol·√(g H)
   Analysis analysis = Analysis::Dynamic;
   StrengthReductionSettings srm;
-  /// Pore water of the section ([water]; PoreWater::unit_weight = water density × gravity). Read by
-  /// the limit-equilibrium analysis only: the SPH solver has no pore pressure yet (validate()).
+  /// Pore water of the section ([water]; PoreWater::unit_weight = water density × gravity): in
+  /// Bishop's method and, as a prescribed pore pressure (solver.hpp PoreWaterSettings, the table
+  /// clipped to the ground), in the SPH solver of a 2D slope.
   PoreWater water;
+  /// Loading history of the water table in the main phase: times (s) and offsets Δz (m).
+  std::vector<double> water_history_times, water_history_offsets;
   /// Saturated density per material (kg/m³; 0: the material's density), below the phreatic surface.
   std::vector<double> saturated_densities;
   /// Pseudo-static coefficients ([seismic]): in Bishop's method and in the strength-reduction trials.
