@@ -94,6 +94,16 @@ void validate_water_and_seismic(const RunConfig& c) {
       (c.scenario != ScenarioType::Slope || c.dimension != 2))
     throw InputError("a strength reduction with seismic coefficients needs the 2D slope scenario", c.config_source,
                      "seismic.kh");
+  if (le && !(c.numerics.gravity > 0.0))
+    throw InputError("the limit-equilibrium analysis needs gravity", c.config_source, "numerics.gravity",
+                     std::to_string(c.numerics.gravity));
+  // The Newmark analysis samples the record every millisecond (a dynamic run reports it beside the
+  // SPH, whose own time steps bound the record's length in practice).
+  const bool slope2d = c.scenario == ScenarioType::Slope && c.dimension == 2;
+  if ((le || (c.analysis == Analysis::Dynamic && slope2d)) && c.numerics.earthquake.active() &&
+      !(c.numerics.earthquake.end_time() <= 1e4))
+    throw InputError("the earthquake must end within 10^4 s (Newmark samples it every millisecond)", c.config_source,
+                     "earthquake.duration", std::to_string(c.numerics.earthquake.end_time()));
   if (!water && !le) return;
   auto s = limit_equilibrium_section(c, true);  // InputError naming run.scenario for other scenarios
   s.water.phreatic = c.water.phreatic;          // the table as given (above the ground everywhere?)
@@ -140,28 +150,35 @@ nlohmann::json newmark_report(const RunConfig& c) {
   const auto r = bishop_critical_circle(s, set);
   const double g = c.numerics.gravity, ay = r.yield_coefficient * g;
   // The record is the acceleration applied to every particle (loading.hpp): it drives the block in the
-  // direction of sliding where direction · a_h > a_y. Integrated past the record's end until the
-  // block has stopped (it decelerates at a_y: at most v_max / a_y later).
-  const double dt = 1e-3, t_end = quake.end_time() + 1.0;
+  // direction of sliding where direction · a_h > a_y. Integrated to the record's end; a block still
+  // sliding then decelerates at a_y and adds v²/(2 a_y) (unbounded for k_y = 0: null).
+  const double dt = 1e-3, t_end = quake.end_time() + dt;
   auto run = [&](int direction) {
     auto n = newmark_displacement(quake, ay, direction, t_end, dt);
-    if (ay > 0.0 && n.max_velocity > 0.0)
-      n = newmark_displacement(quake, ay, direction, t_end + n.max_velocity / ay, dt);
+    if (n.final_velocity > 0.0) {
+      if (ay > 0.0) {
+        n.displacement += 0.5 * n.final_velocity * n.final_velocity / ay;
+        n.sliding_time += n.final_velocity / ay;
+      } else {
+        n.displacement = std::numeric_limits<double>::infinity();
+      }
+    }
     return n;
   };
   const auto along = run(r.direction), against = run(-r.direction);
   nlohmann::json j = circle_json(r);
   j["yield_acceleration_m_per_s2"] = ay;
-  j["displacement_m"] = along.displacement;
+  auto finite = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+  j["displacement_m"] = finite(along.displacement);
   j["max_velocity_m_per_s"] = along.max_velocity;
   j["sliding_time_s"] = along.sliding_time;
   j["episodes"] = along.episodes;
-  j["displacement_reversed_record_m"] = against.displacement;
+  j["displacement_reversed_record_m"] = finite(against.displacement);
   j["time_step_s"] = dt;
   j["note"] =
       "Newmark (1965) rigid block on the circle of the smallest yield coefficient k_y (Bishop, static); the record "
       "drives it in the direction of sliding as the SPH run applies it to the particles; displacement along the "
-      "slip surface's direction of sliding";
+      "slip surface's direction of sliding; null: k_y = 0 (F <= 1 without shaking), the block never stops";
   return j;
 }
 
@@ -227,9 +244,12 @@ class LimitEquilibriumRun final : public SimulationModel {
     write_text_file(out / "summary.json", summary().dump(2) + "\n");
     if (!quiet_) {
       std::fprintf(stderr, "sph-slope: Bishop factor of safety %.4g", critical_.factor);
-      if (!newmark_.is_null())
-        std::fprintf(stderr, ", k_y %.4g, Newmark displacement %.4g m", newmark_["yield_coefficient"].get<double>(),
-                     newmark_["displacement_m"].get<double>());
+      if (!newmark_.is_null()) {
+        const auto& ky = newmark_["yield_coefficient"];
+        const auto& d = newmark_["displacement_m"];
+        std::fprintf(stderr, ", k_y %.4g, Newmark displacement %s", ky.is_number() ? ky.get<double>() : 0.0,
+                     d.is_number() ? (std::to_string(d.get<double>()) + " m").c_str() : "unbounded (k_y = 0)");
+      }
       std::fprintf(stderr, "; outputs in %s\n", out.string().c_str());
     }
   }

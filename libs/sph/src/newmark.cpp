@@ -61,6 +61,7 @@ NewmarkResult newmark_displacement(const std::vector<double>& a, double dt, doub
       }
     }
   }
+  r.final_velocity = sliding ? v : 0.0;
   return r;
 }
 

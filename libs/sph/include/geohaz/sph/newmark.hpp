@@ -24,10 +24,11 @@ namespace geohaz::sph {
 
 /// Result of a Newmark analysis.
 struct NewmarkResult {
-  double displacement = 0.0;  ///< permanent displacement along the slope's sliding direction (m)
-  double max_velocity = 0.0;  ///< largest sliding velocity (m/s)
-  double sliding_time = 0.0;  ///< total time the block slides (s)
-  int episodes = 0;           ///< number of separate sliding episodes
+  double displacement = 0.0;    ///< permanent displacement along the slope's sliding direction (m)
+  double max_velocity = 0.0;    ///< largest sliding velocity (m/s)
+  double sliding_time = 0.0;    ///< total time the block slides (s)
+  int episodes = 0;             ///< number of separate sliding episodes
+  double final_velocity = 0.0;  ///< sliding velocity at the end of the samples (m/s; 0: at rest)
 };
 
 /// Newmark displacement for the driving acceleration a(t) = direction · record.horizontal(t)
