@@ -90,19 +90,23 @@ TEST(SphSlopeWater, ExampleReportsYieldCoefficientAndNewmarkDisplacement) {
   EXPECT_EQ(n["episodes"].get<int>(), 3);
 }
 
-// A dynamic SPH run with an earthquake on a 2D slope reports the Newmark block beside it.
+// A dynamic SPH run with an earthquake on a 2D slope reports the Newmark block beside it (k_y = 0,
+// a slope failing without shaking, gives a null displacement: the block never stops).
 TEST(SphSlopeWater, DynamicRunWithEarthquakeReportsNewmarkBesideSph) {
   const fs::path out = kWork / "dynamic_newmark";
   fs::remove_all(out);
   const auto r = run("--config " + (kData / "slope_2d_granular.toml").string() + " --out " + out.string() +
                          " --set numerics.spacing=0.025 --set run.end_time=0.1 --set earthquake.type=sine"
-                         " --set earthquake.amplitude=5 --set earthquake.duration=0.1 --set earthquake.ramp=0"
-                         " --quiet",
+                         " --set earthquake.amplitude=8 --set earthquake.frequency=5 --set earthquake.duration=0.1 "
+                         "--set earthquake.ramp=0"
+                         " --set material[0].cohesion=1000 --quiet",
                      "dynamic_newmark");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto s = summary(out);
   ASSERT_TRUE(s.contains("newmark")) << s.dump(2);
-  EXPECT_GE(s["newmark"]["displacement_m"].get<double>(), 0.0);
+  // With c = 1 kPa the 0.25 m slope stands (k_y = 0.54) and the 8 m/s² half-sine (5 Hz) exceeds k_y g.
+  EXPECT_GT(s["newmark"]["yield_coefficient"].get<double>(), 0.0);
+  EXPECT_GT(s["newmark"]["displacement_m"].get<double>(), 0.0);
   EXPECT_EQ(s["newmark"]["sph_max_displacement_m"].get<double>(), s["max_displacement_m"].get<double>());
 }
 
