@@ -193,9 +193,15 @@ class LimitEquilibriumRun final : public SimulationModel {
   void run(const SphSimulation& self, RunObserver* obs) override {
     if (obs) obs->started(self);
     const auto s = limit_equilibrium_section(c_, true);
-    critical_ = bishop_critical_circle(s);
-    newmark_ = newmark_report(c_);
-    if (newmark_.is_null()) {  // the yield coefficient of the static section all the same
+    // No admissible circle (a section that cannot slide, or one no circle of the search fits): a
+    // result, reported in the summary, not an input error (the output folder exists by now).
+    try {
+      critical_ = bishop_critical_circle(s);
+      newmark_ = newmark_report(c_);
+    } catch (const InputError& e) {
+      note_ = e.reason();
+    }
+    if (newmark_.is_null() && critical_.admissible()) {  // the yield coefficient of the static section all the same
       auto st = s;
       st.seismic = {};
       BishopSearchSettings set;
@@ -217,8 +223,9 @@ class LimitEquilibriumRun final : public SimulationModel {
     s["dimension"] = 2;
     s["config"] = c_.config_source;
     s["analysis"] = "limit_equilibrium";
-    s["bishop"] = circle_json(critical_);
-    s["factor_of_safety"] = critical_.factor;
+    s["bishop"] = critical_.admissible() ? circle_json(critical_) : nlohmann::json();
+    s["factor_of_safety"] = critical_.admissible() ? nlohmann::json(critical_.factor) : nlohmann::json();
+    if (!note_.empty()) s["bishop_note"] = note_;
     s["seismic"] = {{"kh", c_.seismic.kh}, {"kv", c_.seismic.kv}};
     const auto& w = c_.water;
     s["water"] = {{"phreatic_surface", w.phreatic.empty() ? nlohmann::json() : nlohmann::json(w.phreatic)},
@@ -243,7 +250,10 @@ class LimitEquilibriumRun final : public SimulationModel {
     for (const auto& [name, table] : tables()) write_text_file(out / (name + ".csv"), table.csv());
     write_text_file(out / "summary.json", summary().dump(2) + "\n");
     if (!quiet_) {
-      std::fprintf(stderr, "sph-slope: Bishop factor of safety %.4g", critical_.factor);
+      if (critical_.admissible())
+        std::fprintf(stderr, "sph-slope: Bishop factor of safety %.4g", critical_.factor);
+      else
+        std::fprintf(stderr, "sph-slope: %s", note_.c_str());
       if (!newmark_.is_null()) {
         const auto& ky = newmark_["yield_coefficient"];
         const auto& d = newmark_["displacement_m"];
@@ -260,6 +270,7 @@ class LimitEquilibriumRun final : public SimulationModel {
   bool quiet_;
   BishopResult critical_, yield_;
   nlohmann::json newmark_;
+  std::string note_;
 };
 
 }  // namespace
