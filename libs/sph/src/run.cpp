@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <optional>
 #include <sstream>
 #include <string_view>
@@ -134,6 +135,28 @@ void clamp_regions(const RunConfig& c, SphStore<Dim>& S) {
 }
 
 /// The particles of the configured scenario.
+/// The profile domain of a DSM cross-section (surface, extent, layers, bedrock; walls left default).
+ProfileDomain section_profile(const RunConfig& c) {
+  const auto& P = c.section.profile;
+  if (P.size() < 2)
+    throw InputError("the cross-section profile has fewer than 2 points", c.config_source, "section.polyline");
+  ProfileDomain d;
+  double zmin = 1e300;
+  for (const auto& p : P) {
+    d.surface.push_back({p.s, p.z});
+    zmin = std::min(zmin, p.z);
+  }
+  d.x_left = P.front().s;
+  d.x_right = P.back().s;
+  d.z_bottom = zmin - c.section.soil_thickness - c.section.base_thickness;
+  d.layer_tops.clear();
+  d.layer_materials = {c.section.base_material};
+  d.surface_layer_depth = c.section.soil_thickness;
+  d.surface_material = c.section.soil_material;
+  if (c.section.bedrock) d.bedrock_depth = c.section.soil_thickness + c.section.base_thickness;
+  return d;
+}
+
 template <int Dim>
 Built<Dim> build(const RunConfig& c) {
   std::vector<double> rho;
@@ -212,25 +235,10 @@ Built<Dim> build(const RunConfig& c) {
     }
     case ScenarioType::Section: {
       const auto& P = c.section.profile;
-      if (P.size() < 2)
-        throw InputError("the cross-section profile has fewer than 2 points", c.config_source, "section.polyline");
-      ProfileDomain d;
-      double zmin = 1e300;
-      for (const auto& p : P) {
-        d.surface.push_back({p.s, p.z});
-        zmin = std::min(zmin, p.z);
-      }
-      d.x_left = P.front().s;
-      d.x_right = P.back().s;
-      d.z_bottom = zmin - c.section.soil_thickness - c.section.base_thickness;
+      ProfileDomain d = section_profile(c);
       d.left = c.left_wall;
       d.right = c.right_wall;
       d.bottom = c.bottom_wall;
-      d.layer_tops.clear();
-      d.layer_materials = {c.section.base_material};
-      d.surface_layer_depth = c.section.soil_thickness;
-      d.surface_material = c.section.soil_material;
-      if (c.section.bedrock) d.bedrock_depth = c.section.soil_thickness + c.section.base_thickness;
       if constexpr (Dim == 3) {
         if (!c.section.bedrock)
           throw InputError("a 3D DSM section needs section.base = \"bedrock\"", c.config_source, "section.base",
@@ -635,22 +643,73 @@ struct SrmTrial {
   std::int64_t steps = 0;
 };
 
-/// The Bishop cross-check on the section of a 2D slope scenario (not admissible, F = +∞, for other
-/// scenarios).
-BishopResult bishop_of(const RunConfig& c) {
-  if (c.scenario != ScenarioType::Slope || c.dimension != 2) return {};
-  ProfileDomain d = c.slope.profile();
-  if (!c.layer_materials.empty()) {
-    d.layer_tops = c.layer_tops;
-    d.layer_materials = c.layer_materials;
+/// The limit-equilibrium section of a 2D slope or DSM-section scenario, dry, at peak strength or with
+/// the residual strengths of a softening soil.
+SlopeSection section_of(const RunConfig& c, bool residual = false) {
+  ProfileDomain d;
+  if (c.scenario == ScenarioType::Slope) {
+    d = c.slope.profile();
+    if (!c.layer_materials.empty()) {
+      d.layer_tops = c.layer_tops;
+      d.layer_materials = c.layer_materials;
+    } else {
+      d.layer_tops.clear();
+      d.layer_materials.clear();
+    }
   } else {
-    d.layer_tops.clear();
-    d.layer_materials.clear();
+    d = section_profile(c);
   }
   std::vector<LimitEquilibriumSoil> soils;
-  for (const auto& m : c.materials) soils.push_back({m.density * c.numerics.gravity, m.cohesion, m.friction});
-  return bishop_critical_circle(SlopeSection::from_profile(d, soils));
+  for (const auto& m : c.materials)
+    soils.push_back({m.density * c.numerics.gravity, residual ? m.residual_cohesion : m.cohesion,
+                     residual ? m.residual_friction : m.friction});
+  return SlopeSection::from_profile(d, soils);
 }
+
+BishopResult bishop_of(const RunConfig& c, bool residual = false) {
+  if (c.dimension != 2 || (c.scenario != ScenarioType::Slope && c.scenario != ScenarioType::Section)) return {};
+  return bishop_critical_circle(section_of(c, residual));
+}
+
+/// The Bishop cross-check beside a dynamic run of a 2D slope or section of frictional soil: the
+/// static, dry factor of the critical circle at peak strength (and, for a softening soil, at residual
+/// strength), or a note saying why there is none.
+struct StaticBishop {
+  BishopResult peak, residual;
+  InfiniteSlopeResult cover;  // the translational slide of a DSM section's soil cover
+  std::string note;
+
+  static StaticBishop of(const RunConfig& c) {
+    StaticBishop b;
+    const bool frictional =
+        std::holds_alternative<DruckerPrager>(c.model) || std::holds_alternative<DruckerPragerSoftening>(c.model);
+    if (c.dimension != 2 || !frictional || (c.scenario != ScenarioType::Slope && c.scenario != ScenarioType::Section))
+      return b;
+    try {
+      b.peak = bishop_of(c);
+      if (std::holds_alternative<DruckerPragerSoftening>(c.model)) b.residual = bishop_of(c, true);
+      if (c.scenario == ScenarioType::Section) b.cover = infinite_slope_minimum(section_of(c));
+    } catch (const InputError& e) {
+      b.note = e.reason();
+    }
+    return b;
+  }
+  static nlohmann::json circle_json(const BishopResult& r) {
+    const auto& C = r.circle;
+    return {{"factor", r.factor},   {"centre_x_m", C.xc},     {"centre_z_m", C.zc},
+            {"radius_m", C.radius}, {"entry_x_m", r.x_entry}, {"exit_x_m", r.x_exit}};
+  }
+  void add_to(nlohmann::json& s) const {
+    if (!note.empty()) s["bishop_note"] = note;
+    if (peak.admissible()) s["bishop"] = circle_json(peak);
+    if (residual.admissible()) s["bishop_residual"] = circle_json(residual);
+    if (std::isfinite(cover.factor))
+      s["infinite_slope"] = {{"factor", cover.factor},
+                             {"x_m", cover.x},
+                             {"angle_deg", cover.angle * 180.0 / std::numbers::pi},
+                             {"window_m", cover.window}};
+  }
+};
 
 /// The table of a list of (x, z) points ("x_m,z_m": a surface or a circle).
 Table xz_table(const std::vector<std::array<double, 2>>& points) {
@@ -815,6 +874,7 @@ class DynamicRun final : public SimulationModel {
   std::size_t next_png_ = 0;
   double next_out_ = 0.0, max_speed_run_ = 0.0, max_runout_ = 0.0, last_moving_ = 0.0, t_start_ = 0.0;
   SeriesRow last_;
+  StaticBishop bishop_;
 };
 
 template <int Dim>
@@ -836,6 +896,7 @@ DynamicRun<Dim>::DynamicRun(const RunConfig& c, bool quiet)
     solver_.track_structures(std::move(bases));
   }
   for (const auto& m : solver_.materials()) rho0_.push_back(m.density);
+  bishop_ = StaticBishop::of(c);
   if (!quiet_) print_header();
 }
 
@@ -850,6 +911,20 @@ void DynamicRun<Dim>::print_header() const {
                  k < c_.material_names.size() ? c_.material_names[k].c_str() : "", mats[k].p_wave_speed,
                  drucker_prager_fit_name(mats[k].fit), solver_.model_name().c_str(),
                  model_parameters(c_.model, mats[k]).dump().c_str());
+  if (bishop_.peak.admissible()) {
+    std::fprintf(stderr, "  Bishop's factor of safety (static, dry, critical circle, x = %.4g to %.4g m): %.3f",
+                 bishop_.peak.x_entry, bishop_.peak.x_exit, bishop_.peak.factor);
+    if (bishop_.residual.admissible()) std::fprintf(stderr, "; at residual strength %.3f", bishop_.residual.factor);
+    std::fprintf(stderr, "\n");
+    if (std::isfinite(bishop_.cover.factor))
+      std::fprintf(stderr,
+                   "  infinite-slope factor of the soil cover (translational slide along its base): %.3f at x = %.4g m "
+                   "(%.1f deg over %.3g m)\n",
+                   bishop_.cover.factor, bishop_.cover.x, bishop_.cover.angle * 180.0 / std::numbers::pi,
+                   bishop_.cover.window);
+  } else if (!bishop_.note.empty()) {
+    std::fprintf(stderr, "  Bishop's factor of safety: none (%s)\n", bishop_.note.c_str());
+  }
 }
 
 template <int Dim>
@@ -1216,6 +1291,7 @@ nlohmann::json DynamicRun<Dim>::summary_with(const ReleaseOutput& rel) const {
   s["time_to_rest_s"] = last_.max_speed < c_.rest_speed ? nlohmann::json(last_moving_ - t_start_) : nlohmann::json();
   s["rest_speed_m_per_s"] = c_.rest_speed;
   s["bytes_per_particle"] = solver_.bytes_per_particle();
+  bishop_.add_to(s);
   if (section && c_.write_release) {
     s["release"] = {{"file", "release.h5"},
                     {"points", rel.handoff.points.size()},
@@ -1521,11 +1597,8 @@ nlohmann::json StrengthReductionRun<Dim>::summary() const {
   s["analysis"] = "strength_reduction";
   s.update(phase_summary_);
   if (!bishop_note_.empty()) s["bishop_note"] = bishop_note_;
-  if (bishop_.admissible()) {
-    const auto& C = bishop_.circle;
-    s["bishop"] = {{"factor", bishop_.factor}, {"centre_x_m", C.xc},           {"centre_z_m", C.zc},
-                   {"radius_m", C.radius},     {"entry_x_m", bishop_.x_entry}, {"exit_x_m", bishop_.x_exit}};
-  }
+  if (bishop_.admissible()) s["bishop"] = StaticBishop::circle_json(bishop_);
+
   s["outcome"] = outcome_;
   s["factor_of_safety"] = outcome_ == "bracketed" ? nlohmann::json(lo_) : nlohmann::json();
   s["bracket"] = {lo_, hi_};
