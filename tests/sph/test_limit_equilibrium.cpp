@@ -258,10 +258,98 @@ TEST(Bishop, CircleBelowTheRigidBottomIsNotAdmissible) {
   EXPECT_FALSE(bishop_factor(s, {38.0, 24.0, 30.0}).admissible());
 }
 
-TEST(Bishop, SectionWithSurfaceLayerIsRejected) {
+// A surface layer whose material has no soil, and a terrain across the width (3D), are rejected.
+TEST(Bishop, SectionItCannotRepresentIsRejected) {
   ProfileDomain d = SlopeGeometry{}.profile();
   d.surface_layer_depth = 1.0;
+  d.surface_material = 1;
   EXPECT_THROW((void)SlopeSection::from_profile(d, {{}}), InputError);
+  d.surface_material = 0;
+  EXPECT_NO_THROW((void)SlopeSection::from_profile(d, {{}}));
+  d.surface_xy = [](double, double) { return 0.0; };
+  EXPECT_THROW((void)SlopeSection::from_profile(d, {{}}), InputError);
+}
+
+/// A long planar slope at β (rising to the left) with a cover `t` deep (vertical) of `cover` soil over a
+/// base layer of `base` soil, on bedrock that follows the surface `bedrock` below it: a DSM section.
+SlopeSection cover_on_bedrock(double beta, double t, double bedrock, LimitEquilibriumSoil cover,
+                              LimitEquilibriumSoil base) {
+  SlopeSection s;
+  const double L = 300.0;
+  s.surface = {{0.0, L * std::tan(beta)}, {L, 0.0}};
+  s.x_left = 0.0;
+  s.x_right = L;
+  s.z_bottom = -bedrock;
+  s.layer_materials = {1};
+  s.surface_layer_depth = t;
+  s.surface_material = 0;
+  s.bedrock_depth = bedrock;
+  s.soils = {cover, base};
+  return s;
+}
+
+// A cohesionless cover on a planar slope: every shallow slip surface approaches the infinite-slope
+// factor tan φ / tan β (Taylor 1948; the circle search on bedrock must find the flat circles in the
+// cover). The circles have a curvature, so their bases are not all at β: 2 %.
+TEST(Bishop, CohesionlessCoverOnBedrockGivesTheInfiniteSlopeFactor) {
+  const double beta = 35.0 * kDeg, phi = 30.0 * kDeg;
+  const auto s = cover_on_bedrock(beta, 3.0, 5.0, {19e3, 0.0, phi}, {23e3, 500e3, 45.0 * kDeg});
+  const auto r = bishop_critical_circle(s);
+  ASSERT_TRUE(r.admissible());
+  EXPECT_NEAR(r.factor, std::tan(phi) / std::tan(beta), 0.02 * std::tan(phi) / std::tan(beta));
+}
+
+// With cohesion a circle cannot follow the base of a thin cover: the critical circle is the long flat
+// one that touches it, a lens whose mean depth is about 2t/3 (a parabolic segment of sagitta t), so its
+// factor is close to the infinite-slope factor of a slab 2t/3 deep, c / (γ (2t/3) sin β cos β) +
+// tan φ / tan β, and above the translational slide along the base of the cover, F∞ at depth t (which
+// is why sph-slope reports both on a DSM section). Lens estimate ±3 % (the arc is a circle, not a
+// parabola, and its ends are not at β). The arc stays above the bedrock and inside the cover (the
+// base layer is far stronger).
+TEST(Bishop, CohesiveCoverOnBedrockGivesTheLensFactor) {
+  const double beta = 45.0 * kDeg, phi = 35.0 * kDeg, gamma = 19e3, c = 20e3, t = 3.0;
+  const auto s = cover_on_bedrock(beta, t, 5.0, {gamma, c, phi}, {23e3, 500e3, 45.0 * kDeg});
+  const auto r = bishop_critical_circle(s);
+  ASSERT_TRUE(r.admissible());
+  const double f_inf = c / (gamma * t * std::sin(beta) * std::cos(beta)) + std::tan(phi) / std::tan(beta);
+  const double f_lens =
+      c / (gamma * (2.0 / 3.0) * t * std::sin(beta) * std::cos(beta)) + std::tan(phi) / std::tan(beta);
+  EXPECT_GT(r.factor, f_inf);
+  EXPECT_NEAR(r.factor, f_lens, 0.03 * f_lens);
+  for (int k = 0; k <= 20; ++k) {
+    const double x = r.x_entry + (r.x_exit - r.x_entry) * k / 20.0;
+    const double za =
+        r.circle.zc - std::sqrt(r.circle.radius * r.circle.radius - (x - r.circle.xc) * (x - r.circle.xc));
+    EXPECT_GE(za, s.bottom_at(x) - 1e-6);
+    EXPECT_GE(za, surface_at(s.surface, x) - t - 0.05);
+  }
+  // The same soil in both layers and no bedrock within reach gives the same circle's factor: the layer
+  // by depth weighs and resists like the layers by elevation.
+  SlopeSection one = s;
+  one.soils[1] = one.soils[0];
+  EXPECT_NEAR(bishop_factor(one, r.circle).factor, r.factor, 1e-12 * r.factor);
+}
+
+// The infinite-slope factor of the cover is the closed form on a plane, and on a slope that steepens
+// halfway down its minimum lies on the steep part, at that part's angle.
+TEST(InfiniteSlope, CoverFactorIsTheClosedFormAndFindsTheSteepestReach) {
+  const double beta = 40.0 * kDeg, phi = 33.0 * kDeg, gamma = 19e3, c = 10e3, t = 2.0;
+  auto s = cover_on_bedrock(beta, t, 4.0, {gamma, c, phi}, {23e3, 500e3, 45.0 * kDeg});
+  const double f = c / (gamma * t * std::sin(beta) * std::cos(beta)) + std::tan(phi) / std::tan(beta);
+  const auto r = infinite_slope_minimum(s);
+  EXPECT_NEAR(r.factor, f, 1e-12 * f);
+  EXPECT_DOUBLE_EQ(r.window, 10.0 * t);
+  const double steep = 50.0 * kDeg;
+  s.surface = {{0.0, 0.0}, {150.0, 0.0}};
+  s.surface[0][1] = 150.0 * std::tan(beta) + 150.0 * std::tan(steep);
+  s.surface[1][1] = 150.0 * std::tan(steep);
+  s.surface.push_back({300.0, 0.0});
+  const auto k = infinite_slope_minimum(s);
+  EXPECT_NEAR(k.angle, steep, 1e-9);
+  EXPECT_GT(k.x, 150.0);
+  EXPECT_NEAR(k.factor, c / (gamma * t * std::sin(steep) * std::cos(steep)) + std::tan(phi) / std::tan(steep), 1e-9);
+  s.surface_layer_depth = 0.0;
+  EXPECT_FALSE(std::isfinite(infinite_slope_minimum(s).factor));
 }
 
 }  // namespace

@@ -10,10 +10,7 @@
 namespace geohaz::sph {
 
 SlopeSection SlopeSection::from_profile(const ProfileDomain& d, std::vector<LimitEquilibriumSoil> soils) {
-  if (d.surface_layer_depth > 0.0 || d.bedrock_depth > 0.0 || d.surface_xy)
-    throw InputError(
-        "the limit-equilibrium check needs a section with layers by elevation on a flat rigid bottom (no surface "
-        "layer, bedrock or 3D terrain)");
+  if (d.surface_xy) throw InputError("the limit-equilibrium check needs a 2D section (not a terrain across the width)");
   SlopeSection s;
   s.surface = d.surface;
   s.x_left = d.x_left;
@@ -21,19 +18,30 @@ SlopeSection SlopeSection::from_profile(const ProfileDomain& d, std::vector<Limi
   s.z_bottom = d.z_bottom;
   s.layer_tops = d.layer_tops;
   s.layer_materials = d.layer_materials;
+  s.surface_layer_depth = d.surface_layer_depth;
+  s.surface_material = d.surface_material;
+  s.bedrock_depth = d.bedrock_depth;
   s.soils = std::move(soils);
-  for (int m : s.layer_materials)
+  if (s.soils.empty()) throw InputError("the limit-equilibrium check needs at least one soil");
+  auto check = [&](int m) {
     if (m < 0 || static_cast<std::size_t>(m) >= s.soils.size())
       throw InputError("layer material " + std::to_string(m) + " has no soil for the limit-equilibrium check");
-  if (s.soils.empty()) throw InputError("the limit-equilibrium check needs at least one soil");
+  };
+  for (int m : s.layer_materials) check(m);
+  if (s.surface_layer_depth > 0.0) check(s.surface_material);
   return s;
 }
 
-int SlopeSection::material_at(double z) const noexcept {
+int SlopeSection::material_at(double x, double z) const noexcept {
+  if (surface_layer_depth > 0.0 && z > surface_at(surface, x) - surface_layer_depth) return surface_material;
   if (layer_materials.empty()) return 0;
   for (std::size_t k = 0; k < layer_tops.size(); ++k)
     if (z < layer_tops[k]) return layer_materials[k];
   return layer_materials.back();
+}
+
+double SlopeSection::bottom_at(double x) const noexcept {
+  return bedrock_depth > 0.0 ? surface_at(surface, x) - bedrock_depth : z_bottom;
 }
 
 double PoreWater::level_at(double x) const noexcept {
@@ -100,7 +108,7 @@ struct Column {
   double w = 0.0, wz = 0.0;
 };
 
-Column column_of(const SlopeSection& s, double z0, double z1, double zw) {
+Column column_of(const SlopeSection& s, double x, double z0, double z1, double zw) {
   Column c;
   if (!(z1 > z0)) return c;
   auto add = [&](const LimitEquilibriumSoil& soil, double a, double b) {  // a < b within one soil
@@ -109,14 +117,22 @@ Column column_of(const SlopeSection& s, double z0, double z1, double zw) {
     c.w += ws + wm;
     c.wz += ws * 0.5 * (a + mid) + wm * 0.5 * (mid + b);
   };
+  // The surface layer by depth above z_s(x) − its depth, the layers by elevation below.
+  double top = z1;
+  if (s.surface_layer_depth > 0.0) {
+    const double zl = surface_at(s.surface, x) - s.surface_layer_depth;
+    if (z1 > std::max(z0, zl)) add(s.soils[static_cast<std::size_t>(s.surface_material)], std::max(z0, zl), z1);
+    top = std::min(z1, zl);
+    if (!(top > z0)) return c;
+  }
   if (s.layer_materials.empty()) {
-    add(s.soils[0], z0, z1);
+    add(s.soils[0], z0, top);
     return c;
   }
   double lo = -1e300;
   for (std::size_t k = 0; k <= s.layer_tops.size(); ++k) {
     const double hi = k < s.layer_tops.size() ? s.layer_tops[k] : 1e300;
-    const double a = std::max(lo, z0), b = std::min(hi, z1);
+    const double a = std::max(lo, z0), b = std::min(hi, top);
     if (b > a) add(s.soils[static_cast<std::size_t>(s.layer_materials[k])], a, b);
     lo = hi;
   }
@@ -136,7 +152,9 @@ BishopResult bishop_mass(const SlopeSection& s, const SlipCircle& c, double x0, 
   r.circle = c;
   r.x_entry = x0;
   r.x_exit = x1;
-  if (arc_at(c, std::clamp(c.xc, x0, x1)) < s.z_bottom - 1e-9 * c.radius) return r;  // through the rigid bottom
+  const bool bedrock = s.bedrock_depth > 0.0;
+  if (!bedrock && arc_at(c, std::clamp(c.xc, x0, x1)) < s.z_bottom - 1e-9 * c.radius)
+    return r;  // through the rigid bottom
   const double b = (x1 - x0) / slices;
   const bool phreatic = !s.water.phreatic.empty();
   const double kh = s.seismic.kh, kv = s.seismic.kv, gw = s.water.unit_weight;
@@ -156,11 +174,12 @@ BishopResult bishop_mass(const SlopeSection& s, const SlipCircle& c, double x0, 
     const double x = x0 + (i + 0.5) * b;
     const double zb = arc_at(c, x), zt = surface_at(s.surface, x);
     if (!(zt > zb)) continue;
+    if (bedrock && zb < zt - s.bedrock_depth - 1e-9 * c.radius) return r;  // through the bedrock
     const double zw = phreatic ? s.water.level_at(x) : -1e300;
-    const Column col = column_of(s, zb, zt, zw);
+    const Column col = column_of(s, x, zb, zt, zw);
     const double w = b * col.w;
     const double ww = zw > zt ? b * gw * (zw - zt) : 0.0;  // ponded water on the slice
-    const auto& soil = s.soils[static_cast<std::size_t>(s.material_at(zb))];
+    const auto& soil = s.soils[static_cast<std::size_t>(s.material_at(x, zb))];
     const double sa = (c.xc - x) / c.radius;
     const double ca = std::sqrt(std::max(0.0, 1.0 - sa * sa));
     // c b = c ℓ cos α with the slice's exact arc length ℓ: the mid-point b/cos α misses most of a
@@ -281,62 +300,36 @@ BishopResult bishop_factor(const SlopeSection& s, const SlipCircle& c, int slice
   return best;
 }
 
-BishopResult bishop_critical_circle(const SlopeSection& s, const BishopSearchSettings& set) {
-  double ztop = -1e300;
-  for (const auto& p : s.surface) ztop = std::max(ztop, p[1]);
-  const double height = ztop - s.z_bottom, length = s.x_right - s.x_left;
-  const double zc_hi = ztop + std::max(2.0 * height, 0.5 * length);
-  // A circle as (x_c, z_c, bottom elevation z_c − R).
-  // The objective: the factor of safety, or the yield coefficient (+∞ where not determined).
-  auto key = [&](const BishopResult& r) {
-    if (!set.minimise_yield_coefficient || !r.admissible()) return r.factor;
-    return r.yield_coefficient;
-  };
-  auto eval = [&](double xc, double zc, double zlow) {
-    BishopResult r;
-    if (!(zlow >= s.z_bottom - height) || !(zc > zlow)) return r;
-    r = bishop_factor(s, {xc, zc, zc - zlow}, set.slices);
-    if (r.admissible() && set.min_depth > 0.0) {
-      double dmax = 0.0;
-      for (int k = 0; k <= 20; ++k) {
-        const double x = r.x_entry + (r.x_exit - r.x_entry) * k / 20.0;
-        dmax = std::max(dmax, surface_at(s.surface, x) - arc_at(r.circle, x));
-      }
-      if (dmax < set.min_depth) return BishopResult{};
-    }
-    return r;
-  };
-  const int n = std::max(set.grid, 2);
+namespace {
+
+/// A circle search: `eval` maps a point of the search's own coordinates to a Bishop result (+∞ where
+/// not admissible); `grid` lists the grid stage's points. The best `refine_starts` grid circles are
+/// refined by a compass search: try ± step along each coordinate, move to the best improvement,
+/// halve the steps when none improves, until step[0] is below `stop`.
+/// `key` is the objective: the factor, or the yield coefficient (+∞ where not determined).
+template <class Eval, class Key>
+BishopResult search_circles(const std::vector<std::array<double, 3>>& grid, const std::array<double, 3>& step0,
+                            double stop, int refine_starts, const Eval& eval, const Key& key, bool yield) {
   std::vector<std::pair<double, std::array<double, 3>>> found;
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j)
-      for (int k = 0; k < n; ++k) {
-        const double xc = s.x_left + length * (i + 0.5) / n;
-        const double zc = ztop + (zc_hi - ztop) * (j + 0.5) / n;
-        const double zlow = s.z_bottom - height + 2.0 * height * k / n;
-        const auto r = eval(xc, zc, zlow);
-        if (r.admissible() && key(r) < std::numeric_limits<double>::infinity())
-          found.push_back({key(r), {xc, zc, zlow}});
-      }
+  for (const auto& p : grid) {
+    const auto r = eval(p);
+    if (r.admissible() && key(r) < std::numeric_limits<double>::infinity()) found.push_back({key(r), p});
+  }
   if (found.empty())
-    throw InputError(set.minimise_yield_coefficient
-                         ? "the limit-equilibrium search found no slip circle with a yield coefficient"
-                         : "the limit-equilibrium search found no admissible slip circle");
+    throw InputError(yield ? "the limit-equilibrium search found no slip circle with a yield coefficient"
+                           : "the limit-equilibrium search found no admissible slip circle");
   std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   BishopResult best;
-  const std::array<double, 3> step0{length / n, (zc_hi - ztop) / n, height / n};
-  for (int start = 0; start < std::min<int>(set.refine_starts, static_cast<int>(found.size())); ++start) {
+  for (int start = 0; start < std::min<int>(refine_starts, static_cast<int>(found.size())); ++start) {
     std::array<double, 3> p = found[static_cast<std::size_t>(start)].second, step = step0;
-    BishopResult cur = eval(p[0], p[1], p[2]);
-    // Compass search: try ± step along each coordinate, move to the best improvement, halve the steps
-    // when none improves, until the steps are 1e-5 of the section.
-    while (step[0] > 1e-5 * length) {
+    BishopResult cur = eval(p);
+    while (step[0] > stop) {
       bool moved = false;
-      for (int a = 0; a < 3; ++a)
+      for (std::size_t a = 0; a < 3; ++a)
         for (double sgn : {-1.0, 1.0}) {
           auto q = p;
-          q[static_cast<std::size_t>(a)] += sgn * step[static_cast<std::size_t>(a)];
-          const auto r = eval(q[0], q[1], q[2]);
+          q[a] += sgn * step[a];
+          const auto r = eval(q);
           if (key(r) < key(cur)) {
             cur = r;
             p = q;
@@ -349,6 +342,106 @@ BishopResult bishop_critical_circle(const SlopeSection& s, const BishopSearchSet
     if (key(cur) < key(best)) best = cur;
   }
   return best;
+}
+
+/// Deepest point of a circle's mass below the surface (m), sampled at 21 points.
+double mass_depth(const SlopeSection& s, const BishopResult& r) {
+  double dmax = 0.0;
+  for (int k = 0; k <= 20; ++k) {
+    const double x = r.x_entry + (r.x_exit - r.x_entry) * k / 20.0;
+    dmax = std::max(dmax, surface_at(s.surface, x) - arc_at(r.circle, x));
+  }
+  return dmax;
+}
+
+/// The circle through the surface points at x1 and x1 + chord (chord measured along x) whose arc lies
+/// `sagitta` below the straight chord at its middle, the centre above the chord.
+SlipCircle circle_through(const SlopeSection& s, double x1, double chord, double sagitta) {
+  const double x2 = x1 + chord;
+  const double z1 = surface_at(s.surface, x1), z2 = surface_at(s.surface, x2);
+  const double dx = x2 - x1, dz = z2 - z1, L = std::hypot(dx, dz);
+  const double R = (0.25 * L * L + sagitta * sagitta) / (2.0 * sagitta);
+  // Unit normal of the chord pointing up (n_z = dx / L > 0).
+  const double nx = -dz / L, nz = dx / L;
+  return {0.5 * (x1 + x2) + (R - sagitta) * nx, 0.5 * (z1 + z2) + (R - sagitta) * nz, R};
+}
+
+}  // namespace
+
+BishopResult bishop_critical_circle(const SlopeSection& s, const BishopSearchSettings& set) {
+  const int n = std::max(set.grid, 2);
+  const double length = s.x_right - s.x_left;
+  // The objective: the factor of safety, or the yield coefficient (+∞ where not determined).
+  auto key = [&](const BishopResult& r) {
+    return set.minimise_yield_coefficient && r.admissible() ? r.yield_coefficient : r.factor;
+  };
+  const bool yield = set.minimise_yield_coefficient;
+  auto depth_ok = [&](const BishopResult& r) {
+    return !r.admissible() || !(set.min_depth > 0.0) || mass_depth(s, r) >= set.min_depth;
+  };
+  if (s.bedrock_depth > 0.0) {
+    // Entry x1, log chord, log sagitta.
+    const double D = s.bedrock_depth;
+    const double c_lo = 2.0 * D, c_hi = std::min(60.0 * D, length), s_lo = 0.05 * D, s_hi = 1.5 * D;
+    auto eval = [&](const std::array<double, 3>& p) {
+      const double chord = std::exp(p[1]), sag = std::exp(p[2]);
+      if (!(p[0] >= s.x_left) || !(p[0] + chord <= s.x_right) || !(sag > 0.0)) return BishopResult{};
+      const auto r = bishop_factor(s, circle_through(s, p[0], chord, sag), set.slices);
+      return depth_ok(r) ? r : BishopResult{};
+    };
+    std::vector<std::array<double, 3>> grid;
+    const int entries = std::max(2, static_cast<int>(length / D));
+    const double dlc = std::log(c_hi / c_lo) / (n - 1), dls = std::log(s_hi / s_lo) / (n - 1);
+    for (int i = 0; i < entries; ++i)
+      for (int j = 0; j < n; ++j)
+        for (int k = 0; k < n; ++k)
+          grid.push_back({s.x_left + length * i / entries, std::log(c_lo) + dlc * j, std::log(s_lo) + dls * k});
+    return search_circles(grid, {D, dlc, dls}, 1e-5 * length, set.refine_starts, eval, key, yield);
+  }
+  double ztop = -1e300;
+  for (const auto& p : s.surface) ztop = std::max(ztop, p[1]);
+  const double height = ztop - s.z_bottom;
+  const double zc_hi = ztop + std::max(2.0 * height, 0.5 * length);
+  // A circle as (x_c, z_c, bottom elevation z_c − R).
+  auto eval = [&](const std::array<double, 3>& p) {
+    const double xc = p[0], zc = p[1], zlow = p[2];
+    BishopResult r;
+    if (!(zlow >= s.z_bottom - height) || !(zc > zlow)) return r;
+    r = bishop_factor(s, {xc, zc, zc - zlow}, set.slices);
+    return depth_ok(r) ? r : BishopResult{};
+  };
+  std::vector<std::array<double, 3>> grid;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      for (int k = 0; k < n; ++k)
+        grid.push_back({s.x_left + length * (i + 0.5) / n, ztop + (zc_hi - ztop) * (j + 0.5) / n,
+                        s.z_bottom - height + 2.0 * height * k / n});
+  return search_circles(grid, {length / n, (zc_hi - ztop) / n, height / n}, 1e-5 * length, set.refine_starts, eval, key,
+                        yield);
+}
+
+InfiniteSlopeResult infinite_slope_minimum(const SlopeSection& s, double window) {
+  InfiniteSlopeResult r;
+  const double t = s.surface_layer_depth;
+  if (!(t > 0.0)) return r;
+  r.window = window > 0.0 ? window : 10.0 * t;
+  const auto& soil = s.soils[static_cast<std::size_t>(s.surface_material)];
+  const double w = r.window, length = s.x_right - s.x_left;
+  const int n = std::max(1, static_cast<int>(std::floor(10.0 * (length - w) / w)));
+  for (int k = 0; k <= n; ++k) {
+    const double x = length > w ? s.x_left + 0.5 * w + (length - w) * k / n : 0.5 * (s.x_left + s.x_right);
+    const double h = std::min(0.5 * w, 0.5 * length);
+    const double beta = std::atan(std::abs(surface_at(s.surface, x + h) - surface_at(s.surface, x - h)) / (2.0 * h));
+    if (!(beta > 0.0)) continue;
+    const double f = soil.cohesion / (soil.unit_weight * t * std::sin(beta) * std::cos(beta)) +
+                     std::tan(soil.friction) / std::tan(beta);
+    if (f < r.factor) {
+      r.factor = f;
+      r.x = x;
+      r.angle = beta;
+    }
+  }
+  return r;
 }
 
 }  // namespace geohaz::sph

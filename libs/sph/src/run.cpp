@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <optional>
 #include <sstream>
 #include <string_view>
@@ -135,6 +136,28 @@ void clamp_regions(const RunConfig& c, SphStore<Dim>& S) {
 }
 
 /// The particles of the configured scenario.
+/// The profile domain of a DSM cross-section (surface, extent, layers, bedrock; walls left default).
+ProfileDomain section_profile(const RunConfig& c) {
+  const auto& P = c.section.profile;
+  if (P.size() < 2)
+    throw InputError("the cross-section profile has fewer than 2 points", c.config_source, "section.polyline");
+  ProfileDomain d;
+  double zmin = 1e300;
+  for (const auto& p : P) {
+    d.surface.push_back({p.s, p.z});
+    zmin = std::min(zmin, p.z);
+  }
+  d.x_left = P.front().s;
+  d.x_right = P.back().s;
+  d.z_bottom = zmin - c.section.soil_thickness - c.section.base_thickness;
+  d.layer_tops.clear();
+  d.layer_materials = {c.section.base_material};
+  d.surface_layer_depth = c.section.soil_thickness;
+  d.surface_material = c.section.soil_material;
+  if (c.section.bedrock) d.bedrock_depth = c.section.soil_thickness + c.section.base_thickness;
+  return d;
+}
+
 template <int Dim>
 Built<Dim> build(const RunConfig& c) {
   std::vector<double> rho;
@@ -213,25 +236,10 @@ Built<Dim> build(const RunConfig& c) {
     }
     case ScenarioType::Section: {
       const auto& P = c.section.profile;
-      if (P.size() < 2)
-        throw InputError("the cross-section profile has fewer than 2 points", c.config_source, "section.polyline");
-      ProfileDomain d;
-      double zmin = 1e300;
-      for (const auto& p : P) {
-        d.surface.push_back({p.s, p.z});
-        zmin = std::min(zmin, p.z);
-      }
-      d.x_left = P.front().s;
-      d.x_right = P.back().s;
-      d.z_bottom = zmin - c.section.soil_thickness - c.section.base_thickness;
+      ProfileDomain d = section_profile(c);
       d.left = c.left_wall;
       d.right = c.right_wall;
       d.bottom = c.bottom_wall;
-      d.layer_tops.clear();
-      d.layer_materials = {c.section.base_material};
-      d.surface_layer_depth = c.section.soil_thickness;
-      d.surface_material = c.section.soil_material;
-      if (c.section.bedrock) d.bedrock_depth = c.section.soil_thickness + c.section.base_thickness;
       if constexpr (Dim == 3) {
         if (!c.section.bedrock)
           throw InputError("a 3D DSM section needs section.base = \"bedrock\"", c.config_source, "section.base",
@@ -638,13 +646,85 @@ struct SrmTrial {
   std::int64_t steps = 0;
 };
 
-/// The Bishop cross-check on the section of a 2D slope scenario (not admissible, F = +∞, for other
-/// scenarios).
-BishopResult bishop_of(const RunConfig& c) {
-  if (c.scenario != ScenarioType::Slope || c.dimension != 2) return {};
-  // The strength reduction's water (clipped to the ground as the SPH's) and seismic coefficients.
-  return bishop_critical_circle(limit_equilibrium_section(c, true));
+/// The limit-equilibrium section of a 2D slope or DSM-section scenario, at peak strength or with the
+/// residual strengths of a softening soil; a slope with the config's pore water and seismic
+/// coefficients.
+SlopeSection section_of(const RunConfig& c, bool residual = false) {
+  ProfileDomain d;
+  if (c.scenario == ScenarioType::Slope) {
+    d = c.slope.profile();
+    if (!c.layer_materials.empty()) {
+      d.layer_tops = c.layer_tops;
+      d.layer_materials = c.layer_materials;
+    } else {
+      d.layer_tops.clear();
+      d.layer_materials.clear();
+    }
+  } else {
+    d = section_profile(c);
+  }
+  std::vector<LimitEquilibriumSoil> soils;
+  for (std::size_t k = 0; k < c.materials.size(); ++k) {
+    const auto& m = c.materials[k];
+    const double sat = k < c.saturated_densities.size() ? c.saturated_densities[k] : 0.0;
+    soils.push_back({m.density * c.numerics.gravity, residual ? m.residual_cohesion : m.cohesion,
+                     residual ? m.residual_friction : m.friction, sat * c.numerics.gravity});
+  }
+  auto s = SlopeSection::from_profile(d, soils);
+  if (c.scenario == ScenarioType::Slope) {
+    // The pore water (clipped to the ground as the SPH's) and the pseudo-static coefficients of the
+    // strength reduction (a dynamic run has none: its earthquake is the record).
+    const auto le = limit_equilibrium_section(c, true);
+    s.water = le.water;
+    s.seismic = le.seismic;
+  }
+  return s;
 }
+
+BishopResult bishop_of(const RunConfig& c, bool residual = false) {
+  if (c.dimension != 2 || (c.scenario != ScenarioType::Slope && c.scenario != ScenarioType::Section)) return {};
+  return bishop_critical_circle(section_of(c, residual));
+}
+
+/// The Bishop cross-check beside a dynamic run of a 2D slope or section of frictional soil: the
+/// static factor of the critical circle (with the run's pore water, if any) at peak strength (and, for a softening
+/// soil, at residual strength), or a note saying why there is none.
+struct StaticBishop {
+  BishopResult peak, residual;
+  InfiniteSlopeResult cover;  // the translational slide of a DSM section's soil cover
+  std::string note;
+
+  static StaticBishop of(const RunConfig& c) {
+    StaticBishop b;
+    const bool frictional =
+        std::holds_alternative<DruckerPrager>(c.model) || std::holds_alternative<DruckerPragerSoftening>(c.model);
+    if (c.dimension != 2 || !frictional || (c.scenario != ScenarioType::Slope && c.scenario != ScenarioType::Section))
+      return b;
+    try {
+      b.peak = bishop_of(c);
+      if (std::holds_alternative<DruckerPragerSoftening>(c.model)) b.residual = bishop_of(c, true);
+      if (c.scenario == ScenarioType::Section) b.cover = infinite_slope_minimum(section_of(c));
+    } catch (const InputError& e) {
+      b.note = e.reason();
+    }
+    return b;
+  }
+  static nlohmann::json circle_json(const BishopResult& r) {
+    const auto& C = r.circle;
+    return {{"factor", r.factor},   {"centre_x_m", C.xc},     {"centre_z_m", C.zc},
+            {"radius_m", C.radius}, {"entry_x_m", r.x_entry}, {"exit_x_m", r.x_exit}};
+  }
+  void add_to(nlohmann::json& s) const {
+    if (!note.empty()) s["bishop_note"] = note;
+    if (peak.admissible()) s["bishop"] = circle_json(peak);
+    if (residual.admissible()) s["bishop_residual"] = circle_json(residual);
+    if (std::isfinite(cover.factor))
+      s["infinite_slope"] = {{"factor", cover.factor},
+                             {"x_m", cover.x},
+                             {"angle_deg", cover.angle * 180.0 / std::numbers::pi},
+                             {"window_m", cover.window}};
+  }
+};
 
 /// The table of a list of (x, z) points ("x_m,z_m": a surface or a circle).
 Table xz_table(const std::vector<std::array<double, 2>>& points) {
@@ -786,6 +866,7 @@ class DynamicRun final : public SimulationModel {
   std::size_t next_png_ = 0;
   double next_out_ = 0.0, max_speed_run_ = 0.0, max_runout_ = 0.0, last_moving_ = 0.0, t_start_ = 0.0;
   SeriesRow last_;
+  StaticBishop bishop_;
 };
 
 template <int Dim>
@@ -807,6 +888,7 @@ DynamicRun<Dim>::DynamicRun(const RunConfig& c, bool quiet)
     solver_.track_structures(std::move(bases));
   }
   for (const auto& m : solver_.materials()) rho0_.push_back(m.density);
+  bishop_ = StaticBishop::of(c);
   if (!quiet_) print_header();
 }
 
@@ -821,6 +903,20 @@ void DynamicRun<Dim>::print_header() const {
                  k < c_.material_names.size() ? c_.material_names[k].c_str() : "", mats[k].p_wave_speed,
                  drucker_prager_fit_name(mats[k].fit), solver_.model_name().c_str(),
                  model_parameters(c_.model, mats[k]).dump().c_str());
+  if (bishop_.peak.admissible()) {
+    std::fprintf(stderr, "  Bishop's factor of safety (static, critical circle, x = %.4g to %.4g m): %.3f",
+                 bishop_.peak.x_entry, bishop_.peak.x_exit, bishop_.peak.factor);
+    if (bishop_.residual.admissible()) std::fprintf(stderr, "; at residual strength %.3f", bishop_.residual.factor);
+    std::fprintf(stderr, "\n");
+    if (std::isfinite(bishop_.cover.factor))
+      std::fprintf(stderr,
+                   "  infinite-slope factor of the soil cover (translational slide along its base): %.3f at x = %.4g m "
+                   "(%.1f deg over %.3g m)\n",
+                   bishop_.cover.factor, bishop_.cover.x, bishop_.cover.angle * 180.0 / std::numbers::pi,
+                   bishop_.cover.window);
+  } else if (!bishop_.note.empty()) {
+    std::fprintf(stderr, "  Bishop's factor of safety: none (%s)\n", bishop_.note.c_str());
+  }
 }
 
 template <int Dim>
@@ -1187,6 +1283,7 @@ nlohmann::json DynamicRun<Dim>::summary_with(const ReleaseOutput& rel) const {
   s["time_to_rest_s"] = last_.max_speed < c_.rest_speed ? nlohmann::json(last_moving_ - t_start_) : nlohmann::json();
   s["rest_speed_m_per_s"] = c_.rest_speed;
   s["bytes_per_particle"] = solver_.bytes_per_particle();
+  bishop_.add_to(s);
   if (section && c_.write_release) {
     s["release"] = {{"file", "release.h5"},
                     {"points", rel.handoff.points.size()},
@@ -1509,12 +1606,11 @@ nlohmann::json StrengthReductionRun<Dim>::summary() const {
   s.update(phase_summary_);
   if (!bishop_note_.empty()) s["bishop_note"] = bishop_note_;
   if (bishop_.admissible()) {
-    const auto& C = bishop_.circle;
-    s["bishop"] = {{"factor", bishop_.factor}, {"centre_x_m", C.xc},           {"centre_z_m", C.zc},
-                   {"radius_m", C.radius},     {"entry_x_m", bishop_.x_entry}, {"exit_x_m", bishop_.x_exit}};
+    s["bishop"] = StaticBishop::circle_json(bishop_);
     if (std::isfinite(bishop_.yield_coefficient)) s["bishop"]["yield_coefficient"] = bishop_.yield_coefficient;
   }
   s["seismic"] = {{"kh", c_.seismic.kh}, {"kv", c_.seismic.kv}};
+
   s["outcome"] = outcome_;
   s["factor_of_safety"] = outcome_ == "bracketed" ? nlohmann::json(lo_) : nlohmann::json();
   s["bracket"] = {lo_, hi_};

@@ -36,6 +36,11 @@
 /// at the ends of any ponded water. The horizontal force enters only the driving moment, so the
 /// k_h that makes F = 1 on a given circle (its yield coefficient k_y) is explicit:
 ///     k_y = (Σ [c′ b + (V − u b) tan φ′] / m_α(F = 1) − Σ V sin α − M_w/R) / Σ W (z_c − z_g)/R.
+/// A DSM section (a soil cover of given depth below the surface over a base layer, on bedrock that
+/// follows the surface at `bedrock_depth`) is represented too: there a mass is admissible when every
+/// slice base stays above the bedrock, and the critical circle is searched by its entry and exit on the
+/// surface and its depth (bishop_critical_circle), since a centre grid over a long mountainside
+/// section almost never hits a circle that stays inside a cover a few metres thick.
 /// Units SI (m, Pa, N/m³, radians).
 
 #include <array>
@@ -94,17 +99,23 @@ struct SlopeSection {
   std::vector<LimitEquilibriumSoil> soils;     ///< by material index
   PoreWater water;                             ///< pore pressure (default: dry)
   SeismicCoefficients seismic;                 ///< pseudo-static coefficients (default: none)
+  /// As ProfileDomain: z > z_s(x) − surface_layer_depth holds `surface_material` (0: no such layer).
+  double surface_layer_depth = 0.0;
+  int surface_material = 0;
+  /// As ProfileDomain: > 0 puts the rigid bottom at z_s(x) − bedrock_depth instead of z_bottom.
+  double bedrock_depth = 0.0;
 
-  /// The section of a profile domain. Throws InputError for what it cannot represent (a surface
-  /// layer by depth, bedrock following the surface, a terrain across the width) or a material index
-  /// without a soil.
+  /// The section of a profile domain. Throws InputError for what it cannot represent (a terrain
+  /// across the width) or a material index without a soil.
   static SlopeSection from_profile(const ProfileDomain& d, std::vector<LimitEquilibriumSoil> soils);
-  /// Material index at elevation z.
-  int material_at(double z) const noexcept;
   /// Checks what the per-key ranges cannot: r_u in [0, 1) and not with a phreatic surface, the
   /// phreatic surface's x non-decreasing and below the ground somewhere, γ_sat ≥ γ ≥ 0.
   /// Throws InputError naming `key_prefix` + the key ("water.phreatic", "water.ru", ...).
   void validate_water(const std::string& key_prefix = "") const;
+  /// Material index at (x, z): the surface layer by depth, else the layers by elevation.
+  int material_at(double x, double z) const noexcept;
+  /// Elevation of the rigid bottom below x (m).
+  double bottom_at(double x) const noexcept;
 };
 
 /// A circular slip surface (m).
@@ -141,11 +152,34 @@ struct BishopSearchSettings {
   bool minimise_yield_coefficient = false;
 };
 
-/// The circle of the smallest Bishop factor. The grid spans centres over the section's extent from
-/// the highest surface point up to the larger of twice the section's height and half its length
-/// above it, and circle bottoms (the lowest point of the whole circle, which may lie beyond the
-/// mass) from one section height below z_bottom to the highest surface point. Throws InputError if
-/// no admissible circle exists (with minimise_yield_coefficient: none with a determined k_y).
+/// The circle of the smallest Bishop factor. On a flat rigid bottom the grid spans centres over the
+/// section's extent from the highest surface point up to the larger of twice the section's height
+/// and half its length above it, and circle bottoms (the lowest point of the whole circle, which may
+/// lie beyond the mass) from one section height below z_bottom to the highest surface point. On
+/// bedrock that follows the surface (bedrock_depth > 0) the circles are given by their entry and
+/// exit points on the surface and their sagitta below the chord instead: entries every
+/// `bedrock_depth` along the section, chords from 2 to 60 bedrock depths (geometric), sagittas from
+/// 0.05 to 1.5 bedrock depths (geometric), `grid` values each. In both cases the best grid circles are
+/// refined by a compass search in the grid's own coordinates. Throws InputError if no admissible
+/// circle exists (with minimise_yield_coefficient: none with a determined k_y).
 BishopResult bishop_critical_circle(const SlopeSection& s, const BishopSearchSettings& settings = {});
+
+/// The translational slide along the base of a section's surface layer (a soil cover on a DSM
+/// section): the infinite-slope factor F∞ = c / (γ t sin β cos β) + tan φ / tan β of the surface
+/// layer's soil at its vertical depth t (Taylor 1948; Skempton & DeLory 1957), with β the surface
+/// inclination over a window of `window` m centred at x, sampled every window/10 along the section.
+/// A circle cannot follow the base of a thin cover (its mass is a lens about 2t/3 deep on average), so
+/// on such sections Bishop's circle overestimates the factor of the slide the cover would make; this
+/// is its bound from below. The window (10 t by default, the length beyond which end effects stay
+/// below about 10 %, Griffiths et al. 2011) keeps single DSM steps from posing as slopes.
+struct InfiniteSlopeResult {
+  double factor = std::numeric_limits<double>::infinity();  ///< +∞: no surface layer or flat ground
+  double x = 0.0;                                           ///< where the minimum lies (m)
+  double angle = 0.0;                                       ///< surface inclination there (rad)
+  double window = 0.0;                                      ///< m
+};
+
+/// The smallest infinite-slope factor of the surface layer along the section (window ≤ 0: 10 t).
+InfiniteSlopeResult infinite_slope_minimum(const SlopeSection& s, double window = 0.0);
 
 }  // namespace geohaz::sph
