@@ -27,6 +27,8 @@ BasalFriction read_friction(ConfigReader& cfg) {
   const std::string law = cfg.get_choice("model.friction", ModifiedManningFriction::name, BasalFrictionNames::choices(),
                                          {"", BasalFrictionNames::help("basal shear law")});
   const std::string where = cfg.source().empty() ? "command line" : cfg.source();
+  // δ₁, δ₂ are read in degrees (rounded to 0.01°; the law holds their tangents).
+  const auto deg_of = [](double t) { return std::round(std::atan(t) * 18000.0 / std::numbers::pi) / 100.0; };
   const double n = cfg.get("model.n", manning.n, Range::closed(0.005, 0.5),
                            {"s/m^(1/3)",
                             "Manning roughness (manning; 0.02–0.1 for natural channels) or turbulent-dispersive n_td "
@@ -68,9 +70,9 @@ BasalFriction read_friction(ConfigReader& cfg) {
                             {"Pa*s", "α₁ of η = α₁ exp(β₁ C_v) (obrien_julien with model.cv)"});
   const double vb = cfg.get("model.viscosity_beta", 22.1, Range::closed(0.0, 100.0),
                             {"1", "β₁ of η = α₁ exp(β₁ C_v) (obrien_julien with model.cv)"});
-  const double delta1 = cfg.get("model.delta1", 21.0, Range::open_closed(0.0, 60.0),
+  const double delta1 = cfg.get("model.delta1", deg_of(pf.tan_delta1), Range::open_closed(0.0, 60.0),
                                 {"deg", "δ₁: slope below which no layer flows (pouliquen)"});
-  const double delta2 = cfg.get("model.delta2", 33.0, Range::open_closed(0.0, 80.0),
+  const double delta2 = cfg.get("model.delta2", deg_of(pf.tan_delta2), Range::open_closed(0.0, 80.0),
                                 {"deg", "δ₂ > δ₁: slope above which no layer stops (pouliquen)"});
   const double length =
       cfg.get("model.hstop_length", pf.length, Range::open_closed(0.0, 100.0),

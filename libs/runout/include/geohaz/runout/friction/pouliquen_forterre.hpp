@@ -62,14 +62,17 @@ inline double speed_after_friction(double s_star, double dt, const PouliquenFort
 }
 
 struct PouliquenForterreFriction {
-  double tan_delta1 = 0.3839;  ///< tan δ₁ (1), δ₁ = 21°: below it no layer flows
-  double tan_delta2 = 0.6494;  ///< tan δ₂ (1), δ₂ = 33°: above it no steady flow
-  double length = 1e-3;        ///< L (m), the h_stop length scale (a few grain diameters)
-  double beta = 0.136;         ///< β of the flow rule (1)
-  double gamma = 0.0;          ///< γ of the flow rule (1)
+  // Defaults: 0.5 mm glass beads on a rough bed (Forterre & Pouliquen 2003): δ₁ = 20.9°,
+  // δ₂ = 32.76°, L = 0.65 mm, β = 0.136, γ = 0.
+  double tan_delta1 = 0.38186;  ///< tan δ₁ (1): below δ₁ no layer flows
+  double tan_delta2 = 0.64347;  ///< tan δ₂ (1): above δ₂ no layer stops
+  double length = 6.5e-4;       ///< L (m), the h_stop length scale (about a grain diameter)
+  double beta = 0.136;          ///< β of the flow rule (1)
+  double gamma = 0.0;           ///< γ of the flow rule (1)
   static constexpr const char* name = "pouliquen";
   static constexpr const char* summary =
-      "Pouliquen-Forterre mu(Fr, h) with h_stop (delta1, delta2, hstop_length, beta, gamma; P&F 2002)";
+      "Pouliquen-Forterre mu(Fr, h) with h_stop (delta1, delta2, hstop_length, flow_rule_beta, flow_rule_gamma; P&F "
+      "2002)";
   /// h_stop(θ) (m) on a slope tan θ (infinite at or below δ₁, 0 at or above δ₂).
   double h_stop(double tan_theta) const noexcept {
     const double t1 = tan_delta1, t2 = tan_delta2;
