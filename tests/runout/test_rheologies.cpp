@@ -5,12 +5,19 @@
 // the h_stop curve and flow rule of Pouliquen & Forterre (2002).
 #include <gtest/gtest.h>
 #include <omp.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 #include <random>
+#include <tuple>
 
+#include "geohaz/core/config.hpp"
+#include "geohaz/core/errors.hpp"
+#include "geohaz/runout/ensemble.hpp"
 #include "geohaz/runout/processes.hpp"
 #include "geohaz/runout/solver.hpp"
 
@@ -360,4 +367,46 @@ TEST(RheologyPouliquen, StopsBelowHStopAndFollowsTheFlowRuleAbove) {
     std::printf("pouliquen 25 deg h/h_stop %.1f: Fr %.5f, rule %.5f\n", ratio, fr, rule);
     EXPECT_NEAR(fr, rule, 0.02 * rule) << ratio;
   }
+}
+
+// --- Ensembles: a rheology coefficient is a numeric key like any other ---------------------------
+
+TEST(RheologyEnsemble, YieldStressAndFlowIndexAreSampledAndCheckedPerMember) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("geohaz_rheology_ensemble_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  {
+    std::ofstream base(dir / "base.toml");
+    base << "[terrain]\ndsm = \"dsm.tif\"\n[release]\nfile = \"rel.tif\"\n"
+         << "[model]\nfriction = \"herschel_bulkley\"\ntau_y = 500.0\n";
+  }
+  const auto plan = [&](double tau_lo, double n_hi) {
+    std::ofstream e(dir / "ens.toml");
+    e << "[ensemble]\nbase = \"base.toml\"\nmembers = 6\nseed = 34\n"
+      << "[[ensemble.parameter]]\nkey = \"model.tau_y\"\ndistribution = \"uniform\"\nmin = " << tau_lo
+      << "\nmax = 2000.0\n"
+      << "[[ensemble.parameter]]\nkey = \"model.flow_index\"\ndistribution = \"uniform\"\nmin = 0.3\nmax = " << n_hi
+      << "\n";
+  };
+  plan(100.0, 0.6);
+  ConfigReader ok = ConfigReader::from_file(dir / "ens.toml");
+  const EnsembleSetup s = read_ensemble(ok);
+  ASSERT_EQ(s.values.size(), 6u);
+  for (const auto& v : s.values) {
+    EXPECT_GE(v[0], 100.0);
+    EXPECT_LE(v[1], 0.6);
+  }
+  // A draw outside the key's range (τ_y < 0, n > 2) is bad input naming the key, before any run.
+  for (const auto& [lo, hi, key] :
+       {std::tuple{-1000.0, 0.6, "model.tau_y"}, std::tuple{100.0, 3.0, "model.flow_index"}}) {
+    plan(lo, hi);
+    ConfigReader bad = ConfigReader::from_file(dir / "ens.toml");
+    try {
+      (void)read_ensemble(bad);
+      ADD_FAILURE() << key << ": no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
+  fs::remove_all(dir);
 }
