@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <tuple>
@@ -409,4 +410,28 @@ TEST(RheologyEnsemble, YieldStressAndFlowIndexAreSampledAndCheckedPerMember) {
     }
   }
   fs::remove_all(dir);
+}
+
+// --- Friction zones: a yield-stress field holds the flow where it exceeds the driving -----------
+
+TEST(RheologyZones, BinghamParticleStopsWhereTheYieldStressFieldExceedsTheDrivingStress) {
+  // One particle (depth 1 m) on tan θ = 0.1, global τ_y = 200 Pa (flows: ρ g h sin θ = 1757 Pa);
+  // for x > 30 m the field sets τ_y = 3000 Pa: it must stop past x = 30 m and stay there.
+  const double th = std::atan(0.1);
+  auto s = lone_particle(BinghamFriction{200.0, 100.0}, th, 1.0, 0.0, 120.0);
+  SpatialProcesses proc;
+  proc.grid = {400, 20, -10.0, 10.0, 1.0, 1.0};  // x ∈ [−10, 390] m, y ∈ [−10, 10] m
+  auto& tau = proc.friction[kYieldStress];
+  tau.assign(proc.grid.cells(), std::numeric_limits<double>::quiet_NaN());  // NaN: the global value
+  for (int r = 0; r < proc.grid.ny; ++r)
+    for (int c = 0; c < proc.grid.nx; ++c)
+      if (proc.grid.centre(c, r).x() > 30.0) tau[proc.grid.index(c, r)] = 3000.0;
+  s.set_processes(proc);
+  s.initialise();
+  run_to_end(s);
+  const double x = s.particles().get<Position<2>>()[0].x();
+  std::printf("bingham zone: stopped at x = %.2f m\n", x);
+  EXPECT_TRUE(s.all_stopped());
+  EXPECT_GT(x, 30.0);
+  EXPECT_LT(x, 60.0);
 }
