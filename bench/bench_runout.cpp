@@ -4,9 +4,10 @@
 //  2. wall time of the lecture's case at the lecture's scale: 10 simulated minutes of a ~5000-particle
 //     release (d0 = 5 m, h0 = 1 m, 2 m thick over 300 m × 200 m) on the synthetic 5 km valley DSM of 2000 × 1000 cells
 //     at 2.5 m, n = 0.06, i_cr = 0.15 (target < 10 s), with the hazard maps recorded every step as the app does.
-// Prints rates; never asserts. Usage: bench_runout [particles=100000] [steps=40] [all|plane|seed|processes|barrier]
-// [threads] [skin] (the third argument runs one case only, the fourth one thread count only, the fifth sets
-// numerics.skin in units of d0: for profiling and for comparing list strategies).
+// Prints rates; never asserts. Usage: bench_runout [particles=100000] [steps=40]
+// [all|plane|seed|processes|barrier|laws|law=<name>] [threads] [skin] (the third argument runs one case only, the
+// fourth one thread count only, the fifth sets numerics.skin in units of d0: for profiling and for comparing list
+// strategies).
 #include <omp.h>
 
 #include <chrono>
@@ -15,6 +16,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <string>
+#include <vector>
 
 #include "geohaz/runout/hazard_maps.hpp"
 #include "geohaz/runout/release.hpp"
@@ -62,14 +64,15 @@ unsigned long long state_hash(const RunoutStore& st) {
 /// forest field, so every particle looks up three cells per step and erodes. `barrier`: a wall with
 /// a 1 m crest across the middle of the 2 m deep block, so that the front half of the particles is
 /// within its reach or held by it, and the deeper ones overtop.
-Rate plane_rate(std::size_t target, int steps, int threads, double skin, bool processes = false, bool barrier = false) {
+Rate plane_rate(std::size_t target, int steps, int threads, double skin, bool processes = false, bool barrier = false,
+                BasalFriction friction = ModifiedManningFriction{0.06, 0.15, 0.0}) {
   omp_set_num_threads(threads);
   RunoutParameters p;
   p.d0 = 5.0;
   p.h0 = 1.0;
   p.duration = 1e9;
   p.skin = skin;
-  p.friction = ModifiedManningFriction{0.06, 0.15, 0.0};
+  p.friction = friction;
   InclinedPlane plane;
   plane.slope = Vec2(-0.3, 0.0);
   const int n = static_cast<int>(std::sqrt(static_cast<double>(target)));
@@ -110,6 +113,19 @@ Rate plane_rate(std::size_t target, int steps, int threads, double skin, bool pr
   const double ps = static_cast<double>(st.size()) * steps;
   return {ps / wall, ps / c, state_hash(st)};
 }
+/// The laws compared by `laws` and `law=<name>`, Voellmy first. Parameters that keep the 2 m layer
+/// on tan θ = 0.3 moving (τ_b = 10 kPa), so every particle takes the law's moving branch.
+const std::vector<BasalFriction>& bench_laws() {
+  static const std::vector<BasalFriction> laws{VoellmyFriction{0.15, 500.0},
+                                               VoellmyCohesionFriction{0.15, 500.0, 1000.0},
+                                               BinghamFriction{1000.0, 100.0},
+                                               HerschelBulkleyFriction{1000.0, 100.0, 0.4},
+                                               OBrienJulienFriction{1000.0, 100.0, 24.0, 0.06},
+                                               PouliquenForterreFriction{0.176, 0.466, 0.5, 0.65, 0.136},
+                                               ModifiedManningFriction{0.06, 0.15, 0.0},
+                                               CoulombFriction{0.15}};
+  return laws;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -126,6 +142,40 @@ int main(int argc, char** argv) {
       const Rate a = plane_rate(n, steps, t, skin), b = plane_rate(n, steps, t, skin, true);
       std::printf("  %d thread(s): plain %.3g, with processes %.3g particle-steps/s (wall); ratio %.3f (CPU %.3f)\n", t,
                   a.wall, b.wall, b.wall / a.wall, b.cpu / a.cpu);
+      std::fflush(stdout);
+    }
+    return 0;
+  }
+  if (which.rfind("law=", 0) == 0) {
+    // One law only (for instruction counts under callgrind: --toggle-collect on RunoutSolver::step).
+    for (const BasalFriction& law : bench_laws())
+      if (friction_name(law) == which.substr(4)) {
+        const Rate r = plane_rate(n, steps, only_threads > 0 ? only_threads : 1, skin, false, false, law);
+        std::printf("%s: %.3g particle-steps/s (CPU); state %016llx\n", which.c_str() + 4, r.cpu, r.state);
+        return 0;
+      }
+    std::fprintf(stderr, "bench_runout: unknown law %s\n", which.c_str() + 4);
+    return 2;
+  }
+  if (which == "laws") {
+    // Each basal law against Voellmy on the plane, back to back, best of 3 each (issue 34: no law
+    // more than 10 % slower per particle-step).
+    const BasalFriction voellmy = bench_laws().front();
+    const std::vector<BasalFriction> laws(bench_laws().begin() + 1, bench_laws().end());
+    const int t = only_threads > 0 ? only_threads : 1;
+    std::printf("bench_runout: %zu particles on a plane, %d steps, %d thread(s), each law vs voellmy (best of 3)\n", n,
+                steps, t);
+    for (const BasalFriction& law : laws) {
+      Rate a{0.0, 0.0}, b{0.0, 0.0};
+      for (int k = 0; k < 3; ++k) {
+        const Rate ra = plane_rate(n, steps, t, skin, false, false, voellmy);
+        const Rate rb = plane_rate(n, steps, t, skin, false, false, law);
+        a = {std::max(a.wall, ra.wall), std::max(a.cpu, ra.cpu)};
+        b = {std::max(b.wall, rb.wall), std::max(b.cpu, rb.cpu)};
+      }
+      std::printf(
+          "  %-17s %.3g vs voellmy %.3g particle-steps/s (CPU); time per particle-step %+.1f %% (wall %+.1f %%)\n",
+          friction_name(law).c_str(), b.cpu, a.cpu, 100.0 * (a.cpu / b.cpu - 1.0), 100.0 * (a.wall / b.wall - 1.0));
       std::fflush(stdout);
     }
     return 0;

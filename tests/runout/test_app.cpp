@@ -189,6 +189,39 @@ TEST(DebrisRunoutApp, BadInputsExitTwoAndWriteNothing) {
   }
 }
 
+TEST(DebrisRunoutApp, BadRheologyInputsExitTwoNamingTheKey) {
+  // The rheologies of issue 34: a negative yield stress or cohesion, a flow index or a
+  // concentration out of range, δ₂ ≤ δ₁, a coefficient of another law, C_v together with τ_y:
+  // exit 2, the message names the key, nothing written.
+  const fs::path dsm = tiny_dsm();
+  const std::string rel = (work_dir() / "tiny_release.tif").string();
+  const fs::path out = work_dir() / "bad_rheology_out";
+  const std::string base = dsm.string() + " --release " + rel;
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {" --friction bingham --set model.tau_y=-5", "model.tau_y"},
+      {" --friction herschel_bulkley --set model.tau_y=-0.1", "model.tau_y"},
+      {" --friction herschel_bulkley --set model.flow_index=3", "model.flow_index"},
+      {" --friction herschel_bulkley --set model.flow_index=0", "model.flow_index"},
+      {" --friction herschel_bulkley --set model.consistency=-1", "model.consistency"},
+      {" --friction bingham --set model.viscosity=0", "model.viscosity"},
+      {" --friction voellmy_cohesion --set model.cohesion=-10", "model.cohesion"},
+      {" --friction voellmy_cohesion --set model.cohesion=500 --set model.mu=1.5", "model.mu"},
+      {" --friction obrien_julien --set model.cv=0.9", "model.cv"},
+      {" --friction obrien_julien --set model.cv=0.4 --set model.tau_y=100", "model.tau_y"},
+      {" --friction pouliquen --set model.delta1=30 --set model.delta2=25", "model.delta2"},
+      {" --friction pouliquen --set model.hstop_length=-1", "model.hstop_length"},
+      {" --friction bingham --set model.consistency=5", "model.consistency"},
+      {" --friction voellmy --set model.tau_y=50", "model.tau_y"},
+  };
+  for (const auto& [args, key] : cases) {
+    fs::remove_all(out);
+    const auto r = run(base + args + " --out " + out.string() + " --quiet");
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.output;
+    EXPECT_NE(r.output.find(key), std::string::npos) << args << "\n" << r.output;
+    EXPECT_FALSE(dir_has_files(out)) << args;
+  }
+}
+
 TEST(DebrisRunoutApp, ReleaseFromSphSlopeFileMatchesVolume) {
   // A release.h5 as sph-slope writes it (docs/handoff.md): 2D map points with volumes, in the
   // DSM's CRS. The app must report the volume read and seed exactly that volume.

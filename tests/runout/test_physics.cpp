@@ -55,7 +55,7 @@ TEST(Friction, ImplicitStepNeverReverses) {
         EXPECT_NEAR(out, s - dt * (t.rest + t.drag * out * out), 1e-12 * std::max(1.0, s));
       }
     }
-  EXPECT_EQ(speed_after_friction(0.1, 1.0, {0.2, 0.0}), 0.0);  // stops, does not go to −0.1
+  EXPECT_EQ(speed_after_friction(0.1, 1.0, FrictionTerms{0.2, 0.0}), 0.0);  // stops, does not go to −0.1
 }
 
 TEST(Friction, VoellmyEqualsManningWithMuIcrAndXi) {
@@ -63,7 +63,7 @@ TEST(Friction, VoellmyEqualsManningWithMuIcrAndXi) {
   const double h = 2.3, n = 0.06, icr = 0.15, gn = kG * std::cos(0.3);
   const ModifiedManningFriction manning{n, icr, 0.0};
   const VoellmyFriction voellmy{icr, std::cbrt(h) / (n * n)};
-  const auto a = manning.terms(kG, gn, h, 3.0), b = voellmy.terms(kG, gn, h, 3.0);
+  const auto a = manning.terms(kG, gn, h, 3.0, 1800.0), b = voellmy.terms(kG, gn, h, 3.0, 1800.0);
   EXPECT_NEAR(a.rest, b.rest, 1e-12);
   EXPECT_NEAR(a.drag, b.drag, 1e-12 * a.drag);
   EXPECT_EQ(friction_name(BasalFriction{CoulombFriction{}}), "coulomb");

@@ -167,15 +167,27 @@ SpatialProcesses load_processes(const ProcessSpec& s, const RunoutParameters& p,
   out.grid = g;
 
   // Friction zones: polygons with coefficient attributes, then per-coefficient rasters.
-  const std::array<std::pair<double, double>, kFrictionParameters> ranges{
-      {{0.005, 0.5}, {0.0, 2.0}, {0.0, 2.0}, {0.0, 2.0}, {1e-9, 1e5}}};
-  const std::array<const char*, kFrictionParameters> units{"s/m^(1/3)", "", "", "", "m/s^2"};
+  // The ranges and units of the model.<name> keys (config.cpp).
+  const std::array<std::pair<double, double>, kFrictionParameters> ranges{{{0.005, 0.5},
+                                                                           {0.0, 2.0},
+                                                                           {0.0, 2.0},
+                                                                           {0.0, 2.0},
+                                                                           {1e-9, 1e5},
+                                                                           {0.0, 1e6},
+                                                                           {0.0, 1e6},
+                                                                           {1e-6, 1e6},
+                                                                           {1e-6, 1e6},
+                                                                           {0.1, 2.0},
+                                                                           {0.0, 60.0},
+                                                                           {0.0, 80.0}}};
+  const std::array<const char*, kFrictionParameters> units{"s/m^(1/3)", "",     "",       "", "m/s^2", "Pa",
+                                                           "Pa",        "Pa*s", "Pa*s^n", "", "deg",   "deg"};
   const std::string law = friction_name(p.friction);
-  const auto law_has = [&](int k) {
-    if (law == ModifiedManningFriction::name) return k == kManningN || k == kCriticalSlope || k == kYieldExponent;
-    if (law == VoellmyFriction::name) return k == kCoulombMu || k == kVoellmyXi;
-    return k == kCoulombMu;
-  };
+  const auto law_has = [&](int k) { return has_parameter(p.friction, k); };
+  std::string law_keys;
+  for (int k = 0; k < kFrictionParameters; ++k)
+    if (law_has(k))
+      law_keys += (law_keys.empty() ? "" : ", ") + std::string(kFrictionParameterNames[static_cast<std::size_t>(k)]);
   if (!s.zones.empty()) {
     const std::vector<std::string> fields = vector_field_names(s.zones);
     bool any = false;
@@ -197,11 +209,7 @@ SpatialProcesses load_processes(const ProcessSpec& s, const RunoutParameters& p,
     }
     if (!any)
       throw InputError("the friction zones hold no attribute for a coefficient of the " + law +
-                           " law (expected one of " +
-                           (law == ModifiedManningFriction::name ? std::string("n, icr, m")
-                            : law == VoellmyFriction::name       ? std::string("mu, xi")
-                                                                 : std::string("mu")) +
-                           ")",
+                           " law (expected one of " + law_keys + ")",
                        s.zones, "zones.file");
   }
   for (int k = 0; k < kFrictionParameters; ++k) {

@@ -2,13 +2,17 @@
 /// \file basal_friction.hpp
 /// Basal shear laws of the depth-averaged debris-flow model, each written as a deceleration
 /// (basal shear stress τ_b divided by ρ h_n, h_n the flow depth normal to the bed = hydraulic
-/// radius R_h of a wide flow) of the form
+/// radius R_h of a wide flow) acting against the velocity (3D, along the bed),
 ///
-///     a_f(|v|) = a_rest(|v|) + k · |v|²        acting against the velocity (3D, along the bed)
+///     a_f(|v|) = a_rest + a_move(|v|),   a_move(0) = 0, increasing,
 ///
-/// so one implicit integrator serves all of them (see RunoutSolver): a_rest is the Coulomb-like
-/// yield part that can hold a particle at rest, k the turbulent (velocity-squared) drag.
-/// g_n = g cos θ is the bed-normal component of gravity.
+/// so one implicit step serves all of them (friction/friction_terms.hpp, RunoutSolver): a_rest is
+/// the yield part that can hold a particle at rest (Coulomb, cohesion, yield stress, h_stop),
+/// a_move the rate-dependent part. Laws with a_move = visc |v| + k |v|² return FrictionTerms; the
+/// plug-flow and granular laws return their own terms with a closed-form or Newton step.
+/// g_n = g cos θ is the bed-normal component of gravity. The laws of issue 34 (Voellmy with
+/// cohesion, Bingham, Herschel–Bulkley, O'Brien–Julien, Pouliquen–Forterre) live one per file in
+/// friction/, each with its source and equation as implemented; docs/runout.md tabulates them.
 ///
 /// The law is chosen once (a std::variant visited once per step), never inside the particle loop.
 
@@ -17,14 +21,14 @@
 #include <variant>
 
 #include "geohaz/core/name_table.hpp"
+#include "geohaz/runout/friction/bingham.hpp"
+#include "geohaz/runout/friction/friction_terms.hpp"
+#include "geohaz/runout/friction/herschel_bulkley.hpp"
+#include "geohaz/runout/friction/obrien_julien.hpp"
+#include "geohaz/runout/friction/pouliquen_forterre.hpp"
+#include "geohaz/runout/friction/voellmy_cohesion.hpp"
 
 namespace geohaz::runout {
-
-/// Per-particle friction coefficients: deceleration = rest + drag·|v|² (m/s², 1/m).
-struct FrictionTerms {
-  double rest;  ///< yield part (m/s²)
-  double drag;  ///< coefficient of |v|² (1/m)
-};
 
 /// Modified Manning law for a soil–water mixture (SWJTU lecture 2010, §3):
 ///   τ_b = (τ_cr |v|^m + ρ g n² |v|² / R_h^{1/3}) v/|v|,   τ_cr = ρ g_n R_h i_cr,   R_h = h_n.
@@ -38,7 +42,7 @@ struct ModifiedManningFriction {
   double m = 0.0;
   static constexpr const char* name = "manning";
   static constexpr const char* summary = "modified Manning for a debris flow (n, icr, m; SWJTU lecture 2010)";
-  FrictionTerms terms(double g, double g_n, double h_n, double speed) const noexcept {
+  FrictionTerms terms(double g, double g_n, double h_n, double speed, double /*rho*/) const noexcept {
     const double rest = m == 0.0 ? g_n * i_cr : g_n * i_cr * std::pow(speed, m);
     return {rest, g * n * n / (h_n * std::cbrt(h_n))};
   }
@@ -52,7 +56,7 @@ struct VoellmyFriction {
   double xi = 500.0;
   static constexpr const char* name = "voellmy";
   static constexpr const char* summary = "Voellmy, Coulomb plus turbulent drag (mu, xi; Voellmy 1955, as in RAMMS)";
-  FrictionTerms terms(double g, double g_n, double h_n, double /*speed*/) const noexcept {
+  FrictionTerms terms(double g, double g_n, double h_n, double /*speed*/, double /*rho*/) const noexcept {
     return {g_n * mu, g / (xi * h_n)};
   }
 };
@@ -62,7 +66,7 @@ struct CoulombFriction {
   double mu = 0.15;
   static constexpr const char* name = "coulomb";
   static constexpr const char* summary = "dry Coulomb friction (mu)";
-  FrictionTerms terms(double /*g*/, double g_n, double /*h_n*/, double /*speed*/) const noexcept {
+  FrictionTerms terms(double /*g*/, double g_n, double /*h_n*/, double /*speed*/, double /*rho*/) const noexcept {
     return {g_n * mu, 0.0};
   }
 };
@@ -70,23 +74,14 @@ struct CoulombFriction {
 /// The law of a run, chosen from the config, and the one name table of the laws: its
 /// alternatives' `name`s are the values of `model.friction`. The config reader sets a law's
 /// coefficients in an exhaustive visit, so a law added here without its case fails to compile.
-using BasalFriction = std::variant<ModifiedManningFriction, VoellmyFriction, CoulombFriction>;
+using BasalFriction =
+    std::variant<ModifiedManningFriction, VoellmyFriction, CoulombFriction, VoellmyCohesionFriction, BinghamFriction,
+                 HerschelBulkleyFriction, OBrienJulienFriction, PouliquenForterreFriction>;
 using BasalFrictionNames = NameTable<BasalFriction>;
 
-/// The name of the law held ("manning", "voellmy", "coulomb").
+/// The name of the law held ("manning", "voellmy", ...).
 inline std::string friction_name(const BasalFriction& f) {
   return std::string(BasalFrictionNames::name_of(f));
-}
-
-/// Speed after one implicit friction step: solves s = s* − dt (a_rest + k s²) for s ≥ 0, i.e. the
-/// friction may stop a particle but never reverse it. s* is the speed after the driving forces.
-inline double speed_after_friction(double s_star, double dt, const FrictionTerms& t) noexcept {
-  const double b = s_star - dt * t.rest;
-  if (b <= 0.0) return 0.0;
-  const double kdt = t.drag * dt;
-  if (kdt <= 0.0) return b;
-  // Root of kdt·s² + s − b = 0, written without cancellation.
-  return 2.0 * b / (1.0 + std::sqrt(1.0 + 4.0 * kdt * b));
 }
 
 }  // namespace geohaz::runout

@@ -16,6 +16,7 @@
 #include <cstddef>
 #include <limits>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "geohaz/core/vec.hpp"
@@ -25,23 +26,74 @@
 namespace geohaz::runout {
 
 /// The coefficients a friction field can set (each law reads those it has).
-enum FrictionParameter : int { kManningN, kCriticalSlope, kYieldExponent, kCoulombMu, kVoellmyXi, kFrictionParameters };
-/// Config names of the coefficients, as in model.<name>: n, icr, m, mu, xi.
-inline constexpr std::array<const char*, kFrictionParameters> kFrictionParameterNames{"n", "icr", "m", "mu", "xi"};
+enum FrictionParameter : int {
+  kManningN,
+  kCriticalSlope,
+  kYieldExponent,
+  kCoulombMu,
+  kVoellmyXi,
+  kCohesion,
+  kYieldStress,
+  kViscosity,
+  kConsistency,
+  kFlowIndex,
+  kDelta1,
+  kDelta2,
+  kFrictionParameters
+};
+/// Config names of the coefficients, as in model.<name>.
+inline constexpr std::array<const char*, kFrictionParameters> kFrictionParameterNames{
+    "n", "icr", "m", "mu", "xi", "cohesion", "tau_y", "viscosity", "consistency", "flow_index", "delta1", "delta2"};
 
-/// Set coefficient k of a law from a field value (coefficients the law does not have are ignored:
-/// the config refuses a field for them).
-inline void set_parameter(ModifiedManningFriction& l, int k, double v) noexcept {
-  if (k == kManningN) l.n = v;
-  if (k == kCriticalSlope) l.i_cr = v;
-  if (k == kYieldExponent) l.m = v;
+/// Set coefficient k of a law from a field value; false (and nothing set) when the law has no such
+/// coefficient (the config refuses a field for it).
+inline bool set_parameter(ModifiedManningFriction& l, int k, double v) noexcept {
+  if (k == kManningN) return l.n = v, true;
+  if (k == kCriticalSlope) return l.i_cr = v, true;
+  if (k == kYieldExponent) return l.m = v, true;
+  return false;
 }
-inline void set_parameter(VoellmyFriction& l, int k, double v) noexcept {
-  if (k == kCoulombMu) l.mu = v;
-  if (k == kVoellmyXi) l.xi = v;
+inline bool set_parameter(VoellmyFriction& l, int k, double v) noexcept {
+  if (k == kCoulombMu) return l.mu = v, true;
+  if (k == kVoellmyXi) return l.xi = v, true;
+  return false;
 }
-inline void set_parameter(CoulombFriction& l, int k, double v) noexcept {
-  if (k == kCoulombMu) l.mu = v;
+inline bool set_parameter(CoulombFriction& l, int k, double v) noexcept {
+  if (k == kCoulombMu) return l.mu = v, true;
+  return false;
+}
+inline bool set_parameter(VoellmyCohesionFriction& l, int k, double v) noexcept {
+  if (k == kCoulombMu) return l.mu = v, true;
+  if (k == kVoellmyXi) return l.xi = v, true;
+  if (k == kCohesion) return l.cohesion = v, true;
+  return false;
+}
+inline bool set_parameter(BinghamFriction& l, int k, double v) noexcept {
+  if (k == kYieldStress) return l.tau_y = v, true;
+  if (k == kViscosity) return l.viscosity = v, true;
+  return false;
+}
+inline bool set_parameter(HerschelBulkleyFriction& l, int k, double v) noexcept {
+  if (k == kYieldStress) return l.tau_y = v, true;
+  if (k == kConsistency) return l.consistency = v, true;
+  if (k == kFlowIndex) return l.flow_index = v, true;
+  return false;
+}
+inline bool set_parameter(OBrienJulienFriction& l, int k, double v) noexcept {
+  if (k == kYieldStress) return l.tau_y = v, true;
+  if (k == kViscosity) return l.viscosity = v, true;
+  if (k == kManningN) return l.n_td = v, true;
+  return false;
+}
+/// δ₁, δ₂ are given in degrees (as model.delta1, model.delta2); the law holds their tangents.
+inline bool set_parameter(PouliquenForterreFriction& l, int k, double v) noexcept {
+  if (k == kDelta1) return l.tan_delta1 = std::tan(v * 3.14159265358979323846 / 180.0), true;
+  if (k == kDelta2) return l.tan_delta2 = std::tan(v * 3.14159265358979323846 / 180.0), true;
+  return false;
+}
+/// Whether the law held by f has coefficient k.
+inline bool has_parameter(const BasalFriction& f, int k) noexcept {
+  return std::visit([k](auto l) { return set_parameter(l, k, 1.0); }, f);
 }
 
 /// How the bed is eroded (docs/runout.md, "Entrainment").

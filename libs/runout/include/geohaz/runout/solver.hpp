@@ -652,9 +652,9 @@ class RunoutSolver {
       //    The law's coefficients of the particle's friction zone; forest drag k_f |v|² on top.
       Law local = law;
       if (zones) local = proc_.law_at(law, cell);
-      FrictionTerms t = local.terms(g, std::max(g + kv, 0.0) * cos_theta, h_n, s_star);
-      const double basal_drag = t.drag;
-      if (forest && cell != SpatialProcesses::npos && proc_.forest_drag[cell] > 0.0) t.drag += proc_.forest_drag[cell];
+      auto t = local.terms(g, std::max(g + kv, 0.0) * cos_theta, h_n, s_star, p_.density);
+      if (forest && cell != SpatialProcesses::npos && proc_.forest_drag[cell] > 0.0)
+        t.extra_drag = proc_.forest_drag[cell];
       double s = speed_after_friction(s_star, dt, t);
       //    Erosion the particle asks for over the step (granted in entrain(), capped by the layer).
       if (erode && s > 0.0 && cell != SpatialProcesses::npos && proc_.erodible_depth[cell] > 0.0) {
@@ -662,7 +662,7 @@ class RunoutSolver {
         if (ent.law == EntrainmentLaw::GrowthRate) {
           want = vol[i] * std::expm1(ent.growth_rate * s * dt);  // V (exp(E_s Δs) − 1), Δs = S Δt
         } else {
-          const double tau_b = p_.density * h_n * (t.rest + basal_drag * s * s);  // basal shear (Pa)
+          const double tau_b = p_.density * h_n * t.acceleration(s);  // basal shear (Pa)
           const double rate = ent.erosion_coefficient * std::max(tau_b - ent.critical_shear, 0.0);
           want = rate * dt * vol[i] / h_n;  // ė Δt × bed area V/h_n
         }

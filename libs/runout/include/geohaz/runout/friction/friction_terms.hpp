@@ -1,0 +1,54 @@
+#pragma once
+/// \file friction_terms.hpp
+/// The one form every basal law of the debris-runout model is reduced to, and its implicit step.
+///
+/// A law turns the local state (g, g_n = bed-normal gravity, h_n = bed-normal depth, the surface
+/// speed s and the density ρ) into a deceleration a(s) = τ_b(s)/(ρ h_n) acting against the
+/// velocity, split as
+///
+///     a(s) = a_rest + a_move(s),   a_move(0) = 0, a_move increasing,
+///
+/// a_rest being the yield part that can hold a particle at rest. The friction step solves
+///
+///     s = s* − Δt a(s),  s ≥ 0                                   (backward Euler in the speed)
+///
+/// for the speed s after friction, s* the speed after the driving forces: if s* ≤ Δt a_rest the
+/// particle stops (and a particle at rest stays at rest while its driving stays below the yield:
+/// no creep), else the root is unique because a is increasing. The step can stop a particle but
+/// never reverse it, and a steady state of the discrete step satisfies the law exactly (the
+/// deceleration is evaluated at the new speed). Laws whose a_move is a polynomial of degree ≤ 2
+/// return FrictionTerms (closed-form root); the others return their own terms type with the same
+/// members `rest`, `extra_drag` and `acceleration(s)` and their own speed_after_friction overload.
+
+#include <cmath>
+
+namespace geohaz::runout {
+
+/// Deceleration a(s) = rest + visc·s + drag·s² (m/s²), plus the drag of the surroundings
+/// (forest) added by the solver in extra_drag: a law's own shear is acceleration(s).
+struct FrictionTerms {
+  double rest;              ///< yield part (m/s²)
+  double drag;              ///< coefficient of s² (1/m)
+  double visc = 0.0;        ///< coefficient of s (1/s): laminar (viscous) resistance
+  double extra_drag = 0.0;  ///< coefficient of s² from outside the law (forest, 1/m)
+  /// The law's basal deceleration τ_b/(ρ h_n) at speed s (without extra_drag).
+  double acceleration(double s) const noexcept { return rest + (visc + drag * s) * s; }
+};
+
+/// Speed after an implicit step of the drag k s² alone: root of Δt k s² + s − s₀ = 0.
+inline double speed_after_drag(double s0, double kdt) noexcept {
+  return kdt > 0.0 && s0 > 0.0 ? 2.0 * s0 / (1.0 + std::sqrt(1.0 + 4.0 * kdt * s0)) : s0;
+}
+
+/// Speed after one implicit friction step: solves s = s* − Δt (rest + visc s + (drag + extra) s²)
+/// for s ≥ 0, i.e. the friction may stop a particle but never reverse it.
+inline double speed_after_friction(double s_star, double dt, const FrictionTerms& t) noexcept {
+  const double b = s_star - dt * t.rest;
+  if (b <= 0.0) return 0.0;
+  const double kdt = (t.drag + t.extra_drag) * dt, c = 1.0 + t.visc * dt;
+  if (kdt <= 0.0) return b / c;
+  // Root of kdt·s² + c·s − b = 0, written without cancellation.
+  return 2.0 * b / (c + std::sqrt(c * c + 4.0 * kdt * b));
+}
+
+}  // namespace geohaz::runout
