@@ -207,6 +207,8 @@ Raster read_raster(const std::filesystem::path& path, CrsPolicy policy) {
   const double nd = band->GetNoDataValue(&has_nodata);
   if (has_nodata) r.nodata = nd;
   if (const char* d = band->GetDescription()) r.description = d;
+  for (const char* item : {"TIFFTAG_COPYRIGHT", "ATTRIBUTION", "COPYRIGHT", "LICENSE"})
+    if (const char* a = ds->GetMetadataItem(item); a && *a && r.attribution.empty()) r.attribution = a;
   if (const char* u = band->GetUnitType()) r.unit = u;
 
   // The header alone may declare any size (a 1.8 MB sparse GeoTIFF can declare 10^10 cells): check

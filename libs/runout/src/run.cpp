@@ -688,20 +688,35 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
     }
     write_qgis_class_style(out / "intensity.qml", cls);
   }
-  // Quick-look maps for the report (docs/report.md): cropped to the affected area with a 200 m
-  // margin, over the hillshade, with scale bar, north arrow, a legend with units and the barrier
-  // lines.
+  // Maps for the report (docs/report.md): all of one run on one extent (the cells the flow
+  // reached and the release, output.map_margin around them), over GDAL's hillshade, with
+  // coordinates, the release outline and barriers, scale bar, north arrow, classed legends at the
+  // configured thresholds and the attribution.
+  Raster release_mask = dsm.like(0.0, -9999.0);
+  for (std::size_t k = 0; k < release_mask.data.size() && k < sim.inputs().thickness.size(); ++k)
+    release_mask.data[k] = sim.inputs().thickness[k];
+  const std::vector<std::vector<Vec2>> release_outlines = mask_outlines(release_mask, 0.0);
+  std::vector<Vec2> release_points;
+  for (const auto& ring : release_outlines) release_points.insert(release_points.end(), ring.begin(), ring.end());
+  const std::array<double, 4> extent = map_extent(r_depth, 0.01, c.output.map_margin, release_points);
+  const std::string attribution = !c.output.attribution.empty() ? c.output.attribution
+                                  : !dsm.attribution.empty()    ? "Terrain: " + dsm.attribution
+                                                                : "";
   const auto map_png = [&](const char* name, const Raster& r, ColourRamp ramp, const char* title, const char* unit,
-                           double overlay_min, const std::vector<StyleClass>& classes = {}) {
+                           double overlay_min, const std::vector<StyleClass>& classes = {},
+                           const std::vector<double>& breaks = {}) {
     QuicklookOptions o;
     o.ramp = ramp;
     o.title = title;
     o.unit = unit;
     o.overlay_min = overlay_min;
     o.classes = classes;
-    o.crop_margin_m = 200.0;
+    o.class_breaks = breaks;
+    o.extent = extent;
     o.scale_bar = true;
     o.north_arrow = true;
+    o.outlines = release_outlines;
+    o.attribution = attribution;
     for (const Barrier& b : sim.inputs().barriers) o.lines.push_back(b.vertices);  // barrier lines
     write_quicklook_png(out / (std::string(name) + ".png"), dsm, &r, o);
   };
@@ -712,13 +727,15 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
     if (c.output.pngs) map_png("erosion_depth", r_ero, ColourRamp::Magma, "eroded depth", "m", 0.001);
   }
   if (c.output.pngs) {
-    map_png("max_depth", r_depth, ColourRamp::Viridis, "peak flow depth", "m", 0.01);
-    map_png("deposit", r_dep, ColourRamp::Viridis, "deposit thickness", "m", 0.01);
+    map_png("max_depth", r_depth, ColourRamp::Viridis, "peak flow depth", "m", 0.01, {}, c.output.map_depth_classes);
+    map_png("deposit", r_dep, ColourRamp::Viridis, "deposit thickness", "m", 0.01, {}, c.output.map_depth_classes);
     map_png("max_speed", r_speed, ColourRamp::Magma, "peak speed", "m/s", 0.01);
     Raster r_kpa = r_pressure;  // kPa reads better than 2.2e+06 Pa
     for (double& v : r_kpa.data)
       if (v != -9999.0) v *= 1e-3;
-    map_png("max_pressure", r_kpa, ColourRamp::Magma, "peak pressure rho v^2", "kPa", 0.01);
+    std::vector<double> kpa_breaks;
+    for (double b : c.output.map_pressure_classes) kpa_breaks.push_back(b * 1e-3);
+    map_png("max_pressure", r_kpa, ColourRamp::Magma, "peak dynamic pressure", "kPa", 0.01, {}, kpa_breaks);
     map_png("arrival_time", r_arrival, ColourRamp::Viridis, "arrival time", "s", -1.0);
     map_png("intensity", r_int, ColourRamp::Intensity, "intensity class", "", 0.5, intensity_classes_legend);
   }

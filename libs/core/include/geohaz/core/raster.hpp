@@ -29,6 +29,9 @@ struct Raster {
   std::vector<double> data;              ///< nx·ny values, row-major, row 0 north
   std::string description;               ///< band description (what the values are), "" if none
   std::string unit;                      ///< unit of the values ("m", "m/s", "Pa", "1"), "" if none
+  /// Data attribution or licence found in the file's metadata (TIFFTAG_COPYRIGHT, or an item named
+  /// ATTRIBUTION, COPYRIGHT or LICENSE), "" if none; maps print it.
+  std::string attribution;
 
   /// An empty raster on the same grid and CRS, filled with `fill`.
   Raster like(double fill, std::optional<double> nodata_value = std::nullopt) const;
@@ -135,9 +138,10 @@ struct Polyline {
 std::vector<Polyline> read_lines(const std::filesystem::path& path, const std::string& attribute,
                                  const std::string& target_wkt);
 
-/// Colour ramps for quick-look pictures.
+/// Colour ramps for maps and plots: Viridis, Magma and Cividis are the 256-entry tables of
+/// matplotlib's perceptually uniform maps; Terrain and BlueRed are interpolated between stops.
 /// Intensity: three steps (yellow, orange, red) for class rasters 1–3 drawn with vmin 0.5, vmax 3.5.
-enum class ColourRamp { Viridis, Magma, Terrain, BlueRed, Intensity };
+enum class ColourRamp { Viridis, Magma, Terrain, BlueRed, Intensity, Cividis };
 
 /// A QGIS layer style (.qml) for a single-band raster: a continuous colour ramp between vmin and
 /// vmax, the legend labelled with `unit`, values at or below `transparent_below` not drawn.
@@ -169,17 +173,64 @@ struct QuicklookOptions {
   double crop_margin_m = -1.0;
   bool scale_bar = false;    ///< a scale bar (1, 2 or 5 × 10^k m) in the lower left corner of the map
   bool north_arrow = false;  ///< a north arrow in the upper right corner (the raster is north-up)
-  /// Polylines in map (CRS) coordinates, drawn as dark lines two pixels wide (barriers, sections).
+  /// Polylines in map (CRS) coordinates, drawn as dark lines with a white halo (barriers, sections).
   std::vector<std::vector<Vec2>> lines;
+  std::string lines_label = "barrier";  ///< legend entry of `lines` (shown when there are lines)
+  /// Closed outlines in map coordinates (release areas), drawn dashed with a white halo.
+  std::vector<std::vector<Vec2>> outlines;
+  std::string outlines_label = "release area";  ///< legend entry of `outlines`
+  /// The map's extent in CRS coordinates (xmin, ymin, xmax, ymax); overrides crop_margin_m, so
+  /// every map of a run can share one (map_extent). Clipped to the raster.
+  std::optional<std::array<double, 4>> extent;
+  /// Class breaks for a continuous overlay (ascending, in the overlay's unit, e.g. 0.5, 1, 2 m):
+  /// the values above overlay_min are drawn in breaks.size() + 1 classes of the ramp with a class
+  /// legend ("< 0.5 m", "0.5–1 m", …, "≥ 2 m") instead of the colour bar.
+  std::vector<double> class_breaks;
+  /// Whole picture width in pixels (the map frame is this less the margins for the coordinate
+  /// labels); at least 1600 for print.
+  int width_px = 1800;
+  /// Data attribution printed under the map (e.g. the terrain's licence text); "" for none.
+  std::string attribution;
+  /// Coordinate ticks and grid in the raster's CRS, and its name and EPSG code under the map.
+  bool coordinates = true;
 };
 
-/// Write a quick-look PNG: a hillshade of `elevation` (sun from the north-west, 45° high),
-/// overlaid where `overlay` is present, finite, not nodata and above `opt.overlay_min` by the
-/// colour ramp between vmin and vmax, then the legend below the map (colour bar with ticks and
-/// "title (unit)", or the class legend). Without an overlay the elevation itself is tinted.
-/// InputError when the grids differ or are empty (nothing written). Goes through GDAL's PNG driver.
-void write_quicklook_png(const std::filesystem::path& path, const Raster& elevation, const Raster* overlay,
-                         const QuicklookOptions& opt);
+/// Where write_quicklook_png put things, in pixels of the written picture (for tests and for
+/// checks that a map carries its legend, ticks and scale).
+struct MapLayout {
+  int width = 0, height = 0;                                   ///< the picture
+  int frame_x = 0, frame_y = 0, frame_w = 0, frame_h = 0;      ///< the map frame
+  double metres_per_pixel = 0.0;                               ///< map scale inside the frame
+  int legend_x = 0, legend_y = 0, legend_w = 0, legend_h = 0;  ///< the legend box (0 size: none)
+  int scale_bar_x = 0, scale_bar_y = 0, scale_bar_px = 0;      ///< left end, baseline, length (0: none)
+  double scale_bar_m = 0.0;                                    ///< length the scale bar stands for
+  int x_ticks = 0, y_ticks = 0;                                ///< coordinate ticks labelled on each axis
+  std::string crs_label;                                       ///< the CRS line printed under the map
+};
+
+/// The extent (xmin, ymin, xmax, ymax) of the cells of `r` whose value is finite, not nodata and
+/// above `threshold`, grown by `margin_m` and clipped to the raster; the whole raster when no
+/// cell qualifies. `also` adds points (e.g. a release outline) to the affected area.
+std::array<double, 4> map_extent(const Raster& r, double threshold, double margin_m,
+                                 const std::vector<Vec2>& also = {});
+
+/// The boundaries of the cells of `r` holding a value above `threshold` (finite, not nodata), as
+/// closed polylines along the cell edges in CRS coordinates (the outline of a release area given
+/// on the grid, whatever its source).
+std::vector<std::vector<Vec2>> mask_outlines(const Raster& r, double threshold);
+
+/// "name (EPSG:code)" of a CRS given as WKT (the code when GDAL can identify one), "" for none.
+std::string crs_label(const std::string& wkt);
+
+/// Write a map as PNG (Cairo and Pango, render.cpp): GDAL's multidirectional hillshade of
+/// `elevation` (GDALDEMProcessing), overlaid where `overlay` is present, finite, not nodata and
+/// above `opt.overlay_min` by the colour ramp between vmin and vmax (or its classes), the title
+/// above, coordinate ticks and grid in the CRS, outlines and lines, scale bar and north arrow in
+/// the frame, and below it the CRS line, the legend (colour bar, or class swatches) and the
+/// attribution. Without an overlay the elevation itself is tinted. InputError when the grids
+/// differ or are empty (nothing written); IoError when the file cannot be written.
+MapLayout write_quicklook_png(const std::filesystem::path& path, const Raster& elevation, const Raster* overlay,
+                              const QuicklookOptions& opt);
 /// The positional form of the above (whole raster, colour bar titled `label`, no scale bar).
 void write_quicklook_png(const std::filesystem::path& path, const Raster& elevation, const Raster* overlay,
                          ColourRamp ramp, const std::string& label, double vmin = 0.0, double vmax = 0.0,
@@ -198,11 +249,11 @@ void write_png(const std::filesystem::path& path, const Image& img);
 /// Colour of value t ∈ [0, 1] on a ramp.
 std::array<std::uint8_t, 3> ramp_colour(ColourRamp ramp, double t) noexcept;
 
-/// Draw `text` in the 5×7 bitmap font (ASCII letters, digits, + - . , : / ( ) % = ^ _; other
-/// bytes are skipped), its top left corner at (x, y), each font pixel `scale` × `scale` pixels.
+/// Draw UTF-8 `text` with Pango (DejaVu Sans, antialiased) at a size where the capitals are
+/// 7 · `scale` pixels high, the top of the capitals at y and the text starting at x.
 void draw_text(Image& img, int x, int y, const std::string& text, int scale,
                std::array<std::uint8_t, 3> colour = {0, 0, 0}) noexcept;
-/// Width in pixels of `text` drawn by draw_text (its height is 7 · scale).
+/// Width in pixels of `text` drawn by draw_text (its capitals are 7 · scale high).
 int text_width(const std::string& text, int scale) noexcept;
 /// Tick values at a "nice" step (1, 2 or 5 × 10^k) giving about `n` ticks within [lo, hi], both
 /// ends included when they fall on the step (empty when hi ≤ lo or either is not finite).
