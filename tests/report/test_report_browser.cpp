@@ -12,6 +12,8 @@
 #include <fstream>
 #include <string>
 
+#include "geohaz/core/app.hpp"
+#include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
 #include "geohaz/core/raster_extra.hpp"
 #include "report.hpp"
@@ -181,6 +183,84 @@ TEST(ReportInBrowser, EveryImageDecodesWithoutErrorsAndTheScreenshotShowsThePage
   EXPECT_GE(page_mark(broken.output, "data-errors"), 1);
   EXPECT_NE(broken.output.find("cracks_sigma3_10MPa.png"), std::string::npos);
 
+  std::error_code ec;
+  fs::remove_all(root, ec);
+}
+
+// Issue #33 item 6: `geohaz-report --pdf` prints the page to an A4 PDF, each run from a new page.
+// pdfinfo gives the page count and size, pdftoppm renders the first page, which must not be blank.
+TEST(ReportInBrowser, PdfIsA4WithARunPerPageAndAFirstPageThatShowsSomething) {
+  if (geohaz::report::find_chromium().empty()) GTEST_SKIP() << "chromium is not installed (scripts/setup)";
+  if (run_command("command -v pdfinfo && command -v pdftoppm").code != 0)
+    GTEST_SKIP() << "poppler-utils is not installed (scripts/setup)";
+  const fs::path root = fs::temp_directory_path() /
+                        ("geohaz_report_pdf_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+  fs::remove_all(root);
+  make_results(root / "results");
+  const fs::path results = root / "results";
+  const auto gen = run_command(std::string("'") + GEOHAZ_REPORT_EXE + "' '" + results.string() + "' --pdf");
+  ASSERT_EQ(gen.code, 0) << gen.output;
+  ASSERT_TRUE(fs::exists(results / "report.pdf"));
+  EXPECT_FALSE(fs::exists(results / "report.pdf.partial"));
+  const auto info = run_command("pdfinfo '" + (results / "report.pdf").string() + "'");
+  ASSERT_EQ(info.code, 0) << info.output;
+  // A4 is 595 × 842 pt (210 × 297 mm); pdfinfo names it.
+  EXPECT_NE(info.output.find(" pts (A4)"), std::string::npos) << info.output;
+  const auto pages_at = info.output.find("Pages:");
+  ASSERT_NE(pages_at, std::string::npos);
+  const int pages = std::stoi(info.output.substr(pages_at + 6));
+  // The title and overview, then each of the two runs from a new page; the biaxial run fits one.
+  EXPECT_GE(pages, 3) << info.output;
+  EXPECT_LE(pages, 8) << info.output;
+  const auto text = run_command("pdftotext -f 2 -l 2 '" + (results / "report.pdf").string() + "' -");
+  EXPECT_EQ(text.output.rfind("1-runout", 0), 0u) << text.output.substr(0, 200);  // page 2 opens the first run
+  const auto ppm = run_command("pdftoppm -f 1 -l 1 -r 40 -png '" + (results / "report.pdf").string() + "' '" +
+                               (root / "page").string() + "'");
+  ASSERT_EQ(ppm.code, 0) << ppm.output;
+  fs::path first;
+  for (const auto& e : fs::directory_iterator(root))
+    if (e.path().extension() == ".png") first = e.path();
+  ASSERT_FALSE(first.empty());
+  const geohaz::Image img = geohaz::read_image(first);
+  int dark = 0;
+  for (std::size_t i = 0; i < img.rgb.size(); i += 3) dark += img.rgb[i] < 100 && img.rgb[i + 1] < 100;
+  EXPECT_GT(dark, 200);  // the title and the overview table, not a white page
+  std::error_code ec;
+  fs::remove_all(root, ec);
+}
+
+// Issue #29 item 6: the report written into a run folder names the run after the folder, writes
+// nothing hidden, and lists its files in the run's manifest, so the next run into the folder
+// (run_in_output_dir, the --out policy of every app) cleans them instead of refusing.
+TEST(ReportInRunFolder, NamesTheRunAfterItsFolderAndTheNextRunAcceptsTheFolder) {
+  const fs::path root = fs::temp_directory_path() /
+                        ("geohaz_report_run_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+  fs::remove_all(root);
+  const fs::path run = root / "my-run";
+  const auto body = [&] {
+    write_file(run / "summary.json", R"({"model": "debris-runout", "max_speed_m_s": 12.5})");
+    write_file(run / "series.csv", "time_s,max_speed_m_s\n0,0\n1,5\n2,12.5\n");
+    return 0;
+  };
+  fs::create_directories(run);
+  ASSERT_EQ(geohaz::run_in_output_dir(run, "debris-runout", {}, body), 0);
+  geohaz::report::write_report(run, "one run");
+  const std::string html = slurp(run / "report.html");
+  EXPECT_NE(html.find("<h2>my-run</h2>"), std::string::npos);
+  EXPECT_EQ(html.find("<h2>.</h2>"), std::string::npos);
+  for (auto it = fs::recursive_directory_iterator(run); it != fs::recursive_directory_iterator(); ++it)
+    EXPECT_NE(it->path().filename().string().front(), '.') << it->path();
+  EXPECT_TRUE(fs::exists(run / "report_files" / "my-run_series.svg"));
+  const std::string manifest = slurp(run / geohaz::kOutputManifest);
+  EXPECT_NE(manifest.find("report.html\n"), std::string::npos) << manifest;
+  EXPECT_NE(manifest.find("report_files/my-run_series.svg\n"), std::string::npos) << manifest;
+  // The next run into the folder: accepted, and the old report is gone with the old run.
+  EXPECT_NO_THROW(geohaz::run_in_output_dir(run, "debris-runout", {}, body));
+  EXPECT_FALSE(fs::exists(run / "report.html"));
+  EXPECT_FALSE(fs::exists(run / "report_files"));
+  // Control: a file the run did not write still stops the next run (exit 2).
+  write_file(run / "notes.txt", "mine");
+  EXPECT_THROW(geohaz::run_in_output_dir(run, "debris-runout", {}, body), geohaz::InputError);
   std::error_code ec;
   fs::remove_all(root, ec);
 }
