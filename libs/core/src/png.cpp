@@ -84,7 +84,11 @@ void write_rgb_png(const std::filesystem::path& path, int w, int h, const std::v
     throw std::runtime_error("cannot fill the in-memory image" + detail::gdal_last_error());
   bool ok;
   {
-    std::unique_ptr<GDALDataset> out(png_driver->CreateCopy(tmp.c_str(), mem.get(), FALSE, nullptr, nullptr, nullptr));
+    // zlib level 3: a print-size map (1800 × 2800 px) is written 3–4 times faster than at the
+    // default level 6, for a file a few per cent larger.
+    const char* options[] = {"ZLEVEL=3", nullptr};
+    std::unique_ptr<GDALDataset> out(
+        png_driver->CreateCopy(tmp.c_str(), mem.get(), FALSE, const_cast<char**>(options), nullptr, nullptr));
     ok = out != nullptr;
   }
   ok = ok && CPLGetLastErrorType() != CE_Failure && CPLGetLastErrorType() != CE_Fatal;

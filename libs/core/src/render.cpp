@@ -85,6 +85,19 @@ std::array<std::uint8_t, 3> ramp_colour(ColourRamp ramp, double t) noexcept {
   return table(kViridisTable, t);
 }
 
+std::array<std::uint8_t, 3> class_colour(ColourRamp ramp, std::size_t k, std::size_t n) noexcept {
+  return ramp_colour(ramp, n <= 1 ? 0.5 : 0.1 + 0.85 * double(k) / double(n - 1));
+}
+
+std::string legend_number(double v) {
+  char buf[32];
+  if (v == std::round(v) && std::abs(v) < 1e9)
+    std::snprintf(buf, sizeof buf, "%.0f", v);  // 30000, not 3e+04
+  else
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Cairo and Pango helpers
 
@@ -440,39 +453,22 @@ std::string coordinate_text(double v) {
   return (neg ? "\u2212" : "") + o;
 }
 
-/// A legend number: up to 3 significant digits, no trailing zeros.
-std::string legend_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
-
-/// Write a Cairo surface as PNG to "<path>.partial", then rename it.
+/// Write a Cairo RGB24 surface as PNG (through write_png: GDAL's PNG driver, atomic).
 void write_surface_png(cairo_surface_t* s, const std::filesystem::path& path) {
-  const std::string file = path.string(), tmp = file + ".partial";
-  struct Sink {
-    std::ofstream out;
-  } sink{std::ofstream(tmp, std::ios::binary)};
-  std::error_code ec;
-  if (!sink.out) throw IoError("cannot open the PNG for writing", file);
-  const cairo_status_t st = cairo_surface_write_to_png_stream(
-      s,
-      [](void* closure, const unsigned char* data, unsigned int length) {
-        auto* k = static_cast<Sink*>(closure);
-        k->out.write(reinterpret_cast<const char*>(data), length);
-        return k->out ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
-      },
-      &sink);
-  sink.out.close();
-  if (st != CAIRO_STATUS_SUCCESS || sink.out.fail()) {
-    std::filesystem::remove(tmp, ec);
-    throw IoError(std::string("cannot write the PNG: ") + cairo_status_to_string(st), file);
+  const int w = cairo_image_surface_get_width(s), h = cairo_image_surface_get_height(s);
+  const int stride = cairo_image_surface_get_stride(s);
+  const unsigned char* data = cairo_image_surface_get_data(s);
+  Image img(w, h);
+  for (int j = 0; j < h; ++j) {
+    const auto* row = reinterpret_cast<const std::uint32_t*>(data + static_cast<std::size_t>(j) * stride);
+    std::uint8_t* dst = &img.rgb[static_cast<std::size_t>(j) * w * 3];
+    for (int i = 0; i < w; ++i, dst += 3) {
+      dst[0] = static_cast<std::uint8_t>(row[i] >> 16);
+      dst[1] = static_cast<std::uint8_t>(row[i] >> 8);
+      dst[2] = static_cast<std::uint8_t>(row[i]);
+    }
   }
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw IoError("cannot move the PNG into place: " + ec.message(), file);
-  }
+  write_png(path, img);
 }
 
 struct LegendItem {
@@ -565,9 +561,7 @@ MapLayout write_quicklook_png(const std::filesystem::path& path, const Raster& e
   std::vector<LegendItem> items;
   const std::string unit_suffix = opt.unit.empty() ? "" : " " + opt.unit;
   const std::size_t nclass = opt.class_breaks.size() + 1;
-  const auto class_colour = [&](std::size_t k) {
-    return ramp_colour(opt.ramp, nclass == 1 ? 0.5 : 0.1 + 0.85 * double(k) / double(nclass - 1));
-  };
+  const auto colour_of_class = [&](std::size_t k) { return class_colour(opt.ramp, k, nclass); };
   if (!opt.classes.empty()) {
     for (const auto& k : opt.classes) items.push_back({k.colour, k.label, 0});
   } else if (!opt.class_breaks.empty()) {
@@ -576,7 +570,7 @@ MapLayout write_quicklook_png(const std::filesystem::path& path, const Raster& e
       std::string l = k == 0            ? "< " + legend_number(b[0])
                       : k + 1 == nclass ? "\u2265 " + legend_number(b[k - 1])
                                         : legend_number(b[k - 1]) + "\u2013" + legend_number(b[k]);
-      items.push_back({class_colour(k), l + unit_suffix, 0});
+      items.push_back({colour_of_class(k), l + unit_suffix, 0});
     }
   }
   const Rgb ink{25, 25, 25};
@@ -593,7 +587,7 @@ MapLayout write_quicklook_png(const std::filesystem::path& path, const Raster& e
     if (!opt.class_breaks.empty()) {
       std::size_t k = 0;
       while (k < opt.class_breaks.size() && v >= opt.class_breaks[k]) ++k;
-      return class_colour(k);
+      return colour_of_class(k);
     }
     return ramp_colour(opt.ramp, (v - vmin) / (vmax - vmin));
   };

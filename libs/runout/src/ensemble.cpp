@@ -983,9 +983,22 @@ void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, 
           kFieldUnits[f], ramp, 0.0);
     }
   }
-  if (!first_probability.data.empty())
-    write_quicklook_png(out / "probability.png", dsm, &first_probability, ColourRamp::BlueRed, first_label, 0.0, 1.0,
-                        1e-9);
+  if (!first_probability.data.empty()) {
+    // The first probability map over the cells any member reached (200 m around), in classes of a
+    // sequential ramp, with coordinates, scale bar and north arrow (issue #33).
+    QuicklookOptions o;
+    o.ramp = ColourRamp::Viridis;
+    o.title = first_label;
+    o.overlay_min = 1e-9;
+    o.vmin = 0.0;
+    o.vmax = 1.0;
+    o.class_breaks = {0.1, 0.3, 0.5, 0.7, 0.9};
+    o.extent = map_extent(first_probability, 1e-9, 200.0);
+    o.scale_bar = true;
+    o.north_arrow = true;
+    if (!dsm.attribution.empty()) o.attribution = "Terrain: " + dsm.attribution;
+    write_quicklook_png(out / "probability.png", dsm, &first_probability, o);
+  }
 
   // 4. The member table, the distributions of run-out and H/L, the summary.
   {

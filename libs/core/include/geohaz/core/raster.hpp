@@ -147,6 +147,18 @@ enum class ColourRamp { Viridis, Magma, Terrain, BlueRed, Intensity, Cividis };
 /// vmax, the legend labelled with `unit`, values at or below `transparent_below` not drawn.
 void write_qgis_ramp_style(const std::filesystem::path& path, ColourRamp ramp, double vmin, double vmax,
                            const std::string& unit, double transparent_below);
+/// A QGIS layer style (.qml) for a continuous raster drawn in classes (a discrete colour ramp):
+/// below breaks[0], between consecutive breaks, and at or above the last, in the colours the maps
+/// give them (class_colour), labelled "< 0.5 m", "0.5–1 m", "≥ 2 m"; values at or below
+/// `transparent_below` not drawn.
+void write_qgis_classed_style(const std::filesystem::path& path, ColourRamp ramp, const std::vector<double>& breaks,
+                              const std::string& unit, double transparent_below);
+/// Colour of class k of n drawn from a ramp (the maps' and the styles' classes): the ramp at
+/// 0.1 + 0.85 k/(n − 1), so the first class is not the ramp's darkest end.
+std::array<std::uint8_t, 3> class_colour(ColourRamp ramp, std::size_t k, std::size_t n) noexcept;
+/// A legend number: at most 3 significant digits, no trailing zeros ("0.5", "1.58", "3e+04").
+std::string legend_number(double v);
+
 /// One class of a categorical raster: its value, legend label and colour.
 struct StyleClass {
   double value;
@@ -155,6 +167,20 @@ struct StyleClass {
 };
 /// A QGIS layer style (.qml) for a categorical raster (paletted renderer).
 void write_qgis_class_style(const std::filesystem::path& path, const std::vector<StyleClass>& classes);
+
+/// Polygonise a class raster (values rounded to integers; ≤ 0, nodata and NaN are not a zone) with
+/// GDAL (4-connected cells of one class become one polygon) into a GeoPackage layer `layer` with the
+/// fields class, label and colour and an OGR style per feature (from `legend`), and, when `kml` is
+/// not empty, the same polygons as KML in WGS 84. Written as *.partial and renamed; IoError when a
+/// file cannot be written.
+void write_class_zones(const std::filesystem::path& gpkg, const std::filesystem::path& kml, const Raster& classes,
+                       const std::string& layer, const std::vector<StyleClass>& legend);
+
+/// Write a class raster (values 0–254 rounded; NaN and nodata become 255, the nodata value) as a
+/// Byte Cloud-Optimized GeoTIFF with a colour table (each class of `legend` in its colour, other
+/// values white: a TIFF colour map holds no alpha, the .qml leaves them undrawn) and a raster attribute table (value, class label, red, green, blue; GDAL
+/// keeps it in the side-car `<path>.aux.xml`). Same checks and errors as write_geotiff.
+void write_class_geotiff(const std::filesystem::path& path, const Raster& r, const std::vector<StyleClass>& legend);
 
 /// How a quick-look map is drawn (write_quicklook_png). The defaults draw the whole raster with a
 /// numbered colour bar and nothing else, as the positional overload always did.
