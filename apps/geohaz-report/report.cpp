@@ -18,6 +18,7 @@
 #include "geohaz/core/app.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
+#include "geohaz/core/raster.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -796,7 +797,7 @@ const char* kStyle =
     "section{border-top:2px solid #444;margin-top:2em}h3{margin-bottom:0.3em}"
     ".key{margin-right:1em;white-space:nowrap}.key i{display:inline-block;width:0.9em;height:0.9em;margin-right:0.3em;"
     "vertical-align:middle}#page-check{display:none;background:#fdd;padding:0.5em;border:1px solid #c00}"
-    "ul.files{columns:3;font-size:85%}"
+    "ul.files{columns:3;font-size:85%}.map-problem{color:#c00;font-weight:bold}"
     // Print (geohaz-report --pdf, or the browser's own print): A4, each run from a new page,
     // figures and tables never cut, pictures as wide as the page allows.
     "@page{size:A4;margin:12mm}@media print{body{margin:0;max-width:none;font-size:10pt}"
@@ -824,6 +825,7 @@ const char* kCheckScript = R"(<script>
     d.setAttribute('data-images', imgs.length);
     d.setAttribute('data-decoded', decoded);
     d.setAttribute('data-errors', errors.length);
+    d.setAttribute('data-map-problems', document.querySelectorAll('.map-problem').length);
     if (errors.length) { d.textContent = 'Not shown: ' + errors.join('; '); d.style.display = 'block'; }
   });
 })();
@@ -1014,6 +1016,11 @@ fs::path write_report(const fs::path& root, const std::string& title, const fs::
       body << "<figure><img alt=\"" << escape(stem) << "\" src=\"" << escape(fs::relative(p, root).generic_string())
            << "\"><figcaption><b>" << escape(p.filename().string()) << "</b> " << escape(caption);
       if (stem.rfind("cracks_", 0) == 0) body << "<br>" << kCrackLegend;
+      // A map drawn by write_quicklook_png must carry its legend, coordinate ticks and scale bar
+      // (check_map_png probes the pixels where its recorded layout puts them).
+      const auto problems = check_map_png(p);
+      if (problems.empty() || problems.front().rfind("records no map layout", 0) != 0)
+        for (const auto& m : problems) body << "<br><span class=map-problem>map check: " << escape(m) << "</span>";
       body << "</figcaption></figure>\n";
     }
     for (const auto& [name, svg] : r.plots)

@@ -8,8 +8,11 @@
 // Skipped (with a message) only when no chromium is installed; scripts/setup installs it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 
 #include "geohaz/core/app.hpp"
@@ -160,6 +163,9 @@ TEST(ReportInBrowser, EveryImageDecodesWithoutErrorsAndTheScreenshotShowsThePage
   EXPECT_EQ(page_mark(dom.output, "data-images"), static_cast<int>(images)) << dom.output;
   EXPECT_EQ(page_mark(dom.output, "data-decoded"), static_cast<int>(images)) << dom.output;
   EXPECT_EQ(page_mark(dom.output, "data-errors"), 0) << dom.output;
+  // Every map carries its legend, coordinate ticks and scale bar (issue #33).
+  EXPECT_EQ(page_mark(dom.output, "data-map-problems"), 0) << dom.output;
+  EXPECT_TRUE(geohaz::check_map_png(results / "1-runout" / "max_depth.png").empty());
   EXPECT_EQ(dom.output.find(":CONSOLE"), std::string::npos) << dom.output;  // nothing logged by the page
 
   const geohaz::Image img = geohaz::read_image(shot);
@@ -174,6 +180,63 @@ TEST(ReportInBrowser, EveryImageDecodesWithoutErrorsAndTheScreenshotShowsThePage
   }
   EXPECT_GT(dark, 2000);
   EXPECT_GT(mid_grey, 2000);
+
+  // Control: maps drawn without a scale bar, without coordinates, or with the legend box blanked
+  // are each reported by the map check, and the page shows it.
+  {
+    geohaz::Raster dem;
+    dem.nx = 120;
+    dem.ny = 90;
+    dem.geotransform = {600000.0, 5.0, 0.0, 5100000.0, 0.0, -5.0};
+    dem.data.resize(static_cast<std::size_t>(dem.nx) * dem.ny);
+    for (int r = 0; r < dem.ny; ++r)
+      for (int c = 0; c < dem.nx; ++c) dem.at(c, r) = 1500.0 - 2.0 * std::hypot(c - 60.0, r - 45.0);
+    geohaz::QuicklookOptions o;
+    o.title = "peak flow depth";
+    o.unit = "m";
+    o.scale_bar = true;
+    const fs::path bad = root / "bad";
+    fs::create_directories(bad);
+    o.scale_bar = false;
+    geohaz::write_quicklook_png(bad / "no_scale.png", dem, &dem, o);
+    o.scale_bar = true;
+    o.coordinates = false;
+    geohaz::write_quicklook_png(bad / "no_ticks.png", dem, &dem, o);
+    o.coordinates = true;
+    const geohaz::MapLayout lay = geohaz::write_quicklook_png(bad / "no_legend.png", dem, &dem, o);
+    geohaz::Image img = geohaz::read_image(bad / "no_legend.png");
+    for (int y = lay.legend_y; y < lay.legend_y + lay.legend_h; ++y)
+      for (int x = lay.legend_x; x < lay.legend_x + lay.legend_w; ++x) img.set(x, y, {255, 255, 255});
+    const auto text = [&] {  // keep the recorded layout: rewrite with the same text chunk
+      return std::vector<std::pair<std::string, std::string>>{
+          {"geohaz_map", "frame=" + std::to_string(lay.frame_x) + "," + std::to_string(lay.frame_y) + "," +
+                             std::to_string(lay.frame_w) + "," + std::to_string(lay.frame_h) +
+                             ";legend=" + std::to_string(lay.legend_x) + "," + std::to_string(lay.legend_y) + "," +
+                             std::to_string(lay.legend_w) + "," + std::to_string(lay.legend_h) +
+                             ";scale_bar=" + std::to_string(lay.scale_bar_x) + "," + std::to_string(lay.scale_bar_y) +
+                             "," + std::to_string(lay.scale_bar_px) + ";ticks=" + std::to_string(lay.x_ticks) + "," +
+                             std::to_string(lay.y_ticks) + ";scale=1"}};
+    }();
+    geohaz::write_png(bad / "no_legend.png", img, text);
+    const auto has = [](const std::vector<std::string>& v, const std::string& what) {
+      return std::find(v.begin(), v.end(), what) != v.end();
+    };
+    const auto p1 = geohaz::check_map_png(bad / "no_scale.png"), p2 = geohaz::check_map_png(bad / "no_ticks.png"),
+               p3 = geohaz::check_map_png(bad / "no_legend.png");
+    EXPECT_TRUE(has(p1, "no scale bar")) << p1.size();
+    EXPECT_FALSE(has(p1, "no legend"));
+    EXPECT_TRUE(has(p2, "no coordinate ticks")) << p2.size();
+    EXPECT_FALSE(has(p2, "no scale bar"));
+    EXPECT_TRUE(has(p3, "no legend")) << p3.size();
+    EXPECT_FALSE(has(p3, "no coordinate ticks"));
+    // In the page: the map without a scale bar among the run's pictures is flagged.
+    fs::copy_file(bad / "no_scale.png", results / "1-runout" / "max_speed.png");
+    ASSERT_EQ(run_command(std::string("'") + GEOHAZ_REPORT_EXE + "' '" + results.string() + "'").code, 0);
+    const auto flagged = run_command(common + "--dump-dom " + url);
+    EXPECT_EQ(page_mark(flagged.output, "data-map-problems"), 1) << flagged.output;
+    fs::remove(results / "1-runout" / "max_speed.png");
+    ASSERT_EQ(run_command(std::string("'") + GEOHAZ_REPORT_EXE + "' '" + results.string() + "'").code, 0);
+  }
 
   // Control: a picture that is gone is reported by the page (so the marks above can fail).
   fs::remove(results / "2-rock-biaxial" / "cracks_sigma3_10MPa.png");

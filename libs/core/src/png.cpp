@@ -67,7 +67,8 @@ std::vector<double> nice_ticks(double lo, double hi, int n) {
 namespace {
 
 /// Write an RGB image through GDAL's MEM and PNG drivers, to "<path>.partial" then renamed.
-void write_rgb_png(const std::filesystem::path& path, int w, int h, const std::vector<std::uint8_t>& rgb) {
+void write_rgb_png(const std::filesystem::path& path, int w, int h, const std::vector<std::uint8_t>& rgb,
+                   const std::vector<std::pair<std::string, std::string>>& text = {}) {
   detail::ensure_gdal_registered();
   const std::string file = path.string();
   const std::string tmp = file + ".partial";
@@ -82,11 +83,12 @@ void write_rgb_png(const std::filesystem::path& path, int w, int h, const std::v
   if (mem->RasterIO(GF_Write, 0, 0, w, h, const_cast<std::uint8_t*>(rgb.data()), w, h, GDT_Byte, 3, bands, 3,
                     static_cast<GSpacing>(3) * w, 1, nullptr) != CE_None)
     throw std::runtime_error("cannot fill the in-memory image" + detail::gdal_last_error());
+  for (const auto& [key, value] : text) mem->SetMetadataItem(key.c_str(), value.c_str());
   bool ok;
   {
     // zlib level 3: a print-size map (1800 × 2800 px) is written 3–4 times faster than at the
     // default level 6, for a file a few per cent larger.
-    const char* options[] = {"ZLEVEL=3", nullptr};
+    const char* options[] = {"ZLEVEL=3", "WRITE_METADATA_AS_TEXT=YES", nullptr};
     std::unique_ptr<GDALDataset> out(
         png_driver->CreateCopy(tmp.c_str(), mem.get(), FALSE, const_cast<char**>(options), nullptr, nullptr));
     ok = out != nullptr;
@@ -114,6 +116,14 @@ void write_png(const std::filesystem::path& path, const Image& img) {
       img.rgb.size() != static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height) * 3)
     throw InputError("image buffer does not match its size", path.string());
   write_rgb_png(path, img.width, img.height, img.rgb);
+}
+
+void write_png(const std::filesystem::path& path, const Image& img,
+               const std::vector<std::pair<std::string, std::string>>& text) {
+  if (img.width <= 0 || img.height <= 0 ||
+      img.rgb.size() != static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height) * 3)
+    throw InputError("image buffer does not match its size", path.string());
+  write_rgb_png(path, img.width, img.height, img.rgb, text);
 }
 
 Image read_image(const std::filesystem::path& path) {

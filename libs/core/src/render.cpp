@@ -19,10 +19,13 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <sstream>
+#include <string>
 
 #include "gdal_common.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
+#include "geohaz/core/raster_extra.hpp"
 
 namespace geohaz {
 
@@ -454,7 +457,8 @@ std::string coordinate_text(double v) {
 }
 
 /// Write a Cairo RGB24 surface as PNG (through write_png: GDAL's PNG driver, atomic).
-void write_surface_png(cairo_surface_t* s, const std::filesystem::path& path) {
+void write_surface_png(cairo_surface_t* s, const std::filesystem::path& path,
+                       const std::vector<std::pair<std::string, std::string>>& text) {
   const int w = cairo_image_surface_get_width(s), h = cairo_image_surface_get_height(s);
   const int stride = cairo_image_surface_get_stride(s);
   const unsigned char* data = cairo_image_surface_get_data(s);
@@ -468,7 +472,7 @@ void write_surface_png(cairo_surface_t* s, const std::filesystem::path& path) {
       dst[2] = static_cast<std::uint8_t>(row[i]);
     }
   }
-  write_png(path, img);
+  write_png(path, img, text);
 }
 
 struct LegendItem {
@@ -901,8 +905,72 @@ MapLayout write_quicklook_png(const std::filesystem::path& path, const Raster& e
     text(cr, fx, attr_y, opt.attribution, fs_small, Rgb{70, 70, 70}, HAlign::Left, VAlign::Top);
 
   cairo_surface_flush(surface.get());
-  write_surface_png(surface.get(), path);
+  // The layout, recorded in the PNG for check_map_png.
+  std::ostringstream rec;
+  rec << "frame=" << lay.frame_x << ',' << lay.frame_y << ',' << lay.frame_w << ',' << lay.frame_h
+      << ";legend=" << lay.legend_x << ',' << lay.legend_y << ',' << lay.legend_w << ',' << lay.legend_h
+      << ";scale_bar=" << lay.scale_bar_x << ',' << lay.scale_bar_y << ',' << lay.scale_bar_px
+      << ";ticks=" << lay.x_ticks << ',' << lay.y_ticks << ";scale=" << u;
+  write_surface_png(surface.get(), path, {{"geohaz_map", rec.str()}, {"geohaz_crs", lay.crs_label}});
   return lay;
+}
+
+std::vector<std::string> check_map_png(const std::filesystem::path& path) {
+  std::vector<std::string> problems;
+  std::string rec;
+  {
+    detail::ensure_gdal_registered();
+    detail::QuietGdalErrors quiet;
+    std::unique_ptr<GDALDataset> ds(GDALDataset::Open(path.string().c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
+    if (!ds) return {"cannot be read as a picture"};
+    if (const char* v = ds->GetMetadataItem("geohaz_map")) rec = v;
+  }
+  if (rec.empty()) return {"records no map layout (not drawn by write_quicklook_png)"};
+  // "name=a,b,c;…" → numbers per name.
+  std::map<std::string, std::vector<double>> f;
+  std::istringstream in(rec);
+  std::string item;
+  while (std::getline(in, item, ';')) {
+    const auto eq = item.find('=');
+    if (eq == std::string::npos) continue;
+    std::istringstream nums(item.substr(eq + 1));
+    std::string n;
+    while (std::getline(nums, n, ',')) f[item.substr(0, eq)].push_back(std::atof(n.c_str()));
+  }
+  const auto get = [&](const char* k, std::size_t i) { return i < f[k].size() ? f[k][i] : 0.0; };
+  const Image img = read_image(path);
+  const auto px = [&](int x, int y) -> Rgb {
+    if (x < 0 || y < 0 || x >= img.width || y >= img.height) return {255, 255, 255};
+    const std::size_t i = (static_cast<std::size_t>(y) * img.width + x) * 3;
+    return {img.rgb[i], img.rgb[i + 1], img.rgb[i + 2]};
+  };
+  const auto count = [&](int x0, int y0, int x1, int y1, auto pred) {
+    int n = 0;
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) n += pred(px(x, y));
+    return n;
+  };
+  const auto not_white = [](Rgb c) { return c[0] < 235 || c[1] < 235 || c[2] < 235; };
+  const auto dark = [](Rgb c) { return c[0] < 90 && c[1] < 90 && c[2] < 90; };
+  const double u = get("scale", 0) > 0 ? get("scale", 0) : 1.0;
+  const int fx = static_cast<int>(get("frame", 0)), fy = static_cast<int>(get("frame", 1));
+  const int fw = static_cast<int>(get("frame", 2)), fh = static_cast<int>(get("frame", 3));
+  const int lx = static_cast<int>(get("legend", 0)), ly = static_cast<int>(get("legend", 1));
+  const int lw = static_cast<int>(get("legend", 2)), lh = static_cast<int>(get("legend", 3));
+  if (lw <= 0 || lh <= 0 || count(lx, ly, lx + lw, ly + lh, not_white) < 500) problems.push_back("no legend");
+  const int band = static_cast<int>(40 * u);
+  if (get("ticks", 0) < 2 || get("ticks", 1) < 2 || count(fx, fy + fh + 2, fx + fw, fy + fh + band, dark) < 50 ||
+      count(fx - static_cast<int>(150 * u), fy, fx - 2, fy + fh, dark) < 50)
+    problems.push_back("no coordinate ticks");
+  const int sx = static_cast<int>(get("scale_bar", 0)), sy = static_cast<int>(get("scale_bar", 1));
+  const int sl = static_cast<int>(get("scale_bar", 2));
+  bool bar = sl > 8;
+  if (bar) {  // the first quarter black, the second white, at the bar's middle height
+    const int y = sy - static_cast<int>(5 * u);
+    bar = px(sx + sl / 8, y) == Rgb{0, 0, 0} && px(sx + 3 * sl / 8, y) == Rgb{255, 255, 255};
+  }
+  if (!bar) problems.push_back("no scale bar");
+  return problems;
 }
 
 }  // namespace geohaz

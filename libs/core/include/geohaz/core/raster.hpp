@@ -178,8 +178,9 @@ void write_class_zones(const std::filesystem::path& gpkg, const std::filesystem:
 
 /// Write a class raster (values 0–254 rounded; NaN and nodata become 255, the nodata value) as a
 /// Byte Cloud-Optimized GeoTIFF with a colour table (each class of `legend` in its colour, other
-/// values white: a TIFF colour map holds no alpha, the .qml leaves them undrawn) and a raster attribute table (value, class label, red, green, blue; GDAL
-/// keeps it in the side-car `<path>.aux.xml`). Same checks and errors as write_geotiff.
+/// values white: a TIFF colour map holds no alpha, the .qml leaves them undrawn) and a raster attribute table (value,
+/// class label, red, green, blue; GDAL keeps it in the side-car `<path>.aux.xml`). Same checks and errors as
+/// write_geotiff.
 void write_class_geotiff(const std::filesystem::path& path, const Raster& r, const std::vector<StyleClass>& legend);
 
 /// How a quick-look map is drawn (write_quicklook_png). The defaults draw the whole raster with a
@@ -272,6 +273,16 @@ struct Image {
   void fill_circle(double cx, double cy, double radius, std::array<std::uint8_t, 3> c) noexcept;
 };
 void write_png(const std::filesystem::path& path, const Image& img);
+/// The same with text chunks (PNG tEXt, key and value), which GDAL and image viewers read back.
+void write_png(const std::filesystem::path& path, const Image& img,
+               const std::vector<std::pair<std::string, std::string>>& text);
+
+/// What is wrong with a map picture written by write_quicklook_png, judged from the layout it
+/// records in the PNG (text chunk "geohaz_map") and from its pixels: no recorded layout, no legend
+/// (fewer than 500 drawn pixels in the legend box), no coordinate ticks (fewer than two labelled
+/// on an axis, or no label pixels beside the frame), no scale bar (none recorded, or no black and
+/// white quarters where it is recorded). Empty when the map carries all of them.
+std::vector<std::string> check_map_png(const std::filesystem::path& path);
 /// Colour of value t ∈ [0, 1] on a ramp.
 std::array<std::uint8_t, 3> ramp_colour(ColourRamp ramp, double t) noexcept;
 
