@@ -742,11 +742,13 @@ bool natural_less(const std::string& a, const std::string& b) {
 
 /// Captions of the pictures the apps write; the maps first, in this order.
 struct Caption {
-  const char* stem;  ///< file name without .png, or a prefix ending in '*'
+  const char* stem;  ///< file name without .png, or a pattern with one '*' (prefix*suffix)
   const char* text;
 };
 const Caption kCaptions[] = {
-    {"max_depth", "Peak flow depth over the hillshade (the affected area, 200 m around)."},
+    {"max_depth",
+     "Peak flow depth in classes over the hillshade; every map of the run on one extent (the "
+     "affected area and the release, output.map_margin around)."},
     {"max_speed", "Peak speed."},
     {"max_pressure", "Peak dynamic pressure ρv² (kPa)."},
     {"intensity", "Intensity classes (thresholds in the run's config; docs/runout.md)."},
@@ -761,12 +763,24 @@ const Caption kCaptions[] = {
     {"velocity_*", "Speed of the particles at this time."},
     {"cracks_*", "Bonds and cracks at the end of the test at this confining stress."},
     {"deposit_profile", "Deposit thickness along the profile."},
+    {"profile",
+     "Thalweg long profile along the flow's centreline: terrain, peak depth above it (exaggerated), "
+     "the α line from the top of the release to the run-out point; peak speed below."},
+    {"probability", "Probability over the ensemble, in classes, on the cells any member reached."},
+    {"mean_max_depth", "Mean of the members' peak flow depth."},
+    {"p*_max_depth", "Percentile of the members' peak flow depth (log-binned histogram)."},
 };
 
 int caption_rank(const std::string& stem) {
   for (std::size_t k = 0; k < std::size(kCaptions); ++k) {
     const std::string c = kCaptions[k].stem;
-    if (c.back() == '*' ? stem.rfind(c.substr(0, c.size() - 1), 0) == 0 : stem == c) return static_cast<int>(k);
+    const auto star = c.find('*');  // "prefix*suffix": any stem with that prefix and suffix
+    const bool match =
+        star == std::string::npos
+            ? stem == c
+            : stem.size() >= c.size() - 1 && stem.rfind(c.substr(0, star), 0) == 0 &&
+                  stem.compare(stem.size() - (c.size() - star - 1), std::string::npos, c.substr(star + 1)) == 0;
+    if (match) return static_cast<int>(k);
   }
   return static_cast<int>(std::size(kCaptions));
 }
