@@ -3,8 +3,8 @@
 // parse as XML with the expected ramp or classes. Read back with GDAL itself.
 #include <cpl_minixml.h>
 #include <gdal_priv.h>
-#include <gtest/gtest.h>
 #include <gdal_rat.h>
+#include <gtest/gtest.h>
 #include <ogrsf_frmts.h>
 #include <unistd.h>
 
