@@ -4,6 +4,7 @@
 #include "report.hpp"
 
 #include <toml++/toml.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -11,10 +12,13 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 
+#include "geohaz/core/app.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
+#include "geohaz/core/raster.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -738,11 +742,13 @@ bool natural_less(const std::string& a, const std::string& b) {
 
 /// Captions of the pictures the apps write; the maps first, in this order.
 struct Caption {
-  const char* stem;  ///< file name without .png, or a prefix ending in '*'
+  const char* stem;  ///< file name without .png, or a pattern with one '*' (prefix*suffix)
   const char* text;
 };
 const Caption kCaptions[] = {
-    {"max_depth", "Peak flow depth over the hillshade (the affected area, 200 m around)."},
+    {"max_depth",
+     "Peak flow depth in classes over the hillshade; every map of the run on one extent (the "
+     "affected area and the release, output.map_margin around)."},
     {"max_speed", "Peak speed."},
     {"max_pressure", "Peak dynamic pressure ρv² (kPa)."},
     {"intensity", "Intensity classes (thresholds in the run's config; docs/runout.md)."},
@@ -757,12 +763,24 @@ const Caption kCaptions[] = {
     {"velocity_*", "Speed of the particles at this time."},
     {"cracks_*", "Bonds and cracks at the end of the test at this confining stress."},
     {"deposit_profile", "Deposit thickness along the profile."},
+    {"profile",
+     "Thalweg long profile along the flow's centreline: terrain, peak depth above it (exaggerated), "
+     "the α line from the top of the release to the run-out point; peak speed below."},
+    {"probability", "Probability over the ensemble, in classes, on the cells any member reached."},
+    {"mean_max_depth", "Mean of the members' peak flow depth."},
+    {"p*_max_depth", "Percentile of the members' peak flow depth (log-binned histogram)."},
 };
 
 int caption_rank(const std::string& stem) {
   for (std::size_t k = 0; k < std::size(kCaptions); ++k) {
     const std::string c = kCaptions[k].stem;
-    if (c.back() == '*' ? stem.rfind(c.substr(0, c.size() - 1), 0) == 0 : stem == c) return static_cast<int>(k);
+    const auto star = c.find('*');  // "prefix*suffix": any stem with that prefix and suffix
+    const bool match =
+        star == std::string::npos
+            ? stem == c
+            : stem.size() >= c.size() - 1 && stem.rfind(c.substr(0, star), 0) == 0 &&
+                  stem.compare(stem.size() - (c.size() - star - 1), std::string::npos, c.substr(star + 1)) == 0;
+    if (match) return static_cast<int>(k);
   }
   return static_cast<int>(std::size(kCaptions));
 }
@@ -793,7 +811,13 @@ const char* kStyle =
     "section{border-top:2px solid #444;margin-top:2em}h3{margin-bottom:0.3em}"
     ".key{margin-right:1em;white-space:nowrap}.key i{display:inline-block;width:0.9em;height:0.9em;margin-right:0.3em;"
     "vertical-align:middle}#page-check{display:none;background:#fdd;padding:0.5em;border:1px solid #c00}"
-    "ul.files{columns:3;font-size:85%}";
+    "ul.files{columns:3;font-size:85%}.map-problem{color:#c00;font-weight:bold}"
+    // Print (geohaz-report --pdf, or the browser's own print): A4, each run from a new page,
+    // figures and tables never cut, pictures as wide as the page allows.
+    "@page{size:A4;margin:12mm}@media print{body{margin:0;max-width:none;font-size:10pt}"
+    "section{break-before:page;border-top:none}figure,table,tr,svg,img{break-inside:avoid}"
+    "img{max-width:100%;height:auto}figure{display:block;margin:0 0 4mm 0}figcaption{max-width:none}"
+    "details{display:block}details>summary{list-style:none}}";
 
 // The page checks itself on load: every image decoded, no resource or script error. The result is
 // kept in #page-check's attributes (read by the browser test, tests/report) and shown to the
@@ -815,6 +839,7 @@ const char* kCheckScript = R"(<script>
     d.setAttribute('data-images', imgs.length);
     d.setAttribute('data-decoded', decoded);
     d.setAttribute('data-errors', errors.length);
+    d.setAttribute('data-map-problems', document.querySelectorAll('.map-problem').length);
     if (errors.length) { d.textContent = 'Not shown: ' + errors.join('; '); d.style.display = 'block'; }
   });
 })();
@@ -829,9 +854,78 @@ void rows_table(std::ostringstream& o, const std::vector<Row>& rows) {
   o << "</table>\n";
 }
 
+/// The name of a run folder given itself: its own folder name (the absolute path's last part).
+std::string run_folder_name(const fs::path& root) {
+  const fs::path abs = fs::weakly_canonical(fs::absolute(root));
+  const std::string name = abs.filename().string();
+  return name.empty() ? "run" : name;
+}
+
+/// When RESULTS is itself a run folder (it holds the run's geohaz-manifest.txt), list the report's
+/// files in that manifest, so the next run into the folder removes them as its own (issue #29).
+void add_to_run_manifest(const fs::path& root, const std::vector<std::string>& files) {
+  const fs::path m = root / kOutputManifest;
+  std::ifstream in(m);
+  if (!in) return;
+  std::string first, line;
+  if (!std::getline(in, first) || first.rfind("app = ", 0) != 0) return;
+  std::set<std::string> listed;
+  while (std::getline(in, line))
+    if (!line.empty()) listed.insert(line);
+  in.close();
+  listed.insert(files.begin(), files.end());
+  std::string text = first + "\n";
+  for (const auto& f : listed) text += f + "\n";
+  write_text_file(m, text);
+}
+
 }  // namespace
 
-fs::path write_report(const fs::path& root, const std::string& title) {
+std::string find_chromium() {
+  for (const char* dir : {"/usr/bin", "/usr/local/bin", "/snap/bin"})
+    for (const char* name : {"chromium", "chromium-browser", "google-chrome"}) {
+      const fs::path p = fs::path(dir) / name;
+      std::error_code ec;
+      if (fs::exists(p, ec)) return p.string();
+    }
+  return "";
+}
+
+void print_pdf(const fs::path& html, const fs::path& pdf) {
+  const std::string chromium = find_chromium();
+  if (chromium.empty())
+    throw IoError("no Chromium to print the PDF with (install the Debian package chromium)", pdf.string());
+  const fs::path tmp = pdf.string() + ".partial";
+  const fs::path profile = fs::temp_directory_path() / ("geohaz-report-chromium-" + std::to_string(::getpid()));
+  const auto quote = [](const std::string& s) {
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+  };
+  // Headless, no network, no first-run or background work; A4 comes from the page's @page rule.
+  const std::string cmd = "DBUS_SESSION_BUS_ADDRESS=disabled: " + quote(chromium) +
+                          " --headless --no-sandbox --disable-gpu --no-first-run --disable-background-networking"
+                          " --disable-extensions --user-data-dir=" +
+                          quote(profile.string()) +
+                          " --no-pdf-header-footer --print-to-pdf-no-header --virtual-time-budget=10000"
+                          " --print-to-pdf=" +
+                          quote(tmp.string()) + " " + quote("file://" + fs::absolute(html).string()) +
+                          " >/dev/null 2>&1";
+  const int rc = std::system(cmd.c_str());
+  std::error_code ec;
+  fs::remove_all(profile, ec);
+  if (rc != 0 || !fs::exists(tmp, ec) || fs::file_size(tmp, ec) == 0) {
+    fs::remove(tmp, ec);
+    throw IoError("Chromium could not print the page to PDF (exit status " + std::to_string(rc) + ")", pdf.string());
+  }
+  fs::rename(tmp, pdf, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw IoError("cannot move the PDF into place: " + ec.message(), pdf.string());
+  }
+}
+
+fs::path write_report(const fs::path& root, const std::string& title, const fs::path& pdf) {
   if (!fs::is_directory(root)) throw InputError("not a directory", "", "RESULTS_DIR", root.string());
   std::vector<fs::path> runs;
   for (auto it = fs::recursive_directory_iterator(root); it != fs::recursive_directory_iterator(); ++it) {
@@ -854,7 +948,9 @@ fs::path write_report(const fs::path& root, const std::string& title) {
   for (const auto& dir : runs) {
     Run r;
     r.dir = dir;
-    r.name = fs::relative(dir, root).string();
+    // A run folder given itself (geohaz-report RUN_DIR) is named after the folder, never ".".
+    r.name = fs::relative(dir, root).generic_string();
+    if (r.name.empty() || r.name == ".") r.name = run_folder_name(root);
     try {
       r.summary = summarise(json::parse(slurp(dir / "summary.json")));
     } catch (const json::exception& e) {
@@ -864,6 +960,8 @@ fs::path write_report(const fs::path& root, const std::string& title) {
     std::vector<fs::path> csvs;
     for (const auto& e : fs::directory_iterator(dir)) {
       if (!e.is_regular_file()) continue;
+      const std::string fname = e.path().filename().string();
+      if (fname == "report.html" || fname == "report.pdf" || fname == kOutputManifest) continue;  // ours
       const auto ext = e.path().extension();
       if (ext == ".png")
         r.pngs.push_back(e.path());
@@ -885,6 +983,7 @@ fs::path write_report(const fs::path& root, const std::string& title) {
       if (!is_plottable(csv)) continue;
       std::string svg_name = r.name + "_" + c.stem().string() + ".svg";
       std::replace(svg_name.begin(), svg_name.end(), '/', '_');
+      while (!svg_name.empty() && svg_name.front() == '.') svg_name.erase(0, 1);  // nothing hidden
       r.plots.emplace_back(svg_name, svg_plot(csv, plot_title(c.stem().string()) + " (" + c.filename().string() + ")"));
     }
     all.push_back(std::move(r));
@@ -931,6 +1030,11 @@ fs::path write_report(const fs::path& root, const std::string& title) {
       body << "<figure><img alt=\"" << escape(stem) << "\" src=\"" << escape(fs::relative(p, root).generic_string())
            << "\"><figcaption><b>" << escape(p.filename().string()) << "</b> " << escape(caption);
       if (stem.rfind("cracks_", 0) == 0) body << "<br>" << kCrackLegend;
+      // A map drawn by write_quicklook_png must carry its legend, coordinate ticks and scale bar
+      // (check_map_png probes the pixels where its recorded layout puts them).
+      const auto problems = check_map_png(p);
+      if (problems.empty() || problems.front().rfind("records no map layout", 0) != 0)
+        for (const auto& m : problems) body << "<br><span class=map-problem>map check: " << escape(m) << "</span>";
       body << "</figcaption></figure>\n";
     }
     for (const auto& [name, svg] : r.plots)
@@ -963,6 +1067,14 @@ fs::path write_report(const fs::path& root, const std::string& title) {
        << head.str() << body.str() << "</body></html>\n";
   const fs::path out = root / "report.html";
   write_text_file(out, html.str());
+  std::vector<std::string> written{"report.html"};
+  for (const auto& r : all)
+    for (const auto& p : r.plots) written.push_back("report_files/" + p.first);
+  if (!pdf.empty()) {
+    print_pdf(out, pdf);
+    written.push_back(fs::relative(pdf, root).generic_string());
+  }
+  add_to_run_manifest(root, written);
   return out;
 }
 

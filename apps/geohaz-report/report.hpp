@@ -79,9 +79,20 @@ Summary summarise(const nlohmann::json& summary);
 /// keys of the parameter table are shown (the whole file is linked). Empty when there is no file.
 std::vector<Row> input_parameters(const std::filesystem::path& resolved_config);
 
-/// Write RESULTS/report.html and RESULTS/report_files/*.svg from every run folder (a sub-folder,
-/// up to two levels deep, holding a summary.json). InputError when there is none or a
-/// summary.json does not parse. Returns the path of report.html.
-std::filesystem::path write_report(const std::filesystem::path& results, const std::string& title);
+/// Write RESULTS/report.html and RESULTS/report_files/*.svg from every run folder (RESULTS itself
+/// or a sub-folder, up to two levels deep, holding a summary.json); with `pdf` not empty, print
+/// the page to that PDF too (print_pdf). A run folder given itself is named after the folder, and
+/// when RESULTS holds a run's geohaz-manifest.txt the report's files are added to it, so the next
+/// run into the folder cleans them. InputError when there is no run or a summary.json does not
+/// parse; IoError when the PDF cannot be made. Returns the path of report.html.
+std::filesystem::path write_report(const std::filesystem::path& results, const std::string& title,
+                                   const std::filesystem::path& pdf = {});
+
+/// Chromium's path ("" when none is installed).
+std::string find_chromium();
+
+/// Print an HTML page to PDF with headless Chromium (A4 from the page's @page rule, no header or
+/// footer), written as PDF.partial and renamed. IoError when no Chromium is installed or it fails.
+void print_pdf(const std::filesystem::path& html, const std::filesystem::path& pdf);
 
 }  // namespace geohaz::report

@@ -470,8 +470,20 @@ TEST(RasterRamp, EndpointsAreTheControlColours) {
   EXPECT_EQ(ramp_colour(ColourRamp::Viridis, 2.0), ramp_colour(ColourRamp::Viridis, 1.0));  // clamped
   EXPECT_EQ(ramp_colour(ColourRamp::Magma, -1.0), (std::array<std::uint8_t, 3>{0, 0, 4}));
   EXPECT_EQ(ramp_colour(ColourRamp::BlueRed, 0.5), (std::array<std::uint8_t, 3>{247, 247, 247}));
-  // Halfway between the first two Viridis stops (t = 0.125).
-  EXPECT_EQ(ramp_colour(ColourRamp::Viridis, 0.125), (std::array<std::uint8_t, 3>{64, 42, 112}));
+  // The full 256-entry tables: t = 0.125 is entry 32 of matplotlib's viridis, (0.278826,
+  // 0.175490, 0.483397) in sRGB fractions; the middle of magma is entry 128, (0.716387, 0.214982,
+  // 0.475290).
+  EXPECT_EQ(ramp_colour(ColourRamp::Viridis, 0.125), (std::array<std::uint8_t, 3>{71, 45, 123}));
+  EXPECT_EQ(ramp_colour(ColourRamp::Magma, 0.5), (std::array<std::uint8_t, 3>{183, 55, 121}));
+  // Perceptually uniform: the lightness rises monotonically along viridis (sum of channels as a
+  // proxy, weighted as luma).
+  double last = -1.0;
+  for (int k = 0; k <= 255; k += 5) {
+    const auto c = ramp_colour(ColourRamp::Viridis, k / 255.0);
+    const double luma = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    EXPECT_GT(luma, last) << k;
+    last = luma;
+  }
 }
 
 TEST_F(RasterTest, ImageWritesAPngThatGdalReadsBack) {
@@ -502,55 +514,72 @@ TEST_F(RasterTest, QuicklookHasHillshadeOverlayAndColourBar) {
   Raster over = dem.like(-1.0, -1.0);
   for (int row = 50; row < 100; ++row)
     for (int col = 100; col < 150; ++col) over.at(col, row) = 1.0 + (col - 100) * 0.1;
-  const fs::path png = dir_ / "quick.png";
-  write_quicklook_png(png, dem, &over, ColourRamp::Viridis, "max depth (m)");
-  const Image img = read_image(png);
-  EXPECT_EQ(img.width, 300);
-  EXPECT_GT(img.height, 200);  // the map plus the colour bar
-  EXPECT_LT(img.height, 300);
-  auto px = [&](int x, int y) {
-    const std::size_t i = (static_cast<std::size_t>(y) * img.width + x) * 3;
+  QuicklookOptions o;
+  o.title = "max depth";
+  o.unit = "m";
+  const MapLayout lay = write_quicklook_png(dir_ / "quick.png", dem, &over, o);
+  const Image img = read_image(dir_ / "quick.png");
+  // Print size: 1800 px wide, the whole 1500 m × 1000 m raster in a frame of at least 1600 px.
+  EXPECT_EQ(img.width, 1800);
+  EXPECT_EQ(img.height, lay.height);
+  EXPECT_GE(lay.frame_w, 1600);
+  EXPECT_NEAR(lay.frame_w * lay.metres_per_pixel, 1500.0, 1.0);
+  EXPECT_NEAR(lay.frame_h * lay.metres_per_pixel, 1000.0, 1.0);
+  auto px = [&](double x, double y) {
+    const std::size_t i = (static_cast<std::size_t>(y) * img.width + static_cast<std::size_t>(x)) * 3;
     return std::array<int, 3>{img.rgb[i], img.rgb[i + 1], img.rgb[i + 2]};
   };
   auto grey = [](std::array<int, 3> c) { return c[0] == c[1] && c[1] == c[2]; };
-  int coloured_inside = 0, grey_outside = 0, outside = 0;
-  for (int y = 0; y < 200; ++y)
-    for (int x = 0; x < 300; ++x) {
-      const bool in = x >= 100 && x < 150 && y >= 50 && y < 100;
-      if (in)
-        coloured_inside += !grey(px(x, y));
-      else {
-        ++outside;
-        grey_outside += grey(px(x, y));
-      }
+  // Pixel of a map point (metres from the raster's west and north edges).
+  const auto at = [&](double east, double south) {
+    return px(lay.frame_x + east / lay.metres_per_pixel, lay.frame_y + south / lay.metres_per_pixel);
+  };
+  // The overlay block (500–750 m east, 250–500 m south) is coloured; the hillshade around it grey
+  // (probed 3 px inside and outside its edges: the cells are drawn as cells, nearest).
+  int coloured = 0, probes = 0;
+  for (double e = 505; e < 750; e += 10)
+    for (double s = 255; s < 500; s += 10) {
+      ++probes;
+      coloured += !grey(at(e, s));
     }
-  EXPECT_EQ(coloured_inside, 50 * 50);
+  EXPECT_EQ(coloured, probes);
+  int grey_outside = 0, outside = 0;
+  for (double e = 20; e < 1500; e += 37)
+    for (double s = 20; s < 1000; s += 37) {
+      if (e > 480 && e < 770 && s > 230 && s < 520) continue;
+      if (e < 400 && s > 700) continue;  // the scale bar's box
+      ++outside;
+      grey_outside += grey(at(e, s));
+    }
   EXPECT_EQ(grey_outside, outside);
-  // The hillshade varies (sunny and shaded slopes), not one flat grey.
-  EXPECT_NE(px(10, 40), px(10, 160));
-  // The colour bar below the map has the ramp's ends.
+  // GDAL's hillshade varies (sunny and shaded slopes), not one flat grey.
+  EXPECT_NE(at(50, 200), at(50, 800));
+  // The colour bar below the frame carries the ramp; ticks and the CRS with its EPSG code.
   int bar = 0;
-  for (int y = 200; y < img.height; ++y)
-    for (int x = 0; x < 300; ++x) bar += !grey(px(x, y));
-  EXPECT_GT(bar, 200);
-  // Large rasters are downsampled to at most 1600 px.
+  for (int y = lay.legend_y; y < lay.legend_y + lay.legend_h; ++y)
+    for (int x = lay.legend_x; x < lay.legend_x + lay.legend_w; x += 3) bar += !grey(px(x, y));
+  EXPECT_GT(bar, 2000);
+  EXPECT_GE(lay.x_ticks, 3);
+  EXPECT_GE(lay.y_ticks, 2);
+  EXPECT_NE(lay.crs_label.find("EPSG:32632"), std::string::npos) << lay.crs_label;
+  EXPECT_NE(lay.crs_label.find("UTM zone 32N"), std::string::npos) << lay.crs_label;
+  // A large raster still gives one print-size picture.
   Raster wide = make_grid(3300, 12, 1.0, 1.0);
   fill(wide, [](double x, double) { return 0.01 * (x - 500000.0); });
   write_quicklook_png(dir_ / "wide.png", wide, nullptr, ColourRamp::Terrain, "elevation (m)");
   const Image w = read_image(dir_ / "wide.png");
-  EXPECT_LE(w.width, 1600);
-  EXPECT_GE(w.width, 1000);
+  EXPECT_EQ(w.width, 1800);
   // Mismatched overlay grid is an input error, and nothing is written.
   const Raster small = make_grid(10, 10, 5.0, 5.0);
   EXPECT_THROW(write_quicklook_png(dir_ / "bad.png", dem, &small, ColourRamp::Magma, "x"), InputError);
   EXPECT_FALSE(fs::exists(dir_ / "bad.png"));
 }
 
-// Issue #16: maps an engineer can hand on. A 300 × 200 grid of 5 m cells with an overlay block of
-// 50 × 50 cells (cols 100–149, rows 50–99), cropped with a 50 m margin (10 cells): the window is
-// cols 90–159 × rows 40–109 (70 cells), enlarged to 840 px (12 px per cell), so 5/12 m per pixel;
-// at that width the text scale is 2 (margins 12 px).
-TEST_F(RasterTest, QuicklookCropsScalesAndDrawsScaleBarArrowLinesAndClasses) {
+// Issue #33: a map an engineer can hand on. A 300 × 200 grid of 5 m cells, an overlay block of
+// 50 × 50 cells (cols 100–149, rows 50–99) at 2.6 m, an extent 50 m around it (cols 90–159 ×
+// rows 40–109: 350 m × 350 m), classes at 0.5/1/2 m, the block's outline, a line, scale bar and
+// north arrow.
+TEST_F(RasterTest, QuicklookOnAnExtentWithClassesOutlinesScaleBarAndArrow) {
   Raster dem = make_grid(300, 200, 5.0, 5.0);
   fill(dem, [](double x, double y) { return 1000.0 + 0.2 * (x - 500000.0) - 0.1 * (y - 5200000.0); });
   Raster over = dem.like(0.0, -9999.0);
@@ -559,60 +588,71 @@ TEST_F(RasterTest, QuicklookCropsScalesAndDrawsScaleBarArrowLinesAndClasses) {
   QuicklookOptions o;
   o.title = "peak flow depth";
   o.unit = "m";
-  o.crop_margin_m = 50.0;
+  o.ramp = ColourRamp::Viridis;
+  o.overlay_min = 0.01;
+  o.class_breaks = {0.5, 1.0, 2.0};
+  o.extent = map_extent(over, 0.01, 50.0);
   o.scale_bar = true;
   o.north_arrow = true;
-  o.classes = {{1.0, "low", {255, 221, 51}}, {3.0, "strong", {200, 30, 45}}};
-  // A line along the centre of cell row 45 from cell 95 to cell 155 (pixel row (45.5 − 40)·12 = 66).
+  o.outlines = mask_outlines(over, 0.01);
   o.lines = {{dem.cell_centre(95, 45), dem.cell_centre(155, 45)}};
-  write_quicklook_png(dir_ / "map.png", dem, &over, o);
+  o.attribution = "Terrain: test data";
+  ASSERT_EQ(o.outlines.size(), 1u);
+  EXPECT_EQ(o.outlines[0].size(), 5u);  // the block's four corners, closed
+  const auto& e = *o.extent;
+  EXPECT_DOUBLE_EQ(e[0], 500000.0 + 90 * 5.0);
+  EXPECT_DOUBLE_EQ(e[2], 500000.0 + 160 * 5.0);
+  EXPECT_DOUBLE_EQ(e[3], 5200000.0 - 40 * 5.0);
+  EXPECT_DOUBLE_EQ(e[1], 5200000.0 - 110 * 5.0);
+  const MapLayout lay = write_quicklook_png(dir_ / "map.png", dem, &over, o);
   const Image img = read_image(dir_ / "map.png");
-  ASSERT_EQ(img.width, 840);
-  ASSERT_GT(img.height, 840);
-  auto px = [&](int x, int y) {
-    const std::size_t i = (static_cast<std::size_t>(y) * img.width + x) * 3;
+  ASSERT_EQ(img.width, 1800);
+  EXPECT_NEAR(lay.frame_w * lay.metres_per_pixel, 350.0, 1.0);
+  auto px = [&](double x, double y) {
+    const std::size_t i = (static_cast<std::size_t>(y) * img.width + static_cast<std::size_t>(x)) * 3;
     return std::array<int, 3>{img.rgb[i], img.rgb[i + 1], img.rgb[i + 2]};
   };
-  auto grey = [](std::array<int, 3> c) { return c[0] == c[1] && c[1] == c[2]; };
-  // The overlay block is pixels 120–719 both ways, nothing else in the map is coloured; the value
-  // 2.6 is nearest the "strong" class, drawn red.
-  int coloured = 0, stray = 0;
-  for (int y = 0; y < 840; ++y)
-    for (int x = 0; x < 840; ++x) {
-      const bool in = x >= 120 && x < 720 && y >= 120 && y < 720;
-      if (!grey(px(x, y))) (in ? coloured : stray) += 1;
+  const auto at = [&](double east, double south) {  // metres from the extent's west and north edges
+    return px(lay.frame_x + east / lay.metres_per_pixel, lay.frame_y + south / lay.metres_per_pixel);
+  };
+  // 2.6 m is in the top class (≥ 2 m), drawn in its exact legend colour: viridis at 0.95.
+  const auto top = ramp_colour(ColourRamp::Viridis, 0.95);
+  const std::array<int, 3> top_i{top[0], top[1], top[2]};
+  EXPECT_EQ(at(175, 175), top_i);
+  EXPECT_EQ(at(100, 240), top_i);
+  // The legend shows the four class swatches in their exact colours and the two symbols.
+  int swatch_top = 0, swatch_low = 0;
+  const auto low = ramp_colour(ColourRamp::Viridis, 0.1);
+  for (int y = lay.legend_y; y < lay.legend_y + lay.legend_h; ++y)
+    for (int x = lay.legend_x; x < lay.legend_x + lay.legend_w; ++x) {
+      const auto c = px(x, y);
+      swatch_top += c == top_i;
+      swatch_low += c == std::array<int, 3>{low[0], low[1], low[2]};
     }
-  EXPECT_EQ(coloured, 600 * 600);
-  EXPECT_EQ(stray, 0);
-  const auto centre = px(420, 420);
-  EXPECT_GT(centre[0], 2 * centre[1]);
-  EXPECT_GT(centre[0], 2 * centre[2]);
-  // Scale bar: 50 m (the longest 1/2/5 × 10^k within a quarter of 840 px · 5/12 m) is 120 px;
-  // its black half is 60 px from x = 24, in the 10 rows just above y = 840 − 24.
-  EXPECT_EQ(px(24, 810), (std::array<int, 3>{0, 0, 0}));
-  EXPECT_EQ(px(83, 810), (std::array<int, 3>{0, 0, 0}));
-  EXPECT_EQ(px(100, 810), (std::array<int, 3>{255, 255, 255}));
-  EXPECT_EQ(px(144, 810), (std::array<int, 3>{0, 0, 0}));  // the frame's right end: 24 + 120
-  EXPECT_EQ(px(160, 810), px(160, 770));                   // hillshade beyond it
-  // North arrow: black pixels in the upper right corner box.
+  EXPECT_GT(swatch_top, 400);  // a 26 × 26 px swatch less its border
+  EXPECT_GT(swatch_low, 400);
+  // Scale bar: the longest 1/2/5 × 10^k m within a quarter of the frame: 50 m; its first quarter
+  // black, its second white.
+  EXPECT_DOUBLE_EQ(lay.scale_bar_m, 50.0);
+  EXPECT_NEAR(lay.scale_bar_px, 50.0 / lay.metres_per_pixel, 1.0);
+  const int q = lay.scale_bar_px / 4, yb = lay.scale_bar_y - 5;
+  EXPECT_EQ(px(lay.scale_bar_x + q / 2, yb), (std::array<int, 3>{0, 0, 0}));
+  EXPECT_EQ(px(lay.scale_bar_x + q + q / 2, yb), (std::array<int, 3>{255, 255, 255}));
+  // North arrow: black pixels in the frame's upper right corner.
   int arrow = 0;
-  for (int y = 0; y < 110; ++y)
-    for (int x = 760; x < 840; ++x) arrow += px(x, y) == std::array<int, 3>{0, 0, 0};
-  EXPECT_GT(arrow, 200);
-  // The line: dark on pixel rows 66–69 (4 px at text scale 2) between its ends (x 66–786).
-  EXPECT_EQ(px(300, 66), (std::array<int, 3>{20, 20, 20}));
-  EXPECT_EQ(px(300, 69), (std::array<int, 3>{20, 20, 20}));
-  EXPECT_NE(px(300, 72), (std::array<int, 3>{20, 20, 20}));
-  EXPECT_NE(px(40, 66), (std::array<int, 3>{20, 20, 20}));
-  // The class legend below the map shows both swatches in their exact colours.
-  int low = 0, strong = 0;
-  for (int y = 840; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x) {
-      low += px(x, y) == std::array<int, 3>{255, 221, 51};
-      strong += px(x, y) == std::array<int, 3>{200, 30, 45};
-    }
-  EXPECT_EQ(low, 400);  // 20 × 20 swatches at text scale 2
-  EXPECT_EQ(strong, 400);
+  for (int y = lay.frame_y; y < lay.frame_y + 140; ++y)
+    for (int x = lay.frame_x + lay.frame_w - 80; x < lay.frame_x + lay.frame_w; ++x)
+      arrow += px(x, y) == std::array<int, 3>{0, 0, 0};
+  EXPECT_GT(arrow, 300);
+  // The line along row 45 (5–10 m south of the extent's edge… its centre 27.5 m) is dark.
+  EXPECT_EQ(at(175, 27.5), (std::array<int, 3>{25, 25, 25}));
+  // Ticks on both axes and the CRS line.
+  EXPECT_GE(lay.x_ticks, 3);
+  EXPECT_GE(lay.y_ticks, 3);
+  EXPECT_NE(lay.crs_label.find("EPSG:32632"), std::string::npos);
+  // Decreasing class breaks are refused.
+  o.class_breaks = {1.0, 0.5};
+  EXPECT_THROW(write_quicklook_png(dir_ / "bad.png", dem, &over, o), InputError);
 }
 
 TEST(QuicklookTicks, NiceTicksFallOnOneTwoFiveSteps) {

@@ -8,10 +8,15 @@
 // Skipped (with a message) only when no chromium is installed; scripts/setup installs it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 
+#include "geohaz/core/app.hpp"
+#include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
 #include "geohaz/core/raster_extra.hpp"
 #include "report.hpp"
@@ -158,6 +163,9 @@ TEST(ReportInBrowser, EveryImageDecodesWithoutErrorsAndTheScreenshotShowsThePage
   EXPECT_EQ(page_mark(dom.output, "data-images"), static_cast<int>(images)) << dom.output;
   EXPECT_EQ(page_mark(dom.output, "data-decoded"), static_cast<int>(images)) << dom.output;
   EXPECT_EQ(page_mark(dom.output, "data-errors"), 0) << dom.output;
+  // Every map carries its legend, coordinate ticks and scale bar (issue #33).
+  EXPECT_EQ(page_mark(dom.output, "data-map-problems"), 0) << dom.output;
+  EXPECT_TRUE(geohaz::check_map_png(results / "1-runout" / "max_depth.png").empty());
   EXPECT_EQ(dom.output.find(":CONSOLE"), std::string::npos) << dom.output;  // nothing logged by the page
 
   const geohaz::Image img = geohaz::read_image(shot);
@@ -173,6 +181,63 @@ TEST(ReportInBrowser, EveryImageDecodesWithoutErrorsAndTheScreenshotShowsThePage
   EXPECT_GT(dark, 2000);
   EXPECT_GT(mid_grey, 2000);
 
+  // Control: maps drawn without a scale bar, without coordinates, or with the legend box blanked
+  // are each reported by the map check, and the page shows it.
+  {
+    geohaz::Raster dem;
+    dem.nx = 120;
+    dem.ny = 90;
+    dem.geotransform = {600000.0, 5.0, 0.0, 5100000.0, 0.0, -5.0};
+    dem.data.resize(static_cast<std::size_t>(dem.nx) * dem.ny);
+    for (int r = 0; r < dem.ny; ++r)
+      for (int c = 0; c < dem.nx; ++c) dem.at(c, r) = 1500.0 - 2.0 * std::hypot(c - 60.0, r - 45.0);
+    geohaz::QuicklookOptions o;
+    o.title = "peak flow depth";
+    o.unit = "m";
+    o.scale_bar = true;
+    const fs::path bad = root / "bad";
+    fs::create_directories(bad);
+    o.scale_bar = false;
+    geohaz::write_quicklook_png(bad / "no_scale.png", dem, &dem, o);
+    o.scale_bar = true;
+    o.coordinates = false;
+    geohaz::write_quicklook_png(bad / "no_ticks.png", dem, &dem, o);
+    o.coordinates = true;
+    const geohaz::MapLayout lay = geohaz::write_quicklook_png(bad / "no_legend.png", dem, &dem, o);
+    geohaz::Image img = geohaz::read_image(bad / "no_legend.png");
+    for (int y = lay.legend_y; y < lay.legend_y + lay.legend_h; ++y)
+      for (int x = lay.legend_x; x < lay.legend_x + lay.legend_w; ++x) img.set(x, y, {255, 255, 255});
+    const auto text = [&] {  // keep the recorded layout: rewrite with the same text chunk
+      return std::vector<std::pair<std::string, std::string>>{
+          {"geohaz_map", "frame=" + std::to_string(lay.frame_x) + "," + std::to_string(lay.frame_y) + "," +
+                             std::to_string(lay.frame_w) + "," + std::to_string(lay.frame_h) +
+                             ";legend=" + std::to_string(lay.legend_x) + "," + std::to_string(lay.legend_y) + "," +
+                             std::to_string(lay.legend_w) + "," + std::to_string(lay.legend_h) +
+                             ";scale_bar=" + std::to_string(lay.scale_bar_x) + "," + std::to_string(lay.scale_bar_y) +
+                             "," + std::to_string(lay.scale_bar_px) + ";ticks=" + std::to_string(lay.x_ticks) + "," +
+                             std::to_string(lay.y_ticks) + ";scale=1"}};
+    }();
+    geohaz::write_png(bad / "no_legend.png", img, text);
+    const auto has = [](const std::vector<std::string>& v, const std::string& what) {
+      return std::find(v.begin(), v.end(), what) != v.end();
+    };
+    const auto p1 = geohaz::check_map_png(bad / "no_scale.png"), p2 = geohaz::check_map_png(bad / "no_ticks.png"),
+               p3 = geohaz::check_map_png(bad / "no_legend.png");
+    EXPECT_TRUE(has(p1, "no scale bar")) << p1.size();
+    EXPECT_FALSE(has(p1, "no legend"));
+    EXPECT_TRUE(has(p2, "no coordinate ticks")) << p2.size();
+    EXPECT_FALSE(has(p2, "no scale bar"));
+    EXPECT_TRUE(has(p3, "no legend")) << p3.size();
+    EXPECT_FALSE(has(p3, "no coordinate ticks"));
+    // In the page: the map without a scale bar among the run's pictures is flagged.
+    fs::copy_file(bad / "no_scale.png", results / "1-runout" / "max_speed.png");
+    ASSERT_EQ(run_command(std::string("'") + GEOHAZ_REPORT_EXE + "' '" + results.string() + "'").code, 0);
+    const auto flagged = run_command(common + "--dump-dom " + url);
+    EXPECT_EQ(page_mark(flagged.output, "data-map-problems"), 1) << flagged.output;
+    fs::remove(results / "1-runout" / "max_speed.png");
+    ASSERT_EQ(run_command(std::string("'") + GEOHAZ_REPORT_EXE + "' '" + results.string() + "'").code, 0);
+  }
+
   // Control: a picture that is gone is reported by the page (so the marks above can fail).
   fs::remove(results / "2-rock-biaxial" / "cracks_sigma3_10MPa.png");
   const auto broken = run_command(common + "--dump-dom " + url);
@@ -181,6 +246,84 @@ TEST(ReportInBrowser, EveryImageDecodesWithoutErrorsAndTheScreenshotShowsThePage
   EXPECT_GE(page_mark(broken.output, "data-errors"), 1);
   EXPECT_NE(broken.output.find("cracks_sigma3_10MPa.png"), std::string::npos);
 
+  std::error_code ec;
+  fs::remove_all(root, ec);
+}
+
+// Issue #33 item 6: `geohaz-report --pdf` prints the page to an A4 PDF, each run from a new page.
+// pdfinfo gives the page count and size, pdftoppm renders the first page, which must not be blank.
+TEST(ReportInBrowser, PdfIsA4WithARunPerPageAndAFirstPageThatShowsSomething) {
+  if (geohaz::report::find_chromium().empty()) GTEST_SKIP() << "chromium is not installed (scripts/setup)";
+  if (run_command("command -v pdfinfo && command -v pdftoppm").code != 0)
+    GTEST_SKIP() << "poppler-utils is not installed (scripts/setup)";
+  const fs::path root = fs::temp_directory_path() /
+                        ("geohaz_report_pdf_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+  fs::remove_all(root);
+  make_results(root / "results");
+  const fs::path results = root / "results";
+  const auto gen = run_command(std::string("'") + GEOHAZ_REPORT_EXE + "' '" + results.string() + "' --pdf");
+  ASSERT_EQ(gen.code, 0) << gen.output;
+  ASSERT_TRUE(fs::exists(results / "report.pdf"));
+  EXPECT_FALSE(fs::exists(results / "report.pdf.partial"));
+  const auto info = run_command("pdfinfo '" + (results / "report.pdf").string() + "'");
+  ASSERT_EQ(info.code, 0) << info.output;
+  // A4 is 595 × 842 pt (210 × 297 mm); pdfinfo names it.
+  EXPECT_NE(info.output.find(" pts (A4)"), std::string::npos) << info.output;
+  const auto pages_at = info.output.find("Pages:");
+  ASSERT_NE(pages_at, std::string::npos);
+  const int pages = std::stoi(info.output.substr(pages_at + 6));
+  // The title and overview, then each of the two runs from a new page; the biaxial run fits one.
+  EXPECT_GE(pages, 3) << info.output;
+  EXPECT_LE(pages, 8) << info.output;
+  const auto text = run_command("pdftotext -f 2 -l 2 '" + (results / "report.pdf").string() + "' -");
+  EXPECT_EQ(text.output.rfind("1-runout", 0), 0u) << text.output.substr(0, 200);  // page 2 opens the first run
+  const auto ppm = run_command("pdftoppm -f 1 -l 1 -r 40 -png '" + (results / "report.pdf").string() + "' '" +
+                               (root / "page").string() + "'");
+  ASSERT_EQ(ppm.code, 0) << ppm.output;
+  fs::path first;
+  for (const auto& e : fs::directory_iterator(root))
+    if (e.path().extension() == ".png") first = e.path();
+  ASSERT_FALSE(first.empty());
+  const geohaz::Image img = geohaz::read_image(first);
+  int dark = 0;
+  for (std::size_t i = 0; i < img.rgb.size(); i += 3) dark += img.rgb[i] < 100 && img.rgb[i + 1] < 100;
+  EXPECT_GT(dark, 200);  // the title and the overview table, not a white page
+  std::error_code ec;
+  fs::remove_all(root, ec);
+}
+
+// Issue #29 item 6: the report written into a run folder names the run after the folder, writes
+// nothing hidden, and lists its files in the run's manifest, so the next run into the folder
+// (run_in_output_dir, the --out policy of every app) cleans them instead of refusing.
+TEST(ReportInRunFolder, NamesTheRunAfterItsFolderAndTheNextRunAcceptsTheFolder) {
+  const fs::path root = fs::temp_directory_path() /
+                        ("geohaz_report_run_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+  fs::remove_all(root);
+  const fs::path run = root / "my-run";
+  const auto body = [&] {
+    write_file(run / "summary.json", R"({"model": "debris-runout", "max_speed_m_s": 12.5})");
+    write_file(run / "series.csv", "time_s,max_speed_m_s\n0,0\n1,5\n2,12.5\n");
+    return 0;
+  };
+  fs::create_directories(run);
+  ASSERT_EQ(geohaz::run_in_output_dir(run, "debris-runout", {}, body), 0);
+  geohaz::report::write_report(run, "one run");
+  const std::string html = slurp(run / "report.html");
+  EXPECT_NE(html.find("<h2>my-run</h2>"), std::string::npos);
+  EXPECT_EQ(html.find("<h2>.</h2>"), std::string::npos);
+  for (auto it = fs::recursive_directory_iterator(run); it != fs::recursive_directory_iterator(); ++it)
+    EXPECT_NE(it->path().filename().string().front(), '.') << it->path();
+  EXPECT_TRUE(fs::exists(run / "report_files" / "my-run_series.svg"));
+  const std::string manifest = slurp(run / geohaz::kOutputManifest);
+  EXPECT_NE(manifest.find("report.html\n"), std::string::npos) << manifest;
+  EXPECT_NE(manifest.find("report_files/my-run_series.svg\n"), std::string::npos) << manifest;
+  // The next run into the folder: accepted, and the old report is gone with the old run.
+  EXPECT_NO_THROW(geohaz::run_in_output_dir(run, "debris-runout", {}, body));
+  EXPECT_FALSE(fs::exists(run / "report.html"));
+  EXPECT_FALSE(fs::exists(run / "report_files"));
+  // Control: a file the run did not write still stops the next run (exit 2).
+  write_file(run / "notes.txt", "mine");
+  EXPECT_THROW(geohaz::run_in_output_dir(run, "debris-runout", {}, body), geohaz::InputError);
   std::error_code ec;
   fs::remove_all(root, ec);
 }

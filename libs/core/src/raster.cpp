@@ -7,6 +7,7 @@
 #include <cpl_conv.h>
 #include <cpl_error.h>
 #include <gdal_priv.h>
+#include <gdal_rat.h>
 #include <ogr_spatialref.h>
 
 #include <algorithm>
@@ -207,6 +208,8 @@ Raster read_raster(const std::filesystem::path& path, CrsPolicy policy) {
   const double nd = band->GetNoDataValue(&has_nodata);
   if (has_nodata) r.nodata = nd;
   if (const char* d = band->GetDescription()) r.description = d;
+  for (const char* item : {"TIFFTAG_COPYRIGHT", "ATTRIBUTION", "COPYRIGHT", "LICENSE"})
+    if (const char* a = ds->GetMetadataItem(item); a && *a && r.attribution.empty()) r.attribution = a;
   if (const char* u = band->GetUnitType()) r.unit = u;
 
   // The header alone may declare any size (a 1.8 MB sparse GeoTIFF can declare 10^10 cells): check
@@ -231,24 +234,73 @@ Raster read_raster(const std::filesystem::path& path, CrsPolicy policy) {
   return r;
 }
 
-void write_geotiff(const std::filesystem::path& path, const Raster& r, bool float64) {
+namespace {
+
+/// Copy an in-memory raster into a Cloud-Optimized GeoTIFF at `path` (deflate, 256 × 256 tiles,
+/// nearest-neighbour overviews) through "<path>.partial", renamed when complete; a PAM side-car
+/// (.aux.xml, where GDAL keeps a raster attribute table) is renamed with it.
+void copy_to_cog(GDALDataset* src, const std::filesystem::path& path) {
   const std::string file = path.string();
+  // The COG driver does not depend on the extension, so "<name>.partial" (the project-wide
+  // temporary name that remove_partial_files() knows) works.
+  const std::string tmp = file + ".partial";
+  GDALDriver* cog = GetGDALDriverManager()->GetDriverByName("COG");
+  if (!cog) throw std::runtime_error("GDAL has no COG driver");
+  // From here on a failure is the file system's (full disk, size limit, permission): IoError.
+  const char* options[] = {"COMPRESS=DEFLATE", "BLOCKSIZE=256", "RESAMPLING=NEAREST", "OVERVIEWS=AUTO", nullptr};
+  CPLErrorReset();
+  bool ok = true;
+  {
+    std::unique_ptr<GDALDataset> ds(
+        cog->CreateCopy(tmp.c_str(), src, FALSE, const_cast<char**>(options), nullptr, nullptr));
+    if (!ds) {
+      const std::string msg = gdal_last_error();
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);
+      std::filesystem::remove(tmp + ".aux.xml", ec);
+      throw IoError("cannot write the GeoTIFF" + msg, file);
+    }
+    ok = CPLGetLastErrorType() != CE_Failure && CPLGetLastErrorType() != CE_Fatal;
+  }  // closes the dataset (writes the rest)
+  ok = ok && CPLGetLastErrorType() != CE_Failure && CPLGetLastErrorType() != CE_Fatal;
+  std::error_code ec;
+  if (!ok) {
+    const std::string msg = gdal_last_error();
+    std::filesystem::remove(tmp, ec);
+    std::filesystem::remove(tmp + ".aux.xml", ec);
+    throw IoError("writing the GeoTIFF failed" + msg, file);
+  }
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    std::filesystem::remove(tmp + ".aux.xml", ec);
+    throw IoError("cannot move the GeoTIFF into place: " + ec.message(), file);
+  }
+  if (std::filesystem::exists(tmp + ".aux.xml", ec)) {
+    std::filesystem::rename(tmp + ".aux.xml", file + ".aux.xml", ec);
+    if (ec) throw IoError("cannot move the GeoTIFF's side-car into place: " + ec.message(), file + ".aux.xml");
+  }
+}
+
+void check_writable(const Raster& r, const std::string& file, OGRSpatialReference& srs) {
   if (r.nx <= 0 || r.ny <= 0 || r.data.size() != static_cast<std::size_t>(r.nx) * static_cast<std::size_t>(r.ny))
     throw InputError("cannot write an empty or inconsistent raster (" + std::to_string(r.nx) + " x " +
                          std::to_string(r.ny) + ", " + std::to_string(r.data.size()) + " values)",
                      file);
   ensure_gdal_registered();
-  OGRSpatialReference srs;
   if (!r.crs_wkt.empty() && !detail::parse_srs(r.crs_wkt, srs))
     throw InputError("the raster's CRS cannot be interpreted", file, "", r.crs_wkt);
+}
 
-  // The COG driver does not depend on the extension, so "<name>.partial" (the project-wide
-  // temporary name that remove_partial_files() knows) works.
-  const std::string tmp = file + ".partial";
+}  // namespace
+
+void write_geotiff(const std::filesystem::path& path, const Raster& r, bool float64) {
+  const std::string file = path.string();
+  OGRSpatialReference srs;
+  check_writable(r, file, srs);
   QuietGdalErrors quiet;
   GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
-  GDALDriver* cog = GetGDALDriverManager()->GetDriverByName("COG");
-  if (!mem || !cog) throw std::runtime_error("GDAL has no MEM or COG driver");
+  if (!mem) throw std::runtime_error("GDAL has no MEM driver");
   // The raster is assembled in memory, then copied by the COG driver (tiles, overviews, layout).
   std::unique_ptr<GDALDataset> src(mem->Create("", r.nx, r.ny, 1, float64 ? GDT_Float64 : GDT_Float32, nullptr));
   if (!src) throw std::runtime_error("GDAL cannot create an in-memory raster" + gdal_last_error());
@@ -262,33 +314,60 @@ void write_geotiff(const std::filesystem::path& path, const Raster& r, bool floa
   if (band->RasterIO(GF_Write, 0, 0, r.nx, r.ny, const_cast<double*>(r.data.data()), r.nx, r.ny, GDT_Float64, 0, 0,
                      nullptr) != CE_None)
     throw std::runtime_error("GDAL cannot fill an in-memory raster" + gdal_last_error());
-  // From here on a failure is the file system's (full disk, size limit, permission): IoError.
-  const char* options[] = {"COMPRESS=DEFLATE", "BLOCKSIZE=256", "RESAMPLING=NEAREST", "OVERVIEWS=AUTO", nullptr};
-  CPLErrorReset();
-  bool ok = true;
-  {
-    std::unique_ptr<GDALDataset> ds(
-        cog->CreateCopy(tmp.c_str(), src.get(), FALSE, const_cast<char**>(options), nullptr, nullptr));
-    if (!ds) {
-      const std::string msg = gdal_last_error();
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);
-      throw IoError("cannot write the GeoTIFF" + msg, file);
-    }
-    ok = CPLGetLastErrorType() != CE_Failure && CPLGetLastErrorType() != CE_Fatal;
-  }  // closes the dataset (writes the rest)
-  ok = ok && CPLGetLastErrorType() != CE_Failure && CPLGetLastErrorType() != CE_Fatal;
-  std::error_code ec;
-  if (!ok) {
-    const std::string msg = gdal_last_error();
-    std::filesystem::remove(tmp, ec);
-    throw IoError("writing the GeoTIFF failed" + msg, file);
+  copy_to_cog(src.get(), path);
+}
+
+void write_class_geotiff(const std::filesystem::path& path, const Raster& r, const std::vector<StyleClass>& legend) {
+  const std::string file = path.string();
+  OGRSpatialReference srs;
+  check_writable(r, file, srs);
+  QuietGdalErrors quiet;
+  GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+  if (!mem) throw std::runtime_error("GDAL has no MEM driver");
+  std::unique_ptr<GDALDataset> src(mem->Create("", r.nx, r.ny, 1, GDT_Byte, nullptr));
+  if (!src) throw std::runtime_error("GDAL cannot create an in-memory raster" + gdal_last_error());
+  std::array<double, 6> gt = r.geotransform;
+  src->SetGeoTransform(gt.data());
+  if (!r.crs_wkt.empty()) src->SetSpatialRef(&srs);
+  GDALRasterBand* band = src->GetRasterBand(1);
+  constexpr std::uint8_t kNodata = 255;
+  band->SetNoDataValue(kNodata);
+  if (!r.description.empty()) band->SetDescription(r.description.c_str());
+  if (!r.unit.empty()) band->SetUnitType(r.unit.c_str());
+  std::vector<std::uint8_t> v(r.data.size());
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    const double x = r.data[k];
+    v[k] =
+        !std::isfinite(x) || r.is_nodata(x) ? kNodata : static_cast<std::uint8_t>(std::clamp(std::lround(x), 0L, 254L));
   }
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw IoError("cannot move the GeoTIFF into place: " + ec.message(), file);
+  if (band->RasterIO(GF_Write, 0, 0, r.nx, r.ny, v.data(), r.nx, r.ny, GDT_Byte, 0, 0, nullptr) != CE_None)
+    throw std::runtime_error("GDAL cannot fill an in-memory raster" + gdal_last_error());
+  // Colour table: each class in its colour, everything else (0 = not reached, nodata) white.
+  GDALColorTable ct;
+  for (int k = 0; k < 256; ++k) {
+    GDALColorEntry e{255, 255, 255, 0};
+    for (const auto& c : legend)
+      if (std::lround(c.value) == k) e = {c.colour[0], c.colour[1], c.colour[2], 255};
+    ct.SetColorEntry(k, &e);
   }
+  band->SetColorTable(&ct);
+  band->SetColorInterpretation(GCI_PaletteIndex);
+  // Raster attribute table: value, class label, colour.
+  GDALDefaultRasterAttributeTable rat;
+  rat.CreateColumn("value", GFT_Integer, GFU_MinMax);
+  rat.CreateColumn("class", GFT_String, GFU_Name);
+  rat.CreateColumn("red", GFT_Integer, GFU_Red);
+  rat.CreateColumn("green", GFT_Integer, GFU_Green);
+  rat.CreateColumn("blue", GFT_Integer, GFU_Blue);
+  rat.SetRowCount(static_cast<int>(legend.size()));
+  for (std::size_t k = 0; k < legend.size(); ++k) {
+    const int row = static_cast<int>(k);
+    rat.SetValue(row, 0, static_cast<int>(std::lround(legend[k].value)));
+    rat.SetValue(row, 1, legend[k].label.c_str());
+    for (int c = 0; c < 3; ++c) rat.SetValue(row, 2 + c, static_cast<int>(legend[k].colour[c]));
+  }
+  band->SetDefaultRAT(&rat);
+  copy_to_cog(src.get(), path);
 }
 
 // ---------------------------------------------------------------------------------------------

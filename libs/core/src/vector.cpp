@@ -1,11 +1,15 @@
 /// \file vector.cpp
 /// Polygons and lines from OGR data sources (Shapefile, GeoJSON, GeoPackage, ...), see raster.hpp.
 
+#include <cpl_string.h>
+#include <gdal_alg.h>
 #include <gdal_priv.h>
+#include <gdal_utils.h>
 #include <ogr_spatialref.h>
 #include <ogrsf_frmts.h>
 
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <memory>
 
@@ -220,6 +224,104 @@ std::vector<Polyline> read_lines(const std::filesystem::path& path, const std::s
   }
   if (out.empty()) throw InputError("no line in the first layer ('" + std::string(v.layer->GetName()) + "')", file);
   return out;
+}
+
+}  // namespace geohaz
+
+// ---------------------------------------------------------------------------------------------
+// Class zones as polygons
+
+namespace geohaz {
+
+void write_class_zones(const std::filesystem::path& gpkg, const std::filesystem::path& kml, const Raster& classes,
+                       const std::string& layer, const std::vector<StyleClass>& legend) {
+  detail::ensure_gdal_registered();
+  detail::QuietGdalErrors quiet;
+  const std::string file = gpkg.string();
+  GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+  GDALDriver* gpkg_driver = GetGDALDriverManager()->GetDriverByName("GPKG");
+  GDALDriver* kml_driver = GetGDALDriverManager()->GetDriverByName("KML");
+  if (!mem || !gpkg_driver) throw std::runtime_error("GDAL lacks the MEM or GPKG driver");
+  // The class raster as Int32, nodata and classes ≤ 0 masked out.
+  std::unique_ptr<GDALDataset> src(mem->Create("", classes.nx, classes.ny, 2, GDT_Int32, nullptr));
+  if (!src) throw std::runtime_error("cannot create an in-memory raster" + detail::gdal_last_error());
+  std::array<double, 6> gt = classes.geotransform;
+  src->SetGeoTransform(gt.data());
+  std::vector<std::int32_t> value(classes.data.size()), mask(classes.data.size());
+  for (std::size_t k = 0; k < value.size(); ++k) {
+    const double v = classes.data[k];
+    const bool on = std::isfinite(v) && !classes.is_nodata(v) && v > 0.0;
+    value[k] = on ? static_cast<std::int32_t>(std::lround(v)) : 0;
+    mask[k] = on ? 1 : 0;
+  }
+  if (src->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, classes.nx, classes.ny, value.data(), classes.nx, classes.ny,
+                                      GDT_Int32, 0, 0, nullptr) != CE_None ||
+      src->GetRasterBand(2)->RasterIO(GF_Write, 0, 0, classes.nx, classes.ny, mask.data(), classes.nx, classes.ny,
+                                      GDT_Int32, 0, 0, nullptr) != CE_None)
+    throw std::runtime_error("cannot fill the in-memory raster" + detail::gdal_last_error());
+
+  const std::string tmp = file + ".partial";
+  std::error_code ec;
+  std::filesystem::remove(tmp, ec);
+  {
+    std::unique_ptr<GDALDataset> out(gpkg_driver->Create(tmp.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+    if (!out) throw IoError("cannot create the GeoPackage" + detail::gdal_last_error(), file);
+    OGRSpatialReference srs;
+    const bool has_srs = !classes.crs_wkt.empty() && detail::parse_srs(classes.crs_wkt, srs);
+    if (has_srs) srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    OGRLayer* lyr = out->CreateLayer(layer.c_str(), has_srs ? &srs : nullptr, wkbPolygon, nullptr);
+    if (!lyr) throw IoError("cannot create the layer " + layer + detail::gdal_last_error(), file);
+    OGRFieldDefn cls("class", OFTInteger);
+    OGRFieldDefn label("label", OFTString);
+    OGRFieldDefn colour("colour", OFTString);
+    if (lyr->CreateField(&cls) != OGRERR_NONE || lyr->CreateField(&label) != OGRERR_NONE ||
+        lyr->CreateField(&colour) != OGRERR_NONE)
+      throw IoError("cannot create the layer's fields" + detail::gdal_last_error(), file);
+    out->StartTransaction();
+    // 4-connected polygons of equal class (GDALPolygonize), written into field 0 ("class").
+    if (GDALPolygonize(src->GetRasterBand(1), src->GetRasterBand(2), lyr, 0, nullptr, nullptr, nullptr) != CE_None)
+      throw IoError("cannot polygonise the classes" + detail::gdal_last_error(), file);
+    // Labels and colours (the OGR style string lets QGIS and Google Earth draw each class).
+    lyr->ResetReading();
+    std::vector<std::unique_ptr<OGRFeature>> feats;
+    while (OGRFeature* f = lyr->GetNextFeature()) feats.emplace_back(f);
+    for (auto& f : feats) {
+      const int k = f->GetFieldAsInteger(0);
+      for (const auto& c : legend)
+        if (std::lround(c.value) == k) {
+          char hex[8];
+          std::snprintf(hex, sizeof hex, "#%02x%02x%02x", c.colour[0], c.colour[1], c.colour[2]);
+          f->SetField(1, c.label.c_str());
+          f->SetField(2, hex);
+          f->SetStyleString((std::string("BRUSH(fc:") + hex + "b0);PEN(c:" + hex + ",w:1px)").c_str());
+        }
+      if (lyr->SetFeature(f.get()) != OGRERR_NONE)
+        throw IoError("cannot label the zones" + detail::gdal_last_error(), file);
+    }
+    if (out->CommitTransaction() != OGRERR_NONE)
+      throw IoError("cannot write the GeoPackage" + detail::gdal_last_error(), file);
+    // KML (WGS 84, as Google Earth and phones read it) as a copy of the layer.
+    if (!kml.empty() && kml_driver) {
+      const std::string ktmp = kml.string() + ".partial";
+      std::filesystem::remove(ktmp, ec);
+      CPLStringList args;
+      for (const char* a : {"-f", "KML", "-t_srs", "EPSG:4326", "-dsco", "NameField=label"}) args.AddString(a);
+      std::unique_ptr<GDALVectorTranslateOptions, void (*)(GDALVectorTranslateOptions*)> opts(
+          GDALVectorTranslateOptionsNew(args.List(), nullptr), GDALVectorTranslateOptionsFree);
+      GDALDatasetH in = GDALDataset::ToHandle(out.get());
+      int usage = 0;
+      GDALDatasetH k = GDALVectorTranslate(ktmp.c_str(), nullptr, 1, &in, opts.get(), &usage);
+      if (!k) throw IoError("cannot write the KML" + detail::gdal_last_error(), kml.string());
+      GDALClose(k);
+      std::filesystem::rename(ktmp, kml, ec);
+      if (ec) throw IoError("cannot move the KML into place: " + ec.message(), kml.string());
+    }
+  }
+  std::filesystem::rename(tmp, gpkg, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw IoError("cannot move the GeoPackage into place: " + ec.message(), file);
+  }
 }
 
 }  // namespace geohaz

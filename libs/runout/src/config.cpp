@@ -255,6 +255,37 @@ void read_barriers(ConfigReader& cfg, BarrierSpec& b) {
               {"m", "retained volume = volume upstream of the line within this distance at the end"});
 }
 
+/// The map keys (docs/runout.md "Outputs"): class breaks of the depth and pressure maps, the
+/// margin around the affected area and the attribution printed under every map.
+void read_map_settings(ConfigReader& cfg, OutputSettings& o) {
+  const std::string file = cfg.source().empty() ? "command line" : cfg.source();
+  const auto increasing = [&](const char* key, const std::vector<double>& v, const char* unit) {
+    for (std::size_t k = 1; k < v.size(); ++k)
+      if (!(v[k] > v[k - 1]))
+        throw InputError(std::string(key) + " must increase (got " + std::to_string(v[k - 1]) + " then " +
+                             std::to_string(v[k]) + " " + unit + ")",
+                         file, key);
+    return v;
+  };
+  o.map_depth_classes = increasing(
+      "output.map_depth_classes",
+      cfg.get_array("output.map_depth_classes", o.map_depth_classes, Range::open_closed(0.0, 1e3),
+                    {"m", "class breaks of the peak depth and deposit maps, increasing (empty: a continuous ramp)"}),
+      "m");
+  o.map_pressure_classes = increasing(
+      "output.map_pressure_classes",
+      cfg.get_array(
+          "output.map_pressure_classes", o.map_pressure_classes, Range::open_closed(0.0, 1e9),
+          {"Pa", "class breaks of the peak pressure map, increasing (shown in kPa; empty: a continuous ramp)"}),
+      "Pa");
+  o.map_margin = cfg.get("output.map_margin", o.map_margin, Range::closed(0.0, 1e5),
+                         {"m", "margin around the affected area (and the release) in every map of the run"});
+  o.attribution = cfg.get_string("output.attribution", o.attribution,
+                                 {"",
+                                  "data attribution printed under every map (the terrain's licence often asks "
+                                  "for it); empty: the DSM's own metadata (TIFFTAG_COPYRIGHT), if any"});
+}
+
 }  // namespace
 
 RunoutCase read_case(ConfigReader& cfg) {
@@ -344,6 +375,7 @@ RunoutCase read_case(ConfigReader& cfg) {
                      cfg.source().empty() ? "command line" : cfg.source(), "intensity.pressure_classes");
   it.medium_pressure = classes[0];
   it.strong_pressure = classes[1];
+  read_map_settings(cfg, o);
   return c;
 }
 

@@ -952,10 +952,8 @@ void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, 
   const auto prob = [&](int field, double t, const std::string& name, const std::string& what) {
     Raster r = put(name, agg.exceedance(field, t), what + of_n, "1", ColourRamp::BlueRed, 1.0);
     if (first_probability.data.empty()) {
-      // The picture's font has no '>': words instead.
       first_probability = r, first_label = what;
-      for (const auto& [sym, word] : {std::pair<std::string, std::string>{" >= ", " at least "}, {" > ", " above "}})
-        for (std::size_t k; (k = first_label.find(sym)) != std::string::npos;) first_label.replace(k, sym.size(), word);
+      for (std::size_t k; (k = first_label.find(" >= ")) != std::string::npos;) first_label.replace(k, 4, " \u2265 ");
     }
   };
   for (double t : a.depth_thresholds)
@@ -969,23 +967,52 @@ void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, 
   for (int k : a.intensity_classes)
     prob(3, k, "prob_intensity_ge_" + std::to_string(k),
          "probability intensity class >= " + std::to_string(k) + " (" + to_string(a.intensity.scheme) + ")");
+  std::vector<std::pair<std::string, Raster>> depth_maps;  // mean and percentiles of the peak depth, drawn below
   for (int f = 0; f < 3; ++f) {
     const ColourRamp ramp = f == 0 ? ColourRamp::Viridis : ColourRamp::Magma;
-    put(std::string("mean_") + kFieldNames[f], agg.mean(f), std::string("mean ") + kFieldDescriptions[f] + of_n,
-        kFieldUnits[f], ramp, 0.0);
+    Raster mean = put(std::string("mean_") + kFieldNames[f], agg.mean(f),
+                      std::string("mean ") + kFieldDescriptions[f] + of_n, kFieldUnits[f], ramp, 0.0);
+    if (f == 0) depth_maps.emplace_back(std::string("mean_") + kFieldNames[f], std::move(mean));
     for (double q : a.percentiles) {
       std::string name = "p";  // built step by step: GCC 12 warns (-Wrestrict, a false positive) on "p" + string
       name += threshold_name(q);
       name += '_';
       name += kFieldNames[f];
-      put(name, agg.percentile(f, q),
-          "percentile " + threshold_name(q) + " of the " + kFieldDescriptions[f] + of_n + " (log-binned histogram)",
-          kFieldUnits[f], ramp, 0.0);
+      Raster pr =
+          put(name, agg.percentile(f, q),
+              "percentile " + threshold_name(q) + " of the " + kFieldDescriptions[f] + of_n + " (log-binned histogram)",
+              kFieldUnits[f], ramp, 0.0);
+      if (f == 0) depth_maps.emplace_back(name, std::move(pr));
     }
   }
-  if (!first_probability.data.empty())
-    write_quicklook_png(out / "probability.png", dsm, &first_probability, ColourRamp::BlueRed, first_label, 0.0, 1.0,
-                        1e-9);
+  if (!first_probability.data.empty()) {
+    // The first probability map over the cells any member reached (200 m around), in classes of a
+    // sequential ramp, with coordinates, scale bar and north arrow (issue #33).
+    QuicklookOptions o;
+    o.ramp = ColourRamp::Viridis;
+    o.title = first_label;
+    o.overlay_min = 1e-9;
+    o.vmin = 0.0;
+    o.vmax = 1.0;
+    o.class_breaks = {0.1, 0.3, 0.5, 0.7, 0.9};
+    o.extent = map_extent(first_probability, 1e-9, 200.0);
+    o.scale_bar = true;
+    o.north_arrow = true;
+    if (!dsm.attribution.empty()) o.attribution = "Terrain: " + dsm.attribution;
+    write_quicklook_png(out / "probability.png", dsm, &first_probability, o);
+    // The mean and percentile maps of the peak depth on the same extent, in the depth classes of
+    // the single runs (0.5, 1, 2 m).
+    for (const auto& [name, r] : depth_maps) {
+      QuicklookOptions d = o;
+      d.title = name.rfind("mean", 0) == 0 ? "mean peak flow depth" + of_n
+                                           : "percentile " + name.substr(1, name.find('_') - 1) + " of peak flow depth";
+      d.unit = "m";
+      d.overlay_min = 0.01;
+      d.vmin = d.vmax = 0.0;
+      d.class_breaks = OutputSettings{}.map_depth_classes;
+      write_quicklook_png(out / (name + ".png"), dsm, &r, d);
+    }
+  }
 
   // 4. The member table, the distributions of run-out and H/L, the summary.
   {

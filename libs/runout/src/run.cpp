@@ -16,6 +16,7 @@
 #include "geohaz/core/output.hpp"
 #include "geohaz/core/progress.hpp"
 #include "geohaz/core/snapshot.hpp"
+#include "geohaz/runout/profile.hpp"
 
 namespace fs = std::filesystem;
 
@@ -622,6 +623,38 @@ std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int t
   return j.dump(2);
 }
 
+/// The thalweg profile along the flow's own centreline (profile.hpp): from the highest cell of the
+/// release through the depth-weighted centroids of the arrival fronts (arrival_centreline, one per
+/// output.series_interval); points off the DSM's data are skipped.
+void write_flow_profile(const RunoutCase& c, const RunoutSimulation& sim, const Raster& depth, const Raster& speed,
+                        const Raster& pressure, const Raster& arrival, const fs::path& out) {
+  const Raster& dsm = sim.inputs().dsm;
+  const Terrain terrain(dsm);
+  Vec2 start(std::numeric_limits<double>::quiet_NaN(), 0.0);
+  double z_top = -std::numeric_limits<double>::infinity();
+  const auto& thick = sim.inputs().thickness;
+  for (int row = 0; row < dsm.ny; ++row)
+    for (int col = 0; col < dsm.nx; ++col) {
+      const std::size_t k = static_cast<std::size_t>(row) * dsm.nx + col;
+      if (k >= thick.size() || !(thick[k] > 0.0)) continue;
+      const Vec2 q = dsm.cell_centre(col, row);
+      const double z = terrain.elevation(q.x(), q.y());
+      if (std::isfinite(z) && z > z_top) {
+        z_top = z;
+        start = q;
+      }
+    }
+  if (!std::isfinite(start.x())) return;  // no release on the grid (a hand-off outside it): no profile
+  std::vector<Vec2> path;
+  for (const Vec2& q : arrival_centreline(arrival, depth, start, c.output.series_interval, dsm.cell_size_x()))
+    if (std::isfinite(terrain.elevation(q.x(), q.y()))) path.push_back(q);
+  if (path.size() < 2) return;
+  const double min_depth = std::max(c.output.intensity.min_depth, 0.01);
+  const ThalwegProfile p = thalweg_profile(dsm, depth, speed, pressure, path, dsm.cell_size_x(), min_depth);
+  write_profile_csv(out / "profile.csv", p);
+  if (c.output.pngs) write_profile_png(out / "profile.png", p);
+}
+
 void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::path& out, int threads) {
   const Raster& dsm = sim.inputs().dsm;
   // Maps on the DSM's grid and CRS; nodata where the DSM has none.
@@ -636,6 +669,7 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
     return r;
   };
   const HazardMaps& maps = sim.maps();
+  const std::vector<double> no_breaks;
   // Every raster with its band description, unit and a QGIS style beside it (docs/runout.md,
   // "Outputs"); continuous maps transparent where zero.
   const auto put = [&](const char* name, const std::vector<double>& v, double fill_unreached, const char* description,
@@ -647,7 +681,14 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
     double vmax = 0.0;
     for (std::size_t k = 0; k < r.data.size(); ++k)
       if (r.data[k] != -9999.0) vmax = std::max(vmax, r.data[k]);
-    write_qgis_ramp_style(out / (std::string(name) + ".qml"), ramp, 0.0, vmax > 0.0 ? vmax : 1.0, unit, 0.0);
+    const std::string n = name;
+    const std::vector<double>& breaks = n == "max_depth" || n == "deposit" ? c.output.map_depth_classes
+                                        : n == "max_pressure"              ? c.output.map_pressure_classes
+                                                                           : no_breaks;
+    if (!breaks.empty())  // the same classes and colours as the map
+      write_qgis_classed_style(out / (n + ".qml"), ramp, breaks, unit, 0.0);
+    else
+      write_qgis_ramp_style(out / (n + ".qml"), ramp, 0.0, vmax > 0.0 ? vmax : 1.0, unit, 0.0);
     return r;
   };
   const Raster r_depth =
@@ -670,7 +711,6 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
                           ? "intensity class (depth_speed: 2 medium, 3 strong; 0 not reached)"
                           : "intensity class (pressure: 1 low, 2 medium, 3 strong; 0 not reached)";
   r_int.unit = "1";
-  write_geotiff(out / "intensity.tif", r_int);
   std::vector<StyleClass> intensity_classes_legend;
   {
     std::vector<StyleClass>& cls = intensity_classes_legend;
@@ -686,22 +726,41 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
       low << "low: p < " << itab.medium_pressure / 1e3 << " kPa";
       cls = {{1.0, low.str(), col(0.1)}, {2.0, medium.str(), col(0.5)}, {3.0, strong.str(), col(0.9)}};
     }
+    // Byte with a colour table and a raster attribute table (value, label, colour).
+    write_class_geotiff(out / "intensity.tif", r_int, cls);
     write_qgis_class_style(out / "intensity.qml", cls);
+    // The zones as polygons, for planners (GeoPackage with class, label, colour; KML in WGS 84).
+    write_class_zones(out / "intensity_zones.gpkg", out / "intensity_zones.kml", r_int, "intensity", cls);
   }
-  // Quick-look maps for the report (docs/report.md): cropped to the affected area with a 200 m
-  // margin, over the hillshade, with scale bar, north arrow, a legend with units and the barrier
-  // lines.
+  // Maps for the report (docs/report.md): all of one run on one extent (the cells the flow
+  // reached and the release, output.map_margin around them), over GDAL's hillshade, with
+  // coordinates, the release outline and barriers, scale bar, north arrow, classed legends at the
+  // configured thresholds and the attribution.
+  Raster release_mask = dsm.like(0.0, -9999.0);
+  for (std::size_t k = 0; k < release_mask.data.size() && k < sim.inputs().thickness.size(); ++k)
+    release_mask.data[k] = sim.inputs().thickness[k];
+  const std::vector<std::vector<Vec2>> release_outlines = mask_outlines(release_mask, 0.0);
+  std::vector<Vec2> release_points;
+  for (const auto& ring : release_outlines) release_points.insert(release_points.end(), ring.begin(), ring.end());
+  const std::array<double, 4> extent = map_extent(r_depth, 0.01, c.output.map_margin, release_points);
+  const std::string attribution = !c.output.attribution.empty() ? c.output.attribution
+                                  : !dsm.attribution.empty()    ? "Terrain: " + dsm.attribution
+                                                                : "";
   const auto map_png = [&](const char* name, const Raster& r, ColourRamp ramp, const char* title, const char* unit,
-                           double overlay_min, const std::vector<StyleClass>& classes = {}) {
+                           double overlay_min, const std::vector<StyleClass>& classes = {},
+                           const std::vector<double>& breaks = {}) {
     QuicklookOptions o;
     o.ramp = ramp;
     o.title = title;
     o.unit = unit;
     o.overlay_min = overlay_min;
     o.classes = classes;
-    o.crop_margin_m = 200.0;
+    o.class_breaks = breaks;
+    o.extent = extent;
     o.scale_bar = true;
     o.north_arrow = true;
+    o.outlines = release_outlines;
+    o.attribution = attribution;
     for (const Barrier& b : sim.inputs().barriers) o.lines.push_back(b.vertices);  // barrier lines
     write_quicklook_png(out / (std::string(name) + ".png"), dsm, &r, o);
   };
@@ -712,16 +771,20 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
     if (c.output.pngs) map_png("erosion_depth", r_ero, ColourRamp::Magma, "eroded depth", "m", 0.001);
   }
   if (c.output.pngs) {
-    map_png("max_depth", r_depth, ColourRamp::Viridis, "peak flow depth", "m", 0.01);
-    map_png("deposit", r_dep, ColourRamp::Viridis, "deposit thickness", "m", 0.01);
+    map_png("max_depth", r_depth, ColourRamp::Viridis, "peak flow depth", "m", 0.01, {}, c.output.map_depth_classes);
+    map_png("deposit", r_dep, ColourRamp::Viridis, "deposit thickness", "m", 0.01, {}, c.output.map_depth_classes);
     map_png("max_speed", r_speed, ColourRamp::Magma, "peak speed", "m/s", 0.01);
     Raster r_kpa = r_pressure;  // kPa reads better than 2.2e+06 Pa
     for (double& v : r_kpa.data)
       if (v != -9999.0) v *= 1e-3;
-    map_png("max_pressure", r_kpa, ColourRamp::Magma, "peak pressure rho v^2", "kPa", 0.01);
+    std::vector<double> kpa_breaks;
+    for (double b : c.output.map_pressure_classes) kpa_breaks.push_back(b * 1e-3);
+    map_png("max_pressure", r_kpa, ColourRamp::Magma, "peak dynamic pressure", "kPa", 0.01, {}, kpa_breaks);
     map_png("arrival_time", r_arrival, ColourRamp::Viridis, "arrival time", "s", -1.0);
     map_png("intensity", r_int, ColourRamp::Intensity, "intensity class", "", 0.5, intensity_classes_legend);
   }
+
+  write_flow_profile(c, sim, r_depth, r_speed, r_pressure, r_arrival, out);
 
   {
     AtomicTextFile csv(out / "series.csv");

@@ -29,6 +29,9 @@ struct Raster {
   std::vector<double> data;              ///< nx·ny values, row-major, row 0 north
   std::string description;               ///< band description (what the values are), "" if none
   std::string unit;                      ///< unit of the values ("m", "m/s", "Pa", "1"), "" if none
+  /// Data attribution or licence found in the file's metadata (TIFFTAG_COPYRIGHT, or an item named
+  /// ATTRIBUTION, COPYRIGHT or LICENSE), "" if none; maps print it.
+  std::string attribution;
 
   /// An empty raster on the same grid and CRS, filled with `fill`.
   Raster like(double fill, std::optional<double> nodata_value = std::nullopt) const;
@@ -135,14 +138,27 @@ struct Polyline {
 std::vector<Polyline> read_lines(const std::filesystem::path& path, const std::string& attribute,
                                  const std::string& target_wkt);
 
-/// Colour ramps for quick-look pictures.
+/// Colour ramps for maps and plots: Viridis, Magma and Cividis are the 256-entry tables of
+/// matplotlib's perceptually uniform maps; Terrain and BlueRed are interpolated between stops.
 /// Intensity: three steps (yellow, orange, red) for class rasters 1–3 drawn with vmin 0.5, vmax 3.5.
-enum class ColourRamp { Viridis, Magma, Terrain, BlueRed, Intensity };
+enum class ColourRamp { Viridis, Magma, Terrain, BlueRed, Intensity, Cividis };
 
 /// A QGIS layer style (.qml) for a single-band raster: a continuous colour ramp between vmin and
 /// vmax, the legend labelled with `unit`, values at or below `transparent_below` not drawn.
 void write_qgis_ramp_style(const std::filesystem::path& path, ColourRamp ramp, double vmin, double vmax,
                            const std::string& unit, double transparent_below);
+/// A QGIS layer style (.qml) for a continuous raster drawn in classes (a discrete colour ramp):
+/// below breaks[0], between consecutive breaks, and at or above the last, in the colours the maps
+/// give them (class_colour), labelled "< 0.5 m", "0.5–1 m", "≥ 2 m"; values at or below
+/// `transparent_below` not drawn.
+void write_qgis_classed_style(const std::filesystem::path& path, ColourRamp ramp, const std::vector<double>& breaks,
+                              const std::string& unit, double transparent_below);
+/// Colour of class k of n drawn from a ramp (the maps' and the styles' classes): the ramp at
+/// 0.1 + 0.85 k/(n − 1), so the first class is not the ramp's darkest end.
+std::array<std::uint8_t, 3> class_colour(ColourRamp ramp, std::size_t k, std::size_t n) noexcept;
+/// A legend number: at most 3 significant digits, no trailing zeros ("0.5", "1.58", "3e+04").
+std::string legend_number(double v);
+
 /// One class of a categorical raster: its value, legend label and colour.
 struct StyleClass {
   double value;
@@ -151,6 +167,21 @@ struct StyleClass {
 };
 /// A QGIS layer style (.qml) for a categorical raster (paletted renderer).
 void write_qgis_class_style(const std::filesystem::path& path, const std::vector<StyleClass>& classes);
+
+/// Polygonise a class raster (values rounded to integers; ≤ 0, nodata and NaN are not a zone) with
+/// GDAL (4-connected cells of one class become one polygon) into a GeoPackage layer `layer` with the
+/// fields class, label and colour and an OGR style per feature (from `legend`), and, when `kml` is
+/// not empty, the same polygons as KML in WGS 84. Written as *.partial and renamed; IoError when a
+/// file cannot be written.
+void write_class_zones(const std::filesystem::path& gpkg, const std::filesystem::path& kml, const Raster& classes,
+                       const std::string& layer, const std::vector<StyleClass>& legend);
+
+/// Write a class raster (values 0–254 rounded; NaN and nodata become 255, the nodata value) as a
+/// Byte Cloud-Optimized GeoTIFF with a colour table (each class of `legend` in its colour, other
+/// values white: a TIFF colour map holds no alpha, the .qml leaves them undrawn) and a raster attribute table (value,
+/// class label, red, green, blue; GDAL keeps it in the side-car `<path>.aux.xml`). Same checks and errors as
+/// write_geotiff.
+void write_class_geotiff(const std::filesystem::path& path, const Raster& r, const std::vector<StyleClass>& legend);
 
 /// How a quick-look map is drawn (write_quicklook_png). The defaults draw the whole raster with a
 /// numbered colour bar and nothing else, as the positional overload always did.
@@ -169,17 +200,64 @@ struct QuicklookOptions {
   double crop_margin_m = -1.0;
   bool scale_bar = false;    ///< a scale bar (1, 2 or 5 × 10^k m) in the lower left corner of the map
   bool north_arrow = false;  ///< a north arrow in the upper right corner (the raster is north-up)
-  /// Polylines in map (CRS) coordinates, drawn as dark lines two pixels wide (barriers, sections).
+  /// Polylines in map (CRS) coordinates, drawn as dark lines with a white halo (barriers, sections).
   std::vector<std::vector<Vec2>> lines;
+  std::string lines_label = "barrier";  ///< legend entry of `lines` (shown when there are lines)
+  /// Closed outlines in map coordinates (release areas), drawn dashed with a white halo.
+  std::vector<std::vector<Vec2>> outlines;
+  std::string outlines_label = "release area";  ///< legend entry of `outlines`
+  /// The map's extent in CRS coordinates (xmin, ymin, xmax, ymax); overrides crop_margin_m, so
+  /// every map of a run can share one (map_extent). Clipped to the raster.
+  std::optional<std::array<double, 4>> extent;
+  /// Class breaks for a continuous overlay (ascending, in the overlay's unit, e.g. 0.5, 1, 2 m):
+  /// the values above overlay_min are drawn in breaks.size() + 1 classes of the ramp with a class
+  /// legend ("< 0.5 m", "0.5–1 m", …, "≥ 2 m") instead of the colour bar.
+  std::vector<double> class_breaks;
+  /// Whole picture width in pixels (the map frame is this less the margins for the coordinate
+  /// labels); at least 1600 for print.
+  int width_px = 1800;
+  /// Data attribution printed under the map (e.g. the terrain's licence text); "" for none.
+  std::string attribution;
+  /// Coordinate ticks and grid in the raster's CRS, and its name and EPSG code under the map.
+  bool coordinates = true;
 };
 
-/// Write a quick-look PNG: a hillshade of `elevation` (sun from the north-west, 45° high),
-/// overlaid where `overlay` is present, finite, not nodata and above `opt.overlay_min` by the
-/// colour ramp between vmin and vmax, then the legend below the map (colour bar with ticks and
-/// "title (unit)", or the class legend). Without an overlay the elevation itself is tinted.
-/// InputError when the grids differ or are empty (nothing written). Goes through GDAL's PNG driver.
-void write_quicklook_png(const std::filesystem::path& path, const Raster& elevation, const Raster* overlay,
-                         const QuicklookOptions& opt);
+/// Where write_quicklook_png put things, in pixels of the written picture (for tests and for
+/// checks that a map carries its legend, ticks and scale).
+struct MapLayout {
+  int width = 0, height = 0;                                   ///< the picture
+  int frame_x = 0, frame_y = 0, frame_w = 0, frame_h = 0;      ///< the map frame
+  double metres_per_pixel = 0.0;                               ///< map scale inside the frame
+  int legend_x = 0, legend_y = 0, legend_w = 0, legend_h = 0;  ///< the legend box (0 size: none)
+  int scale_bar_x = 0, scale_bar_y = 0, scale_bar_px = 0;      ///< left end, baseline, length (0: none)
+  double scale_bar_m = 0.0;                                    ///< length the scale bar stands for
+  int x_ticks = 0, y_ticks = 0;                                ///< coordinate ticks labelled on each axis
+  std::string crs_label;                                       ///< the CRS line printed under the map
+};
+
+/// The extent (xmin, ymin, xmax, ymax) of the cells of `r` whose value is finite, not nodata and
+/// above `threshold`, grown by `margin_m` and clipped to the raster; the whole raster when no
+/// cell qualifies. `also` adds points (e.g. a release outline) to the affected area.
+std::array<double, 4> map_extent(const Raster& r, double threshold, double margin_m,
+                                 const std::vector<Vec2>& also = {});
+
+/// The boundaries of the cells of `r` holding a value above `threshold` (finite, not nodata), as
+/// closed polylines along the cell edges in CRS coordinates (the outline of a release area given
+/// on the grid, whatever its source).
+std::vector<std::vector<Vec2>> mask_outlines(const Raster& r, double threshold);
+
+/// "name (EPSG:code)" of a CRS given as WKT (the code when GDAL can identify one), "" for none.
+std::string crs_label(const std::string& wkt);
+
+/// Write a map as PNG (Cairo and Pango, render.cpp): GDAL's multidirectional hillshade of
+/// `elevation` (GDALDEMProcessing), overlaid where `overlay` is present, finite, not nodata and
+/// above `opt.overlay_min` by the colour ramp between vmin and vmax (or its classes), the title
+/// above, coordinate ticks and grid in the CRS, outlines and lines, scale bar and north arrow in
+/// the frame, and below it the CRS line, the legend (colour bar, or class swatches) and the
+/// attribution. Without an overlay the elevation itself is tinted. InputError when the grids
+/// differ or are empty (nothing written); IoError when the file cannot be written.
+MapLayout write_quicklook_png(const std::filesystem::path& path, const Raster& elevation, const Raster* overlay,
+                              const QuicklookOptions& opt);
 /// The positional form of the above (whole raster, colour bar titled `label`, no scale bar).
 void write_quicklook_png(const std::filesystem::path& path, const Raster& elevation, const Raster* overlay,
                          ColourRamp ramp, const std::string& label, double vmin = 0.0, double vmax = 0.0,
@@ -195,14 +273,24 @@ struct Image {
   void fill_circle(double cx, double cy, double radius, std::array<std::uint8_t, 3> c) noexcept;
 };
 void write_png(const std::filesystem::path& path, const Image& img);
+/// The same with text chunks (PNG tEXt, key and value), which GDAL and image viewers read back.
+void write_png(const std::filesystem::path& path, const Image& img,
+               const std::vector<std::pair<std::string, std::string>>& text);
+
+/// What is wrong with a map picture written by write_quicklook_png, judged from the layout it
+/// records in the PNG (text chunk "geohaz_map") and from its pixels: no recorded layout, no legend
+/// (fewer than 500 drawn pixels in the legend box), no coordinate ticks (fewer than two labelled
+/// on an axis, or no label pixels beside the frame), no scale bar (none recorded, or no black and
+/// white quarters where it is recorded). Empty when the map carries all of them.
+std::vector<std::string> check_map_png(const std::filesystem::path& path);
 /// Colour of value t ∈ [0, 1] on a ramp.
 std::array<std::uint8_t, 3> ramp_colour(ColourRamp ramp, double t) noexcept;
 
-/// Draw `text` in the 5×7 bitmap font (ASCII letters, digits, + - . , : / ( ) % = ^ _; other
-/// bytes are skipped), its top left corner at (x, y), each font pixel `scale` × `scale` pixels.
+/// Draw UTF-8 `text` with Pango (DejaVu Sans, antialiased) at a size where the capitals are
+/// 7 · `scale` pixels high, the top of the capitals at y and the text starting at x.
 void draw_text(Image& img, int x, int y, const std::string& text, int scale,
                std::array<std::uint8_t, 3> colour = {0, 0, 0}) noexcept;
-/// Width in pixels of `text` drawn by draw_text (its height is 7 · scale).
+/// Width in pixels of `text` drawn by draw_text (its capitals are 7 · scale high).
 int text_width(const std::string& text, int scale) noexcept;
 /// Tick values at a "nice" step (1, 2 or 5 × 10^k) giving about `n` ticks within [lo, hi], both
 /// ends included when they fall on the step (empty when hi ≤ lo or either is not finite).

@@ -114,11 +114,15 @@ struct BarrierResult {
 
 /// What to write besides the maps and the summary.
 struct OutputSettings {
-  double series_interval = 1.0;     ///< s between rows of series.csv
-  double snapshot_interval = 30.0;  ///< s between particle snapshots
-  bool snapshots = true;            ///< snapshots.h5 + .xmf
-  bool pngs = true;                 ///< quick-look PNGs
-  IntensityTable intensity;         ///< classes of intensity.tif
+  double series_interval = 1.0;                             ///< s between rows of series.csv
+  double snapshot_interval = 30.0;                          ///< s between particle snapshots
+  bool snapshots = true;                                    ///< snapshots.h5 + .xmf
+  bool pngs = true;                                         ///< quick-look PNGs
+  IntensityTable intensity;                                 ///< classes of intensity.tif
+  std::vector<double> map_depth_classes{0.5, 1.0, 2.0};     ///< class breaks of the depth maps (m)
+  std::vector<double> map_pressure_classes{3e3, 3e4, 1e5};  ///< class breaks of the pressure map (Pa)
+  double map_margin = 200.0;                                ///< m around the affected area in the maps
+  std::string attribution;                                  ///< printed under every map ("" : the DSM's)
 };
 
 /// Everything a run needs, in SI units. Defaults are those of the structs it holds.

@@ -1,0 +1,233 @@
+/// \file profile.cpp
+/// The thalweg long profile (profile.hpp).
+
+#include "geohaz/runout/profile.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <string>
+
+#include "geohaz/core/errors.hpp"
+#include "geohaz/core/output.hpp"
+
+namespace geohaz::runout {
+
+namespace {
+
+/// The value of the map cell holding (x, y); 0 outside, for nodata and NaN.
+double cell_value(const Raster& r, double x, double y) {
+  const int c = static_cast<int>(std::floor((x - r.geotransform[0]) / r.geotransform[1]));
+  const int row = static_cast<int>(std::floor((y - r.geotransform[3]) / r.geotransform[5]));
+  if (c < 0 || row < 0 || c >= r.nx || row >= r.ny) return 0.0;
+  const double v = r.at(c, row);
+  return std::isfinite(v) && !r.is_nodata(v) ? v : 0.0;
+}
+
+}  // namespace
+
+std::vector<Vec2> flow_centreline(const Vec2& start, const std::vector<Vec2>& fronts, double min_spacing) {
+  std::vector<Vec2> out{start};
+  double reach = 0.0;  // distance from the start of the last point kept
+  for (const Vec2& p : fronts) {
+    if (!std::isfinite(p.x()) || !std::isfinite(p.y())) continue;
+    const double d = (p - start).norm();
+    if (d >= reach + min_spacing) {
+      out.push_back(p);
+      reach = d;
+    }
+  }
+  return out;
+}
+
+std::vector<Vec2> arrival_centreline(const Raster& arrival_time, const Raster& max_depth, const Vec2& start, double dt,
+                                     double min_spacing) {
+  if (!(dt > 0.0) || arrival_time.nx != max_depth.nx || arrival_time.ny != max_depth.ny) return {start};
+  double t_end = 0.0;
+  for (double t : arrival_time.data)
+    if (std::isfinite(t) && !arrival_time.is_nodata(t) && t >= 0.0) t_end = std::max(t_end, t);
+  const std::size_t bins = static_cast<std::size_t>(std::floor(t_end / dt)) + 1;
+  if (bins > 10'000'000) return {start};
+  std::vector<double> w(bins, 0.0), wx(bins, 0.0), wy(bins, 0.0);
+  for (int row = 0; row < arrival_time.ny; ++row)
+    for (int col = 0; col < arrival_time.nx; ++col) {
+      const double t = arrival_time.at(col, row), h = max_depth.at(col, row);
+      if (!std::isfinite(t) || arrival_time.is_nodata(t) || t < 0.0) continue;
+      if (!std::isfinite(h) || max_depth.is_nodata(h) || !(h > 0.0)) continue;
+      const std::size_t b = std::min(bins - 1, static_cast<std::size_t>(std::floor(t / dt)));
+      const Vec2 c = arrival_time.cell_centre(col, row);
+      w[b] += h;
+      wx[b] += h * c.x();
+      wy[b] += h * c.y();
+    }
+  std::vector<Vec2> centroids;
+  for (std::size_t b = 0; b < bins; ++b)
+    if (w[b] > 0.0) centroids.emplace_back(wx[b] / w[b], wy[b] / w[b]);
+  return flow_centreline(start, centroids, min_spacing);
+}
+
+ThalwegProfile thalweg_profile(const Raster& dsm, const Raster& max_depth, const Raster& max_speed,
+                               const Raster& max_pressure, const std::vector<Vec2>& path, double spacing,
+                               double min_depth) {
+  if (path.size() < 2 || !(spacing > 0.0))
+    throw InputError("a profile needs a path of at least two points and a positive spacing", "profile");
+  for (const Raster* m : {&max_depth, &max_speed, &max_pressure})
+    if (m->nx != dsm.nx || m->ny != dsm.ny)
+      throw InputError("the peak maps of a profile must be on the DSM's grid", "profile");
+  const Terrain terrain(dsm);
+  ThalwegProfile p;
+  double s0 = 0.0;
+  const auto add = [&](const Vec2& q, double s) {
+    const double z = terrain.elevation(q.x(), q.y());
+    if (!std::isfinite(z))
+      throw InputError("the profile path leaves the terrain's data at (" + std::to_string(q.x()) + ", " +
+                           std::to_string(q.y()) + ")",
+                       "profile");
+    ProfileRow r;
+    r.s = s;
+    r.x = q.x();
+    r.y = q.y();
+    r.z = z;
+    r.depth = cell_value(max_depth, q.x(), q.y());
+    r.speed = cell_value(max_speed, q.x(), q.y());
+    r.pressure = cell_value(max_pressure, q.x(), q.y());
+    p.rows.push_back(r);
+  };
+  add(path.front(), 0.0);
+  for (std::size_t k = 1; k < path.size(); ++k) {
+    const Vec2 a = path[k - 1], b = path[k];
+    const double len = (b - a).norm();
+    if (!(len > 0.0)) continue;
+    const int n = std::max(1, static_cast<int>(std::ceil(len / spacing - 1e-9)));
+    for (int i = 1; i <= n; ++i) add(a + (b - a) * (double(i) / n), s0 + len * double(i) / n);
+    s0 += len;
+  }
+  if (p.rows.size() < 2) throw InputError("the profile path has no length", "profile");
+  // Top and run-out point of the reached part, the α line through both.
+  for (const ProfileRow& r : p.rows) {
+    if (!(r.depth > min_depth)) continue;
+    if (!p.reached || r.z > p.z_top) {
+      p.s_top = r.s;
+      p.z_top = r.z;
+    }
+    if (!p.reached || r.s > p.s_runout) {
+      p.s_runout = r.s;
+      p.z_runout = r.z;
+    }
+    p.reached = true;
+  }
+  const double run = p.s_runout - p.s_top;
+  const double tan_alpha = p.reached && run > 0.0 ? (p.z_top - p.z_runout) / run : 0.0;
+  p.alpha_deg = std::atan(tan_alpha) * 180.0 / M_PI;
+  for (ProfileRow& r : p.rows) r.alpha_z = p.z_top - tan_alpha * (r.s - p.s_top);
+  return p;
+}
+
+void write_profile_csv(const std::filesystem::path& path, const ThalwegProfile& p) {
+  AtomicTextFile csv(path);
+  csv << "s_along_path_m,x_m,y_m,terrain_elevation_m,max_depth_m,max_speed_m_s,max_pressure_Pa,"
+         "alpha_line_elevation_m\n";
+  csv.stream() << std::setprecision(10);
+  for (const ProfileRow& r : p.rows)
+    csv << r.s << ',' << r.x << ',' << r.y << ',' << r.z << ',' << r.depth << ',' << r.speed << ',' << r.pressure << ','
+        << r.alpha_z << '\n';
+  csv.commit();
+}
+
+namespace {
+
+/// A panel of a plot: data range and its pixel box.
+struct Panel {
+  double x0, x1, y0, y1;  // data
+  int left, top, width, height;
+  double px(double x) const { return left + (x - x0) / (x1 - x0) * width; }
+  double py(double y) const { return top + height - (y - y0) / (y1 - y0) * height; }
+};
+
+void axes(Image& img, const Panel& f, const std::string& x_title, const std::string& y_title, int s) {
+  const std::array<std::uint8_t, 3> black{0, 0, 0}, grid{225, 225, 225};
+  for (double v : nice_ticks(f.x0, f.x1, 8)) {
+    const double x = f.px(v);
+    img.line(x, f.top, x, f.top + f.height, grid);
+    img.line(x, f.top + f.height, x, f.top + f.height + 6, black);
+    const std::string t = format_tick(v);
+    draw_text(img, static_cast<int>(x) - text_width(t, s) / 2, f.top + f.height + 10, t, s);
+  }
+  for (double v : nice_ticks(f.y0, f.y1, 5)) {
+    const double y = f.py(v);
+    img.line(f.left, y, f.left + f.width, y, grid);
+    img.line(f.left - 6, y, f.left, y, black);
+    const std::string t = format_tick(v);
+    draw_text(img, f.left - 10 - text_width(t, s), static_cast<int>(y) - 7 * s / 2, t, s);
+  }
+  img.line(f.left, f.top, f.left, f.top + f.height, black);
+  img.line(f.left, f.top + f.height, f.left + f.width, f.top + f.height, black);
+  img.line(f.left, f.top, f.left + f.width, f.top, black);
+  img.line(f.left + f.width, f.top, f.left + f.width, f.top + f.height, black);
+  draw_text(img, f.left + (f.width - text_width(x_title, s)) / 2, f.top + f.height + 20 + 7 * s, x_title, s);
+  draw_text(img, f.left, f.top - 12 - 7 * s, y_title, s);
+}
+
+void thick_polyline(Image& img, const Panel& f, const std::vector<double>& x, const std::vector<double>& y,
+                    std::array<std::uint8_t, 3> c, int width) {
+  for (std::size_t k = 1; k < x.size(); ++k)
+    for (int o = -width / 2; o <= width / 2; ++o)
+      img.line(f.px(x[k - 1]), f.py(y[k - 1]) + o, f.px(x[k]), f.py(y[k]) + o, c);
+}
+
+}  // namespace
+
+void write_profile_png(const std::filesystem::path& path, const ThalwegProfile& p) {
+  const int W = 1800, H = 1250, s = 3;
+  Image img(W, H);
+  std::vector<double> sv, z, top, speed, alpha;
+  double zlo = 1e300, zhi = -1e300, vmax = 0.0, dmax = 0.0;
+  for (const ProfileRow& r : p.rows) {
+    zlo = std::min(zlo, r.z);
+    zhi = std::max(zhi, r.z);
+    vmax = std::max(vmax, r.speed);
+    dmax = std::max(dmax, r.depth);
+  }
+  // The depth drawn above the terrain, exaggerated so that the deepest point shows as 4 % of the
+  // elevation range (a factor of 1, 2 or 5 × 10^k).
+  double ex = 1.0;
+  if (dmax > 0.0) {
+    const double want = 0.04 * std::max(1.0, zhi - zlo) / dmax;
+    const double p10 = std::pow(10.0, std::floor(std::log10(want)));
+    ex = want >= 5 * p10 ? 5 * p10 : want >= 2 * p10 ? 2 * p10 : p10;
+    ex = std::max(1.0, ex);
+  }
+  for (const ProfileRow& r : p.rows) {
+    sv.push_back(r.s);
+    z.push_back(r.z);
+    top.push_back(r.z + ex * r.depth);
+    speed.push_back(r.speed);
+    alpha.push_back(r.alpha_z);
+  }
+  const double pad = 0.05 * std::max(1.0, zhi - zlo);
+  const Panel upper{sv.front(), sv.back(), zlo - pad, zhi + pad, 170, 90, W - 230, 700};
+  const Panel lower{sv.front(), sv.back(), 0.0, vmax > 0.0 ? 1.1 * vmax : 1.0, 170, 960, W - 230, 200};
+  // The flow (depth above the terrain) filled, then the terrain, the α line, the run-out point.
+  for (std::size_t k = 0; k < sv.size(); ++k)
+    if (top[k] > z[k]) img.line(upper.px(sv[k]), upper.py(z[k]), upper.px(sv[k]), upper.py(top[k]), {70, 130, 200});
+  axes(img, upper, "horizontal distance along the path (m)", "elevation (m)", s);
+  thick_polyline(img, upper, sv, top, {40, 90, 170}, 2);
+  thick_polyline(img, upper, sv, z, {30, 30, 30}, 3);
+  if (p.reached) {
+    const std::vector<double> as{p.s_top, p.s_runout}, az{p.z_top, p.z_runout};
+    thick_polyline(img, upper, as, az, {200, 40, 40}, 2);
+    img.fill_circle(upper.px(p.s_runout), upper.py(p.z_runout), 9, {200, 40, 40});
+    img.fill_circle(upper.px(p.s_top), upper.py(p.z_top), 7, {200, 40, 40});
+  }
+  const std::string legend1 = "terrain (black), peak depth x " + format_tick(ex) + " above it (blue)";
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "alpha line (red): alpha = %.1f deg, run-out point at s = %.0f m", p.alpha_deg,
+                p.s_runout);
+  draw_text(img, upper.left + 20, upper.top + 20, legend1, 2);
+  draw_text(img, upper.left + 20, upper.top + 50, p.reached ? buf : "the flow did not reach the path", 2);
+  axes(img, lower, "horizontal distance along the path (m)", "peak speed (m/s)", s);
+  thick_polyline(img, lower, sv, speed, {150, 60, 150}, 2);
+  write_png(path, img);
+}
+
+}  // namespace geohaz::runout

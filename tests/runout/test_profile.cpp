@@ -1,0 +1,135 @@
+// The thalweg long profile (profile.hpp, issue #33): on an inclined plane carrying a uniform flow
+// in a straight strip, the profile along the strip is the analytic one.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "geohaz/core/errors.hpp"
+#include "geohaz/core/raster_extra.hpp"
+#include "geohaz/runout/profile.hpp"
+
+namespace fs = std::filesystem;
+using namespace geohaz;
+using namespace geohaz::runout;
+
+namespace {
+
+// A 30° plane falling to the east, 5 m cells, 200 × 40 cells (1000 m × 200 m).
+constexpr double kDx = 5.0, kX0 = 500000.0, kY0 = 5200000.0, kZ0 = 2000.0;
+const double kTan = std::tan(30.0 * M_PI / 180.0);
+
+Raster plane() {
+  Raster r;
+  r.nx = 200;
+  r.ny = 40;
+  r.geotransform = {kX0, kDx, 0.0, kY0, 0.0, -kDx};
+  r.crs_wkt = crs_to_wkt("EPSG:32632");
+  r.nodata = -9999.0;
+  r.data.resize(static_cast<std::size_t>(r.nx) * r.ny);
+  for (int row = 0; row < r.ny; ++row)
+    for (int col = 0; col < r.nx; ++col) r.at(col, row) = kZ0 - kTan * (r.cell_centre(col, row).x() - kX0);
+  return r;
+}
+
+}  // namespace
+
+// A uniform flow of depth h = 1.2 m at v = 8 m/s (pressure ρv² with ρ = 2000 kg/m³) covers the cells
+// from 100 m to 600 m east, rows 15–24. Along the strip's centre line from 50 m to 700 m, sampled
+// every metre: the terrain is the plane (bilinear is exact on a plane), the peak values are h, v
+// and ρv² inside the reached part and 0 outside, the run-out point is the last sample before 600 m,
+// and α is the plane's 30° (any two points of a plane along its fall line give its slope).
+TEST(ThalwegProfile, UniformFlowOnAPlaneGivesTheAnalyticProfile) {
+  const Raster dsm = plane();
+  Raster depth = dsm.like(0.0, -9999.0), speed = depth, pressure = depth;
+  const double h = 1.2, v = 8.0, rho = 2000.0;
+  for (int row = 15; row < 25; ++row)
+    for (int col = 20; col < 120; ++col) {
+      depth.at(col, row) = h;
+      speed.at(col, row) = v;
+      pressure.at(col, row) = rho * v * v;
+    }
+  const double yc = kY0 - 20 * kDx;  // the strip's centre line (between rows 19 and 20)
+  const ThalwegProfile p =
+      thalweg_profile(dsm, depth, speed, pressure, {{kX0 + 50.0, yc}, {kX0 + 700.0, yc}}, 1.0, 0.01);
+  ASSERT_EQ(p.rows.size(), 651u);
+  ASSERT_TRUE(p.reached);
+  for (const ProfileRow& r : p.rows) {
+    const double x = r.x - kX0;
+    EXPECT_NEAR(r.s, x - 50.0, 1e-9);
+    EXPECT_NEAR(r.z, kZ0 - kTan * x, 1e-9) << x;
+    const bool inside = x >= 100.0 && x < 600.0;
+    EXPECT_DOUBLE_EQ(r.depth, inside ? h : 0.0) << x;
+    EXPECT_DOUBLE_EQ(r.speed, inside ? v : 0.0) << x;
+    EXPECT_DOUBLE_EQ(r.pressure, inside ? rho * v * v : 0.0) << x;
+    // The α line runs along the plane itself here.
+    EXPECT_NEAR(r.alpha_z, r.z, 1e-9) << x;
+  }
+  EXPECT_DOUBLE_EQ(p.s_top, 50.0);      // x = 100 m, the first reached sample
+  EXPECT_DOUBLE_EQ(p.s_runout, 549.0);  // x = 599 m, the last sample inside the last cell
+  EXPECT_NEAR(p.alpha_deg, 30.0, 1e-9);
+  EXPECT_NEAR(p.z_top - p.z_runout, kTan * 499.0, 1e-9);
+
+  // The files: a CSV row per sample and a picture.
+  const fs::path dir = fs::temp_directory_path() / ("geohaz_profile_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  write_profile_csv(dir / "profile.csv", p);
+  write_profile_png(dir / "profile.png", p);
+  const Image img = read_image(dir / "profile.png");
+  EXPECT_EQ(img.width, 1800);
+  std::ifstream in(dir / "profile.csv");
+  std::string line;
+  int lines = 0;
+  while (std::getline(in, line)) ++lines;
+  EXPECT_EQ(lines, 652);
+  fs::remove_all(dir);
+}
+
+// The flow's own centreline keeps the start and the fronts at least one spacing apart.
+TEST(ThalwegProfile, CentrelineThinsTheFronts) {
+  const auto c = flow_centreline({0, 0}, {{0.5, 0}, {2, 0}, {2.5, 0}, {6, 0}}, 1.0);
+  ASSERT_EQ(c.size(), 3u);
+  EXPECT_DOUBLE_EQ(c[1].x(), 2.0);
+  EXPECT_DOUBLE_EQ(c[2].x(), 6.0);
+}
+
+// A path off the terrain is an input error naming the point.
+TEST(ThalwegProfile, PathOffTheTerrainIsAnInputError) {
+  const Raster dsm = plane();
+  const Raster zero = dsm.like(0.0, -9999.0);
+  EXPECT_THROW(
+      thalweg_profile(dsm, zero, zero, zero, {{kX0 + 50.0, kY0 - 50.0}, {kX0 + 5000.0, kY0 - 50.0}}, 1.0, 0.01),
+      InputError);
+}
+
+// The centreline from the arrival map: a flow whose front moves east by 10 m each second in a
+// 50 m wide strip, with a lone cell reached far to the north at 5 s; the depth-weighted centroid
+// of each second's front stays on the strip's axis, the lone cell pulls one point by its weight
+// share only.
+TEST(ThalwegProfile, ArrivalCentrelineFollowsTheBulkOfTheFlow) {
+  const Raster dsm = plane();
+  Raster arrival = dsm.like(-9999.0, -9999.0), depth = dsm.like(0.0, -9999.0);
+  for (int row = 15; row < 25; ++row)
+    for (int col = 0; col < 100; ++col) {
+      arrival.at(col, row) = 0.5 * col + 0.25;  // 2 cells (10 m) per second
+      depth.at(col, row) = 1.0;
+    }
+  arrival.at(50, 2) = 5.1;  // the lone cell, 1 m deep like the others
+  depth.at(50, 2) = 1.0;
+  const Vec2 start(kX0, kY0 - 100.0);
+  const auto c = arrival_centreline(arrival, depth, start, 1.0, 5.0);
+  ASSERT_GE(c.size(), 40u);
+  const double axis = kY0 - 100.0;  // between rows 19 and 20
+  int off_axis = 0;
+  for (std::size_t k = 1; k < c.size(); ++k) {
+    if (std::abs(c[k].y() - axis) > 1e-6) ++off_axis;
+    EXPECT_LT(std::abs(c[k].y() - axis), (kY0 - 12.5 - axis) / 21.0 + 1e-6);  // at most 1/21 of the way
+    if (k > 1) {
+      EXPECT_GT(c[k].x(), c[k - 1].x());  // in order of time
+    }
+  }
+  EXPECT_EQ(off_axis, 1);
+}
