@@ -55,7 +55,7 @@ set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 set(CPACK_DEBIAN_PACKAGE_DEPENDS "python3 (>= 3.9), python3-numpy")
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS
-    "cmake, libeigen3-dev, libboost-program-options-dev, libgdal-dev, libcgal-dev, libhdf5-dev, libtomlplusplus-dev, nlohmann-json3-dev")
+    "cmake, libeigen3-dev, libboost-program-options-dev, libgdal-dev, libcgal-dev, libhdf5-dev, libtomlplusplus-dev, nlohmann-json3-dev, libnlopt-cxx-dev")
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS "python3-matplotlib, bash-completion")
 set(CPACK_PACKAGE_DESCRIPTION
     "geohaz: landslides from the first slip to the final deposit. SPH slope failure (sph-slope), depth-averaged debris runout with hazard maps (debris-runout), bonded-disc DEM (dem-avalanche), the C++ libraries with their CMake package, the Python module geohaz, example data and documentation (/usr/share/geohaz).")

@@ -1,0 +1,179 @@
+// The calibration library (calibrate.hpp): the parameter scales, the along-thalweg coordinate, the
+// misfit's areas and score in closed form, the Morris design, and identifiability: a synthetic
+// observation made by a run with known parameters is recovered by the search.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "calibration_case.hpp"
+#include "geohaz/core/config.hpp"
+#include "geohaz/core/errors.hpp"
+#include "geohaz/runout/calibrate.hpp"
+
+namespace fs = std::filesystem;
+using namespace geohaz;
+using namespace geohaz::runout;
+
+namespace {
+
+fs::path work_dir(const std::string& name) {
+  const fs::path d =
+      fs::path(GEOHAZ_BINARY_DIR) / "tests" / "runout" / "calibrate_work" / (name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+/// A 10 × 1 strip of 2 m cells along x, the thalweg along its axis from x = 0.
+Observation strip(std::vector<std::uint8_t> footprint) {
+  Observation o;
+  o.grid = GridGeometry{10, 1, 0.0, 2.0, 2.0, 2.0};
+  o.footprint = std::move(footprint);
+  o.thalweg = {Vec2(0.0, 1.0), Vec2(20.0, 1.0)};
+  for (int c = 0; c < 10; ++c) o.s.push_back(along_thalweg(o.thalweg, o.grid.centre(c, 0)));
+  for (std::size_t k = 0; k < o.s.size(); ++k)
+    if (o.footprint[k]) o.runout_s = std::max(o.runout_s, o.s[k]);
+  return o;
+}
+
+nlohmann::json summary(const fs::path& out) {
+  std::ifstream in(out / "summary.json");
+  return nlohmann::json::parse(in);
+}
+
+}  // namespace
+
+TEST(CalibrationParameter, LinearAndLogScalesMapTheUnitIntervalOntoTheBounds) {
+  const CalibrationParameter lin{"model.n", 0.02, 0.1, false}, lg{"model.xi", 100.0, 10000.0, true};
+  EXPECT_DOUBLE_EQ(lin.value(0.0), 0.02);
+  EXPECT_DOUBLE_EQ(lin.value(1.0), 0.1);
+  EXPECT_DOUBLE_EQ(lin.value(0.5), 0.06);
+  EXPECT_NEAR(lg.value(0.5), 1000.0, 1e-9);  // the geometric mean
+  for (double u : {0.0, 0.13, 0.5, 0.97, 1.0}) {
+    EXPECT_NEAR(lin.unit(lin.value(u)), u, 1e-12);
+    EXPECT_NEAR(lg.unit(lg.value(u)), u, 1e-12);
+  }
+}
+
+TEST(Calibration, AlongThalwegIsTheArcLengthToTheNearestSegment) {
+  const std::vector<Vec2> t{Vec2(0, 0), Vec2(10, 0), Vec2(10, 10)};
+  EXPECT_DOUBLE_EQ(along_thalweg(t, Vec2(4, 3)), 4.0);
+  EXPECT_DOUBLE_EQ(along_thalweg(t, Vec2(13, 6)), 16.0);  // second leg, 6 m up it
+  EXPECT_DOUBLE_EQ(along_thalweg(t, Vec2(-5, 1)), 0.0);   // before the start: clamped
+}
+
+TEST(Calibration, MisfitAreasTverskyAndRunoutTermInClosedForm) {
+  // Observed cells 2..6, modelled (depth > 0.1 m) cells 3..8: TP 4 cells, FP 2, FN 1 (4 m² each).
+  const Observation o = strip({0, 0, 1, 1, 1, 1, 1, 0, 0, 0});
+  std::vector<double> depth(10, 0.0), deposit(10, 0.0);
+  for (int c = 3; c <= 8; ++c) depth[static_cast<std::size_t>(c)] = 0.5;
+  depth[9] = 0.1;  // at the threshold: not affected
+  ScoreSettings s;
+  const Misfit m = compute_misfit(o, s, depth, deposit, 0.0);
+  EXPECT_DOUBLE_EQ(m.tp, 16.0);
+  EXPECT_DOUBLE_EQ(m.fp, 8.0);
+  EXPECT_DOUBLE_EQ(m.fn, 4.0);
+  EXPECT_DOUBLE_EQ(m.tversky, 16.0 / (16.0 + 0.5 * 8.0 + 0.5 * 4.0));  // Dice = 2TP / (2TP + FP + FN)
+  // Run-out: cell 8's centre at s = 17 m against cell 6's at 13 m.
+  EXPECT_DOUBLE_EQ(m.runout_diff, 4.0);
+  EXPECT_DOUBLE_EQ(m.term_runout, 4.0 / 13.0);
+  EXPECT_DOUBLE_EQ(m.score, (1.0 - m.tversky) + 4.0 / 13.0);
+  // Tversky α = 1, β = 0 counts only over-prediction: T = TP / (TP + FP).
+  s.alpha = 1.0, s.beta = 0.0;
+  EXPECT_DOUBLE_EQ(compute_misfit(o, s, depth, deposit, 0.0).tversky, 16.0 / 24.0);
+}
+
+TEST(Calibration, MisfitOfTheObservationItselfIsZeroAndDepthAndVolumeTermsAreRelative) {
+  Observation o = strip({0, 1, 1, 1, 0, 0, 0, 0, 0, 0});
+  o.deposit = {0, 1.0, 2.0, 1.0, 0, 0, 0, 0, 0, 0};
+  o.volume = 16.0;
+  const std::vector<double> depth{0, 1, 2, 1, 0, 0, 0, 0, 0, 0};
+  ScoreSettings s;
+  const Misfit same = compute_misfit(o, s, depth, o.deposit, 16.0);
+  EXPECT_DOUBLE_EQ(same.score, 0.0);
+  EXPECT_DOUBLE_EQ(same.tversky, 1.0);
+  // A deposit 0.5 m thicker everywhere it lies, and 20 % more volume: RMSE 0.5 m over a mean of 4/3 m.
+  std::vector<double> thicker = o.deposit;
+  for (std::size_t k = 1; k <= 3; ++k) thicker[k] += 0.5;
+  const Misfit m = compute_misfit(o, s, depth, thicker, 19.2);
+  EXPECT_DOUBLE_EQ(m.depth_rmse, 0.5);
+  EXPECT_NEAR(m.term_depth, 0.5 / (4.0 / 3.0), 1e-15);
+  EXPECT_NEAR(m.term_volume, 0.2, 1e-15);
+  EXPECT_NEAR(m.score, 0.375 + 0.2, 1e-15);
+}
+
+TEST(Calibration, MorrisTrajectoryMovesEveryFactorOnceByDeltaOnTheGrid) {
+  for (int t = 0; t < 20; ++t) {
+    const auto pts = morris_trajectory(7, t, 3, 4);
+    ASSERT_EQ(pts.size(), 4u);
+    std::set<int> moved;
+    for (std::size_t k = 1; k < pts.size(); ++k) {
+      int changed = 0;
+      for (int d = 0; d < 3; ++d) {
+        const double a = pts[k - 1][static_cast<std::size_t>(d)], b = pts[k][static_cast<std::size_t>(d)];
+        // On the grid {0, 1/3, 2/3, 1}, inside [0, 1].
+        EXPECT_NEAR(a * 3.0, std::round(a * 3.0), 1e-12);
+        EXPECT_GE(b, 0.0);
+        EXPECT_LE(b, 1.0);
+        if (a != b) {
+          ++changed;
+          moved.insert(d);
+          EXPECT_NEAR(std::abs(b - a), 2.0 / 3.0, 1e-12);  // Δ = p / (2 (p − 1))
+        }
+      }
+      EXPECT_EQ(changed, 1);
+    }
+    EXPECT_EQ(moved.size(), 3u);
+  }
+}
+
+namespace {
+
+struct Fit {
+  nlohmann::json summary;
+  std::vector<double> best;
+};
+
+Fit calibrate(const calibration_case::Case& c, const std::string& config) {
+  const fs::path out = c.dir / "out";
+  fs::remove_all(out);
+  ConfigReader cfg = ConfigReader::from_string(config, (c.dir / "calibrate.toml").string());
+  CalibrationSetup s = read_calibration(cfg);
+  run_calibration_serial(s, out, 1, true);
+  Fit f;
+  f.summary = summary(out);
+  f.best = f.summary["best"]["values"].get<std::vector<double>>();
+  return f;
+}
+
+const char* const kManningModel = "friction = \"manning\"\nn = 0.06\nicr = 0.15\nd0 = 5.0\nh0 = 0.5\ndensity = 1800.0";
+const char* const kManningParameters =
+    "[[calibration.parameter]]\nkey = \"model.n\"\nmin = 0.03\nmax = 0.12\nscale = \"log\"\n"
+    "[[calibration.parameter]]\nkey = \"model.icr\"\nmin = 0.08\nmax = 0.3\n";
+const char* const kSearch =
+    "global_members = 12\nmorris_trajectories = 2\nlocal_starts = 2\nlocal_evaluations = 24\nlocal_algorithm = "
+    "\"bobyqa\"\n";
+
+}  // namespace
+
+TEST(CalibrationIdentifiability, RecoversManningNAndCriticalSlopeOfASyntheticEvent) {
+  // Truth n = 0.06, i_cr = 0.15 (the valley example's values). Observation: its footprint, deposit
+  // and (from the footprint) run-out. Acceptance (issue 31): both within 5 %, footprint score T
+  // within 1 % of perfect.
+  const auto c = calibration_case::make(work_dir("manning"), kManningModel, {"model.n=0.06", "model.icr=0.15"});
+  const Fit f = calibrate(c, calibration_case::config(c, kManningParameters, kSearch));
+  const double t = f.summary["best"]["misfit"]["tversky"].get<double>();
+  std::printf("CALIBRATION manning: n %.5f (truth 0.06), icr %.5f (truth 0.15), T %.4f, score %.4g, %d members\n",
+              f.best[0], f.best[1], t, f.summary["best"]["misfit"]["score"].get<double>(),
+              f.summary["members"].get<int>());
+  EXPECT_NEAR(f.best[0], 0.06, 0.05 * 0.06);
+  EXPECT_NEAR(f.best[1], 0.15, 0.05 * 0.15);
+  EXPECT_GE(t, 0.99);
+  fs::remove_all(c.dir);
+}
