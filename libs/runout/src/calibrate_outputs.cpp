@@ -1,6 +1,8 @@
 // What a calibration writes (calibrate.hpp, docs/calibration.md): the best set as a ready-to-run
 // debris-runout config, the member and acceptable tables and plot, the Morris ranking, the
 // comparison map and the thalweg profile, the summary.
+#include <toml++/toml.h>
+
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
@@ -180,17 +182,32 @@ std::vector<MorrisEffect> morris_effects(const CalibrationSetup& s, const Calibr
   return out;
 }
 
-/// The best set as a debris-runout config that runs from anywhere: the base case with the best
-/// values, every input path made absolute; a searched thickness factor becomes best_release.tif.
+/// Set a dotted key ("model.n") in a TOML table, creating the tables on the way.
+template <class V>
+void set_dotted(toml::table& t, const std::string& key, V value) {
+  toml::table* cur = &t;
+  std::size_t start = 0;
+  for (std::size_t dot; (dot = key.find('.', start)) != std::string::npos; start = dot + 1) {
+    const std::string part = key.substr(start, dot - start);
+    if (!cur->contains(part) || !(*cur)[part].is_table()) cur->insert_or_assign(part, toml::table{});
+    cur = (*cur)[part].as_table();
+  }
+  cur->insert_or_assign(key.substr(start), value);
+}
+
+/// The best set as a debris-runout config that runs from anywhere: the base case's own file (the
+/// keys it sets, nothing more) with the best values and every input path made absolute; a
+/// searched thickness factor becomes best_release.tif. Read back through read_case before it is
+/// written.
 std::string best_config(const CalibrationSetup& s, const Evaluation& best, const fs::path& out) {
-  ConfigReader m = ConfigReader::from_file(s.members.base_config);
+  toml::table t = toml::parse_file(s.members.base_config.string());
   RunoutCase base;
   {
     ConfigReader probe = ConfigReader::from_file(s.members.base_config);
     base = read_case(probe);
   }
   const auto set_path = [&](const std::string& key, const std::string& p) {
-    if (!p.empty()) m.apply_override(key + "=\"" + fs::absolute(p).lexically_normal().generic_string() + "\"");
+    if (!p.empty()) set_dotted(t, key, fs::absolute(p).lexically_normal().generic_string());
   };
   set_path("terrain.dsm", base.dsm);
   set_path("release.file", base.release.file);
@@ -204,39 +221,44 @@ std::string best_config(const CalibrationSetup& s, const Evaluation& best, const
   set_path("inflow.hydrograph", base.processes.hydrograph);
   set_path("barriers.file", base.barriers.file);
   std::ostringstream note;
+  note << std::setprecision(17);
   for (std::size_t d = 0; d < s.parameters.size(); ++d) {
     const std::string& key = s.parameters[d].key;
     const double v = best.values[d];
     if (key == kThicknessFactorKey) {
       if (!base.release.handoff.empty()) {
-        note << "# release thickness factor " << std::setprecision(17) << v
-             << ": scale the hand-off release's volumes by it (no debris-runout key does)\n";
+        note << "# release thickness factor " << v << ": scale the hand-off release's volumes by it (no key does)\n";
         continue;
       }
       const RunoutInputs in = load_inputs(base);
-      Raster t;
-      t = read_raster(s.members.dsm).like(0.0, -9999.0);
-      for (std::size_t k = 0; k < t.data.size(); ++k) t.data[k] = in.thickness[k] * v;
-      t.description = "release thickness of the calibrated case (base release x " + fmt(v, 10) + ", vertical)";
-      t.unit = "m";
-      write_geotiff(out / "best_release.tif", t, true);
+      Raster r = read_raster(s.members.dsm).like(0.0, -9999.0);
+      for (std::size_t k = 0; k < r.data.size(); ++k) r.data[k] = in.thickness[k] * v;
+      r.description = "release thickness of the calibrated case (base release x " + fmt(v, 10) + ", vertical)";
+      r.unit = "m";
+      write_geotiff(out / "best_release.tif", r, true);
       set_path("release.file", (out / "best_release.tif").string());
-      m.apply_override("release.thickness_direction=\"vertical\"");
-      note << "# release.file: the base release (vertical thickness) x the fitted factor " << std::setprecision(17) << v
-           << "\n";
+      set_dotted(t, "release.thickness_direction", std::string("vertical"));
+      note << "# release.file: the base release (as a vertical thickness) x the fitted factor " << v << "\n";
       continue;
     }
-    std::ostringstream o;
-    o << key << '=' << std::setprecision(17) << v;
-    m.apply_override(o.str());
+    // Integer keys stay integers (TOML types are checked on reading).
+    if (toml::node* n = t.at_path(key).node(); n && n->is_integer() && v == std::floor(v))
+      set_dotted(t, key, static_cast<std::int64_t>(v));
+    else
+      set_dotted(t, key, v);
   }
-  (void)read_case(m);
-  m.finish();
+  std::ostringstream body;
+  body << t << "\n";
+  {
+    ConfigReader check = ConfigReader::from_string(body.str(), (out / "best.toml").string());
+    (void)read_case(check);
+    check.finish();
+  }
   std::ostringstream o;
   o << "# The best parameter set of geohaz-calibrate (member " << best.index << ", score " << std::setprecision(6)
-    << best.misfit.score << "): run it with\n#   debris-runout --config best.toml --out "
-    << "best-run\n"
-    << note.str() << m.resolved();
+    << best.misfit.score << "): the base case " << s.members.base_config.string()
+    << " with the fitted values.\n#   debris-runout --config best.toml --out best-run\n"
+    << note.str() << body.str();
   return o.str();
 }
 
