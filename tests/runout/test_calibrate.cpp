@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -14,7 +15,9 @@
 #include "calibration_case.hpp"
 #include "geohaz/core/config.hpp"
 #include "geohaz/core/errors.hpp"
+#include "geohaz/core/raster.hpp"
 #include "geohaz/runout/calibrate.hpp"
+#include "geohaz/runout/run.hpp"
 
 namespace fs = std::filesystem;
 using namespace geohaz;
