@@ -9,8 +9,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <sstream>
 
 #include "calibration_case.hpp"
 #include "geohaz/core/config.hpp"
@@ -238,5 +240,27 @@ TEST(CalibrationIdentifiability, FootprintErodedOrDilatedByOneCellShiftsTheFitBy
     EXPECT_NEAR(f.best[0], 0.06, 0.15 * 0.06);
     EXPECT_NEAR(f.best[1], 0.15, 0.15 * 0.15);
   }
+  fs::remove_all(c.dir);
+}
+
+TEST(Calibration, ModelledVolumeIsTheDepositIntegralSoMassConservationZeroesTheVolumeTerm) {
+  // One member at the truth's parameters (bounds 1e-10 wide) against the observed volume = the
+  // integral of the event's deposit raster: the flow stops by the kinetic-energy criterion, which
+  // deposits every particle, so the member's deposit holds the whole release (mass conservation)
+  // and the volume term vanishes to round-off (the rasters are float64).
+  const auto c = calibration_case::make(work_dir("volume"), kManningModel, {"model.n=0.06", "model.icr=0.15"});
+  const Raster dep = read_raster(c.deposit);
+  double v_obs = 0.0;
+  for (double d : dep.data) v_obs += dep.is_nodata(d) ? 0.0 : d;
+  v_obs *= dep.cell_size_x() * dep.cell_size_y();
+  std::ostringstream cfg;
+  cfg << calibration_case::config(c, "[[calibration.parameter]]\nkey = \"model.n\"\nmin = 0.06\nmax = 0.0600000001\n",
+                                  "global_members = 1\nmorris_trajectories = 0\nlocal_starts = 0\n")
+      << "volume = " << std::setprecision(17) << v_obs << "\n";
+  const Fit f = calibrate(c, cfg.str());
+  const auto& m = f.summary["best"]["misfit"];
+  EXPECT_GT(v_obs, 1000.0);
+  EXPECT_NEAR(m["volume_m3"].get<double>(), v_obs, 1e-9 * v_obs);
+  EXPECT_LT(m["terms"]["volume"].get<double>(), 1e-9);
   fs::remove_all(c.dir);
 }

@@ -496,7 +496,14 @@ std::unique_ptr<MemberRunner> make_calibration_runner(const CalibrationSetup& s)
   runner->set_finished_hook([&s](const RunoutSimulation& sim, const MemberRecord& rec, const fs::path& dir) {
     const std::vector<double> deposit = sim.deposit();
     write_member_peaks(dir / "deposit.bin", crop(s.observation.grid, deposit));
-    const Misfit m = compute_misfit(s.observation, s.score, sim.maps().max_depth(), deposit, rec.deposited_m3);
+    // The deposited volume is that of the deposit raster: a run stopped by the kinetic-energy
+    // criterion deposits every particle (RunoutSimulation::deposit), which the volume budget still
+    // counts as mobile.
+    (void)rec;
+    double volume = 0.0;
+    for (double d : deposit) volume += std::isfinite(d) ? d : 0.0;
+    volume *= s.observation.grid.cell_area();
+    const Misfit m = compute_misfit(s.observation, s.score, sim.maps().max_depth(), deposit, volume);
     write_text_file(dir / "misfit.json", misfit_json(m).dump(2) + "\n");
   });
   return runner;

@@ -96,7 +96,8 @@ struct Misfit {
   double score = 0.0;  ///< J
 };
 
-/// Misfit of a run: `max_depth` and `deposit` on the DSM grid (m), `volume` its deposited m³.
+/// Misfit of a run: `max_depth` and `deposit` on the DSM grid (m), `volume` its deposited m³ (the
+/// integral of `deposit`).
 Misfit compute_misfit(const Observation& obs, const ScoreSettings& s, const std::vector<double>& max_depth,
                       const std::vector<double>& deposit, double volume);
 
