@@ -11,6 +11,6 @@ geohaz.SimulationError (a RuntimeError), a failed write geohaz.IoError (an OSErr
 See docs/python.md.
 """
 from ._geohaz import __version__, InputError, IoError, SimulationError
-from . import runout, sph, dem, ensemble
+from . import runout, sph, dem, ensemble, calibrate
 
-__all__ = ["__version__", "InputError", "IoError", "SimulationError", "runout", "sph", "dem", "ensemble"]
+__all__ = ["__version__", "InputError", "IoError", "SimulationError", "runout", "sph", "dem", "ensemble", "calibrate"]

@@ -28,6 +28,7 @@
 #include "geohaz/core/output.hpp"
 #include "geohaz/core/progress.hpp"
 #include "geohaz/core/snapshot.hpp"
+#include "geohaz/runout/calibrate.hpp"
 #include "geohaz/runout/ensemble.hpp"
 #include "geohaz/runout/run.hpp"
 
@@ -292,6 +293,31 @@ std::string ensemble_run(const std::string& config, const std::vector<std::strin
   return text.str();
 }
 
+/// A calibration (geohaz-calibrate's config) run in this process on one rank: members and outputs in
+/// `out` (resumed when it holds the same calibration); returns the text of its summary.json.
+std::string calibrate_run(const std::string& config, const std::vector<std::string>& overrides, const std::string& out,
+                          int threads, bool quiet) {
+  ConfigReader cfg = ConfigReader::from_file(config);
+  for (const auto& o : overrides) cfg.apply_override(o);
+  CalibrationSetup s = read_calibration(cfg);
+  const int nthreads = threads > 0 ? setup_threads(threads) : omp_get_max_threads();
+  {
+    py::gil_scoped_release release;
+    run_calibration_serial(s, out, nthreads, quiet);
+  }
+  std::ifstream in(fs::path(out) / "summary.json");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+/// The config keys of geohaz-calibrate (as its --help-config).
+std::string calibrate_help_config() {
+  ConfigReader d = ConfigReader::describe();
+  describe_calibration(d);
+  return ConfigReader::format_reference(d.reference());
+}
+
 /// The config keys of geohaz-ensemble (as its --help-config).
 std::string ensemble_help_config() {
   ConfigReader d = ConfigReader::describe();
@@ -335,6 +361,9 @@ PYBIND11_MODULE(_geohaz, m) {
   m.def("ensemble_run", &ensemble_run, py::arg("config"), py::arg("overrides"), py::arg("out"), py::arg("threads"),
         py::arg("quiet"));
   m.def("ensemble_help_config", &ensemble_help_config);
+  m.def("calibrate_run", &calibrate_run, py::arg("config"), py::arg("overrides"), py::arg("out"), py::arg("threads"),
+        py::arg("quiet"));
+  m.def("calibrate_help_config", &calibrate_help_config);
   geohaz::python::add_sph(m);
   register_dem(m);
 }

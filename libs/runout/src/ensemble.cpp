@@ -802,6 +802,7 @@ MemberRecord MemberRunner::run(int i, const fs::path& out, int rank, int threads
         }
     }
     write_member_peaks(tmp / "peaks.bin", p);
+    if (hook_) hook_(sim, rec, tmp);
   } catch (const SimulationError& e) {
     rec.ok = false;
     rec.diagnosis = std::string("simulation failed: ") + e.what();

@@ -20,6 +20,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -35,6 +36,7 @@ class ConfigReader;
 namespace geohaz::runout {
 
 class RunObserver;
+class RunoutSimulation;
 
 /// Kinds of parameter distribution.
 enum class DistributionKind {
@@ -214,11 +216,17 @@ class MemberRunner {
   /// Run member i with `threads` OpenMP threads and write members/<i>/ (atomically); `observer`
   /// sees every step (the MPI app answers requests from there). A blow-up is recorded, not thrown.
   MemberRecord run(int i, const std::filesystem::path& out, int rank, int threads, RunObserver* observer = nullptr);
+  /// Called after a member ran to its end, with its record and its folder before that is published
+  /// (a caller's own files join the member atomically: the calibration's misfit, calibrate.hpp).
+  using FinishedHook =
+      std::function<void(const RunoutSimulation&, const MemberRecord&, const std::filesystem::path& folder)>;
+  void set_finished_hook(FinishedHook hook) { hook_ = std::move(hook); }
 
  private:
   struct Cache;
   const EnsembleSetup& s_;
   std::unique_ptr<Cache> cache_;
+  FinishedHook hook_;
 };
 
 /// Aggregate the members in index order and write the products, members.csv, the plots and

@@ -1,0 +1,878 @@
+// Back-analysis of debris-runout against an observed event (calibrate.hpp, docs/calibration.md):
+// configuration, misfit, the search (design + Morris + lockstep NLopt local searches).
+#include "geohaz/runout/calibrate.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <nlopt.hpp>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "geohaz/core/config.hpp"
+#include "geohaz/core/errors.hpp"
+#include "geohaz/core/output.hpp"
+#include "geohaz/core/raster.hpp"
+#include "geohaz/runout/run.hpp"
+
+namespace fs = std::filesystem;
+
+namespace geohaz::runout {
+
+namespace {
+
+std::string fmt(double v, int prec = 6) {
+  std::ostringstream o;
+  o << std::setprecision(prec) << v;
+  return o.str();
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string resolve_path(const ConfigReader& cfg, std::string p) {
+  if (!p.empty() && !cfg.source().empty() && fs::path(p).is_relative() && !fs::exists(p))
+    return (cfg.base_dir() / p).string();
+  return p;
+}
+
+std::string origin(const ConfigReader& cfg) {
+  return cfg.source().empty() ? "command line" : cfg.source();
+}
+
+/// The numeric keys of a debris-runout case (what a parameter may name).
+std::set<std::string> numeric_case_keys() {
+  ConfigReader d = ConfigReader::describe();
+  read_case(d);
+  std::set<std::string> keys;
+  for (const KeyReference& r : d.reference())
+    if (r.type == "number" || r.type == "integer") keys.insert(r.key);
+  return keys;
+}
+
+bool is_vector_file(const fs::path& p) {
+  std::string e = p.extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return e == ".shp" || e == ".geojson" || e == ".json" || e == ".gpkg" || e == ".kml" || e == ".gml";
+}
+
+/// A raster of the observation must lie on the DSM's grid in the DSM's CRS (no silent resampling:
+/// a footprint shifted by half a cell would bias every area).
+void check_same_grid(const Raster& r, const Raster& dsm, const std::string& src, const std::string& key,
+                     const std::string& file) {
+  if (!r.crs_wkt.empty() && !dsm.crs_wkt.empty() && !crs_equal(r.crs_wkt, dsm.crs_wkt))
+    throw InputError(
+        "the raster is in another CRS than the DSM (reproject it onto the DSM grid, e.g. gdalwarp "
+        "-t_srs <DSM CRS> -te <DSM extent> -tr <DSM cell size>)",
+        src, key, file);
+  const double tol = 1e-6 * std::abs(dsm.cell_size_x());
+  bool same = r.nx == dsm.nx && r.ny == dsm.ny;
+  for (int k = 0; k < 6 && same; ++k)
+    same = std::abs(r.geotransform[static_cast<std::size_t>(k)] - dsm.geotransform[static_cast<std::size_t>(k)]) <= tol;
+  if (!same)
+    throw InputError("the raster is on another grid than the DSM (" + std::to_string(r.nx) + " x " +
+                         std::to_string(r.ny) + " cells of " + fmt(r.cell_size_x()) + " m against " +
+                         std::to_string(dsm.nx) + " x " + std::to_string(dsm.ny) + " of " + fmt(dsm.cell_size_x()) +
+                         " m; resample it onto the DSM grid, e.g. gdalwarp -te <DSM extent> -tr <DSM cell size>)",
+                     src, key, file);
+}
+
+bool inside(const Raster& dsm, const Vec2& p) {
+  const auto e = dsm.extent();
+  return p.x() >= e[0].x() && p.x() <= e[1].x() && p.y() >= e[0].y() && p.y() <= e[1].y();
+}
+
+const char* const kParamKeys = "calibration.parameter";
+
+}  // namespace
+
+double CalibrationParameter::value(double u) const noexcept {
+  u = std::clamp(u, 0.0, 1.0);
+  if (log_scale) return lower * std::pow(upper / lower, u);
+  return lower + u * (upper - lower);
+}
+
+double CalibrationParameter::unit(double v) const noexcept {
+  if (upper == lower) return 0.0;
+  if (log_scale) return std::log(v / lower) / std::log(upper / lower);
+  return (v - lower) / (upper - lower);
+}
+
+double Observation::footprint_area() const noexcept {
+  std::size_t n = 0;
+  for (auto f : footprint) n += f;
+  return static_cast<double>(n) * grid.cell_area();
+}
+
+double along_thalweg(const std::vector<Vec2>& t, const Vec2& p) noexcept {
+  double best_d2 = std::numeric_limits<double>::infinity(), best_s = 0.0, s0 = 0.0;
+  for (std::size_t k = 1; k < t.size(); ++k) {
+    const Vec2 a = t[k - 1], ab = t[k] - a;
+    const double len2 = ab.squaredNorm(), len = std::sqrt(len2);
+    const double f = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    const double d2 = (a + ab * f - p).squaredNorm();
+    if (d2 < best_d2) best_d2 = d2, best_s = s0 + f * len;
+    s0 += len;
+  }
+  return best_s;
+}
+
+Misfit compute_misfit(const Observation& obs, const ScoreSettings& s, const std::vector<double>& max_depth,
+                      const std::vector<double>& deposit, double volume) {
+  Misfit m;
+  const double a = obs.grid.cell_area();
+  double s_max = 0.0;
+  double sq = 0.0, obs_sum = 0.0;
+  std::size_t n_union = 0, n_obs = 0;
+  const bool depth = !obs.deposit.empty();
+  for (std::size_t k = 0; k < obs.footprint.size(); ++k) {
+    const bool mod = std::isfinite(max_depth[k]) && max_depth[k] > s.depth_threshold;
+    const bool ob = obs.footprint[k] != 0;
+    if (mod && ob) m.tp += a;
+    if (mod && !ob) m.fp += a;
+    if (!mod && ob) m.fn += a;
+    if (mod) s_max = std::max(s_max, obs.s[k]);
+    if (depth) {
+      const double o = obs.deposit[k], d = std::isfinite(deposit[k]) ? deposit[k] : 0.0;
+      if (o > 0.0 || d > 0.0) sq += (d - o) * (d - o), ++n_union;
+      if (o > 0.0) obs_sum += o, ++n_obs;
+    }
+  }
+  const double denom = m.tp + s.alpha * m.fp + s.beta * m.fn;
+  m.tversky = denom > 0.0 ? m.tp / denom : 0.0;
+  m.runout_s = s_max;
+  m.runout_diff = s_max - obs.runout_s;
+  m.volume = volume;
+  m.term_footprint = s.w_footprint * (1.0 - m.tversky);
+  m.term_runout = obs.runout_s > 0.0 ? s.w_runout * std::abs(m.runout_diff) / obs.runout_s : 0.0;
+  if (depth && n_union > 0 && n_obs > 0) {
+    m.depth_rmse = std::sqrt(sq / static_cast<double>(n_union));
+    m.term_depth = s.w_depth * m.depth_rmse / (obs_sum / static_cast<double>(n_obs));
+  }
+  if (obs.volume > 0.0) m.term_volume = s.w_volume * std::abs(volume - obs.volume) / obs.volume;
+  m.score = m.term_footprint + m.term_runout + m.term_depth + m.term_volume;
+  return m;
+}
+
+// ---- configuration --------------------------------------------------------------------------
+
+namespace {
+
+struct Keys {
+  // Every key declared once: describe mode (--help-config) and reading go through these calls.
+  static void calibration(ConfigReader& cfg, CalibrationSetup& s) {
+    SearchSettings& q = s.search;
+    s.members.base_config = resolve_path(
+        cfg, cfg.require_string("calibration.base",
+                                {"", "the debris-runout config of the base case (DSM, release, law, numerics)"}));
+    q.seed = static_cast<std::uint64_t>(cfg.get_int("calibration.seed", 1, Range::closed(0, 9.0e15),
+                                                    {"1", "seed of the design and the Morris trajectories"}));
+    q.global_members = static_cast<int>(
+        cfg.get_int("calibration.global_members", q.global_members, Range::closed(1, 100000),
+                    {"1", "members of the global stage: a Latin hypercube in the unit cube of the scaled parameters"}));
+    q.morris_trajectories =
+        static_cast<int>(cfg.get_int("calibration.morris_trajectories", q.morris_trajectories, Range::closed(0, 1000),
+                                     {"1", "Morris elementary-effect trajectories (P + 1 members each); 0: none"}));
+    q.morris_levels = static_cast<int>(cfg.get_int("calibration.morris_levels", q.morris_levels, Range::closed(2, 64),
+                                                   {"1", "Morris grid levels p (step p / (2 (p - 1)) in u)"}));
+    if (q.morris_levels % 2 != 0)
+      throw InputError("Morris levels must be even (the step p / (2 (p - 1)) stays on the grid)", origin(cfg),
+                       "calibration.morris_levels", std::to_string(q.morris_levels));
+    q.local_starts =
+        static_cast<int>(cfg.get_int("calibration.local_starts", q.local_starts, Range::closed(0, 1000),
+                                     {"1",
+                                      "local searches, started from the best distinct members (run in lockstep: "
+                                      "one member per search and iteration, so this many ranks stay busy)"}));
+    q.local_evaluations =
+        static_cast<int>(cfg.get_int("calibration.local_evaluations", q.local_evaluations, Range::closed(1, 100000),
+                                     {"1", "members per local search at most"}));
+    q.local_xtol = cfg.get("calibration.local_xtol", q.local_xtol, Range::open_closed(0.0, 1.0),
+                           {"1", "a local search stops when a step moves u (unit cube) by less than this"});
+    q.local_step = cfg.get("calibration.local_step", q.local_step, Range::closed(0.0, 1.0),
+                           {"1", "initial step of the local searches in u; 0: 1 / global_members"});
+    q.local_algorithm =
+        cfg.get_choice("calibration.local_algorithm", q.local_algorithm, {"sbplx", "bobyqa", "neldermead"},
+                       {"",
+                        "NLopt derivative-free bounded local method: sbplx (Rowan 1990), bobyqa "
+                        "(Powell 2009; needs 2 or more parameters), neldermead"});
+    for (double v : cfg.get_array("calibration.inject_failure", {}, Range::closed(0, 1e9),
+                                  {"1", "test hook: these member indices fail on purpose"}))
+      s.members.inject_failure.push_back(static_cast<int>(v));
+  }
+
+  static void parameter(ConfigReader& t, CalibrationParameter& p) {
+    p.key = t.require_string("key", {"",
+                                     "numeric debris-runout key (model.n, model.icr, model.mu, ...) or "
+                                     "release.thickness_factor"});
+    const Range any = Range::closed(-1e12, 1e12);
+    p.lower = t.require("min", any, {"key's unit", "lower bound"});
+    p.upper = t.require("max", any, {"key's unit", "upper bound (> min)"});
+    p.log_scale =
+        t.get_choice("scale", "linear", {"linear", "log"},
+                     {"", "linear, or log (searched in ln: for coefficients spanning decades, min > 0)"}) == "log";
+  }
+
+  static void observation(ConfigReader& cfg, std::string& footprint, double& threshold, std::string& deposit,
+                          std::vector<double>& point, double& volume, std::string& thalweg) {
+    footprint = resolve_path(
+        cfg, cfg.require_string("observation.footprint", {"",
+                                                          "mapped footprint: polygons (Shapefile, GeoJSON, GPKG) or a "
+                                                          "raster on the DSM grid (affected where > threshold)"}));
+    threshold = cfg.get("observation.footprint_threshold", 0.0, Range::closed(-1e12, 1e12),
+                        {"raster's unit", "a footprint raster cell is affected when its value exceeds this"});
+    deposit = resolve_path(cfg, cfg.get_string("observation.deposit", "",
+                                               {"",
+                                                "observed deposit depth raster (m, vertical) on the DSM grid "
+                                                "(optional)"}));
+    point = cfg.get_array("observation.runout_point", {}, Range::closed(-1e8, 1e8),
+                          {"m",
+                           "observed run-out point [x, y] in the DSM's CRS (optional; default: the footprint's "
+                           "farthest cell along the thalweg)"});
+    volume = cfg.get("observation.volume", 0.0, Range::non_negative(),
+                     {"m^3", "observed deposit volume (optional; 0: not used)"});
+    thalweg = resolve_path(
+        cfg, cfg.require_string("observation.thalweg",
+                                {"",
+                                 "the thalweg (flow path) as a line file: the along-path coordinate of the "
+                                 "AIMEC-style comparison, starting at the release"}));
+  }
+
+  static void score(ConfigReader& cfg, ScoreSettings& s) {
+    s.depth_threshold = cfg.get("score.depth_threshold", s.depth_threshold, Range::non_negative(),
+                                {"m", "a modelled cell is affected when its peak flow depth exceeds this"});
+    s.alpha = cfg.get("score.tversky_alpha", s.alpha, Range::non_negative(),
+                      {"1", "Tversky weight of false positives (over-prediction); 0.5 with beta 0.5: Dice"});
+    s.beta = cfg.get("score.tversky_beta", s.beta, Range::non_negative(),
+                     {"1", "Tversky weight of false negatives (under-prediction)"});
+    s.w_footprint = cfg.get("score.w_footprint", s.w_footprint, Range::non_negative(), {"1", "weight of 1 - T"});
+    s.w_runout = cfg.get("score.w_runout", s.w_runout, Range::non_negative(),
+                         {"1", "weight of |run-out difference| / observed run-out (along the thalweg)"});
+    s.w_depth = cfg.get("score.w_depth", s.w_depth, Range::non_negative(),
+                        {"1", "weight of the deposit RMSE / mean observed deposit (with observation.deposit)"});
+    s.w_volume = cfg.get("score.w_volume", s.w_volume, Range::non_negative(),
+                         {"1", "weight of |volume difference| / observed volume (with observation.volume)"});
+    s.failed_penalty = cfg.get("score.failed_penalty", s.failed_penalty, Range::positive(),
+                               {"1", "score of a member whose run failed"});
+    s.acceptable_tolerance = cfg.get("score.acceptable_tolerance", s.acceptable_tolerance, Range::non_negative(),
+                                     {"1", "acceptable set: members whose score is at most the best score + this"});
+    s.profile_bin = cfg.get("score.profile_bin", s.profile_bin, Range::non_negative(),
+                            {"m", "bin length of thalweg_profile.csv along the thalweg; 0: two DSM cells"});
+  }
+};
+
+}  // namespace
+
+void describe_calibration(ConfigReader& cfg) {
+  CalibrationSetup s;
+  Keys::calibration(cfg, s);
+  for (ConfigReader& t : cfg.tables(kParamKeys, {"", "the parameters to fit: key, min, max, scale"})) {
+    CalibrationParameter p;
+    Keys::parameter(t, p);
+  }
+  std::string a, c, f;
+  double th = 0, v = 0;
+  std::vector<double> pt;
+  Keys::observation(cfg, a, th, c, pt, v, f);
+  Keys::score(cfg, s.score);
+}
+
+CalibrationSetup read_calibration(ConfigReader& cfg) {
+  CalibrationSetup s;
+  const std::string src = origin(cfg);
+  Keys::calibration(cfg, s);
+  const std::set<std::string> numeric = numeric_case_keys();
+  auto tables = cfg.tables(kParamKeys, {"", "the parameters to fit"});
+  if (tables.empty())
+    throw InputError("no parameter to fit: add [[calibration.parameter]] tables (key, min, max)", src, kParamKeys);
+  for (std::size_t k = 0; k < tables.size(); ++k) {
+    const std::string where = std::string(kParamKeys) + "[" + std::to_string(k) + "]";
+    CalibrationParameter p;
+    Keys::parameter(tables[k], p);
+    if (p.key != kThicknessFactorKey && !numeric.count(p.key)) {
+      std::string list = kThicknessFactorKey;
+      for (const auto& n : numeric) list += ", " + n;
+      throw InputError("unknown parameter name (a numeric debris-runout key or " + std::string(kThicknessFactorKey) +
+                           "); allowed: " + list,
+                       src, where + ".key", p.key);
+    }
+    for (const auto& q : s.parameters)
+      if (q.key == p.key) throw InputError("parameter given twice", src, where + ".key", p.key);
+    if (!(p.lower < p.upper))
+      throw InputError(
+          "bounds reversed or empty: min must be < max (min = " + fmt(p.lower) + ", max = " + fmt(p.upper) + ")", src,
+          where + ".min", fmt(p.lower));
+    if (p.log_scale && !(p.lower > 0.0))
+      throw InputError("a log scale needs min > 0", src, where + ".min", fmt(p.lower));
+    if (p.key == kThicknessFactorKey && !(p.lower > 0.0))
+      throw InputError("the release thickness factor must be > 0", src, where + ".min", fmt(p.lower));
+    s.parameters.push_back(p);
+  }
+  if (s.search.local_algorithm == "bobyqa" && s.parameters.size() < 2 && s.search.local_starts > 0)
+    throw InputError("bobyqa needs two or more parameters (use sbplx or neldermead for one)", src,
+                     "calibration.local_algorithm", "bobyqa");
+  std::string footprint, deposit, thalweg;
+  double threshold = 0.0;
+  std::vector<double> point;
+  Keys::observation(cfg, footprint, threshold, deposit, point, s.observation.volume, thalweg);
+  Keys::score(cfg, s.score);
+  cfg.finish();
+  s.resolved_config = cfg.resolved();
+
+  // The base case, and the case at every corner of the box (a bound outside its key's range is an
+  // input error naming the parameter, before anything is written).
+  EnsembleSetup& e = s.members;
+  e.resolved_config = s.resolved_config;
+  if (!fs::exists(e.base_config))
+    throw InputError("base case config not found", src, "calibration.base", e.base_config.string());
+  {
+    ConfigReader base = ConfigReader::from_file(e.base_config);
+    const RunoutCase c = read_case(base);
+    base.finish();
+    e.base_resolved = base.resolved();
+    e.dsm = c.dsm;
+  }
+  for (std::size_t k = 0; k < s.parameters.size(); ++k) {
+    const auto& p = s.parameters[k];
+    ParameterDistribution d;
+    d.key = p.key, d.kind = DistributionKind::Uniform, d.a = p.lower, d.b = p.upper;
+    e.plan.parameters.push_back(d);
+    if (p.key == kThicknessFactorKey) continue;
+    for (const double v : {p.lower, p.upper}) {
+      ConfigReader m = ConfigReader::from_file(e.base_config);
+      std::ostringstream o;
+      o << p.key << '=' << std::setprecision(17) << v;
+      m.apply_override(o.str(),
+                       src + " (" + kParamKeys + "[" + std::to_string(k) + "]." + (v == p.lower ? "min" : "max") + ")");
+      (void)read_case(m);
+    }
+  }
+  e.plan.members = 0;
+  e.plan.seed = s.search.seed;
+
+  // The observation on the DSM grid.
+  const Raster dsm = read_raster(e.dsm);
+  s.dsm_crs_wkt = dsm.crs_wkt;
+  Observation& ob = s.observation;
+  ob.grid = geometry_of(dsm);
+  const std::size_t cells = ob.grid.cells();
+  if (!fs::exists(thalweg)) throw InputError("thalweg file not found", src, "observation.thalweg", thalweg);
+  {
+    const auto lines = read_lines(thalweg, "", dsm.crs_wkt);
+    ob.thalweg = lines.front().vertices;
+    if (ob.thalweg.size() < 2)
+      throw InputError("the thalweg needs two or more vertices", src, "observation.thalweg", thalweg);
+    for (const Vec2& v : ob.thalweg)
+      if (!inside(dsm, v))
+        throw InputError("the thalweg leaves the DSM (vertex " + fmt(v.x(), 10) + ", " + fmt(v.y(), 10) + ")", src,
+                         "observation.thalweg", thalweg);
+  }
+  ob.s.resize(cells);
+  for (int r = 0; r < ob.grid.ny; ++r)
+    for (int c = 0; c < ob.grid.nx; ++c) ob.s[ob.grid.index(c, r)] = along_thalweg(ob.thalweg, ob.grid.centre(c, r));
+
+  if (!fs::exists(footprint)) throw InputError("footprint file not found", src, "observation.footprint", footprint);
+  ob.footprint.assign(cells, 0);
+  if (is_vector_file(footprint)) {
+    const auto polys = read_polygons(footprint, "", dsm.crs_wkt);
+    for (const auto& poly : polys)
+      for (const Vec2& v : poly.outer)
+        if (!inside(dsm, v))
+          throw InputError(
+              "the footprint polygon leaves the DSM (vertex " + fmt(v.x(), 10) + ", " + fmt(v.y(), 10) + ")", src,
+              "observation.footprint", footprint);
+    for (int r = 0; r < ob.grid.ny; ++r)
+      for (int c = 0; c < ob.grid.nx; ++c)
+        for (const auto& poly : polys)
+          if (poly.contains(ob.grid.centre(c, r))) {
+            ob.footprint[ob.grid.index(c, r)] = 1;
+            break;
+          }
+  } else {
+    const Raster f = read_raster(footprint, CrsPolicy::Any);
+    check_same_grid(f, dsm, src, "observation.footprint", footprint);
+    for (std::size_t k = 0; k < cells; ++k) ob.footprint[k] = !f.is_nodata(f.data[k]) && f.data[k] > threshold;
+  }
+  for (std::size_t k = 0; k < cells; ++k)
+    if (dsm.is_nodata(dsm.data[k])) ob.footprint[k] = 0;
+  if (ob.footprint_area() <= 0.0)
+    throw InputError("the observed footprint covers no DSM cell (outside the DSM?)", src, "observation.footprint",
+                     footprint);
+  if (!deposit.empty()) {
+    if (!fs::exists(deposit)) throw InputError("deposit raster not found", src, "observation.deposit", deposit);
+    const Raster d = read_raster(deposit, CrsPolicy::Any);
+    check_same_grid(d, dsm, src, "observation.deposit", deposit);
+    ob.deposit.assign(cells, 0.0);
+    for (std::size_t k = 0; k < cells; ++k)
+      ob.deposit[k] = d.is_nodata(d.data[k]) || !std::isfinite(d.data[k]) ? 0.0 : std::max(0.0, d.data[k]);
+  }
+  if (!point.empty()) {
+    if (point.size() != 2)
+      throw InputError("the run-out point is [x, y]", src, "observation.runout_point",
+                       std::to_string(point.size()) + " numbers");
+    const Vec2 p(point[0], point[1]);
+    if (!inside(dsm, p))
+      throw InputError("the run-out point lies outside the DSM", src, "observation.runout_point",
+                       fmt(p.x(), 10) + ", " + fmt(p.y(), 10));
+    ob.runout_s = along_thalweg(ob.thalweg, p);
+    ob.runout_from_point = true;
+  } else {
+    for (std::size_t k = 0; k < cells; ++k)
+      if (ob.footprint[k]) ob.runout_s = std::max(ob.runout_s, ob.s[k]);
+  }
+  return s;
+}
+
+// ---- members --------------------------------------------------------------------------------
+
+namespace {
+
+nlohmann::json misfit_json(const Misfit& m) {
+  return {{"tp_m2", m.tp},
+          {"fp_m2", m.fp},
+          {"fn_m2", m.fn},
+          {"tversky", m.tversky},
+          {"runout_s_m", m.runout_s},
+          {"runout_diff_m", m.runout_diff},
+          {"depth_rmse_m", m.depth_rmse},
+          {"volume_m3", m.volume},
+          {"term_footprint", m.term_footprint},
+          {"term_runout", m.term_runout},
+          {"term_depth", m.term_depth},
+          {"term_volume", m.term_volume},
+          {"score", m.score}};
+}
+
+Misfit parse_misfit(const nlohmann::json& j) {
+  Misfit m;
+  m.tp = j.at("tp_m2"), m.fp = j.at("fp_m2"), m.fn = j.at("fn_m2"), m.tversky = j.at("tversky");
+  m.runout_s = j.at("runout_s_m"), m.runout_diff = j.at("runout_diff_m"), m.depth_rmse = j.at("depth_rmse_m");
+  m.volume = j.at("volume_m3"), m.term_footprint = j.at("term_footprint"), m.term_runout = j.at("term_runout");
+  m.term_depth = j.at("term_depth"), m.term_volume = j.at("term_volume"), m.score = j.at("score");
+  return m;
+}
+
+/// The deposit of a member, cropped like its peaks (depth = deposit, the other two fields zero).
+MemberPeaks crop(const GridGeometry& g, const std::vector<double>& v) {
+  MemberPeaks p;
+  p.nx = g.nx, p.ny = g.ny;
+  int c0 = g.nx, c1 = -1, r0 = g.ny, r1 = -1;
+  for (int r = 0; r < g.ny; ++r)
+    for (int c = 0; c < g.nx; ++c)
+      if (v[g.index(c, r)] > 0.0)
+        c0 = std::min(c0, c), c1 = std::max(c1, c), r0 = std::min(r0, r), r1 = std::max(r1, r);
+  if (c1 < 0) return p;
+  p.c0 = c0, p.r0 = r0, p.w = c1 - c0 + 1, p.h = r1 - r0 + 1;
+  const std::size_t n = static_cast<std::size_t>(p.w) * p.h;
+  p.depth.resize(n), p.speed.assign(n, 0.0), p.pressure.assign(n, 0.0);
+  for (int r = 0; r < p.h; ++r)
+    for (int c = 0; c < p.w; ++c) p.depth[static_cast<std::size_t>(r) * p.w + c] = v[g.index(c0 + c, r0 + r)];
+  return p;
+}
+
+std::vector<double> uncrop(const MemberPeaks& p, const std::vector<double>& v) {
+  std::vector<double> out(static_cast<std::size_t>(p.nx) * p.ny, 0.0);
+  for (int r = 0; r < p.h; ++r)
+    for (int c = 0; c < p.w; ++c)
+      out[static_cast<std::size_t>(p.r0 + r) * p.nx + p.c0 + c] = v[static_cast<std::size_t>(r) * p.w + c];
+  return out;
+}
+
+}  // namespace
+
+std::unique_ptr<MemberRunner> make_calibration_runner(const CalibrationSetup& s) {
+  auto runner = std::make_unique<MemberRunner>(s.members);
+  runner->set_finished_hook([&s](const RunoutSimulation& sim, const MemberRecord& rec, const fs::path& dir) {
+    const std::vector<double> deposit = sim.deposit();
+    write_member_peaks(dir / "deposit.bin", crop(s.observation.grid, deposit));
+    // The deposited volume is that of the deposit raster: a run stopped by the kinetic-energy
+    // criterion deposits every particle (RunoutSimulation::deposit), which the volume budget still
+    // counts as mobile.
+    (void)rec;
+    double volume = 0.0;
+    for (double d : deposit) volume += std::isfinite(d) ? d : 0.0;
+    volume *= s.observation.grid.cell_area();
+    const Misfit m = compute_misfit(s.observation, s.score, sim.maps().max_depth(), deposit, volume);
+    write_text_file(dir / "misfit.json", misfit_json(m).dump(2) + "\n");
+  });
+  return runner;
+}
+
+Evaluation read_evaluation(const CalibrationSetup& s, const fs::path& out, int i) {
+  const fs::path d = member_dir(out, i);
+  const MemberRecord r = parse_member_json(slurp(d / "member.json"));
+  Evaluation e;
+  e.index = i;
+  e.values = r.values;
+  e.ok = r.ok;
+  e.diagnosis = r.diagnosis;
+  if (e.ok) {
+    e.misfit = parse_misfit(nlohmann::json::parse(slurp(d / "misfit.json")));
+  } else {
+    e.misfit.score = s.score.failed_penalty;
+  }
+  return e;
+}
+
+void prepare_calibration_output(const CalibrationSetup& s, const fs::path& out) {
+  if (fs::exists(out / "calibration.resolved.toml") && (slurp(out / "calibration.resolved.toml") != s.resolved_config ||
+                                                        slurp(out / "base.resolved.toml") != s.members.base_resolved))
+    throw InputError(
+        "the output folder holds another calibration (calibration.resolved.toml or base.resolved.toml differ): "
+        "choose another --out or delete it",
+        "command line", "--out", out.string());
+  make_output_dir(out);
+  fs::create_directories(out / "members");
+  for (const auto& e : fs::directory_iterator(out / "members"))
+    if (e.path().filename().string().find(".partial") != std::string::npos) fs::remove_all(e.path());
+  write_text_file(out / "calibration.resolved.toml", s.resolved_config);
+  write_text_file(out / "base.resolved.toml", s.members.base_resolved);
+}
+
+// ---- Morris trajectories --------------------------------------------------------------------
+
+std::vector<std::vector<double>> morris_trajectory(std::uint64_t seed, int t, int parameters, int levels) {
+  // Morris (1991) with the step Δ = p / (2 (p − 1)) on the grid {0, 1/(p−1), …, 1}: each factor
+  // moves once, up or down (a random direction per factor and trajectory, Campolongo et al. 2007),
+  // in a random order; the base level is drawn among those from which the move stays on [0, 1].
+  const double delta = levels / (2.0 * (levels - 1));
+  const int base_levels = levels / 2;  // levels 0 … p/2 − 1 can move up by Δ; p/2 … p − 1 down
+  const auto u = [&](std::uint64_t stream, int j) {
+    return counter_uniform(seed, 3 + stream, static_cast<std::uint64_t>(t), static_cast<std::uint64_t>(j));
+  };
+  std::vector<double> x(static_cast<std::size_t>(parameters));
+  std::vector<int> dir(static_cast<std::size_t>(parameters)), order(static_cast<std::size_t>(parameters));
+  for (int j = 0; j < parameters; ++j) {
+    dir[static_cast<std::size_t>(j)] = u(0, j) < 0.5 ? 1 : -1;
+    const int lvl = std::min(base_levels - 1, static_cast<int>(u(1, j) * base_levels));
+    const int level = dir[static_cast<std::size_t>(j)] > 0 ? lvl : levels - 1 - lvl;
+    x[static_cast<std::size_t>(j)] = static_cast<double>(level) / (levels - 1);
+    order[static_cast<std::size_t>(j)] = j;
+  }
+  for (int j = parameters - 1; j > 0; --j)
+    std::swap(order[static_cast<std::size_t>(j)],
+              order[static_cast<std::size_t>(std::min(j, static_cast<int>(u(2, j) * (j + 1))))]);
+  std::vector<std::vector<double>> pts{x};
+  for (int j : order) {
+    x[static_cast<std::size_t>(j)] =
+        std::clamp(x[static_cast<std::size_t>(j)] + dir[static_cast<std::size_t>(j)] * delta, 0.0, 1.0);
+    pts.push_back(x);
+  }
+  return pts;
+}
+
+// ---- the search -----------------------------------------------------------------------------
+
+namespace {
+
+/// Assigns member indices to points (a point met before keeps its member: no member is run twice)
+/// and runs the new ones as one batch.
+class Evaluator {
+ public:
+  Evaluator(CalibrationSetup& s, const fs::path& out, const BatchRunner& run, CalibrationResult& r, bool quiet)
+      : s_(s), out_(out), run_(run), r_(r), quiet_(quiet) {}
+
+  std::vector<double> values_of(const std::vector<double>& u) const {
+    std::vector<double> v(u.size());
+    for (std::size_t d = 0; d < u.size(); ++d) v[d] = s_.parameters[d].value(u[d]);
+    return v;
+  }
+
+  /// Scores of the points (u in the unit cube), in order.
+  std::vector<double> evaluate(const std::vector<std::vector<double>>& us, const std::vector<std::string>& stages) {
+    std::vector<int> idx;
+    std::vector<int> fresh;
+    for (std::size_t k = 0; k < us.size(); ++k) {
+      const std::vector<double> v = values_of(us[k]);
+      const auto it = known_.find(v);
+      if (it != known_.end()) {
+        idx.push_back(it->second);
+        continue;
+      }
+      const int i = next_++;
+      known_[v] = i;
+      idx.push_back(i);
+      auto& values = s_.members.values;
+      if (values.size() <= static_cast<std::size_t>(i)) values.resize(static_cast<std::size_t>(i) + 1);
+      values[static_cast<std::size_t>(i)] = v;
+      stage_[i] = stages[k];
+      if (member_done(out_, i)) {
+        // A member of an earlier (killed) run: it must be the same point, or the folder is another search's.
+        const MemberRecord rec = parse_member_json(slurp(member_dir(out_, i) / "member.json"));
+        if (rec.values != v)
+          throw InputError("member " + std::to_string(i) +
+                               " on disk has other parameter values than this search asks for (the folder holds "
+                               "another calibration): choose another --out or delete it",
+                           "command line", "--out", out_.string());
+        ++resumed_;
+      } else {
+        fresh.push_back(i);
+      }
+    }
+    if (!fresh.empty()) run_(fresh);
+    std::vector<double> f;
+    for (int i : idx) {
+      if (r_.evaluations.size() <= static_cast<std::size_t>(i)) r_.evaluations.resize(static_cast<std::size_t>(i) + 1);
+      Evaluation& e = r_.evaluations[static_cast<std::size_t>(i)];
+      if (e.stage.empty()) {
+        e = read_evaluation(s_, out_, i);
+        e.stage = stage_[i];
+        if (!quiet_) {
+          std::ostringstream o;
+          o << "geohaz-calibrate: member " << i << " (" << e.stage << ")";
+          for (std::size_t d = 0; d < e.values.size(); ++d) o << ' ' << s_.parameters[d].key << '=' << fmt(e.values[d]);
+          if (e.ok)
+            o << ": score " << fmt(e.misfit.score, 4) << " (T " << fmt(e.misfit.tversky, 4) << ", run-out "
+              << fmt(e.misfit.runout_diff, 4) << " m)";
+          else
+            o << ": FAILED (score " << fmt(e.misfit.score) << "): " << e.diagnosis;
+          std::cerr << o.str() << "\n";
+        }
+      }
+      f.push_back(e.misfit.score);
+    }
+    return f;
+  }
+  int resumed() const noexcept { return resumed_; }
+  int members() const noexcept { return next_; }
+
+ private:
+  CalibrationSetup& s_;
+  const fs::path& out_;
+  const BatchRunner& run_;
+  CalibrationResult& r_;
+  bool quiet_;
+  std::map<std::vector<double>, int> known_;
+  std::map<int, std::string> stage_;
+  int next_ = 0, resumed_ = 0;
+};
+
+/// Local searches in lockstep: each NLopt search runs in its own thread and blocks in its objective
+/// until the driver has evaluated one point of every live search as one batch.
+class LockstepSearches {
+ public:
+  struct Search {
+    std::vector<double> x0;
+    bool waiting = false, answered = false, done = false;
+    std::vector<double> request;
+    double answer = 0.0;
+    std::string stop;
+  };
+
+  LockstepSearches(const SearchSettings& q, int dims, std::vector<std::vector<double>> starts) : q_(q), dims_(dims) {
+    searches_.resize(starts.size());
+    for (std::size_t k = 0; k < starts.size(); ++k) searches_[k].x0 = std::move(starts[k]);
+  }
+
+  void run(const std::function<std::vector<double>(const std::vector<std::vector<double>>&,
+                                                   const std::vector<std::size_t>&)>& evaluate) {
+    nlopt::srand(q_.seed);
+    std::vector<std::thread> threads;
+    for (std::size_t k = 0; k < searches_.size(); ++k) threads.emplace_back([this, k] { search(k); });
+    try {
+      for (;;) {
+        std::vector<std::size_t> live;
+        std::vector<std::vector<double>> pts;
+        {
+          std::unique_lock lock(m_);
+          cv_.wait(lock, [&] {
+            return std::all_of(searches_.begin(), searches_.end(), [](const Search& s) { return s.waiting || s.done; });
+          });
+          for (std::size_t k = 0; k < searches_.size(); ++k)
+            if (searches_[k].waiting) live.push_back(k), pts.push_back(searches_[k].request);
+        }
+        if (live.empty()) break;
+        const std::vector<double> f = evaluate(pts, live);
+        {
+          std::lock_guard lock(m_);
+          for (std::size_t j = 0; j < live.size(); ++j) {
+            Search& s = searches_[live[j]];
+            s.answer = f[j], s.waiting = false, s.answered = true;
+          }
+        }
+        cv_.notify_all();
+      }
+    } catch (...) {
+      {
+        std::lock_guard lock(m_);
+        abort_ = true;
+      }
+      cv_.notify_all();
+      for (auto& t : threads) t.join();
+      throw;
+    }
+    for (auto& t : threads) t.join();
+  }
+  const std::vector<Search>& searches() const noexcept { return searches_; }
+
+ private:
+  struct Context {
+    LockstepSearches* self;
+    std::size_t k;
+  };
+  static double objective(const std::vector<double>& x, std::vector<double>& grad, void* data) {
+    (void)grad;  // derivative-free methods only
+    auto* c = static_cast<Context*>(data);
+    LockstepSearches& L = *c->self;
+    Search& s = L.searches_[c->k];
+    std::unique_lock lock(L.m_);
+    if (L.abort_) throw nlopt::forced_stop();
+    s.request = x, s.waiting = true;
+    L.cv_.notify_all();
+    L.cv_.wait(lock, [&] { return s.answered || L.abort_; });
+    if (L.abort_) throw nlopt::forced_stop();
+    s.answered = false;
+    return s.answer;
+  }
+
+  void search(std::size_t k) {
+    Search& s = searches_[k];
+    std::string stop;
+    try {
+      const nlopt::algorithm alg = q_.local_algorithm == "bobyqa"       ? nlopt::LN_BOBYQA
+                                   : q_.local_algorithm == "neldermead" ? nlopt::LN_NELDERMEAD
+                                                                        : nlopt::LN_SBPLX;
+      nlopt::opt opt(alg, static_cast<unsigned>(dims_));
+      opt.set_lower_bounds(std::vector<double>(static_cast<std::size_t>(dims_), 0.0));
+      opt.set_upper_bounds(std::vector<double>(static_cast<std::size_t>(dims_), 1.0));
+      Context ctx{this, k};
+      opt.set_min_objective(&LockstepSearches::objective, &ctx);
+      opt.set_maxeval(q_.local_evaluations);
+      opt.set_xtol_abs(q_.local_xtol);
+      const double step = q_.local_step > 0.0 ? q_.local_step : 1.0 / std::max(1, q_.global_members);
+      std::vector<double> steps(static_cast<std::size_t>(dims_));
+      for (int d = 0; d < dims_; ++d) {
+        // Step towards the interior when the start lies on a bound (BOBYQA needs x0 ± step inside).
+        const double x = s.x0[static_cast<std::size_t>(d)];
+        steps[static_cast<std::size_t>(d)] = std::min(step, std::max(std::max(x, 1.0 - x), 1e-3));
+      }
+      opt.set_initial_step(steps);
+      std::vector<double> x = s.x0;
+      double f = 0.0;
+      const nlopt::result res = opt.optimize(x, f);
+      stop = res == nlopt::MAXEVAL_REACHED   ? "maximum evaluations reached"
+             : res == nlopt::XTOL_REACHED    ? "step below local_xtol"
+             : res == nlopt::FTOL_REACHED    ? "score change below ftol"
+             : res == nlopt::STOPVAL_REACHED ? "stop value reached"
+                                             : "converged";
+    } catch (const nlopt::forced_stop&) {
+      stop = "aborted";
+    } catch (const nlopt::roundoff_limited&) {
+      stop = "round-off limited";
+    } catch (const std::exception& e) {
+      stop = std::string("stopped: ") + e.what();
+    }
+    std::lock_guard lock(m_);
+    s.stop = stop, s.done = true, s.waiting = false;
+    cv_.notify_all();
+  }
+
+  const SearchSettings& q_;
+  int dims_;
+  std::vector<Search> searches_;
+  std::mutex m_;
+  std::condition_variable cv_;
+  bool abort_ = false;
+};
+
+}  // namespace
+
+CalibrationResult run_calibration(CalibrationSetup& s, const fs::path& out, const BatchRunner& run_batch, bool quiet) {
+  CalibrationResult r;
+  const int P = static_cast<int>(s.parameters.size());
+  Evaluator ev(s, out, run_batch, r, quiet);
+  // 1. The global stage: a Latin hypercube in u (the ensemble's sampler on U(0, 1)) and the Morris
+  //    trajectories, as one batch.
+  EnsemblePlan unit;
+  unit.seed = s.search.seed;
+  unit.members = s.search.global_members;
+  unit.sampling = SamplingMethod::LatinHypercube;
+  for (const auto& p : s.parameters) {
+    ParameterDistribution d;
+    d.key = p.key, d.kind = DistributionKind::Uniform, d.a = 0.0, d.b = 1.0;
+    unit.parameters.push_back(d);
+  }
+  std::vector<std::vector<double>> pts = sample_plan(unit);
+  std::vector<std::string> stages(pts.size(), "design");
+  for (int t = 0; t < s.search.morris_trajectories; ++t)
+    for (auto& x : morris_trajectory(s.search.seed, t, P, s.search.morris_levels)) {
+      pts.push_back(x);
+      stages.push_back("morris");
+    }
+  ev.evaluate(pts, stages);
+  r.design_members = s.search.global_members;
+  r.morris_members = ev.members() - r.design_members;
+
+  // 2. Local searches from the best distinct successful members, in lockstep.
+  std::vector<const Evaluation*> ranked;
+  for (const auto& e : r.evaluations)
+    if (e.ok) ranked.push_back(&e);
+  std::stable_sort(ranked.begin(), ranked.end(),
+                   [](const Evaluation* a, const Evaluation* b) { return a->misfit.score < b->misfit.score; });
+  std::vector<std::vector<double>> starts;
+  for (const Evaluation* e : ranked) {
+    if (static_cast<int>(starts.size()) >= s.search.local_starts) break;
+    std::vector<double> u(static_cast<std::size_t>(P));
+    for (int d = 0; d < P; ++d)
+      u[static_cast<std::size_t>(d)] =
+          std::clamp(s.parameters[static_cast<std::size_t>(d)].unit(e->values[static_cast<std::size_t>(d)]), 0.0, 1.0);
+    if (std::find(starts.begin(), starts.end(), u) == starts.end()) starts.push_back(u);
+  }
+  if (!starts.empty()) {
+    LockstepSearches L(s.search, P, starts);
+    L.run([&](const std::vector<std::vector<double>>& us, const std::vector<std::size_t>& which) {
+      std::vector<std::string> st;
+      for (std::size_t k : which) st.push_back("local" + std::to_string(k));
+      return ev.evaluate(us, st);
+    });
+    for (const auto& q : L.searches()) r.local_stops.push_back(q.stop);
+  }
+  // 3. The best member (lowest score, then lowest index).
+  for (const auto& e : r.evaluations)
+    if (r.best < 0 || e.misfit.score < r.evaluations[static_cast<std::size_t>(r.best)].misfit.score) r.best = e.index;
+  if (!quiet)
+    std::cerr << "geohaz-calibrate: " << ev.members() << " members (" << ev.resumed() << " found on disk), best "
+              << r.best << " with score " << fmt(r.evaluations[static_cast<std::size_t>(r.best)].misfit.score, 5)
+              << "\n";
+  return r;
+}
+
+void run_calibration_serial(CalibrationSetup& s, const fs::path& out, int threads, bool quiet) {
+  prepare_calibration_output(s, out);
+  const auto wall0 = std::chrono::steady_clock::now();
+  const std::unique_ptr<MemberRunner> runner = make_calibration_runner(s);
+  const CalibrationResult r = run_calibration(
+      s, out,
+      [&](const std::vector<int>& batch) {
+        for (int i : batch)
+          if (!member_done(out, i)) runner->run(i, out, 0, threads);
+      },
+      quiet);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  write_calibration_outputs(s, r, out, 1, threads, wall, quiet);
+}
+
+// Outputs are in calibrate_outputs.cpp.
+
+std::vector<double> read_member_deposit(const fs::path& out, int i) {
+  const MemberPeaks p = read_member_peaks(member_dir(out, i) / "deposit.bin");
+  return uncrop(p, p.depth);
+}
+
+std::vector<double> read_member_max_depth(const fs::path& out, int i) {
+  const MemberPeaks p = read_member_peaks(member_dir(out, i) / "peaks.bin");
+  return uncrop(p, p.depth);
+}
+
+}  // namespace geohaz::runout

@@ -1,0 +1,101 @@
+// The Alplehner back-analysis (issue #31, label validation): a synthetic event on the real DTM,
+// recovered by a two-parameter calibration; prints the members and the wall time for
+// docs/performance.md.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "calibration_case.hpp"
+#include "geohaz/core/config.hpp"
+#include "geohaz/core/raster.hpp"
+#include "geohaz/runout/calibrate.hpp"
+#include "geohaz/runout/run.hpp"
+
+namespace fs = std::filesystem;
+using namespace geohaz;
+using namespace geohaz::runout;
+
+namespace {
+
+fs::path work_dir(const std::string& name) {
+  const fs::path d =
+      fs::path(GEOHAZ_BINARY_DIR) / "tests" / "runout" / "calibrate_work" / (name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+struct Fit {
+  nlohmann::json summary;
+  std::vector<double> best;
+};
+
+Fit calibrate(const calibration_case::Case& c, const std::string& config) {
+  const fs::path out = c.dir / "out";
+  fs::remove_all(out);
+  ConfigReader cfg = ConfigReader::from_string(config, (c.dir / "calibrate.toml").string());
+  CalibrationSetup s = read_calibration(cfg);
+  run_calibration_serial(s, out, 0, true);
+  std::ifstream in(out / "summary.json");
+  Fit f;
+  f.summary = nlohmann::json::parse(in);
+  f.best = f.summary["best"]["values"].get<std::vector<double>>();
+  return f;
+}
+
+const char* const kSearch =
+    "global_members = 12\nmorris_trajectories = 2\nlocal_starts = 2\nlocal_evaluations = 24\nlocal_algorithm = "
+    "\"bobyqa\"\n";
+
+}  // namespace
+
+TEST(CalibrationValidation, AlplehnerTwoParameterCalibrationRecoversVoellmyMuAndXi) {
+  // The issue's case: a synthetic event on the Alplehner DTM (5 m), made by a run with μ = 0.155,
+  // ξ = 4000 m/s² (com1DFA's, docs/validation/runout.md), particle spacing d0 = 10 m; the
+  // observation is its footprint (peak depth > 0.1 m) and deposit, the thalweg path_aimec.shp.
+  // Printed: the fit, the members and the wall time (docs/performance.md).
+  const fs::path alr = fs::path(GEOHAZ_SOURCE_DIR) / "data" / "terrain" / "alr";
+  const fs::path d = work_dir("alr");
+  std::ofstream(d / "base.toml") << "[terrain]\ndsm = \"" << (alr / "avaAlr.tif").string() << "\"\n[release]\nfile = \""
+                                 << (alr / "relAlr.shp").string()
+                                 << "\"\ndepth = 1.0\n[model]\nfriction = \"voellmy\"\nmu = 0.155\nxi = 4000.0\nd0 = "
+                                    "10.0\nh0 = 0.25\n[run]\nduration = 400.0\n";
+  {
+    ConfigReader cfg = ConfigReader::from_file(d / "base.toml");
+    const RunoutCase rc = read_case(cfg);
+    const RunoutInputs in = load_inputs(rc);
+    RunoutSimulation sim(in, rc.params, rc.output);
+    sim.run();
+    Raster fp = in.dsm.like(0.0, -9999.0), dep = in.dsm.like(0.0, -9999.0);
+    const auto deposit = sim.deposit();
+    for (std::size_t k = 0; k < fp.data.size(); ++k) {
+      fp.data[k] = sim.maps().max_depth()[k] > 0.1 ? 1.0 : 0.0;
+      dep.data[k] = deposit[k];
+    }
+    write_geotiff(d / "footprint.tif", fp);
+    write_geotiff(d / "deposit.tif", dep, true);
+  }
+  calibration_case::Case c{d, d / "base.toml", d / "footprint.tif", d / "deposit.tif", alr / "path_aimec.shp", 0.0};
+  const auto t0 = std::chrono::steady_clock::now();
+  const Fit f = calibrate(
+      c, calibration_case::config(c,
+                                  "[[calibration.parameter]]\nkey = \"model.mu\"\nmin = 0.08\nmax = 0.3\n"
+                                  "[[calibration.parameter]]\nkey = \"model.xi\"\nmin = 500.0\nmax = 10000.0\nscale "
+                                  "= \"log\"\n",
+                                  kSearch));
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double t = f.summary["best"]["misfit"]["tversky"].get<double>();
+  std::printf(
+      "VALIDATION calibration alr d0 = 10 m: mu %.5f (truth 0.155), xi %.1f (truth 4000), T %.4f, %d members, "
+      "wall %.0f s on 1 rank\n",
+      f.best[0], f.best[1], t, f.summary["members"].get<int>(), wall);
+  EXPECT_NEAR(f.best[0], 0.155, 0.05 * 0.155);
+  EXPECT_NEAR(f.best[1], 4000.0, 0.05 * 4000.0);
+  EXPECT_GE(t, 0.99);
+  fs::remove_all(d);
+}
