@@ -119,6 +119,9 @@ struct OutputSettings {
   bool snapshots = true;            ///< snapshots.h5 + .xmf
   bool pngs = true;                 ///< quick-look PNGs
   IntensityTable intensity;         ///< classes of intensity.tif
+  /// A particle alone within 2·d0 paints the peak maps only where the depth it stands for exceeds
+  /// this (m); below it is detached (hazard_maps.hpp). AvaFrame com1DFA's hmin.
+  double sparse_min_depth = 0.05;
 };
 
 /// Everything a run needs, in SI units. Defaults are those of the structs it holds.
