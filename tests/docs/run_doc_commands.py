@@ -7,7 +7,10 @@ after the other, each must exit 0.
 Skip rules (printed with the reason for every command skipped):
   1. A block right after the HTML comment  <!-- doc-commands: skip: REASON -->  (e.g. a run of
      more than a minute, or one the demo check already runs) is not run.
-  2. Commands whose first word is in SKIPPED_PROGRAMS below: they build, install, change the
+  2. data/README.md's tables: the commands in a row's first cell (inline code starting with
+     build/apps/) run when the row's time column says seconds below 60 ("~5 s"); rows whose time
+     is in minutes, a range reaching 60 s or more, or a reference elsewhere are skipped.
+  3. Commands whose first word is in SKIPPED_PROGRAMS below: they build, install, change the
      machine or need a cluster, and CI runs them itself (scripts/test, scripts/demo) or cannot.
 Usage: run_doc_commands.py SOURCE_DIR BUILD_DIR
 """
@@ -70,6 +73,20 @@ def blocks(path):
     return out
 
 
+def table_commands(path):
+    """(line number, skip reason or None, [command]) of each data/README.md table row with a command."""
+    out = []
+    for n, row in enumerate(open(path, encoding="utf-8").read().splitlines(), 1):
+        if not row.startswith("| `build/apps/"):
+            continue
+        cells = [c.strip() for c in row.strip().strip("|").split("|")]
+        cmd = re.match(r"`([^`]*)`", cells[0]).group(1)
+        secs = [float(x) for x in re.findall(r"(\d+(?:\.\d+)?)\s*s\b", cells[-1])]
+        long_ = not secs or "min" in cells[-1] or max(secs) >= 60 or len(cells) < 3
+        out.append((n, f"the table gives its time as '{cells[-1][:40]}'" if long_ else None, [cmd]))
+    return out
+
+
 def main():
     src, build = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
     files = ["README.md", "data/README.md"] + sorted(
@@ -85,7 +102,10 @@ def main():
         + [env.get("PATH", "")])
     ran = failed = skipped = 0
     for f in files:
-        for line, reason, cmds in blocks(os.path.join(src, f)):
+        found = blocks(os.path.join(src, f))
+        if f == "data/README.md":
+            found += table_commands(os.path.join(src, f))
+        for line, reason, cmds in found:
             for cmd in cmds:
                 first = cmd.split()[0]
                 why = reason or SKIPPED_PROGRAMS.get(first)
