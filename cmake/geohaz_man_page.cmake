@@ -1,6 +1,9 @@
 # cmake -DAPP=<exe> -DNAME=<app> -DHELP2MAN=<help2man> -DOUT=<page.1> -DVERSION=<v> -P geohaz_man_page.cmake
 # A man page from `APP --help` and `APP --version` (help2man), with `APP --help-config` (every config
 # key with unit, default and range), when the app has it, as a CONFIGURATION section.
+# help2man and the app run in a UTF-8 locale: in the default C locale help2man writes every
+# non-ASCII character of the help text (m³, θ, °) as "?" (issue #29).
+set(ENV{LC_ALL} C.UTF-8)
 get_filename_component(_dir ${OUT} DIRECTORY)
 file(MAKE_DIRECTORY ${_dir})
 set(_include ${OUT}.include)
@@ -19,7 +22,7 @@ string(REGEX MATCH "^[^\n]*" _first "${_help}")
 string(REGEX REPLACE "^[^:]*: *" "" _name "${_first}")
 string(REGEX REPLACE "\\.$" "" _name "${_name}")
 execute_process(
-  COMMAND ${HELP2MAN} --no-info "--name=${_name}" --no-discard-stderr --section=1 --source=geohaz --version-string=${VERSION}
+  COMMAND ${HELP2MAN} --no-info --locale=C.UTF-8 "--name=${_name}" --no-discard-stderr --section=1 --source=geohaz --version-string=${VERSION}
           --include=${_include} --output=${OUT} ${APP}
   RESULT_VARIABLE _rc ERROR_VARIABLE _err)
 if(NOT _rc EQUAL 0)

@@ -185,7 +185,10 @@ void report(const MemberRecord& r, int n, bool quiet) {
 int run(int argc, char** argv, const World& world) {
   CommonOptions common;
   po::options_description desc("Options (SI units)");
-  add_common_options(desc, common, "ensemble-out");
+  add_common_options(desc, common, "ensemble-out",
+                     "output directory: new, empty, or holding the same ensemble (same config), which resumes: "
+                     "members already done are kept and only the missing ones run; a different ensemble or any "
+                     "other file there stops the run (exit 2)");
   po::positional_options_description pos;
   pos.add("config", 1);
   if (!parse_command_line(argc, argv, kApp,
@@ -193,7 +196,9 @@ int run(int argc, char** argv, const World& world) {
                           "Carlo), on one rank or under mpirun, aggregated into probability-of-exceedance, mean and "
                           "percentile maps (docs/ensemble.md).\n"
                           "Usage: [mpirun -np R] geohaz-ensemble ensemble.toml [--set key=value ...] [--out DIR] "
-                          "[--threads N per rank] [--quiet]",
+                          "[--threads N per rank] [--quiet]\n"
+                          "Example: geohaz-ensemble data/runout/alr_ensemble.toml --set ensemble.members=8 --out "
+                          "ensemble-alr",
                           desc, &pos))
     return kExitOk;
   if (common.help_config) {

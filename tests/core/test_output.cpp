@@ -76,6 +76,37 @@ TEST(Progress, LogModePrintsPlainLinesWithRateAndEta) {
   EXPECT_NE(out.find("done in"), std::string::npos);
 }
 
+// In a pipe or log: one line at the start and one each time the run passes another 10 % (the 60 s
+// interval set out of reach here), whatever the step size; a caller's estimate of the fraction done
+// (a stop criterion) counts when it is ahead of t/end_time, with its note on the line.
+TEST(Progress, LogModePrintsOneLinePerTenPercent) {
+  std::FILE* f = std::tmpfile();
+  ProgressReporter p("test", 10.0, false, f);
+  p.set_terminal(false);
+  p.set_log_interval(1e9);
+  for (int k = 0; k <= 200; ++k) p.update(0.05 * k, k, 10);
+  std::rewind(f);
+  char buf[16384] = {};
+  const std::size_t n = std::fread(buf, 1, sizeof buf - 1, f);
+  std::fclose(f);
+  const std::string out(buf, n);
+  std::size_t lines = 0;
+  for (char c : out) lines += c == '\n';
+  EXPECT_EQ(lines, 11u) << out;  // 0 %, 10 %, ..., 100 %
+  EXPECT_NE(out.find("( 50.0%)"), std::string::npos) << out;
+
+  std::FILE* g = std::tmpfile();
+  ProgressReporter q("test", 600.0, false, g);
+  q.set_terminal(false);
+  q.set_log_interval(1e9);
+  q.update(60.0, 100, 10, 0.5, "kinetic energy 10 % of peak, stops below 1 %");
+  EXPECT_NE(q.last_line().find("( 50.0%)"), std::string::npos) << q.last_line();
+  EXPECT_NE(q.last_line().find("(kinetic energy 10 % of peak, stops below 1 %)"), std::string::npos);
+  q.update(66.0, 110, 10, 0.05, "kinetic energy 79 % of peak, stops below 1 %");  // time ahead: 11 %
+  EXPECT_NE(q.last_line().find("( 50.0%)"), std::string::npos) << "no line before the next 10 %";
+  std::fclose(g);
+}
+
 TEST(Progress, QuietPrintsNothing) {
   std::FILE* f = std::tmpfile();
   ProgressReporter p("test", 1.0, true, f);

@@ -202,6 +202,54 @@ TEST_F(Reliability, ValuesThatWouldRunForHoursAreBadInput) {
   }
 }
 
+// Issue #29, the two inputs the fuzzing still found: a geostatic phase of 1e9 s ran for hours (now
+// bounded by 100 times the slope's natural loading time 20 H/c_p, docs/sph.md), and a 10,000-character
+// file name ended with exit 3 "filesystem error: status: File name too long" (bad input: exit 2
+// naming the key or argument; the check runs before anything is written).
+TEST_F(Reliability, GeostaticPhaseOfHoursIsBadInput) {
+  ChildLimits lim;
+  lim.timeout_s = 30;
+  const auto r = expect_exit(
+      {SPH_SLOPE_EXE, "--config", (kData / "sph/slope_2d_granular.toml").string(), "--set", "numerics.spacing=0.025",
+       "--set", "geostatic.duration=1e9", "--quiet", "--out", (dir_ / "o").string()},
+      2, lim);
+  EXPECT_TRUE(has(r.err, "geostatic.duration")) << r.err;
+  EXPECT_TRUE(has(r.err, "20 H/c_p")) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
+}
+
+TEST_F(Reliability, FileNameTooLongIsBadInputNamingTheKey) {
+  const std::string long_name = (dir_ / std::string(10000, 'a')).string() + ".tif";
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {runout_valley(dir_ / "o") + std::vector<std::string>{"--release", long_name}, "release.file"},
+      {runout_valley(dir_ / "o") + std::vector<std::string>{"--set", "terrain.dsm=\"" + long_name + "\""},
+       "terrain.dsm"},
+      {{DEBRIS_RUNOUT_EXE, (kData / "terrain/alr/avaAlr.tif").string(), "--release",
+        (kData / "terrain/alr/relAlr.shp").string(), "--quiet", "--out", long_name},
+       "--out"},
+      {{SPH_SLOPE_EXE, "--config", (kData / "sph/column_collapse.toml").string(), "--quiet", "--out", long_name},
+       "--out"},
+  };
+  for (const auto& [argv, key] : cases) {
+    ChildLimits lim;
+    lim.timeout_s = 30;
+    const auto r = expect_exit(argv, 2, lim);
+    EXPECT_TRUE(has(r.err, key)) << r.err;
+    EXPECT_TRUE(has(r.err, "file name too long")) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "o"));
+  }
+}
+
+// A missing input file says so, not "cannot read as a raster" (issue #29).
+TEST_F(Reliability, MissingInputFileSaysNoSuchFile) {
+  const auto r = expect_exit({DEBRIS_RUNOUT_EXE, (dir_ / "nothing_here.tif").string(), "--release",
+                              (kData / "terrain/alr/relAlr.shp").string(), "--quiet", "--out", (dir_ / "o").string()},
+                             2);
+  EXPECT_TRUE(has(r.err, "no such file")) << r.err;
+  EXPECT_TRUE(has(r.err, "nothing_here.tif")) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
+}
+
 // Item 5: a malformed index in --set ended with "error: stol", exit 1, in every app.
 TEST_F(Reliability, MalformedSetIndexIsBadInputNamingTheCommandLine) {
   for (const char* set :

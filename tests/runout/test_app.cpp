@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -127,6 +128,41 @@ TEST(DebrisRunoutApp, TinyValleyRunsAndBalancesVolume) {
   EXPECT_EQ(speed.unit, "m/s");
   EXPECT_EQ(speed.description, "peak surface speed");
   EXPECT_TRUE(speed.nodata.has_value());
+}
+
+// In a pipe (a log file, a cluster job) the progress is one plain line per 10 % of the run (or per
+// 60 s of wall time), no terminal control characters; the end says what stopped the run and what
+// "mobile" means (issue #29, item 4).
+TEST(DebrisRunoutApp, ProgressInAPipeIsOneLinePerTenPercent) {
+  const fs::path dsm = tiny_dsm();
+  const fs::path out = work_dir() / "pipe_out";
+  fs::remove_all(out);
+  const auto r = run(dsm.string() + " --release " + (work_dir() / "tiny_release.tif").string() +
+                     " --d0 2.5 --h0 0.75 --duration 60 --out " + out.string() + " --threads 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.output.find('\r'), std::string::npos) << r.output;
+  const std::regex line(R"(^debris-runout: t = [0-9.e+-]+ / 60 s \( *([0-9.]+)%\)  step [0-9]+  [0-9.e+-]+ steps/s  )"
+                        R"([0-9.e+-]+ particle-steps/s  ETA [0-9hms.-]+(  \(kinetic energy [0-9.e+-]+ % of peak, )"
+                        R"(stops below 1 %\))?$)");
+  std::istringstream in(r.output);
+  std::string l;
+  std::vector<double> percent;
+  while (std::getline(in, l)) {
+    if (l.rfind("debris-runout: t = ", 0) != 0) continue;
+    std::smatch m;
+    ASSERT_TRUE(std::regex_match(l, m, line)) << l;
+    percent.push_back(std::stod(m[1].str()));
+  }
+  // A line at the start and one per 10 % after (a fast run: the 60 s interval never comes first).
+  ASSERT_GE(percent.size(), 2u) << r.output;
+  EXPECT_LE(percent.size(), 11u) << r.output;
+  for (std::size_t k = 1; k < percent.size(); ++k) {
+    EXPECT_GE(percent[k], percent[k - 1]);
+    EXPECT_GE(std::floor(percent[k] / 10.0), std::floor(percent[k - 1] / 10.0) + 1) << "two lines in one 10 %";
+  }
+  EXPECT_NE(r.output.find("debris-runout: stopped at t = "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("mobile (not yet held by friction"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("done in"), std::string::npos) << r.output;
 }
 
 TEST(DebrisRunoutApp, BadInputsExitTwoAndWriteNothing) {

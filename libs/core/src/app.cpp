@@ -9,6 +9,7 @@
 #include <set>
 #include <system_error>
 
+#include "geohaz/core/config.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
 
@@ -16,7 +17,12 @@ namespace po = boost::program_options;
 
 namespace geohaz {
 
-void add_common_options(po::options_description& desc, CommonOptions& o, const std::string& default_out) {
+void add_common_options(po::options_description& desc, CommonOptions& o, const std::string& default_out,
+                        const std::string& out_help) {
+  const std::string out_text =
+      !out_help.empty() ? out_help
+                        : "output directory: new, empty, or holding an earlier run of this app (its files, listed in "
+                          "geohaz-manifest.txt, are removed first); any other file there stops the run (exit 2)";
   // One option a line reads better than clang-format's chained layout.
   // clang-format off
   desc.add_options()
@@ -26,9 +32,7 @@ void add_common_options(po::options_description& desc, CommonOptions& o, const s
     ("set", po::value<std::vector<std::string>>(&o.set)->composing(),
      "override a config key (repeatable; values in SI units, TOML syntax; a key in the i-th entry of an "
      "array of tables as table[i].key, counted from 0); see the example above")
-    ("out,o", po::value<std::string>(&o.out)->default_value(default_out),
-     "output directory: new, empty, or holding an earlier run of this app (its files, listed in "
-     "geohaz-manifest.txt, are removed first); any other file there stops the run (exit 2)")
+    ("out,o", po::value<std::string>(&o.out)->default_value(default_out), out_text.c_str())
     ("threads,j", po::value<int>(&o.threads)->default_value(0), "OpenMP threads (0: all cores)")
     ("quiet,q", po::bool_switch(&o.quiet), "no progress output")
     ("help-config", po::bool_switch(&o.help_config), "print every config key with unit, default and range, and exit");
@@ -98,7 +102,18 @@ int run_main(const std::string& app, const std::function<int()>& body) {
     // (resources.hpp); this is what is left: the machine ran short while the run was under way.
     std::cerr << app << ": system error: out of memory\n";
     return kExitIoError;
-  } catch (const std::system_error& e) {  // includes std::filesystem::filesystem_error
+  } catch (const std::filesystem::filesystem_error& e) {
+    // A path the system cannot even look up is bad input, not an I/O failure (issue #29); the
+    // readers name the key first (check_file_name), this catches any other path.
+    if (e.code() == std::errc::filename_too_long) {
+      const std::string p = e.path1().string();
+      std::cerr << app << ": input error: file name too long (" << p.size()
+                << " characters): " << (p.size() > 60 ? p.substr(0, 60) + "..." : p) << "\n";
+      return kExitInputError;
+    }
+    std::cerr << app << ": system error: " << e.what() << "\n";
+    return kExitIoError;
+  } catch (const std::system_error& e) {
     std::cerr << app << ": system error: " << e.what() << "\n";
     return kExitIoError;
   } catch (const std::exception& e) {
@@ -137,6 +152,7 @@ std::optional<OutputManifest> read_output_manifest(const fs::path& dir) {
 }
 
 void clean_output_dir(const fs::path& out, const std::string& app, const std::vector<fs::path>& inputs) {
+  check_file_name(out.string(), "command line", "--out");
   std::error_code ec;
   if (!fs::exists(out, ec)) return;
   if (!fs::is_directory(out, ec))

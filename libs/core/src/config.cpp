@@ -614,4 +614,25 @@ std::string Range::str() const {
   return std::string(min_open ? "(" : "[") + num(min) + ", " + num(max) + (max_open || std::isinf(max) ? ")" : "]");
 }
 
+void check_file_name(const std::string& path, const std::string& source, const std::string& key) {
+  std::size_t longest = 0, start = 0;
+  while (start <= path.size()) {
+    const std::size_t end = std::min(path.find('/', start), path.size());
+    longest = std::max(longest, end - start);
+    start = end + 1;
+  }
+  if (longest <= 255 && path.size() <= 4095) return;
+  const std::string shown = path.size() > 60 ? path.substr(0, 60) + "..." : path;
+  throw InputError("file name too long (" + std::to_string(path.size()) + " characters, the longest part " +
+                       std::to_string(longest) + "): the system allows 255 per folder or file name and 4095 in all",
+                   source, key, shown);
+}
+
+void check_input_file(const std::string& path, const std::string& source, const std::string& key) {
+  check_file_name(path, source, key);
+  if (path.empty() || path.rfind("/vsi", 0) == 0 || path.find("://") != std::string::npos) return;
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw InputError("no such file", path, key);
+}
+
 }  // namespace geohaz

@@ -36,9 +36,14 @@ double ProgressReporter::elapsed() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
+double ProgressReporter::fraction(double t) const {
+  const double by_time = end_time_ > 0 ? std::clamp(t / end_time_, 0.0, 1.0) : 0.0;
+  return std::max(by_time, std::clamp(done_, 0.0, 1.0));
+}
+
 std::string ProgressReporter::format(double t, std::int64_t step, std::size_t n) const {
   const double wall = elapsed();
-  const double frac = end_time_ > 0 ? std::clamp(t / end_time_, 0.0, 1.0) : 0.0;
+  const double frac = fraction(t);
   const double steps = static_cast<double>(step - std::max<std::int64_t>(first_step_, 0));
   const double rate = wall > 0 ? steps / wall : 0.0;
   const double eta = frac > 0 ? wall * (1.0 - frac) / frac : NAN;
@@ -47,7 +52,15 @@ std::string ProgressReporter::format(double t, std::int64_t step, std::size_t n)
                 "%s: t = %.4g / %.4g s (%5.1f%%)  step %lld  %.3g steps/s  %.3g particle-steps/s  ETA %s",
                 label_.c_str(), t, end_time_, 100.0 * frac, static_cast<long long>(step), rate,
                 rate * static_cast<double>(n), format_duration(eta).c_str());
-  return buf;
+  std::string line = buf;
+  if (!note_.empty()) line += "  (" + note_ + ")";
+  return line;
+}
+
+void ProgressReporter::update(double t, std::int64_t step, std::size_t n, double done, const std::string& note) {
+  done_ = done;
+  note_ = note;
+  update(t, step, n);
 }
 
 void ProgressReporter::update(double t, std::int64_t step, std::size_t n) {
@@ -55,7 +68,14 @@ void ProgressReporter::update(double t, std::int64_t step, std::size_t n) {
   if (quiet_ || !stream_) return;
   const auto now = std::chrono::steady_clock::now();
   const double since = std::chrono::duration<double>(now - last_print_).count();
-  if (since < (terminal_ ? 0.2 : log_interval_)) return;
+  if (terminal_) {
+    if (since < 0.2) return;
+  } else {
+    // Logs: at every further log_fraction of the course, or after log_interval without a line.
+    const double frac = fraction(t);
+    if (frac < next_fraction_ && since < log_interval_) return;
+    if (log_fraction_ > 0.0) next_fraction_ = (std::floor(frac / log_fraction_ + 1e-9) + 1.0) * log_fraction_;
+  }
   last_print_ = now;
   last_ = format(t, step, n);
   if (terminal_) {

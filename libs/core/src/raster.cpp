@@ -17,6 +17,7 @@
 #include <mutex>
 
 #include "gdal_common.hpp"
+#include "geohaz/core/config.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster_extra.hpp"
 #include "geohaz/core/resources.hpp"
@@ -152,6 +153,7 @@ std::vector<Vec2> transform_points(const std::vector<Vec2>& pts, const std::stri
 Raster read_raster(const std::filesystem::path& path, CrsPolicy policy) {
   ensure_gdal_registered();
   const std::string file = path.string();
+  check_input_file(file, file, "");
   QuietGdalErrors quiet;
   std::unique_ptr<GDALDataset> ds(
       GDALDataset::Open(file.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));

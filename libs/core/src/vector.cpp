@@ -14,6 +14,7 @@
 #include <memory>
 
 #include "gdal_common.hpp"
+#include "geohaz/core/config.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
 
@@ -80,6 +81,7 @@ struct VectorLayer {
   std::unique_ptr<OGRCoordinateTransformation> ct;
 
   VectorLayer(const std::string& file, const std::string& attribute, const std::string& target_wkt, const char* what) {
+    check_input_file(file, file, "");
     ds.reset(GDALDataset::Open(file.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
     if (!ds) throw InputError("cannot read as a vector data source" + detail::gdal_last_error(), file);
     if (ds->GetLayerCount() < 1) throw InputError("the data source has no layer", file);

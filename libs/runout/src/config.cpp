@@ -155,8 +155,9 @@ BasalFriction read_friction(ConfigReader& cfg) {
 
 /// A path given in the config: relative to the config file's folder when it does not exist as
 /// given (so a case file can name its inputs beside it).
-std::string resolve(const ConfigReader& cfg, std::string p) {
+std::string resolve(const ConfigReader& cfg, const std::string& key, std::string p) {
   namespace fs = std::filesystem;
+  check_file_name(p, cfg.source().empty() ? "command line" : cfg.source(), key);
   if (!p.empty() && !cfg.source().empty() && fs::path(p).is_relative() && !fs::exists(p))
     return (cfg.base_dir() / p).string();
   return p;
@@ -180,8 +181,9 @@ void read_processes(ConfigReader& cfg, RunoutCase& c) {
   e.erosion_coefficient =
       cfg.get("entrainment.coefficient", e.erosion_coefficient, Range::closed(0.0, 1.0),
               {"m/(s*Pa)", "k_e of the shear law: erosion rate (m/s of bed depth) per Pa of excess shear"});
-  s.erodible = resolve(
-      cfg, cfg.get_string("entrainment.file", "", {"", "erodible layer: depth raster (m, vertical) or polygons"}));
+  s.erodible =
+      resolve(cfg, "entrainment.file",
+              cfg.get_string("entrainment.file", "", {"", "erodible layer: depth raster (m, vertical) or polygons"}));
   s.erodible_attribute = cfg.get_string("entrainment.attribute", s.erodible_attribute,
                                         {"", "polygon attribute holding the erodible depth (m)"});
   s.erodible_depth = cfg.get("entrainment.depth", s.erodible_depth, Range::closed(0.0, 100.0),
@@ -194,7 +196,7 @@ void read_processes(ConfigReader& cfg, RunoutCase& c) {
                      "entrainment.coefficient", "0");
 
   s.zones = resolve(
-      cfg,
+      cfg, "zones.file",
       cfg.get_string("zones.file", "",
                      {"",
                       "friction zones: polygons whose attributes (the law's coefficients: n, icr, m, mu, xi, cohesion, "
@@ -202,15 +204,17 @@ void read_processes(ConfigReader& cfg, RunoutCase& c) {
                       "global coefficients inside them"}));
   for (int k = 0; k < kFrictionParameters; ++k) {
     const std::string name = kFrictionParameterNames[static_cast<std::size_t>(k)];
-    s.zone_rasters[static_cast<std::size_t>(k)] = resolve(
-        cfg, cfg.get_string("zones." + name, "",
-                            {"", "raster of the friction coefficient " + name + " (nodata: the global value)"}));
+    s.zone_rasters[static_cast<std::size_t>(k)] =
+        resolve(cfg, "zones." + name,
+                cfg.get_string("zones." + name, "",
+                               {"", "raster of the friction coefficient " + name + " (nodata: the global value)"}));
   }
 
-  s.forest = resolve(cfg, cfg.get_string("forest.file", "",
-                                         {"",
-                                          "forest: polygons (attributes stem_density, stem_diameter) or a "
-                                          "stem-density raster (1/m^2)"}));
+  s.forest = resolve(cfg, "forest.file",
+                     cfg.get_string("forest.file", "",
+                                    {"",
+                                     "forest: polygons (attributes stem_density, stem_diameter) or a "
+                                     "stem-density raster (1/m^2)"}));
   s.stem_density = cfg.get("forest.stem_density", s.stem_density, Range::closed(0.0, 10.0),
                            {"1/m^2", "stems per square metre where the polygons carry none"});
   s.stem_diameter = cfg.get("forest.stem_diameter", s.stem_diameter, Range::open_closed(0.0, 5.0),
@@ -219,7 +223,8 @@ void read_processes(ConfigReader& cfg, RunoutCase& c) {
                                {"1", "drag coefficient C_D of a stem (k_f = ½ C_D n d)"});
 
   s.hydrograph =
-      resolve(cfg, cfg.get_string("inflow.hydrograph", "", {"", "inflow hydrograph table: CSV time_s,discharge_m3_s"}));
+      resolve(cfg, "inflow.hydrograph",
+              cfg.get_string("inflow.hydrograph", "", {"", "inflow hydrograph table: CSV time_s,discharge_m3_s"}));
   s.inflow_points = cfg.get_array("inflow.points", s.inflow_points, Range::closed(-1e8, 1e8),
                                   {"m", "inflow point [x, y] or short line [x1, y1, x2, y2] in the DSM's CRS"});
   s.inflow_azimuth = cfg.get("inflow.azimuth", s.inflow_azimuth, Range::closed_open(-1.0, 360.0),
@@ -233,9 +238,10 @@ void read_processes(ConfigReader& cfg, RunoutCase& c) {
 
 /// Barriers across the flow (docs/runout.md, "Barriers").
 void read_barriers(ConfigReader& cfg, BarrierSpec& b) {
-  b.file = resolve(
-      cfg, cfg.get_string("barriers.file", "",
-                          {"", "barrier lines (Shapefile/GeoJSON/GPKG): check dams, walls, slit or net barriers"}));
+  b.file =
+      resolve(cfg, "barriers.file",
+              cfg.get_string("barriers.file", "",
+                             {"", "barrier lines (Shapefile/GeoJSON/GPKG): check dams, walls, slit or net barriers"}));
   b.height_attribute = cfg.get_string("barriers.height_attribute", b.height_attribute,
                                       {"", "line attribute holding the crest height above the terrain (m)"});
   b.height =
@@ -291,14 +297,17 @@ void read_map_settings(ConfigReader& cfg, OutputSettings& o) {
 RunoutCase read_case(ConfigReader& cfg) {
   RunoutCase c;
   c.config_source = cfg.source();
-  c.dsm = resolve(cfg, cfg.get_string("terrain.dsm", "",
-                                      {"",
-                                       "DSM raster (any GDAL format, projected CRS); the positional "
-                                       "argument overrides it"}));
+  c.dsm = resolve(cfg, "terrain.dsm",
+                  cfg.get_string("terrain.dsm", "",
+                                 {"",
+                                  "DSM raster (any GDAL format, projected CRS); the positional "
+                                  "argument overrides it"}));
   auto& r = c.release;
-  r.file = resolve(cfg, cfg.get_string("release.file", "",
-                                       {"", "release polygons (Shapefile/GeoJSON/GPKG) or thickness raster (m)"}));
-  r.handoff = resolve(cfg, cfg.get_string("release.from", "", {"", "release points from sph-slope (release.h5)"}));
+  r.file = resolve(
+      cfg, "release.file",
+      cfg.get_string("release.file", "", {"", "release polygons (Shapefile/GeoJSON/GPKG) or thickness raster (m)"}));
+  r.handoff = resolve(cfg, "release.from",
+                      cfg.get_string("release.from", "", {"", "release points from sph-slope (release.h5)"}));
   r.attribute = cfg.get_string("release.attribute", r.attribute, {"", "polygon attribute holding the thickness (m)"});
   r.depth = cfg.get("release.depth", r.depth, Range::closed(0.0, 200.0),
                     {"m", "uniform polygon release thickness; 0: use the attribute"});
@@ -353,6 +362,12 @@ RunoutCase read_case(ConfigReader& cfg) {
                                 {"s", "time between particle snapshots"});
   o.snapshots = cfg.get_bool("output.snapshots", o.snapshots, {"", "write snapshots.h5 + .xmf"});
   o.pngs = cfg.get_bool("output.png", o.pngs, {"", "write the quick-look PNGs"});
+  o.sparse_min_depth = cfg.get(
+      "output.sparse_min_depth", o.sparse_min_depth, Range::open_closed(0.0, 10.0),
+      {"m",
+       "a particle with no other within 2 d0 paints the peak maps with its volume over its footprint V/s^2 (s: "
+       "distance to its nearest particle) only where that exceeds this; below it is detached, left out of the maps "
+       "and reported (AvaFrame com1DFA hmin: 0.05 m)"});
   auto& it = o.intensity;
   const std::string scheme =
       cfg.get_choice("intensity.scheme", to_string(it.scheme), {"depth_speed", "pressure"},

@@ -11,21 +11,109 @@
 
 namespace geohaz::runout {
 
-HazardMaps::HazardMaps(GridGeometry grid, double d0, double density)
+HazardMaps::HazardMaps(GridGeometry grid, double d0, double density, double sparse_min_depth)
     : g_(grid),
       d0_(d0),
       density_(density),
       radius_(std::max({0.5 * d0, grid.dx, grid.dy})),
+      self_weight_(CubicSpline<2>::value(0.0, d0)),
+      sparse_min_depth_(sparse_min_depth),
       max_depth_(grid.cells(), 0.0),
       max_speed_(grid.cells(), 0.0),
       max_momentum_(grid.cells(), 0.0),
       arrival_(grid.cells(), std::numeric_limits<double>::quiet_NaN()) {}
 
-void HazardMaps::record(const RunoutStore& store, double t) {
+std::vector<double> HazardMaps::painted_depth(const RunoutStore& store) {
   const auto& x = store.get<Position<2>>();
   const auto& h = store.get<FlowDepth>();
+  const auto& vol = store.get<Volume>();
+  const std::size_t n = store.size();
+  double total = 0.0;
+  for (double v : vol) total += v;
+  std::vector<double> depth(h.begin(), h.end());
+  // Alone within the support: no neighbour added a positive kernel weight (1e-9: the rounding).
+  std::vector<std::size_t> lone;
+  double reach = 0.0;  // the farthest a nearest particle can be and still give sparse_min_depth
+  for (std::size_t i = 0; i < n; ++i)
+    if (h[i] <= vol[i] * self_weight_ * (1.0 + 1e-9) && vol[i] < kDetachedShare * total) {
+      lone.push_back(i);
+      reach = std::max(reach, std::sqrt(vol[i] / sparse_min_depth_));
+    }
+  if (lone.empty()) return depth;
+  // Nearest particle within `reach`: particles bucketed by cells of side `reach` over their bounding
+  // box (counting sort), the 3 × 3 cells around each lone particle searched.
+  Vec2 lo = x[0], hi = x[0];
+  for (std::size_t i = 1; i < n; ++i) {
+    lo = lo.cwiseMin(x[i]);
+    hi = hi.cwiseMax(x[i]);
+  }
+  const double cs = std::max(reach, 2.0 * d0_);
+  const auto ncx = static_cast<std::int64_t>((hi.x() - lo.x()) / cs) + 1,
+             ncy = static_cast<std::int64_t>((hi.y() - lo.y()) / cs) + 1;
+  const auto cell_of = [&](const Vec2& p, std::int64_t& cx, std::int64_t& cy) {
+    cx = std::min(ncx - 1, static_cast<std::int64_t>((p.x() - lo.x()) / cs));
+    cy = std::min(ncy - 1, static_cast<std::int64_t>((p.y() - lo.y()) / cs));
+  };
+  bucket_start_.assign(static_cast<std::size_t>(ncx * ncy + 1), 0);
+  std::int64_t cx, cy;
+  for (std::size_t i = 0; i < n; ++i) {
+    cell_of(x[i], cx, cy);
+    ++bucket_start_[static_cast<std::size_t>(cy * ncx + cx + 1)];
+  }
+  for (std::size_t k = 1; k < bucket_start_.size(); ++k) bucket_start_[k] += bucket_start_[k - 1];
+  bucket_items_.assign(n, 0);
+  std::vector<std::int64_t> fill(bucket_start_.begin(), bucket_start_.end() - 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    cell_of(x[i], cx, cy);
+    bucket_items_[static_cast<std::size_t>(fill[static_cast<std::size_t>(cy * ncx + cx)]++)] = i;
+  }
+  for (std::size_t i : lone) {
+    cell_of(x[i], cx, cy);
+    double s2 = std::numeric_limits<double>::infinity();
+    for (std::int64_t y = std::max<std::int64_t>(0, cy - 1); y <= std::min(ncy - 1, cy + 1); ++y)
+      for (std::int64_t xx = std::max<std::int64_t>(0, cx - 1); xx <= std::min(ncx - 1, cx + 1); ++xx) {
+        const auto b = static_cast<std::size_t>(y * ncx + xx);
+        for (auto k = bucket_start_[b]; k < bucket_start_[b + 1]; ++k) {
+          const std::size_t j = bucket_items_[static_cast<std::size_t>(k)];
+          if (j != i) s2 = std::min(s2, (x[j] - x[i]).squaredNorm());
+        }
+      }
+    // Never more than its kernel depth (a neighbour just outside the support).
+    const double d = std::min(h[i], vol[i] / s2);
+    depth[i] = d > sparse_min_depth_ ? d : 0.0;
+  }
+  return depth;
+}
+
+void HazardMaps::record(const RunoutStore& store, double t) {
+  const auto& x = store.get<Position<2>>();
   const auto& s = store.get<Speed>();
   const auto& moving = store.get<Moving>();
+  const auto& id = store.get<ParticleId>();
+  const auto& vol = store.get<Volume>();
+  // Serial tally by id (store order does not matter): who is detached now, where they were.
+  paint_ = painted_depth(store);
+  detached_now_.assign(store.size(), 0);
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    const auto k = static_cast<std::size_t>(id[i]);
+    if (k >= seen_.size()) {
+      const std::size_t n = std::max<std::size_t>(k + 1, 2 * seen_.size());
+      seen_.resize(n, 0);
+      was_detached_.resize(n, 0);
+      detached_at_.resize(n, Vec2::Zero());
+      last_seen_.resize(n, Vec2::Zero());
+      id_volume_.resize(n, 0.0);
+    }
+    seen_[k] = 1;
+    last_seen_[k] = x[i];
+    id_volume_[k] = vol[i];
+    if (paint_[i] > 0.0) continue;
+    detached_now_[i] = 1;
+    if (!was_detached_[k]) {
+      was_detached_[k] = 1;
+      detached_at_[k] = x[i];
+    }
+  }
   const int rc = static_cast<int>(std::ceil(radius_ / g_.dx)), rr = static_cast<int>(std::ceil(radius_ / g_.dy));
   const double r2 = radius_ * radius_;
   const std::int64_t n = static_cast<std::int64_t>(store.size());
@@ -56,10 +144,10 @@ void HazardMaps::record(const RunoutStore& store, double t) {
     for (std::int64_t ii = 0; ii < n && row_lo <= row_hi; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
       int c0, r0;
-      if (!g_.cell_of(x[i], c0, r0)) continue;
+      if (detached_now_[i] || !g_.cell_of(x[i], c0, r0)) continue;
       const int r_first = std::max(row_lo, r0 - rr), r_last = std::min(row_hi, r0 + rr);
       if (r_first > r_last) continue;
-      const double hi = h[i], si = s[i];
+      const double hi = paint_[i], si = s[i];
       const bool arrives = moving[i] || t == 0.0;
       for (int r = r_first; r <= r_last; ++r)
         for (int c = std::max(0, c0 - rc); c <= std::min(g_.nx - 1, c0 + rc); ++c) {
@@ -72,6 +160,41 @@ void HazardMaps::record(const RunoutStore& store, double t) {
         }
     }
   }
+}
+
+DetachedReport HazardMaps::detached_report(const RunoutStore& store) const {
+  DetachedReport r;
+  std::vector<std::uint8_t> present(seen_.size(), 0);
+  for (auto k : store.get<ParticleId>())
+    if (static_cast<std::size_t>(k) < present.size()) present[static_cast<std::size_t>(k)] = 1;
+  // The raster's extent less 2·d0 and a cell: a particle last seen outside it left by the edge.
+  const double margin = 2.0 * d0_ + std::max(g_.dx, g_.dy);
+  const double xmin = g_.x0 + margin, xmax = g_.x0 + g_.nx * g_.dx - margin;
+  const double ymax = g_.y0 - margin, ymin = g_.y0 - g_.ny * g_.dy + margin;
+  for (std::size_t k = 0; k < seen_.size(); ++k) {
+    if (!seen_[k]) continue;
+    const bool gone = !present[k];
+    if (gone) {
+      const Vec2& p = last_seen_[k];
+      r.exits.push_back(
+          {p, id_volume_[k], was_detached_[k] != 0, p.x() < xmin || p.x() > xmax || p.y() < ymin || p.y() > ymax});
+    }
+    if (!was_detached_[k]) continue;
+    r.volume += id_volume_[k];
+    ++r.particles;
+    if (gone) {
+      r.lost_volume += id_volume_[k];
+      ++r.lost_particles;
+    } else {
+      r.in_domain_volume += id_volume_[k];
+    }
+    const double dist = (last_seen_[k] - detached_at_[k]).norm();
+    if (dist >= r.farthest_distance) {
+      r.farthest_distance = dist;
+      r.farthest = last_seen_[k];
+    }
+  }
+  return r;
 }
 
 std::vector<double> HazardMaps::max_pressure() const {

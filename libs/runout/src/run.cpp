@@ -176,6 +176,98 @@ std::string unfinished_warning(const RunoutResult& r) {
          " m/s): deposit.tif holds the resting mass only, the moving mass is in mobile_at_end.tif; raise run.duration";
 }
 
+/// The warning of a run whose particles left the raster at its edge (empty when none did): how much,
+/// where, and whether it was the flow or particles detached from it (not in the maps).
+std::string edge_warning(const DetachedReport& d) {
+  double vol = 0.0, detached = 0.0, edge = 0.0;
+  std::size_t n = 0;
+  const DetachedReport::Exit* first = nullptr;
+  for (const auto& e : d.exits) {
+    vol += e.volume;
+    ++n;
+    if (e.detached) detached += e.volume;
+    if (e.at_edge) edge += e.volume;
+    if (!first) first = &e;
+  }
+  if (n == 0) return {};
+  std::ostringstream m;
+  m << fmt(vol, 4) << " m^3 (" << n << " particle" << (n == 1 ? "" : "s")
+    << ") reached the edge of the terrain data and left it (" << fmt(edge, 4) << " m^3 at the raster border, "
+    << fmt(vol - edge, 4) << " m^3 over nodata; first last seen at (" << std::fixed << std::setprecision(0)
+    << first->position.x() << ", " << first->position.y() << ")); ";
+  if (detached >= vol * (1.0 - 1e-12))
+    m << "all of it had detached from the flow (alone, thinner than output.sparse_min_depth): the maps leave it "
+         "out, the flow itself stayed on the terrain";
+  else
+    m << fmt(vol - detached, 4)
+      << " m^3 of it was part of the flow: the maps are cut where the terrain data ends; extend the DSM";
+  return m.str();
+}
+
+/// A volume for people: "45,168 m^3" (whole m³ with thousands separators), "29.3 m^3" below 100.
+std::string volume_text(double v) {
+  if (!(std::abs(v) >= 100.0)) return fmt(v, 3) + " m^3";
+  const std::string digits = std::to_string(std::llabs(std::llround(v)));
+  std::string out = v < 0.0 ? "-" : "";
+  for (std::size_t k = 0; k < digits.size(); ++k) {
+    if (k > 0 && (digits.size() - k) % 3 == 0) out += ',';
+    out += digits[k];
+  }
+  return out + " m^3";
+}
+
+/// The end of a run in words (stderr): what stopped it, the key figures, and the volume budget with
+/// what "mobile" means for the way it ended.
+std::string end_text(const RunoutResult& r, const RunoutParameters& p, double mean_speed, const fs::path& out) {
+  std::ostringstream m;
+  m << kModel << ": stopped at t = " << fmt(r.simulated_time, 5) << " s after " << r.steps << " steps ("
+    << fmt(r.wall_time, 3) << " s wall): ";
+  switch (r.ended) {
+    case RunEnd::KineticEnergy:
+      m << "the kinetic energy fell below " << fmt(100.0 * p.stop_energy_fraction, 3)
+        << " % of its peak (run.stop_energy_fraction; the end used by AvaFrame com1DFA and RAMMS: the flow has spent "
+           "its energy, what still moves no longer changes the maps)";
+      break;
+    case RunEnd::AllStopped:
+      m << "every particle is held at rest by friction";
+      break;
+    case RunEnd::NoParticles:
+      m << "no particle is left on the raster";
+      break;
+    case RunEnd::Duration:
+      m << "run.duration (" << fmt(p.duration, 6) << " s) reached";
+      break;
+    case RunEnd::Running:
+      m << "interrupted";
+      break;
+  }
+  m << ".\n"
+    << kModel << ": run-out " << fmt(r.path.runout_length, 5)
+    << " m along the path, H/L = " << fmt(r.path.fahrboeschung, 3) << " (" << fmt(r.path.fahrboeschung_deg, 3)
+    << "°), max speed " << fmt(r.max_speed, 3) << " m/s.\n"
+    << kModel << ": volumes: " << volume_text(r.volumes.deposited) << " at rest (held by basal friction), "
+    << volume_text(r.volumes.mobile) << " mobile (not yet held by friction";
+  if (r.volumes.mobile > 0.0)
+    m << ": mean speed " << fmt(mean_speed, 2) << " m/s, fastest " << fmt(r.max_speed_at_end, 3) << " m/s";
+  m << (r.ended == RunEnd::Duration ? "; in mobile_at_end.tif, not in deposit.tif)"
+                                    : "; counted in deposit.tif where it stood when the run stopped)");
+  if (r.volumes.lost > 0.0) m << ", " << volume_text(r.volumes.lost) << " left the raster";
+  m << ".\n" << kModel << ": outputs in " << out.string() << "\n";
+  return m.str();
+}
+
+/// The stdout line about detached volume (empty when no particle detached).
+std::string detached_line(const DetachedReport& d) {
+  if (d.particles == 0) return {};
+  std::ostringstream m;
+  m << fmt(d.volume, 4) << " m^3 (" << d.particles << " particle" << (d.particles == 1 ? "" : "s")
+    << ") detached from the flow and is left out of the maps: " << fmt(d.in_domain_volume, 4)
+    << " m^3 still on the raster, " << fmt(d.lost_volume, 4) << " m^3 left it; the farthest went "
+    << fmt(d.farthest_distance, 4) << " m from where it detached, to (" << std::fixed << std::setprecision(0)
+    << d.farthest.x() << ", " << d.farthest.y() << ")";
+  return m.str();
+}
+
 /// Writes particle snapshots every output.snapshot_interval (and at the end) while a run goes.
 class SnapshotObserver : public RunObserver {
  public:
@@ -211,7 +303,19 @@ class ProgressObserver : public RunObserver {
   ProgressObserver(double end_time, bool quiet) : p_(kModel, end_time, quiet) {}
   void stepped(const RunoutSimulation& sim) override {
     const auto& s = sim.solver();
-    p_.update(s.time(), s.step_count(), s.particles().size());
+    const VolumeBudget& b = s.budget();
+    const double f = sim.parameters().stop_energy_fraction;
+    if (f > 0.0 && b.peak_kinetic_energy > 0.0 && b.kinetic_energy < b.peak_kinetic_energy) {
+      // The usual end is the energy criterion: E falls from its peak to f·peak, roughly
+      // exponentially, so the fraction done is ln(E_peak/E)/ln(1/f) (an estimate: E may rise again).
+      const double ratio = b.kinetic_energy / b.peak_kinetic_energy;
+      const double done = ratio > 0.0 ? std::log(1.0 / ratio) / std::log(1.0 / f) : 1.0;
+      std::ostringstream note;
+      note << "kinetic energy " << fmt(100.0 * ratio, 2) << " % of peak, stops below " << fmt(100.0 * f, 3) << " %";
+      p_.update(s.time(), s.step_count(), s.particles().size(), done, note.str());
+    } else {
+      p_.update(s.time(), s.step_count(), s.particles().size());
+    }
   }
   void finished(const RunoutSimulation& sim) override {
     const auto& s = sim.solver();
@@ -338,7 +442,7 @@ RunoutSimulation::RunoutSimulation(const RunoutInputs& in, RunoutParameters para
     : in_(in),
       output_(output),
       solver_(surface_for(in.surface, params.d0), params),
-      maps_(in.grid(), solver_.parameters().d0, solver_.parameters().density) {
+      maps_(in.grid(), solver_.parameters().d0, solver_.parameters().density, output.sparse_min_depth) {
   const auto& p = solver_.parameters();
   auto& store = solver_.particles();
   // The particle count is known from the volume before seeding allocates anything.
@@ -515,6 +619,35 @@ std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int t
   j["release_thickness_direction"] = sim.inputs().from_handoff ? "volumes (hand-off)" : to_string(c.release.direction);
   nlohmann::json warnings = nlohmann::json::array();
   if (res.unfinished()) warnings.push_back(unfinished_warning(res));
+  const DetachedReport det = sim.maps().detached_report(solver.particles());
+  if (const std::string w = edge_warning(det); !w.empty()) warnings.push_back(w);
+  {
+    // Detached particles (docs/runout.md, "Detached particles") and every exit from the raster.
+    j["detached"] = {{"volume_m3", det.volume},
+                     {"particles", det.particles},
+                     {"on_raster_at_end_m3", det.in_domain_volume},
+                     {"left_raster_m3", det.lost_volume},
+                     {"left_raster_particles", det.lost_particles},
+                     {"farthest_distance_m", det.farthest_distance},
+                     {"farthest_xy_m", {det.farthest.x(), det.farthest.y()}},
+                     {"in_maps", false}};
+    double edge = 0.0, nodata = 0.0;
+    nlohmann::json exits = nlohmann::json::array();
+    for (const auto& e : det.exits) {
+      (e.at_edge ? edge : nodata) += e.volume;
+      if (exits.size() < 20)
+        exits.push_back({{"x_m", e.position.x()},
+                         {"y_m", e.position.y()},
+                         {"volume_m3", e.volume},
+                         {"detached", e.detached},
+                         {"where", e.at_edge ? "raster edge" : "nodata"}});
+    }
+    j["left_raster"] = {{"volume_m3", b.lost},
+                        {"particles", b.lost_particles},
+                        {"at_edge_m3", edge},
+                        {"over_nodata_m3", nodata},
+                        {"last_seen", exits}};
+  }
   j["warnings"] = warnings;
   j["unfinished"] = res.unfinished();
   j["runout_length_along_path_m"] = sum.runout_length;
@@ -841,14 +974,11 @@ RunoutResult run_case(const RunoutCase& c, const fs::path& out, bool quiet, int 
   // 4-5. Maps, series and summary.
   write_outputs(c, sim, out, threads);
   const RunoutResult r = sim.result();
-  if (!quiet)
-    std::cerr << kModel << ": " << to_string(r.ended) << " at t = " << fmt(r.simulated_time, 5) << " s after "
-              << r.steps << " steps (" << fmt(r.wall_time, 3) << " s wall); run-out " << fmt(r.path.runout_length, 5)
-              << " m along the path, H/L = " << fmt(r.path.fahrboeschung, 3) << " (" << fmt(r.path.fahrboeschung_deg, 3)
-              << "°), max speed " << fmt(r.max_speed, 3) << " m/s; deposited " << fmt(r.volumes.deposited, 8)
-              << " m^3, mobile " << fmt(r.volumes.mobile, 8) << " m^3, lost " << fmt(r.volumes.lost, 8)
-              << " m^3; outputs in " << out.string() << "\n";
+  if (!quiet) std::cerr << end_text(r, p, sim.series().empty() ? 0.0 : sim.series().back().mean_speed, out);
   if (r.unfinished()) std::cout << kModel << ": warning: " << unfinished_warning(r) << "\n";
+  const DetachedReport det = sim.maps().detached_report(sim.solver().particles());
+  if (const std::string d = detached_line(det); !d.empty()) std::cout << kModel << ": " << d << "\n";
+  if (const std::string w = edge_warning(det); !w.empty()) std::cout << kModel << ": warning: " << w << "\n";
   return r;
 }
 

@@ -786,6 +786,23 @@ struct ReleaseOutput {
   double binned = 0.0, max_thickness = 0.0;
 };
 
+/// The geostatic phase's duration (s): geostatic.duration, or 20 H/c_p when it is 0 (20 transits of
+/// a P wave through the slope height let the loading waves die out under Cundall damping).
+/// InputError (key geostatic.duration) above 100 times that default: 2000 wave transits is a
+/// loading that has settled long before or never will (the phase's rest check says which), and
+/// nothing a user means; a value of 1e9 s ran for hours (issue #29).
+double geostatic_duration(const RunConfig& c, double href, double cmax) {
+  const double natural = 20.0 * href / cmax;
+  if (c.geostatic_duration > 100.0 * natural) {
+    std::ostringstream m;
+    m << "'geostatic.duration' = " << c.geostatic_duration
+      << " s is more than 100 times the natural loading time 20 H/c_p = " << natural << " s of this slope (H = " << href
+      << " m, c_p = " << cmax << " m/s): allowed [0, " << 100.0 * natural << "] s (0: 20 H/c_p)";
+    throw InputError(m.str(), c.config_source, "geostatic.duration", std::to_string(c.geostatic_duration));
+  }
+  return c.geostatic_duration > 0.0 ? c.geostatic_duration : natural;
+}
+
 /// A run in time: the geostatic phase (or a restart), then the main phase with its series,
 /// structure loads, quick-looks and the summary's figures (docs/sph.md).
 /// The geostatic phase of `solver` over `dur` seconds, the observer told at the start, every 50
@@ -888,6 +905,8 @@ DynamicRun<Dim>::DynamicRun(const RunConfig& c, bool quiet)
     solver_.track_structures(std::move(bases));
   }
   for (const auto& m : solver_.materials()) rho0_.push_back(m.density);
+  if (c_.geostatic && c_.restart.empty() && c_.scenario != ScenarioType::Biaxial)
+    geostatic_duration(c_, href_, solver_.max_wave_speed());  // checked now
   bishop_ = StaticBishop::of(c);
   if (!quiet_) print_header();
 }
@@ -950,7 +969,7 @@ void DynamicRun<Dim>::load_restart_state() {
 
 template <int Dim>
 void DynamicRun<Dim>::geostatic_phase(const SphSimulation& self, RunObserver* obs) {
-  const double dur = c_.geostatic_duration > 0.0 ? c_.geostatic_duration : 20.0 * href_ / solver_.max_wave_speed();
+  const double dur = geostatic_duration(c_, href_, solver_.max_wave_speed());
   const auto rep = geostatic_with_progress(solver_, dur, c_, self, obs);
   have_loads_ = rep.steps > 0;
   const double tol = c_.rest_tolerance * std::sqrt(c_.numerics.gravity * href_);
@@ -1392,7 +1411,9 @@ StrengthReductionRun<Dim>::StrengthReductionRun(const RunConfig& c, bool quiet)
       settings_(trial_settings<Dim>(c, b_.sc)),
       href_(b_.sc.reference_height),
       geo_(std::move(b_.sc.store), c.materials, c.model, settings_),
-      cmax_(geo_.max_wave_speed()) {}
+      cmax_(geo_.max_wave_speed()) {
+  if (c_.restart.empty()) geostatic_duration(c_, href_, cmax_);  // checked before anything is written
+}
 
 template <int Dim>
 void StrengthReductionRun<Dim>::run(const SphSimulation& self, RunObserver* obs) {
@@ -1413,7 +1434,7 @@ void StrengthReductionRun<Dim>::geostatic_state(const SphSimulation& self, RunOb
     for (auto& u : geo_.store().template get<Displacement<Dim>>()) u.setZero();
     phase_summary_["restart"] = {{"file", c_.restart.string()}, {"time_s", rs.time}};
   } else {
-    const double dur = c_.geostatic_duration > 0.0 ? c_.geostatic_duration : 20.0 * href_ / cmax_;
+    const double dur = geostatic_duration(c_, href_, cmax_);
     const auto rep = geostatic_with_progress(geo_, dur, c_, self, obs);
     phase_summary_["geostatic"] = {{"duration_s", dur}, {"steps", rep.steps}, {"max_speed_m_per_s", rep.max_speed}};
   }

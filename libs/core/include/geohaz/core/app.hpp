@@ -26,8 +26,9 @@ struct CommonOptions {
 };
 
 /// Add --config, --set, --out, --threads, --quiet, --help, --version, --help-config.
+/// `out_help` replaces the text of --out (an app whose folder policy differs: geohaz-ensemble resumes).
 void add_common_options(boost::program_options::options_description& desc, CommonOptions& opts,
-                        const std::string& default_out);
+                        const std::string& default_out, const std::string& out_help = "");
 
 /// Parse argv. Returns false (after printing) when --help or --version was asked for; --help ends
 /// with the exit codes. Unknown options, bad values, or a positional argument the app does not

@@ -122,4 +122,13 @@ class ConfigReader {
   std::string prefix_;
 };
 
+/// InputError naming `source`, `key` and the start of the value when `path` cannot name a file on
+/// this system: a component longer than 255 bytes (NAME_MAX) or more than 4095 in all (PATH_MAX),
+/// which the file system would refuse with "File name too long" (issue #29).
+void check_file_name(const std::string& path, const std::string& source, const std::string& key);
+
+/// The same for a path that must exist: also InputError "no such file" when it does not (GDAL
+/// virtual paths, /vsi…, and URLs are left to GDAL).
+void check_input_file(const std::string& path, const std::string& source, const std::string& key);
+
 }  // namespace geohaz

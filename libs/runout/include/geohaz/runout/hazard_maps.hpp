@@ -10,7 +10,17 @@
 /// is exactly the maximum of ρS² over the steps.
 /// The final deposit thickness is the cubic-spline kernel sum Σ V_j W(|x_c − x_j|, d0) at the cell
 /// centres, so it integrates to the volume left in the domain.
-
+///
+/// Sparse and detached particles (docs/runout.md, "Detached particles"). A particle with no other
+/// within its kernel support 2·d0 has the depth h_i = V_i W(0, d0) of its own kernel term: 0.45 h0 at
+/// any d0, an artefact of the fixed smoothing length, not a flow depth. Such a particle paints the
+/// peak maps with the depth it stands for, its volume over its footprint V_i/s_i² (s_i: the distance
+/// to its nearest particle; a sheet of particles at spacing s is V/s² deep), and only where that
+/// exceeds `sparse_min_depth` (AvaFrame com1DFA's minimum flow thickness hmin, 0.05 m). Below, it
+/// is *detached*: left out of the maps, its volume and where it went reported. A particle that holds
+/// kDetachedShare of the volume in the domain or more always paints its own depth (a run of one
+/// particle, a sliding-block test, still maps).
+///
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -21,15 +31,47 @@
 
 namespace geohaz::runout {
 
+/// A particle alone within its support is treated as sparse only while it holds less than this share
+/// of the volume in the domain, so that a run of a single particle (a sliding-block test) still maps.
+inline constexpr double kDetachedShare = 0.05;
+
+/// What became of the particles that detached from the flow (and of every particle that left the
+/// raster), for the summary: volumes in m³, positions in map coordinates (m).
+struct DetachedReport {
+  double volume = 0.0;  ///< volume of the particles that were detached at some recorded step
+  std::size_t particles = 0;
+  double in_domain_volume = 0.0;  ///< of those, still on the raster at the end
+  double lost_volume = 0.0;       ///< of those, gone off the raster (edge or nodata) since
+  std::size_t lost_particles = 0;
+  double farthest_distance =
+      0.0;  ///< largest horizontal distance from where a particle detached to where it was last seen (m)
+  Vec2 farthest = Vec2::Zero();  ///< where that particle was last seen
+  /// Every particle that left the raster: last recorded position, volume, whether detached then.
+  struct Exit {
+    Vec2 position = Vec2::Zero();
+    double volume = 0.0;
+    bool detached = false;
+    bool at_edge = false;  ///< within 2·d0 + one cell of the raster border (else: over nodata inside)
+  };
+  std::vector<Exit> exits;
+};
+
 /// Which particles a thickness map is made of.
 enum class ParticleSelection { All, Resting, Moving };
 
 class HazardMaps {
  public:
-  HazardMaps(GridGeometry grid, double d0, double density);
+  /// \param sparse_min_depth  depth (m) below which a particle alone within 2·d0 is detached.
+  HazardMaps(GridGeometry grid, double d0, double density, double sparse_min_depth = 0.05);
 
-  /// Paint the current particle state at time t (s).
+  /// Paint the current particle state at time t (s); detached particles are left out and tallied.
   void record(const RunoutStore& store, double t);
+  /// The depth (m) each particle of `store` paints the maps with now: h_i, or V_i/s_i² for a sparse
+  /// particle, 0 for a detached one (see the file comment).
+  std::vector<double> painted_depth(const RunoutStore& store);
+  /// The detached particles so far and the particles that left the raster (by comparing the
+  /// particles recorded with those in `store`).
+  DetachedReport detached_report(const RunoutStore& store) const;
 
   const GridGeometry& grid() const noexcept { return g_; }
   double density() const noexcept { return density_; }                          ///< kg/m³, of the pressure map
@@ -48,8 +90,15 @@ class HazardMaps {
 
  private:
   GridGeometry g_;
-  double d0_, density_, radius_;
+  double d0_, density_, radius_, self_weight_, sparse_min_depth_;
+  std::vector<double> paint_;               // depth painted per particle (scratch)
+  std::vector<std::int64_t> bucket_start_;  // nearest-particle search: counting sort by cell (scratch)
+  std::vector<std::size_t> bucket_items_;
   std::vector<double> max_depth_, max_speed_, max_momentum_, arrival_;
+  // By particle id: seen, detached at some step, where it detached, last recorded position, volume.
+  std::vector<std::uint8_t> seen_, was_detached_, detached_now_;
+  std::vector<Vec2> detached_at_, last_seen_;
+  std::vector<double> id_volume_;
   std::vector<int> band_start_;          // first grid row of each thread's band (scratch)
   std::vector<std::int64_t> row_count_;  // particles per grid row (scratch)
 };

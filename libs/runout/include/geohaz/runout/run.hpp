@@ -123,6 +123,9 @@ struct OutputSettings {
   std::vector<double> map_pressure_classes{3e3, 3e4, 1e5};  ///< class breaks of the pressure map (Pa)
   double map_margin = 200.0;                                ///< m around the affected area in the maps
   std::string attribution;                                  ///< printed under every map ("" : the DSM's)
+  /// A particle alone within 2·d0 paints the peak maps only where the depth it stands for exceeds
+  /// this (m); below it is detached (hazard_maps.hpp). AvaFrame com1DFA's hmin.
+  double sparse_min_depth = 0.05;
 };
 
 /// Everything a run needs, in SI units. Defaults are those of the structs it holds.
