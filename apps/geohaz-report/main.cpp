@@ -27,9 +27,21 @@ int main(int argc, char** argv) {
         "also print the page to RESULTS_DIR/report.pdf (A4, each run from a new page) with headless Chromium");
     po::positional_options_description pos;
     pos.add("results", 1);
-    if (!geohaz::parse_command_line(argc, argv, "geohaz-report",
-                                    "one self-contained HTML report page from the output folders of geohaz runs", desc,
-                                    &pos))
+    if (argc < 2)
+      throw geohaz::InputError(
+          "no results folder given: geohaz-report RESULTS_DIR [--title TEXT] [--pdf] (see geohaz-report --help)",
+          "command line");
+    if (!geohaz::parse_command_line(
+            argc, argv, "geohaz-report",
+            "one self-contained HTML report page from the output folders of geohaz runs.\n"
+            "Usage: geohaz-report RESULTS_DIR [--title TEXT] [--pdf]\n"
+            "RESULTS_DIR is one run's --out folder or a folder holding several (searched two levels deep for "
+            "summary.json).\n"
+            "Example: geohaz-report results/demo --title \"geohaz demo\" --pdf",
+            desc, &pos,
+            "Exit codes: 0 done (the page's path printed, then the PDF's); 2 bad input (no such folder, no run "
+            "in it), nothing written; 3 an I/O or system failure (a file could not be written, no Chromium for "
+            "--pdf)."))
       return 0;
     const std::filesystem::path pdf_path = pdf ? std::filesystem::path(dir) / "report.pdf" : std::filesystem::path();
     if (pdf && geohaz::report::find_chromium().empty())  // before anything is written

@@ -40,7 +40,8 @@ void add_common_options(po::options_description& desc, CommonOptions& o, const s
 }
 
 bool parse_command_line(int argc, const char* const* argv, const std::string& app, const std::string& summary,
-                        po::options_description& desc, po::positional_options_description* positional) {
+                        po::options_description& desc, po::positional_options_description* positional,
+                        const char* exit_codes) {
   po::variables_map vm;
   try {
     // Without a positional description of its own an app takes no positional argument: an empty
@@ -49,7 +50,7 @@ bool parse_command_line(int argc, const char* const* argv, const std::string& ap
     auto parser = po::command_line_parser(argc, argv).options(desc).positional(positional ? *positional : none);
     po::store(parser.run(), vm);
     if (vm.count("help")) {
-      std::cout << app << " " << GEOHAZ_VERSION << ": " << summary << "\n\n" << desc << "\n" << kExitCodesHelp << "\n";
+      std::cout << app << " " << GEOHAZ_VERSION << ": " << summary << "\n\n" << desc << "\n" << exit_codes << "\n";
       return false;
     }
     if (vm.count("version")) {

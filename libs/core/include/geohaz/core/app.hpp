@@ -31,11 +31,12 @@ void add_common_options(boost::program_options::options_description& desc, Commo
                         const std::string& default_out, const std::string& out_help = "");
 
 /// Parse argv. Returns false (after printing) when --help or --version was asked for; --help ends
-/// with the exit codes. Unknown options, bad values, or a positional argument the app does not
-/// take (`positional` null) → InputError.
+/// with the exit codes (`exit_codes`: a tool that runs no simulation lists its own). Unknown options, bad values, or a
+/// positional argument the app does not take (`positional` null) → InputError.
 bool parse_command_line(int argc, const char* const* argv, const std::string& app, const std::string& summary,
                         boost::program_options::options_description& desc,
-                        boost::program_options::positional_options_description* positional = nullptr);
+                        boost::program_options::positional_options_description* positional = nullptr,
+                        const char* exit_codes = kExitCodesHelp);
 
 /// Read the config file (or an empty one) and apply the --set overrides.
 ConfigReader load_config(const CommonOptions& opts);
