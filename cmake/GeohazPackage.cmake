@@ -1,7 +1,7 @@
 # Man pages and bash completion for the apps, and the Debian package (CPack), issue 20.
 include(GNUInstallDirs)
 
-set(_geohaz_apps sph-slope debris-runout dem-avalanche geohaz-report geohaz-ensemble)
+set(_geohaz_apps sph-slope debris-runout dem-avalanche geohaz-report geohaz-ensemble slope-stability)
 
 # Man pages: generated from each app's --help (and --help-config as a CONFIGURATION section) by
 # help2man (Debian package help2man) after the app is built. Without help2man there are none; nor

@@ -46,4 +46,4 @@ _geohaz_complete() {
   mapfile -t COMPREPLY < <(compgen -f -- "$cur")
 }
 
-complete -o filenames -F _geohaz_complete sph-slope debris-runout dem-avalanche geohaz-report geohaz-ensemble
+complete -o filenames -F _geohaz_complete sph-slope debris-runout dem-avalanche geohaz-report geohaz-ensemble slope-stability
