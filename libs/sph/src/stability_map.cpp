@@ -369,6 +369,7 @@ StabilityMapResult run_stability_map(const StabilityMapCase& c, const fs::path& 
       f.overlay_min = -1.0;
       f.scale_bar = true;
       f.north_arrow = true;
+      f.crop_margin_m = 200.0;  // the failed cells and their surroundings
       Raster hours = r_fail;
       for (double& v : hours.data)
         if (v != kNodata) v /= 3600.0;
