@@ -30,15 +30,15 @@ int run(int argc, char** argv) {
                      "DSM raster (positional): GeoTIFF, ESRI ASCII, …; projected CRS, metres");
   po::positional_options_description pos;
   pos.add("dsm", 1);
-  if (!parse_command_line(argc, argv, kApp,
-                          "rainfall-driven infinite-slope stability map of a DSM: factor of safety over time from "
-                          "rain infiltration (Iverson 2000, as in TRIGRS), failure times and the unstable cells as "
-                          "release polygons for debris-runout.\n"
-                          "Usage: slope-stability DSM [--config rain.toml] [--set key=value ...] [--out DIR] "
-                          "[--threads N] [--quiet]\n"
-                          "Example: slope-stability data/terrain/alr/avaAlr.tif --config data/stability/alr_rain.toml "
-                          "--out stability-alr",
-                          desc, &pos))
+  if (!parse_command_line(
+          argc, argv, kApp,
+          "rainfall-driven infinite-slope stability map of a DSM (Iverson 2000 infiltration, as in TRIGRS), "
+          "with failure times and the failed cells as release polygons for debris-runout.\n"
+          "Usage: slope-stability DSM [--config rain.toml] [--set key=value ...] [--out DIR] "
+          "[--threads N] [--quiet]\n"
+          "Example: slope-stability data/terrain/alr/avaAlr.tif --config data/stability/alr_rain.toml "
+          "--out stability-alr",
+          desc, &pos))
     return kExitOk;
   if (common.help_config) {
     ConfigReader d = ConfigReader::describe();

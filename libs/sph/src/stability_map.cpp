@@ -70,29 +70,30 @@ StabilityMapCase read_stability_map_case(ConfigReader& cfg) {
                          {"m", "vertical depth Z of the failure plane (soil-bedrock contact); the release thickness"});
   c.soil_depth_raster = resolve(
       cfg, cfg.get_string("soil.depth_raster", "", {"", "raster of Z (m) on the DSM's grid; overrides soil.depth"}));
-  c.min_slope = kDeg * cfg.get("soil.min_slope", 0.0, Range::closed_open(0.0, 90.0),
+  c.min_slope = kDeg * cfg.get("soil.min_slope", c.min_slope / kDeg, Range::closed_open(0.0, 90.0),
                                {"deg", "cells flatter than this carry no soil cover (no result)"});
-  c.max_slope = kDeg * cfg.get("soil.max_slope", 60.0, Range::open_closed(0.0, 90.0),
+  c.max_slope = kDeg * cfg.get("soil.max_slope", c.max_slope / kDeg, Range::open_closed(0.0, 90.0),
                                {"deg", "cells steeper than this carry no soil cover (rock faces; no result)"});
   auto& s = c.soil;
-  s.cohesion = cfg.get("soil.cohesion", 2e3, Range::non_negative(), {"Pa", "effective cohesion c' (soil and roots)"});
-  s.friction = kDeg * cfg.get("soil.friction_angle", 35.0, Range::open_closed(0.0, 89.0),
+  s.cohesion =
+      cfg.get("soil.cohesion", s.cohesion, Range::non_negative(), {"Pa", "effective cohesion c' (soil and roots)"});
+  s.friction = kDeg * cfg.get("soil.friction_angle", s.friction / kDeg, Range::open_closed(0.0, 89.0),
                               {"deg", "effective friction angle phi'"});
-  s.unit_weight_moist = cfg.get("soil.unit_weight_moist", 18e3, Range::closed(1e3, 5e4),
+  s.unit_weight_moist = cfg.get("soil.unit_weight_moist", s.unit_weight_moist, Range::closed(1e3, 5e4),
                                 {"N/m^3", "unit weight gamma_m of the soil above the water table"});
-  s.unit_weight_saturated = cfg.get("soil.unit_weight_saturated", 20e3, Range::closed(1e3, 5e4),
+  s.unit_weight_saturated = cfg.get("soil.unit_weight_saturated", s.unit_weight_saturated, Range::closed(1e3, 5e4),
                                     {"N/m^3", "unit weight gamma_sat below the water table (>= gamma_m, > gamma_w)"});
-  s.unit_weight_water =
-      cfg.get("soil.unit_weight_water", 9810.0, Range::closed(9e3, 1.2e4), {"N/m^3", "unit weight of water gamma_w"});
-  s.suction = cfg.get_bool("soil.suction", false,
+  s.unit_weight_water = cfg.get("soil.unit_weight_water", s.unit_weight_water, Range::closed(9e3, 1.2e4),
+                                {"N/m^3", "unit weight of water gamma_w"});
+  s.suction = cfg.get_bool("soil.suction", s.suction,
                            {"", "negative pressure heads (above the water table) add strength; false: counted as 0"});
   // Hydrology.
   auto& h = c.hydrology;
-  h.conductivity = cfg.get("hydrology.conductivity", 1e-5, Range::positive(),
+  h.conductivity = cfg.get("hydrology.conductivity", h.conductivity, Range::positive(),
                            {"m/s", "saturated hydraulic conductivity K_s (rain beyond it runs off)"});
-  h.diffusivity = cfg.get("hydrology.diffusivity", 5e-5, Range::positive(),
+  h.diffusivity = cfg.get("hydrology.diffusivity", h.diffusivity, Range::positive(),
                           {"m^2/s", "maximum hydraulic diffusivity D_0 (= K_s / specific storage)"});
-  h.steady_flux = cfg.get("hydrology.steady_infiltration", 0.0, Range::non_negative(),
+  h.steady_flux = cfg.get("hydrology.steady_infiltration", h.steady_flux, Range::non_negative(),
                           {"m/s", "long-term infiltration rate I_ZLT before the rain (< K_s cos^2 delta)"});
   c.water_table_depth =
       cfg.get("hydrology.water_table_depth", c.water_table_depth, Range::non_negative(),
@@ -107,13 +108,14 @@ StabilityMapCase read_stability_map_case(ConfigReader& cfg) {
                     {"m/s", "intensity of each step in turn (1 mm/h = 2.778e-7 m/s); then no rain"});
   c.rain = RainfallHistory::uniform_steps(step, intensity);
   // Run and outputs.
-  c.duration = cfg.get("run.duration", 0.0, Range::closed(0.0, 1e8), {"s", "simulated time; 0: the end of the rain"});
+  c.duration =
+      cfg.get("run.duration", c.duration, Range::closed(0.0, 1e8), {"s", "simulated time; 0: the end of the rain"});
   c.time_step = cfg.get("run.time_step", c.time_step, Range::open_closed(0.0, 1e7),
                         {"s", "evaluation step (failure times are refined between evaluations)"});
   c.output_every =
-      static_cast<int>(cfg.get_int("output.every", 1, Range::closed(1, 1e6),
+      static_cast<int>(cfg.get_int("output.every", c.output_every, Range::closed(1, 1e6),
                                    {"1", "an FS GeoTIFF every this many evaluation steps (and the last)"}));
-  c.pngs = cfg.get_bool("output.pngs", true, {"", "quick-look PNG maps of the minimum FS and the failure time"});
+  c.pngs = cfg.get_bool("output.pngs", c.pngs, {"", "quick-look PNG maps of the minimum FS and the failure time"});
 
   // Cross-checks (the ranges alone cannot see them).
   if (s.unit_weight_moist > s.unit_weight_saturated)

@@ -62,7 +62,7 @@ double iverson_response(double tstar) noexcept;
 /// The hydraulic properties of the soil and the background flux.
 struct InfiltrationParameters {
   double conductivity = 1e-5;  ///< K_s, saturated hydraulic conductivity (m/s), > 0
-  double diffusivity = 1e-4;   ///< D₀, maximum hydraulic diffusivity (m²/s), > 0
+  double diffusivity = 5e-5;   ///< D₀, maximum hydraulic diffusivity (m²/s), > 0
   double steady_flux = 0.0;    ///< I_ZLT, long-term (initial) infiltration rate (m/s), 0 ≤ I_ZLT < K_s cos²δ
 };
 

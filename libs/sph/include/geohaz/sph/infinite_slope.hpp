@@ -24,12 +24,12 @@ namespace geohaz::sph {
 
 /// Strength and unit weights of the soil cover.
 struct InfiniteSlopeSoil {
-  double cohesion = 0.0;                ///< c′ (Pa)
-  double friction = 0.6;                ///< φ′ (rad)
-  double unit_weight_moist = 18e3;      ///< γ_m above the water table (N/m³)
-  double unit_weight_saturated = 20e3;  ///< γ_sat below it (N/m³), ≥ γ_m and > γ_w
-  double unit_weight_water = 9810.0;    ///< γ_w (N/m³)
-  bool suction = false;                 ///< negative pressure heads add strength
+  double cohesion = 2e3;                                    ///< c′ (Pa)
+  double friction = 35.0 * 3.14159265358979323846 / 180.0;  ///< φ′ (rad)
+  double unit_weight_moist = 18e3;                          ///< γ_m above the water table (N/m³)
+  double unit_weight_saturated = 20e3;                      ///< γ_sat below it (N/m³), ≥ γ_m and > γ_w
+  double unit_weight_water = 9810.0;                        ///< γ_w (N/m³)
+  bool suction = false;                                     ///< negative pressure heads add strength
 };
 
 /// Weight W of the vertical column of depth Z (m) per unit horizontal area (N/m²) with pressure head

@@ -32,12 +32,12 @@ namespace geohaz::sph {
 
 /// Everything a stability-map run reads (config keys in read_stability_map_case).
 struct StabilityMapCase {
-  std::string dsm;                ///< DSM raster (projected CRS, m)
-  double soil_depth = 1.5;        ///< Z, vertical depth of the failure plane (m)
-  std::string soil_depth_raster;  ///< Z per cell (m) on the DSM's grid, "" for the constant
-  double min_slope = 0.0;         ///< cells flatter than this carry no soil (rad)
-  double max_slope = 1.0;         ///< cells steeper than this carry no soil (rad)
-  InfiniteSlopeSoil soil;         ///< c′, φ′, unit weights
+  std::string dsm;                                           ///< DSM raster (projected CRS, m)
+  double soil_depth = 1.5;                                   ///< Z, vertical depth of the failure plane (m)
+  std::string soil_depth_raster;                             ///< Z per cell (m) on the DSM's grid, "" for the constant
+  double min_slope = 0.0;                                    ///< cells flatter than this carry no soil (rad)
+  double max_slope = 60.0 * 3.14159265358979323846 / 180.0;  ///< cells steeper than this carry no soil (rad)
+  InfiniteSlopeSoil soil;                                    ///< c′, φ′, unit weights
   InfiltrationParameters hydrology;
   double water_table_depth = 1.5;  ///< d, initial water table depth (vertical, m)
   std::string water_table_raster;  ///< d per cell (m) on the DSM's grid, "" for the constant
