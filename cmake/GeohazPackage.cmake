@@ -58,6 +58,6 @@ set(CPACK_DEBIAN_PACKAGE_RECOMMENDS
     "cmake, libeigen3-dev, libboost-program-options-dev, libgdal-dev, libcgal-dev, libhdf5-dev, libtomlplusplus-dev, nlohmann-json3-dev")
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS "python3-matplotlib, bash-completion")
 set(CPACK_PACKAGE_DESCRIPTION
-    "geohaz: landslides from the first slip to the final deposit. SPH slope failure (sph-slope), depth-averaged debris runout with hazard maps (debris-runout), bonded-disc DEM (dem-avalanche), the C++ libraries with their CMake package, the Python module geohaz, example data and documentation (/usr/share/geohaz).")
+    "geohaz: landslides from the first slip to the final deposit. SPH slope failure (sph-slope), depth-averaged debris runout with hazard maps (debris-runout), bonded-disc DEM (dem-avalanche), rainfall-driven stability maps of a DSM (slope-stability), the C++ libraries with their CMake package, the Python module geohaz, example data and documentation (/usr/share/geohaz).")
 # Only what `cmake --install` installs (no test or benchmark binaries: they are not installed).
 include(CPack)
