@@ -61,7 +61,7 @@ install(FILES ${PROJECT_BINARY_DIR}/geohazConfig.cmake ${PROJECT_BINARY_DIR}/geo
 # Apps: installed by their own CMakeLists.txt; with shared libraries they find them relative to
 # themselves.
 if(GEOHAZ_SHARED_LIBS)
-  foreach(app sph-slope debris-runout dem-avalanche geohaz-report geohaz-ensemble geohaz-calibrate)
+  foreach(app sph-slope debris-runout dem-avalanche geohaz-report geohaz-ensemble geohaz-calibrate slope-stability)
     if(TARGET ${app})
       set_target_properties(${app} PROPERTIES INSTALL_RPATH "$ORIGIN/../${CMAKE_INSTALL_LIBDIR}")
     endif()

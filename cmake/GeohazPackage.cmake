@@ -1,7 +1,7 @@
 # Man pages and bash completion for the apps, and the Debian package (CPack), issue 20.
 include(GNUInstallDirs)
 
-set(_geohaz_apps sph-slope debris-runout dem-avalanche geohaz-report geohaz-ensemble geohaz-calibrate)
+set(_geohaz_apps sph-slope debris-runout dem-avalanche geohaz-report geohaz-ensemble geohaz-calibrate slope-stability)
 
 # Man pages: generated from each app's --help (and --help-config as a CONFIGURATION section) by
 # help2man (Debian package help2man) after the app is built. Without help2man there are none; nor
@@ -58,6 +58,6 @@ set(CPACK_DEBIAN_PACKAGE_RECOMMENDS
     "cmake, libeigen3-dev, libboost-program-options-dev, libgdal-dev, libcgal-dev, libhdf5-dev, libtomlplusplus-dev, nlohmann-json3-dev, libcairo2-dev, libpango1.0-dev, libnlopt-cxx-dev")
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS "python3-matplotlib, bash-completion")
 set(CPACK_PACKAGE_DESCRIPTION
-    "geohaz: landslides from the first slip to the final deposit. SPH slope failure (sph-slope), depth-averaged debris runout with hazard maps (debris-runout), bonded-disc DEM (dem-avalanche), the C++ libraries with their CMake package, the Python module geohaz, example data and documentation (/usr/share/geohaz).")
+    "geohaz: landslides from the first slip to the final deposit. SPH slope failure (sph-slope), depth-averaged debris runout with hazard maps (debris-runout), bonded-disc DEM (dem-avalanche), rainfall-driven stability maps of a DSM (slope-stability), the C++ libraries with their CMake package, the Python module geohaz, example data and documentation (/usr/share/geohaz).")
 # Only what `cmake --install` installs (no test or benchmark binaries: they are not installed).
 include(CPack)

@@ -1,4 +1,4 @@
-# bash completion for the geohaz apps (sph-slope, debris-runout, dem-avalanche, geohaz-report,
+# bash completion for the geohaz apps (sph-slope, debris-runout, dem-avalanche, slope-stability, geohaz-report,
 # geohaz-ensemble).
 # Installed as share/bash-completion/completions/<app>; to try it from a source tree:
 #   source scripts/completion/geohaz.bash
@@ -46,4 +46,4 @@ _geohaz_complete() {
   mapfile -t COMPREPLY < <(compgen -f -- "$cur")
 }
 
-complete -o filenames -F _geohaz_complete sph-slope debris-runout dem-avalanche geohaz-report geohaz-ensemble geohaz-calibrate
+complete -o filenames -F _geohaz_complete sph-slope debris-runout dem-avalanche geohaz-report geohaz-ensemble geohaz-calibrate slope-stability

@@ -2,6 +2,7 @@
 // their attribute, reprojection, refusal of non-line features; and the bundled thalweg.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -78,6 +79,46 @@ TEST(ReadLines, BundledAlplehnerThalweg) {
     length += (lines[0].vertices[i] - lines[0].vertices[i - 1]).norm();
   EXPECT_GT(length, 2500.0);
   EXPECT_LT(length, 5000.0);
+}
+
+// write_raster_polygons (issue #32): equal-valued 4-connected cells form one polygon along the
+// cell edges with the value as attribute; each cell centre lies in exactly its own polygon; nodata,
+// NaN and values <= 0 are left out; read back by read_polygons.
+TEST(WriteRasterPolygons, CellsBecomePolygonsThatContainTheirCentres) {
+  Raster r;
+  r.nx = 5;
+  r.ny = 4;
+  r.geotransform = {500000.0, 2.0, 0.0, 4300000.0, 0.0, -2.0};
+  r.crs_wkt = crs_to_wkt("EPSG:32632");
+  r.nodata = -9999.0;
+  // Two blocks of 1.5, one cell of 0.75 touching the first block, nodata, a NaN and zeros.
+  r.data = {1.5,          1.5,  0.0,  0.0,     1.5,  //
+            1.5,          0.75, 0.0,  -9999.0, 1.5,  //
+            0.0,          0.0,  0.0,  0.0,     0.0,  //
+            std::nan(""), 0.0,  -1.0, 0.0,     0.0};
+  const fs::path p = scratch("cells.gpkg");
+  fs::remove(p);
+  EXPECT_EQ(write_raster_polygons(p, r, "thickness", "release"), 3u);
+  EXPECT_FALSE(fs::exists(p.string() + ".partial"));
+  const auto polys = read_polygons(p, "thickness", r.crs_wkt);
+  ASSERT_EQ(polys.size(), 3u);
+  for (int row = 0; row < r.ny; ++row)
+    for (int col = 0; col < r.nx; ++col) {
+      const double v = r.at(col, row);
+      const bool in = std::isfinite(v) && v > 0.0 && v != -9999.0;
+      int inside = 0;
+      double attribute = 0.0;
+      for (const auto& poly : polys)
+        if (poly.contains(r.cell_centre(col, row))) {
+          ++inside;
+          attribute = poly.attribute;
+        }
+      EXPECT_EQ(inside, in ? 1 : 0) << col << ", " << row;
+      if (in) {
+        EXPECT_EQ(attribute, v) << col << ", " << row;
+      }
+    }
+  EXPECT_THROW(write_raster_polygons(scratch("cells.shp"), r, "thickness", "release"), InputError);
 }
 
 }  // namespace

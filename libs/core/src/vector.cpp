@@ -1,5 +1,6 @@
 /// \file vector.cpp
-/// Polygons and lines from OGR data sources (Shapefile, GeoJSON, GeoPackage, ...), see raster.hpp.
+/// Polygons and lines from OGR data sources (Shapefile, GeoJSON, GeoPackage, ...), and raster cells
+/// written as polygons, see raster.hpp.
 
 #include <cpl_string.h>
 #include <gdal_alg.h>
@@ -8,10 +9,14 @@
 #include <ogr_spatialref.h>
 #include <ogrsf_frmts.h>
 
+#include <array>
+#include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <vector>
 
 #include "gdal_common.hpp"
 #include "geohaz/core/config.hpp"
@@ -226,6 +231,80 @@ std::vector<Polyline> read_lines(const std::filesystem::path& path, const std::s
   }
   if (out.empty()) throw InputError("no line in the first layer ('" + std::string(v.layer->GetName()) + "')", file);
   return out;
+}
+
+std::size_t write_raster_polygons(const std::filesystem::path& path, const Raster& values, const std::string& attribute,
+                                  const std::string& layer) {
+  const std::string file = path.string();
+  std::string ext = path.extension().string();
+  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  const char* driver_name = ext == ".gpkg" ? "GPKG" : ext == ".geojson" ? "GeoJSON" : nullptr;
+  if (!driver_name) throw InputError("polygons are written as GeoPackage (.gpkg) or GeoJSON (.geojson)", file, "", ext);
+  if (values.nx <= 0 || values.ny <= 0 ||
+      values.data.size() != static_cast<std::size_t>(values.nx) * static_cast<std::size_t>(values.ny))
+    throw InputError("cannot polygonise an empty or inconsistent raster", file);
+  detail::ensure_gdal_registered();
+  OGRSpatialReference srs;
+  if (!values.crs_wkt.empty() && !detail::parse_srs(values.crs_wkt, srs))
+    throw InputError("the raster's CRS cannot be interpreted", file, "", values.crs_wkt);
+  srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  detail::QuietGdalErrors quiet;
+
+  // The values and the mask of the cells to write, as in-memory bands.
+  GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+  GDALDriver* drv = GetGDALDriverManager()->GetDriverByName(driver_name);
+  if (!mem || !drv) throw std::runtime_error(std::string("GDAL has no MEM or ") + driver_name + " driver");
+  std::unique_ptr<GDALDataset> src(mem->Create("", values.nx, values.ny, 2, GDT_Float32, nullptr));
+  if (!src) throw std::runtime_error("GDAL cannot create an in-memory raster" + detail::gdal_last_error());
+  std::array<double, 6> gt = values.geotransform;
+  src->SetGeoTransform(gt.data());
+  std::vector<float> v(values.data.size()), mask(values.data.size());
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    const double x = values.data[k];
+    const bool in = !values.is_nodata(x) && std::isfinite(x) && x > 0.0;
+    v[k] = in ? static_cast<float>(x) : 0.0f;
+    mask[k] = in ? 1.0f : 0.0f;
+  }
+  if (src->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, values.nx, values.ny, v.data(), values.nx, values.ny, GDT_Float32,
+                                      0, 0, nullptr) != CE_None ||
+      src->GetRasterBand(2)->RasterIO(GF_Write, 0, 0, values.nx, values.ny, mask.data(), values.nx, values.ny,
+                                      GDT_Float32, 0, 0, nullptr) != CE_None)
+    throw std::runtime_error("GDAL cannot fill an in-memory raster" + detail::gdal_last_error());
+
+  // From here on a failure is the file system's: IoError, and no file is left.
+  const std::string tmp = file + ".partial";
+  std::error_code ec;
+  std::filesystem::remove(tmp, ec);
+  const auto fail = [&](const std::string& what) {
+    const std::string msg = detail::gdal_last_error();
+    std::error_code e2;
+    std::filesystem::remove(tmp, e2);
+    return IoError(what + msg, file);
+  };
+  std::size_t count = 0;
+  {
+    std::unique_ptr<GDALDataset> ds(drv->Create(tmp.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+    if (!ds) throw fail("cannot create the polygon file");
+    OGRLayer* lyr = ds->CreateLayer(layer.c_str(), values.crs_wkt.empty() ? nullptr : &srs, wkbPolygon, nullptr);
+    if (!lyr) throw fail("cannot create the layer '" + layer + "'");
+    OGRFieldDefn field(attribute.c_str(), OFTReal);
+    if (lyr->CreateField(&field) != OGRERR_NONE) throw fail("cannot create the field '" + attribute + "'");
+    const bool transaction = ds->TestCapability(ODsCTransactions) && ds->StartTransaction() == OGRERR_NONE;
+    const CPLErr err = GDALFPolygonize(src->GetRasterBand(1), src->GetRasterBand(2), OGRLayer::ToHandle(lyr), 0,
+                                       nullptr, nullptr, nullptr);
+    if (err != CE_None) throw fail("polygonising the cells failed");
+    if (transaction && ds->CommitTransaction() != OGRERR_NONE) throw fail("cannot write the polygons");
+    count = static_cast<std::size_t>(lyr->GetFeatureCount());
+    CPLErrorReset();
+  }  // closes the file (writes the rest)
+  if (CPLGetLastErrorType() == CE_Failure || CPLGetLastErrorType() == CE_Fatal)
+    throw fail("writing the polygons failed");
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw IoError("cannot move the polygon file into place: " + ec.message(), file);
+  }
+  return count;
 }
 
 }  // namespace geohaz

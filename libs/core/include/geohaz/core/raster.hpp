@@ -138,6 +138,17 @@ struct Polyline {
 std::vector<Polyline> read_lines(const std::filesystem::path& path, const std::string& attribute,
                                  const std::string& target_wkt);
 
+/// Write the cells of `values` that hold a positive value (nodata, NaN and values ≤ 0 are left out)
+/// as polygons along the cell edges (GDAL's polygonizer): 4-connected cells of the same value
+/// (compared as 32-bit floats) form one polygon, with the value in the numeric field `attribute`.
+/// The file is a GeoPackage (".gpkg") or GeoJSON (".geojson") with one layer named `layer` in the
+/// raster's CRS, empty when no cell qualifies; a cell's centre lies inside its polygon and no
+/// other, so a reader that takes the cells whose centre is inside (debris-runout) gets the same
+/// cells back. Written under a temporary name and renamed. InputError for another extension,
+/// IoError when the file cannot be written. Returns the number of polygons written.
+std::size_t write_raster_polygons(const std::filesystem::path& path, const Raster& values, const std::string& attribute,
+                                  const std::string& layer);
+
 /// Colour ramps for maps and plots: Viridis, Magma and Cividis are the 256-entry tables of
 /// matplotlib's perceptually uniform maps; Terrain and BlueRed are interpolated between stops.
 /// Intensity: three steps (yellow, orange, red) for class rasters 1–3 drawn with vmin 0.5, vmax 3.5.
