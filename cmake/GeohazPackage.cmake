@@ -174,3 +174,17 @@ geohaz::core, geohaz::sph, geohaz::runout, geohaz::dem).")
 set(CPACK_DEBIAN_LIBS_DESCRIPTION "landslide models: shared libraries
 The shared libraries of geohaz (core, sph, runout, dem).")
 include(CPack)
+
+# The QGIS plugin (qgis/geohaz_provider, docs/qgis.md) as the zip QGIS's plugin manager installs
+# ("Install from ZIP"): `cmake --build build --target geohaz_qgis_plugin` → build/geohaz_provider-<v>.zip.
+file(GLOB _qgis_plugin_files CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/qgis/geohaz_provider/*.py
+     ${PROJECT_SOURCE_DIR}/qgis/geohaz_provider/metadata.txt)
+set(_qgis_zip ${PROJECT_BINARY_DIR}/geohaz_provider-${PROJECT_VERSION}.zip)
+add_custom_command(
+  OUTPUT ${_qgis_zip}
+  COMMAND ${CMAKE_COMMAND} -E tar cf ${_qgis_zip} --format=zip -- geohaz_provider
+  WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}/qgis
+  DEPENDS ${_qgis_plugin_files}
+  COMMENT "QGIS plugin zip geohaz_provider-${PROJECT_VERSION}.zip"
+  VERBATIM)
+add_custom_target(geohaz_qgis_plugin DEPENDS ${_qgis_zip})
