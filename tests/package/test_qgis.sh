@@ -21,7 +21,9 @@ export XDG_RUNTIME_DIR=$tmp/xdg OMP_NUM_THREADS=1
 mkdir -p "$HOME" "$XDG_RUNTIME_DIR" && chmod 700 "$XDG_RUNTIME_DIR"
 "$qp" plugins enable geohaz_provider >"$tmp/enable.log" 2>&1 || { cat "$tmp/enable.log"; fail "plugins enable failed"; }
 "$qp" list 2>/dev/null | grep -q "geohaz:debris_runout" || fail "geohaz:debris_runout not listed by qgis_process list"
-data=$src/data/runout
+# The inputs copied: QGIS writes GDAL .aux.xml statistics beside rasters it opens.
+data=$tmp/data
+mkdir -p "$data" && cp "$src"/data/runout/valley_small.tif "$src"/data/runout/valley_small_release.tif "$data"/
 "$qp" run geohaz:debris_runout -- DSM="$data/valley_small.tif" RELEASE_RASTER="$data/valley_small_release.tif" \
   FRICTION=0 N=0.06 ICR=0.15 D0=10 H0=0.5 DURATION=30 OUTPUT="$tmp/out" >"$tmp/run.log" 2>&1 || {
   cat "$tmp/run.log"; fail "qgis_process run failed"; }
@@ -44,4 +46,43 @@ import os
 assert os.path.isfile(f"{out}/max_speed.qml"), "no style beside max_speed.tif"
 print("test_qgis: qgis_process geohaz:debris_runout = geohaz.runout.run, maps identical:",
       back["summary"]["runout_length_along_path_m"], "m run-out")
+PY
+
+# Cancel: the algorithm run from QGIS's Python with a feedback that cancels at the first progress
+# report stops the run and writes no maps.
+"$python" - "$src/qgis" "$data" "$tmp/canceled" <<'PY'
+import sys
+plugins, data, out = sys.argv[1:4]
+sys.path.insert(0, plugins)
+from qgis.core import QgsApplication, QgsProcessingContext, QgsProcessingFeedback
+app = QgsApplication([], False)
+app.initQgis()
+from geohaz_provider.algorithms import DebrisRunoutAlgorithm
+
+
+class CancelAtFirstProgress(QgsProcessingFeedback):
+    def __init__(self):
+        super().__init__()
+        self.progress_seen = []
+        self.progressChanged.connect(self._cancel)
+
+    def _cancel(self, p):
+        self.progress_seen.append(p)
+        self.cancel()
+
+
+alg = DebrisRunoutAlgorithm()
+alg.initAlgorithm()
+context, feedback = QgsProcessingContext(), CancelAtFirstProgress()
+params = {"DSM": f"{data}/valley_small.tif", "RELEASE_RASTER": f"{data}/valley_small_release.tif", "FRICTION": 0,
+          "N": 0.06, "ICR": 0.15, "D0": 10.0, "H0": 0.5, "DURATION": 600.0, "OUTPUT": out}
+ok = alg.prepare(params, context, feedback)
+assert ok, "prepare failed"
+result = alg.runPrepared(params, context, feedback)
+import os
+assert feedback.progress_seen and feedback.isCanceled(), feedback.progress_seen
+assert result == {}, result
+assert not os.path.exists(f"{out}/max_depth.tif"), "a canceled run wrote maps"
+print(f"test_qgis: canceled at {feedback.progress_seen[0]:.1f} % of a 600 s run: no maps written")
+app.exitQgis()
 PY
