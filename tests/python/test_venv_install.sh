@@ -4,7 +4,9 @@
 # interpreter), the pytest files run with that venv's python from outside the source tree, and a
 # wheel built with `python3 -m build --wheel --no-isolation` that holds the module.
 # Arguments: source dir, build dir, python3. The CMake build folder of the pip build is kept in
-# <build>/pip-test/cmake, so a second run only relinks.
+# <build>-pip, beside the build folder rather than in it: at the same depth below the source tree,
+# ccache (base_dir) sees the same relative paths as in the build folder and reuses its objects, and
+# a second run only relinks.
 set -euo pipefail
 src=$1 build=$2 python=$3
 work=$build/pip-test
@@ -12,7 +14,7 @@ rm -rf "$work/venv" "$work/dist" "$work/run"
 mkdir -p "$work/run"
 "$python" -m venv --system-site-packages "$work/venv"
 py=$work/venv/bin/python
-export GEOHAZ_CMAKE_BUILD_DIR=$work/cmake
+export GEOHAZ_CMAKE_BUILD_DIR=$build-pip
 unset PYTHONPATH
 "$py" -m pip install --no-build-isolation --no-deps -q "$src" >"$work/pip.log" 2>&1 || {
   tail -40 "$work/pip.log"
