@@ -47,7 +47,7 @@ set_target_properties(geohaz_options PROPERTIES EXPORT_NAME options)
 install(TARGETS geohaz_options geohaz_core geohaz_sph geohaz_runout geohaz_dem
         EXPORT geohazTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev
-        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT libs
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(EXPORT geohazTargets NAMESPACE geohaz:: DESTINATION ${GEOHAZ_INSTALL_CMAKEDIR} COMPONENT dev)
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/geohazConfig.cmake.in
@@ -69,6 +69,6 @@ if(GEOHAZ_SHARED_LIBS)
 endif()
 
 # README, docs and example data with the source tree's layout: share/geohaz/{README.md,docs,data}.
-install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${GEOHAZ_INSTALL_DATADIR} COMPONENT runtime)
+install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${GEOHAZ_INSTALL_DATADIR} COMPONENT apps)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs ${PROJECT_SOURCE_DIR}/data DESTINATION ${GEOHAZ_INSTALL_DATADIR}
-        COMPONENT runtime)
+        COMPONENT apps)

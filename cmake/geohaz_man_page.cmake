@@ -7,7 +7,7 @@ set(ENV{LC_ALL} C.UTF-8)
 get_filename_component(_dir ${OUT} DIRECTORY)
 file(MAKE_DIRECTORY ${_dir})
 set(_include ${OUT}.include)
-set(_text "[SEE ALSO]\nThe documentation in /usr/share/geohaz (README.md, docs/) and the example cases in /usr/share/geohaz/data.\n")
+set(_text "[SEE ALSO]\nThe documentation in @GEOHAZ_DATADIR@ (README.md, docs/) and the example cases in @GEOHAZ_DATADIR@/data.\n")
 execute_process(COMMAND ${APP} --help-config OUTPUT_VARIABLE _cfg RESULT_VARIABLE _rc ERROR_QUIET)
 if(_rc EQUAL 0 AND _cfg)
   # roff: backslashes doubled, no line may start with a control character; kept as preformatted text.

@@ -13,6 +13,7 @@ import numpy as np
 
 from . import _geohaz
 from ._geohaz import InputError
+from ._keys import canonical_keys
 from ._overrides import set_overrides
 
 
@@ -63,6 +64,7 @@ def run(config, *, set=None, out=None, progress=None, progress_every=1, quiet=Tr
     result = _geohaz.dem_run(os.fspath(config), set_overrides(set), os.fspath(out) if out is not None else "",
                              progress, int(progress_every), bool(quiet), int(threads))
     result["tables"] = {stem: _table(text) for stem, text in result.pop("tables_csv")}
+    result["summary"] = canonical_keys(result["summary"])
     for w in result["summary"].get("warnings", []):
         warnings.warn(w, RuntimeWarning, stacklevel=2)
     return result

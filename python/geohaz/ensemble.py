@@ -1,29 +1,43 @@
 """geohaz-ensemble from Python: an ensemble of debris-runout runs and its probability maps, in this
 process on one rank (issue #20; the MPI app runs the same library code, docs/ensemble.md).
 """
-import json
 import os
+import tempfile
 
 from . import _geohaz
 from ._overrides import set_overrides
+from .results import read_run
 
 
-def run(config, *, set=None, out="ensemble-out", threads=0, quiet=True):
-    """Run `geohaz-ensemble config [--set k=v ...] --out out` in this process (one rank).
+def run(config, *, set=None, out=None, threads=0, quiet=True):
+    """Run `geohaz-ensemble config [--set k=v ...] --out out` in this process (one rank) and return
+    its products as arrays.
 
     config   the ensemble TOML (ensemble.base names the debris-runout case).
     set      overrides: {"ensemble.members": 20} or ["ensemble.members=20"].
-    out      the output folder: members/ (kept for resuming), the probability, mean and percentile
-             GeoTIFFs, members.csv, the plots and summary.json. A folder of the same ensemble is
-             resumed (finished members are skipped).
+    out      None (default): the run goes to a temporary folder, read back and deleted, so nothing
+             is left behind. A folder: members/ (kept for resuming), the probability, mean and
+             percentile GeoTIFFs, members.csv, the plots and summary.json stay there; a folder of
+             the same ensemble is resumed (finished members are skipped).
     threads  OpenMP threads per member (0: keep the current setting).
-    Returns the summary (dict of summary.json) with "out" added.
+    Returns geohaz.read_run of the output folder: "summary" (summary.json), "maps" (every
+    probability, mean and percentile map as (ny, nx) arrays), "tables" (members.csv, ...),
+    "units", "geotransform", "crs_wkt", and "out" (the folder, None for a temporary one).
     Raises geohaz.InputError (nothing written), geohaz.IoError.
     """
-    text = _geohaz.ensemble_run(os.fspath(config), set_overrides(set), os.fspath(out), int(threads), bool(quiet))
-    summary = json.loads(text)
-    summary["out"] = os.fspath(out)
-    return summary
+    if out is None:
+        with tempfile.TemporaryDirectory(prefix="geohaz-ensemble-") as tmp:
+            result = _run_into(config, set, os.path.join(tmp, "out"), threads, quiet)
+        result["out"] = None
+        return result
+    result = _run_into(config, set, os.fspath(out), threads, quiet)
+    result["out"] = os.fspath(out)
+    return result
+
+
+def _run_into(config, set, out, threads, quiet):
+    _geohaz.ensemble_run(os.fspath(config), set_overrides(set), out, int(threads), bool(quiet))
+    return read_run(out)
 
 
 def help_config():

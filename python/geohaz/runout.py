@@ -7,6 +7,7 @@ import os
 import warnings
 
 from . import _geohaz
+from ._keys import canonical_keys
 from ._overrides import set_overrides, toml_value
 
 # The app's direct model flags (apps/debris-runout/main.cpp, kDirectFlags) as keyword arguments:
@@ -69,6 +70,8 @@ def run(dsm=None, release=None, *, release_from=None, config=None, set=None, out
     result = _geohaz.runout_run(os.fspath(config) if config is not None else "", overrides,
                                 os.fspath(out) if out is not None else "", progress, int(progress_every),
                                 bool(quiet), int(threads), bool(particles))
+    result["summary"] = canonical_keys(result["summary"])
+    result["series"] = canonical_keys(result["series"])
     if result["summary"]["unfinished"]:
         warnings.warn("the run ended at its duration with part of the volume still moving: "
                       "maps['deposit'] holds the resting mass only, maps['mobile_at_end'] the moving "

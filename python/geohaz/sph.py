@@ -6,6 +6,7 @@ libs/sph/src/config.cpp), the same checks and messages, the same outputs when `o
 import os
 
 from . import _geohaz
+from ._keys import canonical_keys
 from ._overrides import set_overrides
 
 
@@ -34,8 +35,10 @@ def run(config, *, set=None, out=None, progress=None, progress_every=1, quiet=Tr
     Raises geohaz.InputError (the app's message, attributes file, key, value, reason; nothing
     written), SimulationError, IoError.
     """
-    return _geohaz.sph_run(os.fspath(config), set_overrides(set), os.fspath(out) if out is not None else "",
-                           progress, int(progress_every), bool(quiet), int(threads), bool(particles))
+    result = _geohaz.sph_run(os.fspath(config), set_overrides(set), os.fspath(out) if out is not None else "",
+                             progress, int(progress_every), bool(quiet), int(threads), bool(particles))
+    result["summary"] = canonical_keys(result["summary"])
+    return result
 
 
 def help_config():

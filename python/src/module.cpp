@@ -27,6 +27,7 @@
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
 #include "geohaz/core/progress.hpp"
+#include "geohaz/core/raster.hpp"
 #include "geohaz/core/snapshot.hpp"
 #include "geohaz/runout/calibrate.hpp"
 #include "geohaz/runout/ensemble.hpp"
@@ -325,6 +326,26 @@ std::string ensemble_help_config() {
   return ConfigReader::format_reference(d.reference());
 }
 
+/// Band 1 of a GDAL raster (any CRS) through the core reader the apps use: values (ny, nx) float64
+/// with NaN at nodata, the grid, CRS, nodata value, and the band's unit and description as written
+/// by write_geotiff. geohaz.read_run builds on it.
+py::dict read_raster_dict(const std::string& path) {
+  Raster r;
+  {
+    py::gil_scoped_release release;
+    r = read_raster(path, CrsPolicy::Any);
+  }
+  py::dict d;
+  d["values"] = grid_array(r, r.data);
+  d["geotransform"] = py::make_tuple(r.geotransform[0], r.geotransform[1], r.geotransform[2], r.geotransform[3],
+                                     r.geotransform[4], r.geotransform[5]);
+  d["crs_wkt"] = r.crs_wkt;
+  d["nodata"] = r.nodata ? py::object(py::float_(*r.nodata)) : py::object(py::none());
+  d["unit"] = r.unit;
+  d["description"] = r.description;
+  return d;
+}
+
 }  // namespace
 
 void register_dem(py::module_& m);  // python/src/dem.cpp: geohaz.dem in-process
@@ -364,6 +385,7 @@ PYBIND11_MODULE(_geohaz, m) {
   m.def("calibrate_run", &calibrate_run, py::arg("config"), py::arg("overrides"), py::arg("out"), py::arg("threads"),
         py::arg("quiet"));
   m.def("calibrate_help_config", &calibrate_help_config);
+  m.def("read_raster", &read_raster_dict, py::arg("path"));
   geohaz::python::add_sph(m);
   register_dem(m);
 }

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import geohaz
+from geohaz._keys import canonical_keys
 from conftest import app, app_error
 
 # The smallest bonded sample the app accepts (8 R_max a side), one tension test: ~1 s.
@@ -27,7 +28,7 @@ def test_a_lab_run_gives_the_apps_summary_tables_and_files(tmp_path, data):
     assert proc.returncode == 0, proc.stderr
     r = geohaz.dem.run(case, set=TINY_LAB, out=tmp_path / "py", threads=1)
     # One summary builder: the dict is the app's summary.json, number for number.
-    assert r["summary"] == json.loads((tmp_path / "app/summary.json").read_text())
+    assert r["summary"] == canonical_keys(json.loads((tmp_path / "app/summary.json").read_text()))  # key rule: docs/python.md
     assert (tmp_path / "py/summary.json").read_text() == (tmp_path / "app/summary.json").read_text()
     # The same files, the same tables (also as arrays).
     app_files = sorted(p.name for p in (tmp_path / "app").iterdir() if p.suffix != ".h5")
@@ -60,7 +61,7 @@ def test_an_avalanche_without_out_writes_nothing_and_returns_the_final_discs(tmp
         r = geohaz.dem.run(case, set=TINY_AVALANCHE, threads=1)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["app"]
     s = r["summary"]
-    assert s == json.loads((tmp_path / "app/summary.json").read_text())
+    assert s == canonical_keys(json.loads((tmp_path / "app/summary.json").read_text()))
     assert r["out"] is None and sorted(r["tables"]) == ["ae", "deposit", "fragments", "runout"]
     d = r["discs"]["avalanche"]
     assert d["position"].shape == (s["discs"], 2)

@@ -1,6 +1,7 @@
 """geohaz.ensemble: the ensemble run in-process from Python against the geohaz-ensemble app."""
 import json
 
+import numpy as np
 import pytest
 
 import geohaz
@@ -33,7 +34,8 @@ depth_thresholds = [0.5]
 def test_python_and_app_give_the_same_ensemble(tmp_path, data):
     cfg = tmp_path / "ens.toml"
     cfg.write_text(ENSEMBLE.format(base=data / "runout/valley_small.toml"))
-    s = geohaz.ensemble.run(cfg, out=tmp_path / "py", threads=1)
+    r = geohaz.ensemble.run(cfg, out=tmp_path / "py", threads=1)
+    s = r["summary"]
     proc = app("geohaz-ensemble", cfg, "--threads", "1", "--quiet", "--out", tmp_path / "app")
     assert proc.returncode == 0, proc.stderr
     a = json.loads((tmp_path / "app" / "summary.json").read_text())
@@ -42,7 +44,21 @@ def test_python_and_app_give_the_same_ensemble(tmp_path, data):
     assert s["runout_length_along_path_m"] == a["runout_length_along_path_m"]
     assert (tmp_path / "py" / "prob_max_depth_gt_0.5m.tif").read_bytes() == \
         (tmp_path / "app" / "prob_max_depth_gt_0.5m.tif").read_bytes()
+    # The products come back as arrays: the probability map is the GeoTIFF on disk.
+    prob = geohaz.read_raster(tmp_path / "app" / "prob_max_depth_gt_0.5m.tif")["values"]
+    np.testing.assert_array_equal(r["maps"]["prob_max_depth_gt_0.5m"], prob)
+    assert r["out"] == str(tmp_path / "py")
     assert "ensemble.sampling" in geohaz.ensemble.help_config()
+
+
+def test_without_a_folder_nothing_is_left_behind(tmp_path, data, monkeypatch):
+    cfg = tmp_path / "ens.toml"
+    cfg.write_text(ENSEMBLE.format(base=data / "runout/valley_small.toml").replace("members = 3", "members = 2"))
+    monkeypatch.chdir(tmp_path)
+    r = geohaz.ensemble.run(cfg, threads=1)
+    assert r["out"] is None and r["summary"]["succeeded"] == 2
+    assert np.nanmax(r["maps"]["prob_max_depth_gt_0.5m"]) <= 1.0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ens.toml"]  # no ensemble-out
 
 
 def test_bad_input_raises_the_apps_message_and_writes_nothing(tmp_path, data):

@@ -73,7 +73,7 @@ def test_a_run_from_python_matches_the_app_and_writes_the_same_outputs(tmp_path,
     # summary.json may carry more volumes (terms of processes) than the dict; the shared ones agree.
     assert len(s["volumes_m3"]) >= 7
     assert s["volumes_m3"] == {k: a["volumes_m3"][k] for k in s["volumes_m3"]}
-    assert s["max_speed_m_s"] == a["max_speed_m_s"] > 1.0
+    assert s["max_speed_m_per_s"] == a["max_speed_m_s"] > 1.0
     assert s["ended_by"] == "duration reached" and s["simulated_time_s"] == pytest.approx(20.0, abs=1e-9)
     assert (tmp_path / "py/config.resolved.toml").read_text() == r["resolved_config"]
 
@@ -95,8 +95,8 @@ def test_maps_are_numpy_arrays_on_the_dsm_grid(data):
     assert np.nansum(maps["deposit"]) * cell == pytest.approx(s["volumes_m3"]["deposit_raster"], rel=1e-12)
     assert np.nansum(maps["mobile_at_end"]) * cell == pytest.approx(s["volumes_m3"]["mobile_raster"], rel=1e-12)
     assert np.nansum(r["release_thickness"]) * cell == pytest.approx(s["volumes_m3"]["release_read"], rel=1e-12)
-    assert np.nanmax(maps["max_speed"]) == s["max_speed_m_s"]
-    assert np.nanmax(maps["max_pressure"]) == pytest.approx(1800.0 * s["max_speed_m_s"] ** 2, rel=1e-12)
+    assert np.nanmax(maps["max_speed"]) == s["max_speed_m_per_s"]
+    assert np.nanmax(maps["max_pressure"]) == pytest.approx(1800.0 * s["max_speed_m_per_s"] ** 2, rel=1e-12)
     reached = maps["max_depth"] > 0
     # Intensity: every reached cell is medium (2) or strong (3) under the default depth-speed rule;
     # strong exactly where peak depth and peak speed both exceed 1.
@@ -111,7 +111,7 @@ def test_maps_are_numpy_arrays_on_the_dsm_grid(data):
     n = s["particles_left"]
     assert part["position"].shape == (n, 2) and part["speed"].shape == (n,)
     assert part["volume"].sum() == pytest.approx(s["volumes_m3"]["mobile"] + s["volumes_m3"]["deposited"], rel=1e-9)
-    assert set(r["series"]) >= {"time_s", "front_travel_m", "max_speed_m_s"}
+    assert set(r["series"]) >= {"time_s", "front_travel_m", "max_speed_m_per_s"}
     assert r["series"]["time_s"][-1] == pytest.approx(20.0)
 
 
