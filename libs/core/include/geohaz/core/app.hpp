@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "geohaz/core/config.hpp"
+#include "geohaz/core/errors.hpp"
 
 namespace geohaz {
 
