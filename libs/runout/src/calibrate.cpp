@@ -17,6 +17,7 @@
 #include <sstream>
 #include <thread>
 
+#include "case_support.hpp"
 #include "geohaz/core/config.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
@@ -27,39 +28,18 @@ namespace fs = std::filesystem;
 
 namespace geohaz::runout {
 
-namespace {
+using detail::fmt;
+using detail::numeric_case_keys;
+using detail::origin;
+using detail::resolve_path;
 
-std::string fmt(double v, int prec = 6) {
-  std::ostringstream o;
-  o << std::setprecision(prec) << v;
-  return o.str();
-}
+namespace {
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
-}
-
-std::string resolve_path(const ConfigReader& cfg, std::string p) {
-  if (!p.empty() && !cfg.source().empty() && fs::path(p).is_relative() && !fs::exists(p))
-    return (cfg.base_dir() / p).string();
-  return p;
-}
-
-std::string origin(const ConfigReader& cfg) {
-  return cfg.source().empty() ? "command line" : cfg.source();
-}
-
-/// The numeric keys of a debris-runout case (what a parameter may name).
-std::set<std::string> numeric_case_keys() {
-  ConfigReader d = ConfigReader::describe();
-  read_case(d);
-  std::set<std::string> keys;
-  for (const KeyReference& r : d.reference())
-    if (r.type == "number" || r.type == "integer") keys.insert(r.key);
-  return keys;
 }
 
 bool is_vector_file(const fs::path& p) {

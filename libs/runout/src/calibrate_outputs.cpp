@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "case_support.hpp"
 #include "geohaz/core/config.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
@@ -22,13 +23,12 @@ namespace fs = std::filesystem;
 
 namespace geohaz::runout {
 
-namespace {
+using detail::fmt;
+using detail::numeric_case_keys;
+using detail::origin;
+using detail::resolve_path;
 
-std::string fmt(double v, int prec = 6) {
-  std::ostringstream o;
-  o << std::setprecision(prec) << v;
-  return o.str();
-}
+namespace {
 
 std::string csv_text(std::string s) {
   std::replace(s.begin(), s.end(), '"', '\'');

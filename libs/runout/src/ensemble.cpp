@@ -19,6 +19,7 @@
 #include <set>
 #include <sstream>
 
+#include "case_support.hpp"
 #include "geohaz/core/config.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
@@ -28,13 +29,12 @@ namespace fs = std::filesystem;
 
 namespace geohaz::runout {
 
-namespace {
+using detail::fmt;
+using detail::numeric_case_keys;
+using detail::origin;
+using detail::resolve_path;
 
-std::string fmt(double v, int prec = 6) {
-  std::ostringstream o;
-  o << std::setprecision(prec) << v;
-  return o.str();
-}
+namespace {
 
 std::uint64_t splitmix64(std::uint64_t x) noexcept {
   x += 0x9e3779b97f4a7c15ULL;
@@ -387,26 +387,6 @@ MemberRecord parse_member_json(const std::string& text) {
 // ---- configuration --------------------------------------------------------------------------
 
 namespace {
-
-std::string resolve_path(const ConfigReader& cfg, std::string p) {
-  if (!p.empty() && !cfg.source().empty() && fs::path(p).is_relative() && !fs::exists(p))
-    return (cfg.base_dir() / p).string();
-  return p;
-}
-
-std::string origin(const ConfigReader& cfg) {
-  return cfg.source().empty() ? "command line" : cfg.source();
-}
-
-/// The numeric keys of a debris-runout case (what a parameter may name).
-std::set<std::string> numeric_case_keys() {
-  ConfigReader d = ConfigReader::describe();
-  read_case(d);
-  std::set<std::string> keys;
-  for (const KeyReference& r : d.reference())
-    if (r.type == "number" || r.type == "integer") keys.insert(r.key);
-  return keys;
-}
 
 void read_parameter_keys(ConfigReader& t, ParameterDistribution& p, bool describe) {
   const auto kind = t.get_choice("distribution", "uniform", {"uniform", "normal", "lognormal", "discrete", "fixed"},
