@@ -36,7 +36,7 @@ const DirectFlag kDirectFlags[] = {
     {"icr", "model.icr", "critical slope gradient i_cr (1); sets model.icr"},
     {"friction", "model.friction",
      "basal law: manning | voellmy | coulomb | voellmy_cohesion | bingham | herschel_bulkley | "
-     "obrien_julien | pouliquen (docs/runout.md, --help-config for each law's keys); sets model.friction"},
+     "obrien_julien | pouliquen (docs/runout.md lists each law's keys); sets model.friction"},
     {"mu", "model.mu", "Coulomb coefficient μ for voellmy/coulomb (1); sets model.mu"},
     {"xi", "model.xi", "Voellmy turbulence coefficient ξ (m/s^2); sets model.xi"},
     {"density", "model.density", "mixture density ρ (kg/m^3); sets model.density"},

@@ -22,8 +22,11 @@ for f in include/geohaz/core/config.hpp include/geohaz/runout/run.hpp include/ge
 done
 ls "$prefix"/lib/libgeohaz_{core,sph,runout,dem}.* >/dev/null || fail "libraries not installed"
 if [ -e "$build/man/debris-runout.1" ]; then
-  [ -s "$prefix/share/man/man1/debris-runout.1" ] || fail "man page not installed"
-  grep -q "model.friction" "$prefix/share/man/man1/debris-runout.1" || fail "man page lacks the config keys"
+  # Installed gzipped (Debian policy 12.3), with SEE ALSO naming this prefix's data folder.
+  page="$prefix/share/man/man1/debris-runout.1.gz"
+  [ -s "$page" ] || fail "man page not installed (gzipped)"
+  zgrep -q "model.friction" "$page" || fail "man page lacks the config keys"
+  zgrep -q "$prefix/share/geohaz" "$page" || fail "man page SEE ALSO does not name $prefix/share/geohaz"
 fi
 python3 "$here/check_links.py" "$prefix/share/geohaz"
 # The CMake package from a project that knows nothing of the source tree.

@@ -342,9 +342,12 @@ void write_class_zones(const std::filesystem::path& gpkg, const std::filesystem:
     throw std::runtime_error("cannot fill the in-memory raster" + detail::gdal_last_error());
 
   const std::string tmp = file + ".partial";
+  const std::string ktmp = kml.empty() ? std::string() : kml.string() + ".partial";
   std::error_code ec;
   std::filesystem::remove(tmp, ec);
-  {
+  // A failure (a full disk) leaves no half-written file: the datasets are closed while the exception
+  // unwinds out of the block, then their temporary files are removed and the error goes on.
+  try {
     std::unique_ptr<GDALDataset> out(gpkg_driver->Create(tmp.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
     if (!out) throw IoError("cannot create the GeoPackage" + detail::gdal_last_error(), file);
     OGRSpatialReference srs;
@@ -383,7 +386,6 @@ void write_class_zones(const std::filesystem::path& gpkg, const std::filesystem:
       throw IoError("cannot write the GeoPackage" + detail::gdal_last_error(), file);
     // KML (WGS 84, as Google Earth and phones read it) as a copy of the layer.
     if (!kml.empty() && kml_driver) {
-      const std::string ktmp = kml.string() + ".partial";
       std::filesystem::remove(ktmp, ec);
       CPLStringList args;
       for (const char* a : {"-f", "KML", "-t_srs", "EPSG:4326", "-dsco", "NameField=label"}) args.AddString(a);
@@ -397,6 +399,11 @@ void write_class_zones(const std::filesystem::path& gpkg, const std::filesystem:
       std::filesystem::rename(ktmp, kml, ec);
       if (ec) throw IoError("cannot move the KML into place: " + ec.message(), kml.string());
     }
+  } catch (...) {
+    std::error_code e2;
+    std::filesystem::remove(tmp, e2);
+    if (!ktmp.empty()) std::filesystem::remove(ktmp, e2);
+    throw;
   }
   std::filesystem::rename(tmp, gpkg, ec);
   if (ec) {
