@@ -415,8 +415,9 @@ const KeyLabel kKeys[] = {
     {"centre_of_mass.travel_m", kReach, "centre of mass: horizontal travel"},
     {"centre_of_mass.drop_m", kReach, "centre of mass: drop"},
     {"centre_of_mass.angle_deg", kReach, "centre of mass: travel angle"},
-    {"max_speed_m_s", kPeak, "peak speed", true},
+    {"max_speed_m_s", kPeak, "peak speed", true},  // debris-runout folders from before the key rule (python.md)
     {"max_pressure_pa", kPeak, "peak pressure ρv²", true},
+    {"mobile_at_end.max_speed_m_per_s", kPeak, "largest speed at the end"},
     {"mobile_at_end.max_speed_m_s", kPeak, "largest speed at the end"},
     {"kinetic_energy_j.peak", kPeak, "peak kinetic energy"},
     {"kinetic_energy_j.at_end", kPeak, "kinetic energy at the end"},

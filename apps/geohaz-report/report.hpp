@@ -11,7 +11,8 @@
 
 namespace geohaz::report {
 
-/// A quantity as a reader sees it: "mean speed" in "m/s", from a name such as "mean_speed_m_s".
+/// A quantity as a reader sees it: "mean speed" in "m/s", from a name such as "mean_speed_m_per_s" (or the older
+/// "mean_speed_m_s").
 struct Quantity {
   std::string label;  ///< words, e.g. "mean speed"
   std::string unit;   ///< unit for display, e.g. "m/s", "m³", "°" ("" when dimensionless or unknown)

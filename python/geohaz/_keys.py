@@ -2,9 +2,9 @@
 
 A quantity's name ends in its SI unit, a compound unit written with `_per_`: `max_speed_m_per_s`,
 `earthquake_acceleration_m_per_s2`, `discharge_m3_per_s`, `energy_J_per_m` (the form sph-slope and
-dem-avalanche already write). debris-runout's files still say `max_speed_m_s`; the Python results
-use the rule, and the old key stays readable, with a DeprecationWarning, until geohaz 0.2
-(docs/python.md, "Migration").
+dem-avalanche already write). Since issue #37 every app writes the rule; folders written before
+it (`max_speed_m_s`) are read under the new names, and the old key stays readable, with a
+DeprecationWarning, until geohaz 0.2 (docs/python.md, "Migration").
 """
 import re
 import warnings

@@ -9,7 +9,7 @@ from ._overrides import set_overrides
 from .results import read_run
 
 
-def run(config, *, set=None, out=None, threads=0, quiet=True):
+def run(config, *, set=None, out=None, threads=0, quiet=True, progress=None, progress_every=1):
     """Run `geohaz-ensemble config [--set k=v ...] --out out` in this process (one rank) and return
     its products as arrays.
 
@@ -20,6 +20,12 @@ def run(config, *, set=None, out=None, threads=0, quiet=True):
              percentile GeoTIFFs, members.csv, the plots and summary.json stay there; a folder of
              the same ensemble is resumed (finished members are skipped).
     threads  OpenMP threads per member (0: keep the current setting).
+    progress a callable taking a dict, called every `progress_every` steps of each member with the
+             keys of geohaz.runout.run's progress (phase, time, duration, step, particles,
+             mobile_volume) and "member", "members_done", "members_planned"; after each member
+             with phase "member_finished" and "ok". An exception raised in it stops the ensemble
+             (Cancel): finished members stay in `out` for a resumed run, no products are written,
+             and the exception propagates.
     Returns geohaz.read_run of the output folder: "summary" (summary.json), "maps" (every
     probability, mean and percentile map as (ny, nx) arrays), "tables" (members.csv, ...),
     "units", "geotransform", "crs_wkt", and "out" (the folder, None for a temporary one).
@@ -27,16 +33,17 @@ def run(config, *, set=None, out=None, threads=0, quiet=True):
     """
     if out is None:
         with tempfile.TemporaryDirectory(prefix="geohaz-ensemble-") as tmp:
-            result = _run_into(config, set, os.path.join(tmp, "out"), threads, quiet)
+            result = _run_into(config, set, os.path.join(tmp, "out"), threads, quiet, progress, progress_every)
         result["out"] = None
         return result
-    result = _run_into(config, set, os.fspath(out), threads, quiet)
+    result = _run_into(config, set, os.fspath(out), threads, quiet, progress, progress_every)
     result["out"] = os.fspath(out)
     return result
 
 
-def _run_into(config, set, out, threads, quiet):
-    _geohaz.ensemble_run(os.fspath(config), set_overrides(set), out, int(threads), bool(quiet))
+def _run_into(config, set, out, threads, quiet, progress, progress_every):
+    _geohaz.ensemble_run(os.fspath(config), set_overrides(set), out, int(threads), bool(quiet), progress,
+                         int(progress_every))
     return read_run(out)
 
 

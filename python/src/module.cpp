@@ -109,8 +109,8 @@ py::dict series_arrays(const std::vector<SeriesRow>& rows) {
   d["front_y_m"] = column([](const SeriesRow& r) { return r.front.y(); });
   d["front_travel_m"] = column([](const SeriesRow& r) { return r.front_travel; });
   d["front_drop_m"] = column([](const SeriesRow& r) { return r.front_drop; });
-  d["mean_speed_m_s"] = column([](const SeriesRow& r) { return r.mean_speed; });
-  d["max_speed_m_s"] = column([](const SeriesRow& r) { return r.max_speed; });
+  d["mean_speed_m_per_s"] = column([](const SeriesRow& r) { return r.mean_speed; });
+  d["max_speed_m_per_s"] = column([](const SeriesRow& r) { return r.max_speed; });
   d["mobile_volume_m3"] = column([](const SeriesRow& r) { return r.volumes.mobile; });
   d["deposited_volume_m3"] = column([](const SeriesRow& r) { return r.volumes.deposited; });
   d["lost_volume_m3"] = column([](const SeriesRow& r) { return r.volumes.lost; });
@@ -124,6 +124,13 @@ py::object summary_dict(const RunoutSimulation& sim, const RunoutCase& c, int th
   return py::module_::import("json").attr("loads")(summary_json(c, sim, threads));
 }
 
+/// progress_every ≥ 1, progress callable or None (InputError naming the argument).
+void check_progress(const py::object& progress, int progress_every) {
+  if (progress_every < 1) throw InputError("must be ≥ 1", "python", "progress_every", std::to_string(progress_every));
+  if (!progress.is_none() && !PyCallable_Check(progress.ptr()))
+    throw InputError("must be callable (or None)", "python", "progress");
+}
+
 /// The observer of a run from Python: the progress callback (every `every` steps, and at start
 /// and end), snapshots and the progress line when writing into a directory, and Ctrl-C.
 class PythonObserver : public RunObserver {
@@ -134,6 +141,9 @@ class PythonObserver : public RunObserver {
   std::unique_ptr<SnapshotWriter> snapshots;
   double snapshot_interval = 0.0;
   std::unique_ptr<ProgressReporter> progress;
+  /// The member this run is of an ensemble or calibration (-1: a lone run), members finished so
+  /// far and planned: passed to the callback as "member", "members_done", "members_planned".
+  int member = -1, members_done = 0, members_planned = 0;
 
   void started(const RunoutSimulation& sim) override {
     if (snapshots) {
@@ -176,7 +186,12 @@ class PythonObserver : public RunObserver {
     py::dict d;
     d["phase"] = phase;
     d["time"] = s.time();
-    d["duration"] = duration_;
+    d["duration"] = member >= 0 ? sim.parameters().duration : duration_;
+    if (member >= 0) {
+      d["member"] = member;
+      d["members_done"] = members_done;
+      d["members_planned"] = members_planned;
+    }
     d["step"] = s.step_count();
     d["particles"] = s.particles().size();
     d["mobile_volume"] = s.budget().mobile;
@@ -190,9 +205,7 @@ class PythonObserver : public RunObserver {
 /// geohaz._geohaz.runout_run: see python/geohaz/runout.py for the documented signature.
 py::dict runout_run(const std::string& config, const std::vector<std::string>& overrides, const std::string& out,
                     py::object progress, int progress_every, bool quiet, int threads, bool particles) {
-  if (progress_every < 1) throw InputError("must be ≥ 1", "python", "progress_every", std::to_string(progress_every));
-  if (!progress.is_none() && !PyCallable_Check(progress.ptr()))
-    throw InputError("must be callable (or None)", "python", "progress");
+  check_progress(progress, progress_every);
   const int nthreads = setup_threads(threads);
   // Config: the file, then the overrides in the order of the app (--set, direct flags, inputs).
   ConfigReader cfg =
@@ -276,17 +289,48 @@ std::string runout_help_config() {
   return ConfigReader::format_reference(d.reference());
 }
 
+/// The observer of an ensemble or a calibration from Python: each member's steps go to the
+/// progress callback as for a lone run (with the member's index and the count), and after each
+/// member {"phase": "member_finished", "member", "members_done", "members_planned", "ok"}. The
+/// callback raising (Cancel) or Ctrl-C stops the run (ensemble.hpp MemberObserver).
+class PythonMemberObserver : public MemberObserver {
+ public:
+  PythonMemberObserver(py::object callback, int every) : steps_(callback, every, 0.0), cb_(std::move(callback)) {}
+  RunObserver* member_started(int i, int done, int planned) override {
+    steps_.member = i, steps_.members_done = done, steps_.members_planned = planned;
+    return &steps_;
+  }
+  void member_finished(const MemberRecord& rec, int done, int planned) override {
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    if (cb_.is_none()) return;
+    py::dict d;
+    d["phase"] = "member_finished";
+    d["member"] = rec.index;
+    d["members_done"] = done;
+    d["members_planned"] = planned;
+    d["ok"] = rec.ok;
+    cb_(d);
+  }
+
+ private:
+  PythonObserver steps_;
+  py::object cb_;
+};
+
 /// An ensemble (geohaz-ensemble's config) run in this process on one rank: members and products in
 /// `out` (resumed when it holds the same ensemble); returns the text of its summary.json.
 std::string ensemble_run(const std::string& config, const std::vector<std::string>& overrides, const std::string& out,
-                         int threads, bool quiet) {
+                         int threads, bool quiet, py::object progress, int progress_every) {
+  check_progress(progress, progress_every);
   ConfigReader cfg = ConfigReader::from_file(config);
   for (const auto& o : overrides) cfg.apply_override(o);
   const EnsembleSetup s = read_ensemble(cfg);
   const int nthreads = threads > 0 ? setup_threads(threads) : omp_get_max_threads();
+  PythonMemberObserver obs(std::move(progress), progress_every);
   {
     py::gil_scoped_release release;
-    run_ensemble_serial(s, out, nthreads, quiet);
+    run_ensemble_serial(s, out, nthreads, quiet, &obs);
   }
   std::ifstream in(fs::path(out) / "summary.json");
   std::ostringstream text;
@@ -297,14 +341,16 @@ std::string ensemble_run(const std::string& config, const std::vector<std::strin
 /// A calibration (geohaz-calibrate's config) run in this process on one rank: members and outputs in
 /// `out` (resumed when it holds the same calibration); returns the text of its summary.json.
 std::string calibrate_run(const std::string& config, const std::vector<std::string>& overrides, const std::string& out,
-                          int threads, bool quiet) {
+                          int threads, bool quiet, py::object progress, int progress_every) {
+  check_progress(progress, progress_every);
   ConfigReader cfg = ConfigReader::from_file(config);
   for (const auto& o : overrides) cfg.apply_override(o);
   CalibrationSetup s = read_calibration(cfg);
   const int nthreads = threads > 0 ? setup_threads(threads) : omp_get_max_threads();
+  PythonMemberObserver obs(std::move(progress), progress_every);
   {
     py::gil_scoped_release release;
-    run_calibration_serial(s, out, nthreads, quiet);
+    run_calibration_serial(s, out, nthreads, quiet, &obs);
   }
   std::ifstream in(fs::path(out) / "summary.json");
   std::ostringstream text;
@@ -380,10 +426,10 @@ PYBIND11_MODULE(_geohaz, m) {
         py::arg("progress_every"), py::arg("quiet"), py::arg("threads"), py::arg("particles"));
   m.def("runout_help_config", &runout_help_config);
   m.def("ensemble_run", &ensemble_run, py::arg("config"), py::arg("overrides"), py::arg("out"), py::arg("threads"),
-        py::arg("quiet"));
+        py::arg("quiet"), py::arg("progress") = py::none(), py::arg("progress_every") = 1);
   m.def("ensemble_help_config", &ensemble_help_config);
   m.def("calibrate_run", &calibrate_run, py::arg("config"), py::arg("overrides"), py::arg("out"), py::arg("threads"),
-        py::arg("quiet"));
+        py::arg("quiet"), py::arg("progress") = py::none(), py::arg("progress_every") = 1);
   m.def("calibrate_help_config", &calibrate_help_config);
   m.def("read_raster", &read_raster_dict, py::arg("path"));
   geohaz::python::add_sph(m);

@@ -341,7 +341,7 @@ TEST(DemApp, AvalancheRunsToRest) {
   const auto j = read_json(out / "summary.json");
   EXPECT_TRUE(j["at_rest"].get<bool>());
   EXPECT_TRUE(j["warnings"].empty());
-  EXPECT_LE(j["max_speed_at_end_m_s"].get<double>(), 0.1);
+  EXPECT_LE(j["max_speed_at_end_m_per_s"].get<double>(), 0.1);
   EXPECT_EQ(j["moving_mass_fraction_at_end"].get<double>(), 0.0);
   EXPECT_LT(j["runout_duration_s"].get<double>(), 300.0);
 }

@@ -1,6 +1,8 @@
 """geohaz.calibrate: the back-analysis run in-process from Python against the geohaz-calibrate app."""
 import json
+import tomllib
 
+import numpy as np
 import pytest
 
 import geohaz
@@ -58,15 +60,29 @@ def make_event(tmp_path, data):
 
 def test_python_and_app_give_the_same_calibration(tmp_path, data):
     cfg = make_event(tmp_path, data)
-    s = geohaz.calibrate.run(cfg, out=tmp_path / "py", threads=1)
+    seen = []
+    r = geohaz.calibrate.run(cfg, out=tmp_path / "py", threads=1, progress=seen.append, progress_every=50)
+    s = r["summary"]
     proc = app("geohaz-calibrate", cfg, "--threads", "1", "--quiet", "--out", tmp_path / "app")
     assert proc.returncode == 0, proc.stderr
     a = json.loads((tmp_path / "app" / "summary.json").read_text())
     assert s["best"] == a["best"]
     assert (tmp_path / "py" / "members.csv").read_text() == (tmp_path / "app" / "members.csv").read_text()
-    assert set(s["best"]["parameters"]) == {"model.icr"}
-    assert 0.1 <= s["best"]["parameters"]["model.icr"] <= 0.25
+    assert set(r["best"]) == {"model.icr"} and r["best"] == s["best"]["parameters"]
+    assert 0.1 <= r["best"]["model.icr"] <= 0.25
+    assert tomllib.loads(r["best_toml"])["model"]["icr"] == r["best"]["model.icr"]
     assert (tmp_path / "py" / "best.toml").exists() and (tmp_path / "py" / "comparison.png").exists()
+    # The comparison map comes back as an array: its cells of class 1, 2, 3 are the best member's
+    # TP, FP and FN areas.
+    cell = abs(r["geotransform"][1] * r["geotransform"][5])
+    for cls, key in ((1, "tp_m2"), (2, "fp_m2"), (3, "fn_m2")):
+        area = np.count_nonzero(r["maps"]["comparison"] == cls) * cell
+        assert area == pytest.approx(s["best"]["misfit"][key], rel=1e-12), key
+    # Progress: every member ran is reported once as finished, in order, with the count.
+    finished = [p for p in seen if p["phase"] == "member_finished"]
+    assert [p["members_done"] for p in finished] == list(range(1, len(r["tables"]["members"]["member"]) + 1))
+    assert all(p["members_done"] <= p["members_planned"] for p in finished)
+    assert any(p["phase"] == "running" and p["member"] == 0 and 0 < p["time"] <= p["duration"] for p in seen)
     assert "calibration.global_members" in geohaz.calibrate.help_config()
 
 
@@ -79,3 +95,25 @@ def test_bad_bounds_raise_input_error_naming_the_key_and_write_nothing(tmp_path,
     proc = app("geohaz-calibrate", cfg, "--set", "calibration.parameter[0].min=0.3", "--out", tmp_path / "never")
     assert "calibration.parameter[0].min" in app_error(proc, "geohaz-calibrate")
     assert not (tmp_path / "never").exists()
+
+
+def test_raising_in_progress_cancels_and_writes_no_outputs(tmp_path, data):
+    cfg = make_event(tmp_path, data)
+
+    class Cancel(Exception):
+        pass
+
+    def cancel_in_member_1(p):
+        if p.get("member") == 1 and p["phase"] == "running":
+            raise Cancel()
+
+    with pytest.raises(Cancel):
+        geohaz.calibrate.run(cfg, out=tmp_path / "c", threads=1, progress=cancel_in_member_1, progress_every=5)
+    members = sorted(p.name for p in (tmp_path / "c" / "members").iterdir())
+    assert members == ["000000"]  # member 0 finished; member 1 left nothing, not even a .partial folder
+    assert not (tmp_path / "c" / "best.toml").exists() and not (tmp_path / "c" / "summary.json").exists()
+    # The rerun resumes: member 0 is not run again, and the result equals an uninterrupted run's.
+    seen = []
+    r = geohaz.calibrate.run(cfg, out=tmp_path / "c", threads=1, progress=seen.append, progress_every=1000)
+    assert 0 not in [p["member"] for p in seen if p["phase"] == "member_finished"]
+    assert r["best"] == geohaz.calibrate.run(cfg, threads=1)["best"]

@@ -70,3 +70,34 @@ def test_bad_input_raises_the_apps_message_and_writes_nothing(tmp_path, data):
     assert str(e.value) == expected
     assert e.value.key == "ensemble.parameter[0].min"
     assert not (tmp_path / "py").exists() and not (tmp_path / "app").exists()
+
+
+def test_progress_sees_every_member_and_raising_in_it_cancels(tmp_path, data):
+    cfg = tmp_path / "ens.toml"
+    cfg.write_text(ENSEMBLE.format(base=data / "runout/valley_small.toml"))
+    seen = []
+    geohaz.ensemble.run(cfg, out=tmp_path / "full", threads=1, progress=seen.append, progress_every=10)
+    finished = [(p["member"], p["members_done"], p["members_planned"], p["ok"]) for p in seen
+                if p["phase"] == "member_finished"]
+    assert finished == [(0, 1, 3, True), (1, 2, 3, True), (2, 3, 3, True)]
+    running = [p for p in seen if p["phase"] == "running"]
+    assert running and all(p["step"] % 10 == 0 and 0 < p["time"] <= p["duration"] == 60.0 for p in running)
+    # Cancel in member 1: member 0 stays, member 1 leaves nothing, no products; the rerun resumes
+    # and gives the uninterrupted run's probability map, byte for byte.
+
+    class Cancel(Exception):
+        pass
+
+    def cancel(p):
+        if p.get("member") == 1 and p["phase"] == "running":
+            raise Cancel()
+
+    with pytest.raises(Cancel):
+        geohaz.ensemble.run(cfg, out=tmp_path / "c", threads=1, progress=cancel, progress_every=5)
+    assert sorted(p.name for p in (tmp_path / "c" / "members").iterdir()) == ["000000"]
+    assert not list((tmp_path / "c").glob("*.tif")) and not (tmp_path / "c" / "summary.json").exists()
+    again = []
+    geohaz.ensemble.run(cfg, out=tmp_path / "c", threads=1, progress=again.append, progress_every=1000)
+    assert [p["member"] for p in again if p["phase"] == "member_finished"] == [1, 2]
+    assert (tmp_path / "c" / "prob_max_depth_gt_0.5m.tif").read_bytes() == \
+        (tmp_path / "full" / "prob_max_depth_gt_0.5m.tif").read_bytes()

@@ -42,16 +42,28 @@ def test_read_run_gives_back_the_maps_written_to_disk(small_run):
     assert "[model]" in back["resolved_config"]
 
 
-def test_summary_keys_follow_one_rule_and_old_names_still_answer(small_run):
+def test_summary_keys_follow_one_rule_and_old_names_still_answer(small_run, tmp_path):
     r, out = small_run
     on_disk = json.loads((out / "summary.json").read_text())
+    # The app writes the rule (issue #37): no compound unit without _per_ in its files.
+    assert "max_speed_m_per_s" in on_disk and "max_speed_m_s" not in on_disk
+    assert "max_speed_m_per_s" in on_disk["mobile_at_end"]
+    series_header = (out / "series.csv").read_text().splitlines()[0].split(",")
+    assert "mean_speed_m_per_s" in series_header and "max_speed_m_s" not in series_header
+    assert [k for k in series_header if geohaz.results.canonical(k) != k] == []
     s = geohaz.read_run(out)["summary"]
-    assert "max_speed_m_per_s" in r["summary"] and "max_speed_m_per_s" in s
-    assert s["max_speed_m_per_s"] == on_disk["max_speed_m_s"]
-    assert "max_speed_m_s" not in list(s)  # one spelling in the keys ...
-    with pytest.warns(DeprecationWarning, match="max_speed_m_per_s"):
-        assert s["max_speed_m_s"] == s["max_speed_m_per_s"]  # ... the old one readable for a release
+    assert "max_speed_m_per_s" in r["summary"] and s["max_speed_m_per_s"] == on_disk["max_speed_m_per_s"]
     assert "mean_speed_m_per_s" in r["series"]
+    # A folder written before the rename: read under the new names, the old one readable for a release.
+    old = tmp_path / "old"
+    old.mkdir()
+    text = (out / "summary.json").read_text().replace("_m_per_s", "_m_s")
+    (old / "summary.json").write_text(text)
+    s_old = geohaz.read_run(old)["summary"]
+    assert s_old["max_speed_m_per_s"] == on_disk["max_speed_m_per_s"]
+    assert "max_speed_m_s" not in list(s_old)  # one spelling in the keys ...
+    with pytest.warns(DeprecationWarning, match="max_speed_m_per_s"):
+        assert s_old["max_speed_m_s"] == s_old["max_speed_m_per_s"]  # ... the old one readable for a release
     assert geohaz.results.canonical("x_m3_s") == "x_m3_per_s"
     assert geohaz.results.canonical("earthquake_acceleration_m_per_s2") == "earthquake_acceleration_m_per_s2"
 

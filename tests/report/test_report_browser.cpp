@@ -72,12 +72,12 @@ void make_results(const fs::path& root) {
   fs::create_directories(lab);
   write_file(run / "summary.json", R"({"model": "debris-runout", "area_affected_m2": 138975.0,
     "fahrboeschung": {"ratio_H_over_L": 0.5132, "reach_m": 2802.2, "drop_height_m": 1438.0},
-    "max_pressure_pa": 970929.6, "max_speed_m_s": 22.6, "simulated_time_s": 402.9,
+    "max_pressure_pa": 970929.6, "max_speed_m_per_s": 22.6, "simulated_time_s": 402.9,
     "volumes_m3": {"release_read": 17700.0, "deposit_raster": 17678.4}, "barrier_peak_force_N": 1.2e5,
     "wall_time_s": 35.9})");
   write_file(run / "config.resolved.toml", "[model]\nfriction = 'voellmy'\nmu = 0.2\nxi = 500.0\ndensity = 2000.0\n");
   write_file(run / "series.csv",
-             "time_s,step,front_travel_m,max_speed_m_s,mobile_volume_m3,deposited_volume_m3\n"
+             "time_s,step,front_travel_m,max_speed_m_per_s,mobile_volume_m3,deposited_volume_m3\n"
              "0,0,0,0,100,0\n10,5,150,12,80,20\n20,9,260,8,30,70\n30,12,300,1,0,100\n");
   write_file(run / "barrier_forces.csv", "time_s,force_N\n0,0\n10,1.2e5\n20,4e4\n30,0\n");
   // A map as debris-runout draws it: a cone with a flow over one flank.

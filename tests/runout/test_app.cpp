@@ -115,7 +115,7 @@ TEST(DebrisRunoutApp, TinyValleyRunsAndBalancesVolume) {
   EXPECT_GT(j["runout_length_along_path_m"].get<double>(), 100.0);
   EXPECT_GT(j["fahrboeschung"]["angle_deg"].get<double>(), 8.5);
   EXPECT_LT(j["fahrboeschung"]["angle_deg"].get<double>(), 24.0);
-  EXPECT_GT(j["max_speed_m_s"].get<double>(), 1.0);
+  EXPECT_GT(j["max_speed_m_per_s"].get<double>(), 1.0);
   // Intensity areas add up to the affected area (every reached cell is medium or strong).
   const auto& it = j["intensity"];
   EXPECT_EQ(it["scheme"], "depth_speed");
@@ -359,7 +359,7 @@ TEST(DebrisRunoutApp, LibraryRunInProcessGivesTheAppsNumbers) {
   EXPECT_EQ(res.steps, j["steps"].get<std::int64_t>());
   EXPECT_EQ(res.path.runout_length, j["runout_length_along_path_m"].get<double>());
   EXPECT_EQ(res.path.fahrboeschung, j["fahrboeschung"]["ratio_H_over_L"].get<double>());
-  EXPECT_EQ(res.max_speed, j["max_speed_m_s"].get<double>());
+  EXPECT_EQ(res.max_speed, j["max_speed_m_per_s"].get<double>());
   EXPECT_EQ(res.volumes.deposited, j["volumes_m3"]["deposited"].get<double>());
   EXPECT_EQ(std::string(geohaz::runout::to_string(res.ended)), j["ended_by"].get<std::string>());
 }
@@ -512,7 +512,7 @@ TEST(DebrisRunoutApp, ProcessesRunEndToEndAndBalanceVolume) {
 // An inflow hydrograph alone (no release): the injected volume is ∫Q dt and the budget closes.
 TEST(DebrisRunoutApp, HydrographInflowDeliversItsVolume) {
   const fs::path dsm = tiny_dsm(), d = work_dir();
-  write_text(d / "hydrograph.csv", "time_s,discharge_m3_s\n0,0\n5,10\n20,0\n");  // 100 m³
+  write_text(d / "hydrograph.csv", "time_s,discharge_m3_per_s\n0,0\n5,10\n20,0\n");  // 100 m³
   const fs::path out = d / "hydrograph_out";
   fs::remove_all(out);
   const auto r = run(dsm.string() + " --d0 2.5 --h0 0.75 --duration 60 --out " + out.string() + " --quiet --threads 1" +

@@ -158,8 +158,8 @@ TEST(RunoutValidation, SeedScenarioFiveKilometreValley) {
       "600 s), H/L = %.3f (%.1f deg), max speed %.1f m/s, wall %.1f s, steps %d\n",
       j["particles_released"].get<int>(), j["volumes_m3"]["seeded"].get<double>(), travel,
       j["simulated_time_s"].get<double>(), j["fahrboeschung"]["ratio_H_over_L"].get<double>(),
-      j["fahrboeschung"]["angle_deg"].get<double>(), j["max_speed_m_s"].get<double>(), j["wall_time_s"].get<double>(),
-      j["steps"].get<int>());
+      j["fahrboeschung"]["angle_deg"].get<double>(), j["max_speed_m_per_s"].get<double>(),
+      j["wall_time_s"].get<double>(), j["steps"].get<int>());
   // "Travels kilometres in ten minutes": within a factor 2 of the lecture's 4.8 km.
   EXPECT_GT(travel, 2400.0);
   EXPECT_LT(travel, 9600.0);
@@ -184,7 +184,7 @@ TEST(RunoutValidation, AlpineTerrainAlr) {
       "speed %.1f m/s, affected %.0f m^2, deposited %.0f m^3, lost %.0f m^3, ended by %s at %.0f s, wall %.1f s\n",
       j["particles_released"].get<int>(), j["volumes_m3"]["seeded"].get<double>(),
       j["runout_length_along_path_m"].get<double>(), j["fahrboeschung"]["ratio_H_over_L"].get<double>(),
-      j["fahrboeschung"]["angle_deg"].get<double>(), j["max_speed_m_s"].get<double>(),
+      j["fahrboeschung"]["angle_deg"].get<double>(), j["max_speed_m_per_s"].get<double>(),
       j["area_affected_m2"].get<double>(), j["volumes_m3"]["deposited"].get<double>(),
       j["volumes_m3"]["lost"].get<double>(), j["ended_by"].get<std::string>().c_str(),
       j["simulated_time_s"].get<double>(), j["wall_time_s"].get<double>());
@@ -348,7 +348,7 @@ TEST(RunoutValidation, AlpineTerrainVoellmyAgainstCom1DFA) {
     const auto j = nlohmann::json::parse(in);
     const ThalwegMetrics m = thalweg_metrics(out / "max_depth.tif");
     const double lost = j["volumes_m3"]["lost"].get<double>() / j["volumes_m3"]["seeded"].get<double>();
-    const double vmax = j["max_speed_m_s"].get<double>();
+    const double vmax = j["max_speed_m_per_s"].get<double>();
     std::printf(
         "VALIDATION alr voellmy d0 = %.1f m: %d particles, run-out along the thalweg %.0f m (com1DFA %.0f), H/L %.3f, "
         "area > 0.1 m %.1f ha (com1DFA %.1f), peak speed %.1f m/s (com1DFA %.1f), lost %.3f %%, ended by %s at %.0f "

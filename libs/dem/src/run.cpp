@@ -223,7 +223,7 @@ json avalanche_summary(const DemSimulation& sim) {
                   {"simulated_time_s", s.time()},
                   {"runout_duration_s", r.duration},
                   {"at_rest", r.at_rest},
-                  {"max_speed_at_end_m_s", r.max_speed_at_end},
+                  {"max_speed_at_end_m_per_s", r.max_speed_at_end},
                   {"moving_mass_fraction_at_end", r.moving_fraction_at_end},
                   {"peak_kinetic_energy_J_per_m", r.peak_kinetic_energy},
                   {"steps", s.step_count()}};

@@ -828,15 +828,24 @@ CalibrationResult run_calibration(CalibrationSetup& s, const fs::path& out, cons
   return r;
 }
 
-void run_calibration_serial(CalibrationSetup& s, const fs::path& out, int threads, bool quiet) {
+void run_calibration_serial(CalibrationSetup& s, const fs::path& out, int threads, bool quiet,
+                            MemberObserver* observer) {
   prepare_calibration_output(s, out);
   const auto wall0 = std::chrono::steady_clock::now();
   const std::unique_ptr<MemberRunner> runner = make_calibration_runner(s);
+  const SearchSettings& q = s.search;
+  const int planned = q.global_members + q.morris_trajectories * (static_cast<int>(s.parameters.size()) + 1) +
+                      q.local_starts * q.local_evaluations;
+  int done = 0;
   const CalibrationResult r = run_calibration(
       s, out,
       [&](const std::vector<int>& batch) {
-        for (int i : batch)
-          if (!member_done(out, i)) runner->run(i, out, 0, threads);
+        for (int i : batch) {
+          if (member_done(out, i)) continue;
+          RunObserver* steps = observer ? observer->member_started(i, done, std::max(planned, done + 1)) : nullptr;
+          const MemberRecord rec = runner->run(i, out, 0, threads, steps);
+          if (observer) observer->member_finished(rec, ++done, std::max(planned, done));
+        }
       },
       quiet);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -224,7 +224,7 @@ void read_processes(ConfigReader& cfg, RunoutCase& c) {
 
   s.hydrograph =
       resolve(cfg, "inflow.hydrograph",
-              cfg.get_string("inflow.hydrograph", "", {"", "inflow hydrograph table: CSV time_s,discharge_m3_s"}));
+              cfg.get_string("inflow.hydrograph", "", {"", "inflow hydrograph table: CSV time_s,discharge_m3_per_s"}));
   s.inflow_points = cfg.get_array("inflow.points", s.inflow_points, Range::closed(-1e8, 1e8),
                                   {"m", "inflow point [x, y] or short line [x1, y1, x2, y2] in the DSM's CRS"});
   s.inflow_azimuth = cfg.get("inflow.azimuth", s.inflow_azimuth, Range::closed_open(-1.0, 360.0),

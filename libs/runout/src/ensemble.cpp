@@ -341,7 +341,7 @@ std::string member_json(const MemberRecord& r, const EnsemblePlan& plan) {
   j["angle_deg"] = r.hl_deg;
   j["volumes_m3"] = {
       {"release", r.release_m3}, {"deposited", r.deposited_m3}, {"mobile", r.mobile_m3}, {"lost", r.lost_m3}};
-  j["max_speed_m_s"] = r.max_speed;
+  j["max_speed_m_per_s"] = r.max_speed;
   j["area_affected_m2"] = r.affected_area_m2;
   j["simulated_time_s"] = r.simulated_time_s;
   j["steps"] = r.steps;
@@ -371,7 +371,8 @@ MemberRecord parse_member_json(const std::string& text) {
   r.deposited_m3 = v.at("deposited").get<double>();
   r.mobile_m3 = v.at("mobile").get<double>();
   r.lost_m3 = v.at("lost").get<double>();
-  r.max_speed = j.at("max_speed_m_s").get<double>();
+  // members/ of a folder written before the key rule (docs/python.md, Migration) still resume
+  r.max_speed = j.at(j.contains("max_speed_m_per_s") ? "max_speed_m_per_s" : "max_speed_m_s").get<double>();
   r.affected_area_m2 = j.at("area_affected_m2").get<double>();
   r.simulated_time_s = j.at("simulated_time_s").get<double>();
   r.steps = j.at("steps").get<std::int64_t>();
@@ -619,12 +620,17 @@ std::vector<int> prepare_output(const EnsembleSetup& s, const fs::path& out) {
   return pending;
 }
 
-void run_ensemble_serial(const EnsembleSetup& s, const fs::path& out, int threads, bool quiet) {
+void run_ensemble_serial(const EnsembleSetup& s, const fs::path& out, int threads, bool quiet,
+                         MemberObserver* observer) {
   const std::vector<int> pending = prepare_output(s, out);
   const auto wall0 = std::chrono::steady_clock::now();
   MemberRunner runner(s);
+  const int planned = static_cast<int>(pending.size());
+  int done = 0;
   for (int i : pending) {
-    const MemberRecord r = runner.run(i, out, 0, threads);
+    RunObserver* steps = observer ? observer->member_started(i, done, planned) : nullptr;
+    const MemberRecord r = runner.run(i, out, 0, threads, steps);
+    if (observer) observer->member_finished(r, ++done, planned);
     if (!quiet)
       std::cerr << "geohaz-ensemble: member " << i << "/" << s.plan.members << (r.ok ? " done" : " FAILED: ")
                 << r.diagnosis << "\n";
@@ -789,6 +795,10 @@ MemberRecord MemberRunner::run(int i, const fs::path& out, int rank, int threads
   } catch (const InputError& e) {
     rec.ok = false;
     rec.diagnosis = std::string("member input rejected: ") + e.what();
+  } catch (...) {  // stopped from outside (an observer's Cancel): no folder for this member
+    std::error_code ec;
+    fs::remove_all(tmp, ec);
+    throw;
   }
   rec.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   rec.cpu_time_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
@@ -940,7 +950,7 @@ void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, 
   for (double t : a.depth_thresholds)
     prob(0, t, "prob_max_depth_gt_" + threshold_name(t) + "m", "probability peak depth > " + threshold_name(t) + " m");
   for (double t : a.speed_thresholds)
-    prob(1, t, "prob_max_speed_gt_" + threshold_name(t) + "m_s",
+    prob(1, t, "prob_max_speed_gt_" + threshold_name(t) + "m_per_s",
          "probability peak speed > " + threshold_name(t) + " m/s");
   for (double t : a.pressure_thresholds)
     prob(2, t, "prob_max_pressure_gt_" + threshold_name(t) + "Pa",
@@ -1088,7 +1098,7 @@ void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, 
                               {"max_relative_error_speed", ratio(kSpeedRange)},
                               {"max_relative_error_pressure", ratio(kPressureRange)},
                               {"depth_range_m", {kDepthRange.lo, kDepthRange.hi}},
-                              {"speed_range_m_s", {kSpeedRange.lo, kSpeedRange.hi}},
+                              {"speed_range_m_per_s", {kSpeedRange.lo, kSpeedRange.hi}},
                               {"pressure_range_pa", {kPressureRange.lo, kPressureRange.hi}}};
   j["aggregation_window_cells"] = static_cast<std::int64_t>(std::max(0, c1 - c0 + 1)) * std::max(0, r1 - r0 + 1);
   j["aggregation_bytes_per_cell"] = agg.bytes_per_cell();

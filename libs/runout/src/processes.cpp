@@ -134,7 +134,7 @@ void read_hydrograph_table(const std::string& file, Hydrograph& q) {
     std::istringstream row(line);
     std::string a, b;
     if (!std::getline(row, a, ',') || !std::getline(row, b, ','))
-      throw InputError("line " + std::to_string(lineno) + ": expected 'time_s,discharge_m3_s'", file);
+      throw InputError("line " + std::to_string(lineno) + ": expected 'time_s,discharge_m3_per_s'", file);
     double t, d;
     try {
       t = std::stod(a);
@@ -154,7 +154,7 @@ void read_hydrograph_table(const std::string& file, Hydrograph& q) {
     q.time.push_back(t);
     q.discharge.push_back(d);
   }
-  if (q.time.size() < 2) throw InputError("the hydrograph needs at least two rows (time_s,discharge_m3_s)", file);
+  if (q.time.size() < 2) throw InputError("the hydrograph needs at least two rows (time_s,discharge_m3_per_s)", file);
   if (!(q.volume() > 0.0)) throw InputError("the hydrograph delivers no volume (all discharges zero)", file);
 }
 

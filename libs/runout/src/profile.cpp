@@ -125,7 +125,7 @@ ThalwegProfile thalweg_profile(const Raster& dsm, const Raster& max_depth, const
 
 void write_profile_csv(const std::filesystem::path& path, const ThalwegProfile& p) {
   AtomicTextFile csv(path);
-  csv << "s_along_path_m,x_m,y_m,terrain_elevation_m,max_depth_m,max_speed_m_s,max_pressure_Pa,"
+  csv << "s_along_path_m,x_m,y_m,terrain_elevation_m,max_depth_m,max_speed_m_per_s,max_pressure_Pa,"
          "alpha_line_elevation_m\n";
   csv.stream() << std::setprecision(10);
   for (const ProfileRow& r : p.rows)

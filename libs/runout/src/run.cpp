@@ -614,7 +614,7 @@ std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int t
   j["kinetic_energy_j"] = {{"at_end", b.kinetic_energy}, {"peak", b.peak_kinetic_energy}};
   j["mobile_at_end"] = {{"volume_m3", b.mobile},
                         {"fraction", res.mobile_fraction()},
-                        {"max_speed_m_s", res.max_speed_at_end},
+                        {"max_speed_m_per_s", res.max_speed_at_end},
                         {"in_deposit_raster", res.ended != RunEnd::Duration}};
   j["release_thickness_direction"] = sim.inputs().from_handoff ? "volumes (hand-off)" : to_string(c.release.direction);
   nlohmann::json warnings = nlohmann::json::array();
@@ -655,7 +655,7 @@ std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int t
       {"drop_height_m", sum.drop_height},   {"reach_m", sum.reach},   {"ratio_H_over_L", sum.fahrboeschung},
       {"angle_deg", sum.fahrboeschung_deg}, {"toe_x_m", sum.toe.x()}, {"toe_y_m", sum.toe.y()}};
   j["centre_of_mass"] = {{"drop_m", sum.com_drop}, {"travel_m", sum.com_travel}, {"angle_deg", sum.com_angle_deg}};
-  j["max_speed_m_s"] = res.max_speed;
+  j["max_speed_m_per_s"] = res.max_speed;
   j["max_pressure_pa"] = res.max_pressure;
   j["area_affected_m2"] = res.affected_area;
   j["volumes_m3"] = {{"release_read", sim.inputs().volume},
@@ -677,7 +677,7 @@ std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int t
     j["intensity"] = {
         {"scheme", to_string(itab.scheme)}, {"area_low_m2", a[1]}, {"area_medium_m2", a[2]}, {"area_strong_m2", a[3]}};
     if (itab.scheme == IntensityScheme::DepthSpeed)
-      j["intensity"].update({{"strong_depth_m", itab.strong_depth}, {"strong_speed_m_s", itab.strong_speed}});
+      j["intensity"].update({{"strong_depth_m", itab.strong_depth}, {"strong_speed_m_per_s", itab.strong_speed}});
     else
       j["intensity"].update(
           {{"medium_pressure_pa", itab.medium_pressure}, {"strong_pressure_pa", itab.strong_pressure}});
@@ -723,7 +723,7 @@ std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int t
     const Hydrograph& q = proc.inflows.front();
     jp["inflow"] = {{"hydrograph", q.source},    {"volume_of_table_m3", q.volume()},
                     {"injected_m3", b.injected}, {"end_time_s", q.end_time()},
-                    {"speed_m_s", q.speed},      {"direction_xy", {q.direction.x(), q.direction.y()}}};
+                    {"speed_m_per_s", q.speed},  {"direction_xy", {q.direction.x(), q.direction.y()}}};
   }
   j["processes"] = jp;
   // Barriers: the figures of each and its line in map coordinates (the maps draw them).
@@ -921,7 +921,7 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
 
   {
     AtomicTextFile csv(out / "series.csv");
-    csv << "time_s,step,particles,front_x_m,front_y_m,front_travel_m,front_drop_m,mean_speed_m_s,max_speed_m_s,"
+    csv << "time_s,step,particles,front_x_m,front_y_m,front_travel_m,front_drop_m,mean_speed_m_per_s,max_speed_m_per_s,"
            "mobile_volume_m3,deposited_volume_m3,lost_volume_m3,balance_error_m3,entrained_volume_m3,injected_volume_"
            "m3\n";
     csv.stream() << std::setprecision(10);

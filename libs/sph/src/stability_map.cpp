@@ -380,7 +380,7 @@ StabilityMapResult run_stability_map(const StabilityMapCase& c, const fs::path& 
   }
   {
     AtomicTextFile csv(out / "series.csv");
-    csv << "time_s,rain_intensity_m_s,rain_depth_m,unstable_cells,unstable_area_m2\n";
+    csv << "time_s,rain_intensity_m_per_s,rain_depth_m,unstable_cells,unstable_area_m2\n";
     csv.stream() << std::setprecision(10);
     for (std::size_t j = 0; j < r.times.size(); ++j)
       csv << r.times[j] << ',' << c.rain.intensity_at(r.times[j]) << ',' << c.rain.depth_until(r.times[j]) << ','
@@ -407,7 +407,7 @@ StabilityMapResult run_stability_map(const StabilityMapCase& c, const fs::path& 
   j["rain"] = {{"steps", c.rain.intensities.size()},
                {"end_s", c.rain.end()},
                {"total_depth_m", c.rain.depth_until(c.rain.end())},
-               {"peak_intensity_m_s", *std::max_element(c.rain.intensities.begin(), c.rain.intensities.end())}};
+               {"peak_intensity_m_per_s", *std::max_element(c.rain.intensities.begin(), c.rain.intensities.end())}};
   j["duration_s"] = c.duration;
   j["time_step_s"] = c.time_step;
   j["fs_min"] = std::isnan(fsmin) ? nlohmann::json(nullptr) : nlohmann::json(fsmin);

@@ -179,8 +179,10 @@ CalibrationResult run_calibration(CalibrationSetup& s, const std::filesystem::pa
 void write_calibration_outputs(const CalibrationSetup& s, const CalibrationResult& r, const std::filesystem::path& out,
                                int ranks, int threads, double wall_time_s, bool quiet);
 
-/// All of it on one rank (the Python module, the app without MPI).
-void run_calibration_serial(CalibrationSetup& s, const std::filesystem::path& out, int threads, bool quiet);
+/// All of it on one rank (the Python module, the app without MPI); `observer` sees each member
+/// (planned: the design, Morris and local members at most).
+void run_calibration_serial(CalibrationSetup& s, const std::filesystem::path& out, int threads, bool quiet,
+                            MemberObserver* observer = nullptr);
 
 /// Morris elementary effects of one parameter: μ* (mean |EE|), μ, σ (1/unit of u).
 struct MorrisEffect {

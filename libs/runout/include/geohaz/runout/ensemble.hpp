@@ -199,8 +199,24 @@ std::string plan_csv(const EnsembleSetup& s);
 /// resolved configs. Returns the members still to run, in index order.
 std::vector<int> prepare_output(const EnsembleSetup& s, const std::filesystem::path& out);
 
+/// Sees the members of a run in one process (run_ensemble_serial, run_calibration_serial): the
+/// Python module's progress callback and Cancel. An exception thrown from it, or from the
+/// RunObserver it hands out, stops the whole run: the member being run leaves no folder, the
+/// finished ones stay (a rerun into the folder resumes), no products are written.
+class MemberObserver {
+ public:
+  virtual ~MemberObserver() = default;
+  /// Before member i; `done` members of this run have finished, about `planned` will run in all
+  /// (for a calibration an upper bound: the local searches may stop early). Returns the observer
+  /// of the member's steps, or null.
+  virtual RunObserver* member_started(int /*i*/, int /*done*/, int /*planned*/) { return nullptr; }
+  /// After member i ran (ok or failed), with its record.
+  virtual void member_finished(const MemberRecord& /*rec*/, int /*done*/, int /*planned*/) {}
+};
+
 /// Run every pending member in this process and aggregate (one rank; the Python module).
-void run_ensemble_serial(const EnsembleSetup& s, const std::filesystem::path& out, int threads, bool quiet);
+void run_ensemble_serial(const EnsembleSetup& s, const std::filesystem::path& out, int threads, bool quiet,
+                         MemberObserver* observer = nullptr);
 
 /// Folder of member i below the output folder.
 std::filesystem::path member_dir(const std::filesystem::path& out, int i);

@@ -62,7 +62,7 @@ std::vector<Vec2> flow_centreline(const Vec2& start, const std::vector<Vec2>& fr
 std::vector<Vec2> arrival_centreline(const Raster& arrival_time, const Raster& max_depth, const Vec2& start, double dt,
                                      double min_spacing);
 
-/// profile.csv: s_along_path_m, x_m, y_m, terrain_elevation_m, max_depth_m, max_speed_m_s,
+/// profile.csv: s_along_path_m, x_m, y_m, terrain_elevation_m, max_depth_m, max_speed_m_per_s,
 /// max_pressure_Pa, alpha_line_elevation_m (α, top and run-out point are in the figure and in
 /// the rows: the α line meets the terrain there).
 void write_profile_csv(const std::filesystem::path& path, const ThalwegProfile& p);

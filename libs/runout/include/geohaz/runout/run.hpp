@@ -62,7 +62,7 @@ struct ProcessSpec {
   std::string erodible;           ///< erodible depth raster (m) or polygons
   std::string erodible_attribute = "depth";  ///< polygon attribute of the erodible depth (m)
   double erodible_depth = 0.0;               ///< uniform polygon depth (m); 0: use the attribute
-  std::string hydrograph;                    ///< inflow table (CSV time_s, discharge_m3_s)
+  std::string hydrograph;                    ///< inflow table (CSV time_s, discharge_m3_per_s)
   std::vector<double> inflow_points;         ///< [x, y] or [x1, y1, x2, y2] (m, DSM CRS)
   double inflow_azimuth = -1.0;              ///< degrees clockwise from north; < 0: down the slope
   double inflow_speed = 5.0;                 ///< surface speed of the inflowing particles (m/s)
