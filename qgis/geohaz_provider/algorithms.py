@@ -1,7 +1,8 @@
-"""The geohaz Processing algorithms. debris_runout and ensemble run in the QGIS process through the
-Python package geohaz (the apps' own library code: same config keys, checks and outputs);
-report runs the geohaz-report app. Progress goes to the Processing feedback; Cancel stops a run at
-its next step (the progress callback raises, and the run ends without writing its maps)."""
+"""The geohaz Processing algorithms. debris_runout, ensemble and calibrate (calibration.py) run in the
+QGIS process through the Python package geohaz (the apps' own library code: same config keys, checks
+and outputs); slope_stability (stability.py) and report run the apps. Progress goes to the
+Processing feedback; Cancel stops a run at its next step (the progress callback raises, and the run
+ends without writing its maps)."""
 import os
 import shutil
 import subprocess
@@ -49,6 +50,24 @@ def _load_maps(folder, names, context, group):
     return loaded
 
 
+def member_progress(feedback):
+    """The progress callback of geohaz.ensemble.run and geohaz.calibrate.run for a Processing
+    feedback: the bar follows members done plus the simulated time of the member running; Cancel
+    raises _Canceled, which stops the run at its next reported step."""
+    def progress(p):
+        if feedback.isCanceled():
+            raise _Canceled()
+        planned = max(1, p.get("members_planned", 1))
+        if p["phase"] == "member_finished":
+            feedback.setProgress(min(100.0, 100.0 * p["members_done"] / planned))
+            if not p["ok"]:
+                feedback.pushWarning(f"member {p['member']} failed (see members.csv)")
+        elif p.get("duration"):
+            frac = min(1.0, p["time"] / p["duration"])
+            feedback.setProgress(min(100.0, 100.0 * (p["members_done"] + frac) / planned))
+    return progress
+
+
 class _Base(QgsProcessingAlgorithm):
     def group(self):
         return "Landslides"
@@ -88,7 +107,7 @@ class DebrisRunoutAlgorithm(_Base):
                                             optional=True))
         P(QgsProcessingParameterRasterLayer("RELEASE_RASTER", "Release thickness raster (m), instead of polygons",
                                             optional=True))
-        P(QgsProcessingParameterNumber("RELEASE_DEPTH", "Release depth of the polygons (m, slope-normal)",
+        P(QgsProcessingParameterNumber("RELEASE_DEPTH", "Release depth of the polygons (m, slope-normal; 0: their attribute thickness)",
                                        QgsProcessingParameterNumber.Double, 1.0, optional=True, minValue=0.0))
         P(QgsProcessingParameterVectorLayer("BARRIERS", "Barriers (lines or polygons)", optional=True))
         P(QgsProcessingParameterVectorLayer("ZONES", "Friction zones (attributes n, icr, mu, xi)",
@@ -181,7 +200,8 @@ class EnsembleAlgorithm(_Base):
     def shortHelpString(self):  # noqa: N802
         return ("An ensemble of debris-runout runs with sampled parameters (geohaz-ensemble, docs/ensemble.md) "
                 "on one process: probability, mean and percentile maps in the output folder, loaded with styles. "
-                "For many members use the MPI app geohaz-ensemble (package geohaz-ensemble).")
+                "Progress follows the members; Cancel keeps the finished members in the folder (running again "
+                "into it resumes them). For many members use the MPI app geohaz-ensemble (package geohaz-ensemble).")
 
     def initAlgorithm(self, config=None):  # noqa: N802
         self.addParameter(QgsProcessingParameterFile("CONFIG", "Ensemble config (TOML)", extension="toml"))
@@ -196,7 +216,12 @@ class EnsembleAlgorithm(_Base):
         out = self.parameterAsString(parameters, "OUTPUT", context)
         overrides = {"ensemble.members": members} if members > 0 else None
         try:
-            r = geohaz.ensemble.run(self.parameterAsFile(parameters, "CONFIG", context), set=overrides, out=out)
+            r = geohaz.ensemble.run(self.parameterAsFile(parameters, "CONFIG", context), set=overrides, out=out,
+                                    progress=member_progress(feedback), progress_every=20)
+        except _Canceled:
+            feedback.reportError("canceled: the finished members stay in the output folder (a rerun resumes "
+                                 "them); no maps written")
+            return {}
         except geohaz.InputError as e:
             raise QgsProcessingException(f"input error: {e}")
         feedback.pushInfo(f"{r['summary'].get('succeeded')} members finished")

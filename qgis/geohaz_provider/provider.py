@@ -1,7 +1,10 @@
-"""The Processing provider `geohaz`: algorithms geohaz:debris_runout, geohaz:ensemble, geohaz:report."""
+"""The Processing provider `geohaz`: algorithms geohaz:debris_runout, geohaz:ensemble, geohaz:calibrate,
+geohaz:slope_stability, geohaz:report."""
 from qgis.core import QgsProcessingProvider
 
 from .algorithms import DebrisRunoutAlgorithm, EnsembleAlgorithm, ReportAlgorithm
+from .calibration import CalibrateAlgorithm
+from .stability import SlopeStabilityAlgorithm
 
 
 class GeohazProvider(QgsProcessingProvider):
@@ -15,5 +18,6 @@ class GeohazProvider(QgsProcessingProvider):
         return "geohaz landslide models"
 
     def loadAlgorithms(self):  # noqa: N802
-        for alg in (DebrisRunoutAlgorithm(), EnsembleAlgorithm(), ReportAlgorithm()):
+        for alg in (DebrisRunoutAlgorithm(), EnsembleAlgorithm(), CalibrateAlgorithm(), SlopeStabilityAlgorithm(),
+                    ReportAlgorithm()):
             self.addAlgorithm(alg)
