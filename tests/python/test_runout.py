@@ -73,7 +73,7 @@ def test_a_run_from_python_matches_the_app_and_writes_the_same_outputs(tmp_path,
     # summary.json may carry more volumes (terms of processes) than the dict; the shared ones agree.
     assert len(s["volumes_m3"]) >= 7
     assert s["volumes_m3"] == {k: a["volumes_m3"][k] for k in s["volumes_m3"]}
-    assert s["max_speed_m_per_s"] == a["max_speed_m_s"] > 1.0
+    assert s["max_speed_m_per_s"] == a["max_speed_m_per_s"] > 1.0
     assert s["ended_by"] == "duration reached" and s["simulated_time_s"] == pytest.approx(20.0, abs=1e-9)
     assert (tmp_path / "py/config.resolved.toml").read_text() == r["resolved_config"]
 
