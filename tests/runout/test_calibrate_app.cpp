@@ -129,6 +129,25 @@ TEST(CalibrateApp, FailedMemberIsRecordedWithItsParametersAndPenalised) {
   int tp = 0;
   for (double v : cmp.data) tp += v == 1.0;
   EXPECT_NEAR(tp * 25.0, j["best"]["misfit"]["tp_m2"].get<double>(), 1e-6);
+#ifdef GEOHAZ_REPORT_EXE
+  // The report page of this folder (issue #31: "all in the report page"): the back-analysis part
+  // with the best member, the failed one counted, the acceptable set, the Morris table, the map
+  // (which passes the page's map check) and the two thalweg profile plots.
+  const auto rep = geohaz::testing::run_command(std::string(GEOHAZ_REPORT_EXE) + " " + out.string());
+  ASSERT_EQ(rep.code, 0) << rep.output;
+  const std::string html = slurp(out / "report.html");
+  EXPECT_NE(html.find("<h2>Back-analysis (geohaz-calibrate)</h2>"), std::string::npos);
+  EXPECT_NE(html.find("<p>Member " + std::to_string(j["best"]["member"].get<int>()) + " ("), std::string::npos);
+  EXPECT_NE(html.find("local; 1 failed)"), std::string::npos);
+  EXPECT_NE(html.find(std::to_string(j["acceptable_members"].get<int>()) + " successful member(s) with J"),
+            std::string::npos);
+  for (const char* part : {"<table class=calibration-acceptable>", "<table class=calibration-morris>",
+                           "src=\"comparison.png\"", "src=\"acceptable.svg\"", "href=\"best.toml\""})
+    EXPECT_NE(html.find(part), std::string::npos) << part;
+  EXPECT_EQ(html.find("class=map-problem"), std::string::npos);
+  EXPECT_TRUE(fs::exists(out / "report_files" / "out_thalweg_width.svg"));
+  EXPECT_TRUE(fs::exists(out / "report_files" / "out_thalweg_deposit.svg"));
+#endif
   fs::remove_all(c.dir);
 }
 
