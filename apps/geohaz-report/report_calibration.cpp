@@ -114,7 +114,8 @@ void best_set(std::ostringstream& o, const json& s, const std::string& page_dir)
       {"false negative area FN (observed only)", value_of(m.at("fn_m2"), "m²")},
       {"observed footprint area", value_of(ob.at("footprint_area_m2"), "m²")},
       {"modelled run-out along the thalweg", value_of(m.at("runout_s_m"), "m")},
-      {"observed run-out along the thalweg", value_of(ob.at("runout_s_m"), "m")},
+      {"observed run-out along the thalweg (from the " + ob.value("runout_from", std::string("footprint")) + ")",
+       value_of(ob.at("runout_s_m"), "m")},
       {"run-out difference (modelled − observed)", value_of(m.at("runout_diff_m"), "m")}};
   if (ob.at("deposit_raster").get<bool>()) mis.push_back({"deposit RMSE", value_of(m.at("depth_rmse_m"), "m")});
   if (ob.at("volume_m3").get<double>() > 0.0) {
