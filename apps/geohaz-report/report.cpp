@@ -3,7 +3,6 @@
 
 #include "report.hpp"
 
-#include <toml++/toml.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -48,29 +47,6 @@ std::string join(const std::vector<std::string>& v, std::size_t from, std::size_
   return s;
 }
 
-std::string escape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '<':
-        o += "&lt;";
-        break;
-      case '>':
-        o += "&gt;";
-        break;
-      case '&':
-        o += "&amp;";
-        break;
-      case '"':
-        o += "&quot;";
-        break;
-      default:
-        o += c;
-    }
-  }
-  return o;
-}
-
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::ostringstream s;
@@ -93,6 +69,29 @@ constexpr UnitName kUnits[] = {
 };
 
 }  // namespace
+
+std::string escape_html(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    switch (c) {
+      case '<':
+        o += "&lt;";
+        break;
+      case '>':
+        o += "&gt;";
+        break;
+      case '&':
+        o += "&amp;";
+        break;
+      case '"':
+        o += "&quot;";
+        break;
+      default:
+        o += c;
+    }
+  }
+  return o;
+}
 
 Quantity quantity_from_name(const std::string& name) {
   const auto tok = split(name, '_');
@@ -292,7 +291,8 @@ std::string svg_plot(const Csv& csv, const std::string& title) {
   s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H << "\" viewBox=\"0 0 " << W
     << ' ' << H << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
     << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-    << "<text x=\"" << W / 2 << "\" y=\"20\" text-anchor=\"middle\" font-size=\"15\">" << escape(title) << "</text>\n";
+    << "<text x=\"" << W / 2 << "\" y=\"20\" text-anchor=\"middle\" font-size=\"15\">" << escape_html(title)
+    << "</text>\n";
   const int pw = W - ml - mr;
   for (std::size_t p = 0; p < panels.size(); ++p) {
     const int y0 = top + static_cast<int>(p) * (ph + gap);  // panel top
@@ -328,9 +328,9 @@ std::string svg_plot(const Csv& csv, const std::string& title) {
         panels[p].cols.size() == 1 ? quantity_from_name(csv.names[panels[p].cols[0]]).label : unit_word(u);
     ytitle += u.empty() ? "" : (ytitle.empty() ? "" : " ") + std::string("(") + u + ")";
     s << "<text transform=\"translate(" << 18 << ',' << y0 + ph / 2 << ") rotate(-90)\" text-anchor=\"middle\">"
-      << escape(ytitle) << "</text>\n";
-    s << "<text x=\"" << ml + pw / 2 << "\" y=\"" << y0 + ph + 32 << "\" text-anchor=\"middle\">" << escape(xq.label)
-      << (xq.unit.empty() ? "" : " (" + xq.unit + ")") << "</text>\n";
+      << escape_html(ytitle) << "</text>\n";
+    s << "<text x=\"" << ml + pw / 2 << "\" y=\"" << y0 + ph + 32 << "\" text-anchor=\"middle\">"
+      << escape_html(xq.label) << (xq.unit.empty() ? "" : " (" + xq.unit + ")") << "</text>\n";
     for (std::size_t c = 0; c < panels[p].cols.size(); ++c) {
       const auto& y = csv.columns[panels[p].cols[c]];
       const char* colour = kLineColours[c % std::size(kLineColours)];
@@ -341,7 +341,7 @@ std::string svg_plot(const Csv& csv, const std::string& title) {
       const int ly = y0 + 12 + static_cast<int>(c) * 16;
       s << "<line x1=\"" << ml + pw + 10 << "\" y1=\"" << ly - 4 << "\" x2=\"" << ml + pw + 30 << "\" y2=\"" << ly - 4
         << "\" stroke=\"" << colour << "\" stroke-width=\"2\"/><text x=\"" << ml + pw + 34 << "\" y=\"" << ly << "\">"
-        << escape(quantity_from_name(csv.names[panels[p].cols[c]]).label) << "</text>\n";
+        << escape_html(quantity_from_name(csv.names[panels[p].cols[c]]).label) << "</text>\n";
     }
     s << "</g>\n";
   }
@@ -600,122 +600,6 @@ Summary summarise(const json& summary) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Input parameters from config.resolved.toml
-
-namespace {
-
-/// A config key in the user's terms. `when` = "key=value" limits it to runs where another key has
-/// that value (the friction law's own coefficients).
-struct ParamLabel {
-  const char* key;  ///< TOML path; "material[]." for each table of the [[material]] array
-  const char* label;
-  const char* unit;
-  const char* when = nullptr;
-};
-
-const ParamLabel kParams[] = {
-    // sph-slope
-    {"model.constitutive", "constitutive model", ""},
-    {"material[].density", "ρ density", "kg/m³"},
-    {"material[].young", "E Young's modulus", "Pa"},
-    {"material[].poisson", "ν Poisson's ratio", ""},
-    {"material[].cohesion", "c cohesion", "Pa"},
-    {"material[].friction", "φ friction angle", "°"},
-    {"material[].dilatancy", "ψ dilatancy angle", "°"},
-    {"section.soil_thickness", "soil cover thickness", "m"},
-    {"earthquake.type", "earthquake", ""},
-    {"earthquake.amplitude", "earthquake amplitude", "m/s²"},
-    {"earthquake.frequency", "earthquake frequency", "Hz"},
-    {"earthquake.duration", "earthquake duration", "s"},
-    // debris-runout
-    {"model.friction", "basal friction law", ""},
-    {"model.density", "ρ flow density", "kg/m³"},
-    {"model.n", "n Manning roughness", "s/m^(1/3)", "model.friction=manning"},
-    {"model.icr", "i_cr critical slope", "", "model.friction=manning"},
-    {"model.m", "m speed exponent of the yield term", "", "model.friction=manning"},
-    {"model.mu", "μ Coulomb friction coefficient", "", "model.friction=voellmy"},
-    {"model.mu", "μ Coulomb friction coefficient", "", "model.friction=coulomb"},
-    {"model.xi", "ξ Voellmy turbulence coefficient", "m/s²", "model.friction=voellmy"},
-    {"release.from", "release from", ""},
-    {"release.file", "release polygons", ""},
-    {"run.duration", "longest simulated time", "s"},
-    // dem-avalanche
-    {"test", "test", ""},
-    {"material.density", "ρ rock density", "kg/m³"},
-    {"material.youngs_modulus", "E contact Young's modulus", "Pa"},
-    {"material.friction", "μ inter-particle friction", ""},
-    {"bond.modulus", "E_b bond modulus", "Pa"},
-    {"bond.tensile_strength", "σ_t bond tensile strength (mean)", "Pa"},
-    {"bond.tensile_strength_std", "σ_t standard deviation", "Pa"},
-    {"bond.shear_strength", "τ_s bond shear strength (mean)", "Pa"},
-    {"bond.shear_strength_std", "τ_s standard deviation", "Pa"},
-    {"joints.friction", "μ_j joint friction", ""},
-    {"biaxial.confining_stresses", "σ3 confining stresses", "Pa"},
-    {"avalanche.runout_time", "simulated time after release", "s"},
-};
-
-std::string toml_value_text(const toml::node& n, const std::string& unit) {
-  if (const auto* v = n.as_floating_point()) return format_quantity(v->get(), unit);
-  if (const auto* v = n.as_integer()) return format_quantity(static_cast<double>(v->get()), unit);
-  if (const auto* v = n.as_boolean()) return v->get() ? "yes" : "no";
-  if (const auto* v = n.as_string()) return v->get().empty() ? "" : v->get();
-  if (const auto* a = n.as_array()) {
-    std::string s;
-    for (const auto& e : *a) s += (s.empty() ? "" : ", ") + toml_value_text(e, unit);
-    return s;
-  }
-  return "";
-}
-
-}  // namespace
-
-std::vector<Row> input_parameters(const fs::path& resolved_config) {
-  std::vector<Row> rows;
-  if (!fs::is_regular_file(resolved_config)) return rows;
-  toml::table t;
-  try {
-    t = toml::parse_file(resolved_config.string());
-  } catch (const toml::parse_error& e) {
-    throw InputError(std::string("config.resolved.toml does not parse: ") + std::string(e.description()),
-                     resolved_config.string());
-  }
-  const auto holds = [&](const char* when) {
-    if (!when) return true;
-    const std::string w = when;
-    const auto eq = w.find('=');
-    const auto n = t.at_path(w.substr(0, eq));
-    return n && n.value<std::string>() == w.substr(eq + 1);
-  };
-  bool materials_done = false;
-  for (const auto& p : kParams) {
-    if (!holds(p.when)) continue;
-    const std::string key = p.key;
-    if (key.rfind("material[].", 0) == 0) {
-      // Each material's parameters together, in the table's order.
-      const auto* arr = t["material"].as_array();
-      if (!arr || materials_done) continue;
-      materials_done = true;
-      for (const auto& m : *arr) {
-        const auto* mt = m.as_table();
-        if (!mt) continue;
-        const std::string name = (*mt)["name"].value_or(std::string("material"));
-        for (const auto& q : kParams) {
-          const std::string qk = q.key;
-          if (qk.rfind("material[].", 0) != 0 || !mt->contains(qk.substr(11))) continue;
-          rows.push_back({qk, name + ": " + q.label, toml_value_text(*mt->get(qk.substr(11)), q.unit)});
-        }
-      }
-      continue;
-    }
-    const auto n = t.at_path(key);
-    if (!n) continue;
-    const std::string v = toml_value_text(*n.node(), p.unit);
-    if (!v.empty()) rows.push_back({key, p.label, v});
-  }
-  return rows;
-}
-
-// ---------------------------------------------------------------------------------------------
 // The page
 
 namespace {
@@ -813,6 +697,7 @@ const char* kStyle =
     ".key{margin-right:1em;white-space:nowrap}.key i{display:inline-block;width:0.9em;height:0.9em;margin-right:0.3em;"
     "vertical-align:middle}#page-check{display:none;background:#fdd;padding:0.5em;border:1px solid #c00}"
     "ul.files{columns:3;font-size:85%}.map-problem{color:#c00;font-weight:bold}"
+    ".bar{display:inline-block;height:0.8em;background:#4a6fa5}"
     // Print (geohaz-report --pdf, or the browser's own print): A4, each run from a new page,
     // figures and tables never cut, pictures as wide as the page allows.
     "@page{size:A4;margin:12mm}@media print{body{margin:0;max-width:none;font-size:10pt}"
@@ -850,9 +735,17 @@ const char* kCheckScript = R"(<script>
 void rows_table(std::ostringstream& o, const std::vector<Row>& rows) {
   o << "<table>\n";
   for (const auto& r : rows)
-    o << "<tr><td title=\"" << escape(r.key) << "\">" << escape(r.label) << "</td><td class=v>" << escape(r.value)
-      << "</td></tr>\n";
+    o << "<tr><td title=\"" << escape_html(r.key) << "\">" << escape_html(r.label) << "</td><td class=v>"
+      << escape_html(r.value) << "</td></tr>\n";
   o << "</table>\n";
+}
+
+/// The start of the names of a run's SVG plots in report_files/ ("1-runout" → "1-runout_").
+std::string svg_prefix(const std::string& run_name) {
+  std::string p = run_name + "_";
+  std::replace(p.begin(), p.end(), '/', '_');
+  while (!p.empty() && p.front() == '.') p.erase(0, 1);  // nothing hidden
+  return p;
 }
 
 /// The name of a run folder given itself: its own folder name (the absolute path's last part).
@@ -878,6 +771,71 @@ void add_to_run_manifest(const fs::path& root, const std::vector<std::string>& f
   std::string text = first + "\n";
   for (const auto& f : listed) text += f + "\n";
   write_text_file(m, text);
+}
+
+/// What the page shows of a run folder, read before anything is written.
+struct Run {
+  fs::path dir;
+  std::string name;
+  Summary summary;
+  std::vector<Row> inputs;
+  std::vector<std::pair<std::string, std::string>> plots;  // SVG file name, SVG text
+  std::vector<fs::path> pngs, files;
+  CalibrationPart calibration;
+};
+
+Run read_run(const fs::path& dir, const fs::path& root) {
+  Run r;
+  r.dir = dir;
+  // A run folder given itself (geohaz-report RUN_DIR) is named after the folder, never ".".
+  r.name = fs::relative(dir, root).generic_string();
+  if (r.name.empty() || r.name == ".") r.name = run_folder_name(root);
+  json sj;
+  try {
+    sj = json::parse(slurp(dir / "summary.json"));
+  } catch (const json::exception& e) {
+    throw InputError(std::string("summary.json does not parse: ") + e.what(), (dir / "summary.json").string());
+  }
+  r.summary = summarise(sj);
+  r.inputs = input_parameters(dir / "config.resolved.toml");
+  r.calibration = calibration_part(dir, sj, fs::relative(dir, root).generic_string(), svg_prefix(r.name));
+  if (r.calibration.present) {  // the part shows the best set, its misfit and the Morris table
+    r.summary.headline = r.calibration.headline;
+    for (auto& t : r.summary.tables) t.folded = true;
+  }
+  std::vector<fs::path> csvs;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (!e.is_regular_file()) continue;
+    const std::string fname = e.path().filename().string();
+    if (fname == "report.html" || fname == "report.pdf" || fname == kOutputManifest) continue;  // ours
+    const auto ext = e.path().extension();
+    const auto& shown = r.calibration.shown;
+    if (std::find(shown.begin(), shown.end(), fname) != shown.end()) {
+      r.files.push_back(e.path());
+      continue;
+    }
+    if (ext == ".png")
+      r.pngs.push_back(e.path());
+    else
+      r.files.push_back(e.path());
+    if (ext == ".csv") csvs.push_back(e.path());
+  }
+  const auto by_name = [](const fs::path& a, const fs::path& b) {
+    return natural_less(a.filename().string(), b.filename().string());
+  };
+  std::sort(r.files.begin(), r.files.end(), by_name);
+  std::sort(csvs.begin(), csvs.end(), by_name);
+  std::sort(r.pngs.begin(), r.pngs.end(), [&](const fs::path& a, const fs::path& b) {
+    const int ra = caption_rank(a.stem().string()), rb = caption_rank(b.stem().string());
+    return ra != rb ? ra < rb : by_name(a, b);
+  });
+  for (const auto& c : csvs) {
+    const Csv csv = read_csv(c);
+    if (!is_plottable(csv)) continue;
+    r.plots.emplace_back(svg_prefix(r.name) + c.stem().string() + ".svg",
+                         svg_plot(csv, plot_title(c.stem().string()) + " (" + c.filename().string() + ")"));
+  }
+  return r;
 }
 
 }  // namespace
@@ -937,58 +895,8 @@ fs::path write_report(const fs::path& root, const std::string& title, const fs::
   if (runs.empty()) throw InputError("no run folder with a summary.json found", root.string());
 
   // Read everything before writing anything.
-  struct Run {
-    fs::path dir;
-    std::string name;
-    Summary summary;
-    std::vector<Row> inputs;
-    std::vector<std::pair<std::string, std::string>> plots;  // SVG file name, SVG text
-    std::vector<fs::path> pngs, files;
-  };
   std::vector<Run> all;
-  for (const auto& dir : runs) {
-    Run r;
-    r.dir = dir;
-    // A run folder given itself (geohaz-report RUN_DIR) is named after the folder, never ".".
-    r.name = fs::relative(dir, root).generic_string();
-    if (r.name.empty() || r.name == ".") r.name = run_folder_name(root);
-    try {
-      r.summary = summarise(json::parse(slurp(dir / "summary.json")));
-    } catch (const json::exception& e) {
-      throw InputError(std::string("summary.json does not parse: ") + e.what(), (dir / "summary.json").string());
-    }
-    r.inputs = input_parameters(dir / "config.resolved.toml");
-    std::vector<fs::path> csvs;
-    for (const auto& e : fs::directory_iterator(dir)) {
-      if (!e.is_regular_file()) continue;
-      const std::string fname = e.path().filename().string();
-      if (fname == "report.html" || fname == "report.pdf" || fname == kOutputManifest) continue;  // ours
-      const auto ext = e.path().extension();
-      if (ext == ".png")
-        r.pngs.push_back(e.path());
-      else
-        r.files.push_back(e.path());
-      if (ext == ".csv") csvs.push_back(e.path());
-    }
-    const auto by_name = [](const fs::path& a, const fs::path& b) {
-      return natural_less(a.filename().string(), b.filename().string());
-    };
-    std::sort(r.files.begin(), r.files.end(), by_name);
-    std::sort(csvs.begin(), csvs.end(), by_name);
-    std::sort(r.pngs.begin(), r.pngs.end(), [&](const fs::path& a, const fs::path& b) {
-      const int ra = caption_rank(a.stem().string()), rb = caption_rank(b.stem().string());
-      return ra != rb ? ra < rb : by_name(a, b);
-    });
-    for (const auto& c : csvs) {
-      const Csv csv = read_csv(c);
-      if (!is_plottable(csv)) continue;
-      std::string svg_name = r.name + "_" + c.stem().string() + ".svg";
-      std::replace(svg_name.begin(), svg_name.end(), '/', '_');
-      while (!svg_name.empty() && svg_name.front() == '.') svg_name.erase(0, 1);  // nothing hidden
-      r.plots.emplace_back(svg_name, svg_plot(csv, plot_title(c.stem().string()) + " (" + c.filename().string() + ")"));
-    }
-    all.push_back(std::move(r));
-  }
+  for (const auto& dir : runs) all.push_back(read_run(dir, root));
 
   const fs::path files_dir = root / "report_files";
   fs::create_directories(files_dir);
@@ -996,12 +904,12 @@ fs::path write_report(const fs::path& root, const std::string& title, const fs::
   head << "<h2>Overview</h2>\n<table><tr><th>run</th><th>quantity</th><th>value</th></tr>\n";
   for (const auto& r : all) {
     for (const auto& row : r.summary.headline)
-      head << "<tr><td><a href=\"#" << escape(r.name) << "\">" << escape(r.name) << "</a></td><td>" << escape(row.label)
-           << "</td><td class=v>" << escape(row.value) << "</td></tr>\n";
-    body << "<section id=\"" << escape(r.name) << "\"><h2>" << escape(r.name) << "</h2>\n<div class=row>\n";
+      head << "<tr><td><a href=\"#" << escape_html(r.name) << "\">" << escape_html(r.name) << "</a></td><td>"
+           << escape_html(row.label) << "</td><td class=v>" << escape_html(row.value) << "</td></tr>\n";
+    body << "<section id=\"" << escape_html(r.name) << "\"><h2>" << escape_html(r.name) << "</h2>\n<div class=row>\n";
     for (const auto& g : r.summary.groups) {
       if (g.title == std::string(kGroupTitles[kOther])) continue;
-      body << "<div><h3>" << escape(g.title) << "</h3>\n";
+      body << "<div><h3>" << escape_html(g.title) << "</h3>\n";
       rows_table(body, g.rows);
       body << "</div>\n";
     }
@@ -1010,14 +918,14 @@ fs::path write_report(const fs::path& root, const std::string& title, const fs::
       rows_table(body, r.inputs);
       body << "</div>\n";
     }
-    body << "</div>\n";
+    body << "</div>\n" << r.calibration.html;
     const auto sub_table = [&](const SubTable& t) {
-      body << "<h3>" << escape(t.title) << "</h3>\n<table><tr>";
-      for (const auto& h : t.headers) body << "<th>" << escape(h) << "</th>";
+      body << "<h3>" << escape_html(t.title) << "</h3>\n<table><tr>";
+      for (const auto& h : t.headers) body << "<th>" << escape_html(h) << "</th>";
       body << "</tr>\n";
       for (const auto& row : t.cells) {
         body << "<tr>";
-        for (const auto& c : row) body << "<td class=v>" << escape(c) << "</td>";
+        for (const auto& c : row) body << "<td class=v>" << escape_html(c) << "</td>";
         body << "</tr>\n";
       }
       body << "</table>\n";
@@ -1028,21 +936,23 @@ fs::path write_report(const fs::path& root, const std::string& title, const fs::
       const std::string stem = p.stem().string();
       const int rank = caption_rank(stem);
       std::string caption = rank < static_cast<int>(std::size(kCaptions)) ? kCaptions[rank].text : "";
-      body << "<figure><img alt=\"" << escape(stem) << "\" src=\"" << escape(fs::relative(p, root).generic_string())
-           << "\"><figcaption><b>" << escape(p.filename().string()) << "</b> " << escape(caption);
+      body << "<figure><img alt=\"" << escape_html(stem) << "\" src=\""
+           << escape_html(fs::relative(p, root).generic_string()) << "\"><figcaption><b>"
+           << escape_html(p.filename().string()) << "</b> " << escape_html(caption);
       if (stem.rfind("cracks_", 0) == 0) body << "<br>" << kCrackLegend;
       // A map drawn by write_quicklook_png must carry its legend, coordinate ticks and scale bar
       // (check_map_png probes the pixels where its recorded layout puts them).
       const auto problems = check_map_png(p);
       if (problems.empty() || problems.front().rfind("records no map layout", 0) != 0)
-        for (const auto& m : problems) body << "<br><span class=map-problem>map check: " << escape(m) << "</span>";
+        for (const auto& m : problems) body << "<br><span class=map-problem>map check: " << escape_html(m) << "</span>";
       body << "</figcaption></figure>\n";
     }
     for (const auto& [name, svg] : r.plots)
-      body << "<figure><img alt=\"" << escape(name) << "\" src=\"report_files/" << escape(name) << "\"></figure>\n";
+      body << "<figure><img alt=\"" << escape_html(name) << "\" src=\"report_files/" << escape_html(name)
+           << "\"></figure>\n";
     for (const auto& g : r.summary.groups)
       if (g.title == std::string(kGroupTitles[kOther])) {
-        body << "<details><summary>" << escape(g.title) << "</summary>\n";
+        body << "<details><summary>" << escape_html(g.title) << "</summary>\n";
         rows_table(body, g.rows);
         for (const auto& t : r.summary.tables)
           if (t.folded) sub_table(t);
@@ -1050,18 +960,20 @@ fs::path write_report(const fs::path& root, const std::string& title, const fs::
       }
     body << "<details><summary>Files</summary><ul class=files>\n";
     for (const auto& f : r.files)
-      body << "<li><a href=\"" << escape(fs::relative(f, root).generic_string()) << "\">"
-           << escape(f.filename().string()) << "</a></li>\n";
+      body << "<li><a href=\"" << escape_html(fs::relative(f, root).generic_string()) << "\">"
+           << escape_html(f.filename().string()) << "</a></li>\n";
     body << "</ul></details>\n</section>\n";
   }
   head << "</table>\n";
 
-  for (const auto& r : all)
+  for (const auto& r : all) {
     for (const auto& [name, svg] : r.plots) write_text_file(files_dir / name, svg);
+    for (const auto& [name, svg] : r.calibration.plots) write_text_file(files_dir / name, svg);
+  }
   std::ostringstream html;
-  html << "<!DOCTYPE html>\n<html lang=en><head><meta charset=utf-8><title>" << escape(title) << "</title>\n<style>"
-       << kStyle << "</style>\n"
-       << kCheckScript << "</head><body>\n<div id=page-check></div>\n<h1>" << escape(title)
+  html << "<!DOCTYPE html>\n<html lang=en><head><meta charset=utf-8><title>" << escape_html(title)
+       << "</title>\n<style>" << kStyle << "</style>\n"
+       << kCheckScript << "</head><body>\n<div id=page-check></div>\n<h1>" << escape_html(title)
        << "</h1>\n<p>Generated by geohaz " << GEOHAZ_VERSION
        << ". The maps are quick-looks of the GeoTIFFs beside them (open those in QGIS, with the .qml styles); "
           "ParaView opens the <code>.xmf</code> files. Hover a label to see its summary.json key.</p>\n"
@@ -1069,8 +981,10 @@ fs::path write_report(const fs::path& root, const std::string& title, const fs::
   const fs::path out = root / "report.html";
   write_text_file(out, html.str());
   std::vector<std::string> written{"report.html"};
-  for (const auto& r : all)
+  for (const auto& r : all) {
     for (const auto& p : r.plots) written.push_back("report_files/" + p.first);
+    for (const auto& p : r.calibration.plots) written.push_back("report_files/" + p.first);
+  }
   if (!pdf.empty()) {
     print_pdf(out, pdf);
     written.push_back(fs::relative(pdf, root).generic_string());

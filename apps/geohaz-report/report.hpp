@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace geohaz::report {
@@ -79,6 +80,31 @@ Summary summarise(const nlohmann::json& summary);
 /// strengths …) from its config.resolved.toml: rows "symbol — meaning", value with unit. Only the
 /// keys of the parameter table are shown (the whole file is linked). Empty when there is no file.
 std::vector<Row> input_parameters(const std::filesystem::path& resolved_config);
+
+/// The text with <, >, & and " escaped for HTML.
+std::string escape_html(const std::string& s);
+
+/// A debris-runout config key in the user's terms, from the input parameter table ("model.n" →
+/// {"n Manning roughness", "s/m^(1/3)"}); {key, ""} when the table does not name it.
+std::pair<std::string, std::string> parameter_label(const std::string& key);
+
+/// The back-analysis of a geohaz-calibrate output folder (docs/calibration.md) as a part of the
+/// page: the best set (values, search bounds, acceptable ranges, link to best.toml) and its misfit;
+/// the acceptable set as a table and its score/scatter plot (acceptable.svg); the Morris ranking;
+/// the comparison map (true positive, false positive, false negative over the hillshade) and the
+/// thalweg profile, observed against modelled width and deposit, as SVG plots.
+struct CalibrationPart {
+  bool present = false;                                    ///< whether the run folder holds a calibration
+  std::vector<Row> headline;                               ///< best score, T, and the best value of each parameter
+  std::string html;                                        ///< the part (img and link paths relative to the page)
+  std::vector<std::pair<std::string, std::string>> plots;  ///< SVG file name (in report_files/), SVG text
+  std::vector<std::string> shown;  ///< files of the run folder the part shows (not repeated elsewhere)
+};
+/// The part of `run_dir` (whose summary.json is `summary`; empty unless its model is
+/// geohaz-calibrate). `page_dir` is run_dir relative to the page, `svg_prefix` names its plots.
+/// InputError when a table the summary lists does not read.
+CalibrationPart calibration_part(const std::filesystem::path& run_dir, const nlohmann::json& summary,
+                                 const std::string& page_dir, const std::string& svg_prefix);
 
 /// Write RESULTS/report.html and RESULTS/report_files/*.svg from every run folder (RESULTS itself
 /// or a sub-folder, up to two levels deep, holding a summary.json); with `pdf` not empty, print

@@ -1,12 +1,15 @@
 // geohaz-report's pieces (apps/geohaz-report/report.hpp, docs/report.md): names and units read
 // from keys and columns, numbers formatted with units, SVG plots whose points sit where the axes
-// say, the grouping of summary.json (unknown keys kept), the input parameters in the user's terms.
+// say, the grouping of summary.json (unknown keys kept), the input parameters in the user's terms,
+// the back-analysis part of a geohaz-calibrate folder.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include "calibration_results.hpp"
+#include "geohaz/core/errors.hpp"
 #include "report.hpp"
 
 namespace fs = std::filesystem;
@@ -158,5 +161,76 @@ TEST(ReportInputs, ParametersInTheUsersTermsForTheChosenLawOnly) {
   EXPECT_TRUE(c);
   EXPECT_TRUE(phi);
   EXPECT_TRUE(input_parameters(d / "absent.toml").empty());
+  fs::remove_all(d);
+}
+
+namespace {
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
+  return n;
+}
+
+/// The text of the first <table class=NAME> … </table>.
+std::string table_of(const std::string& html, const std::string& cls) {
+  const auto a = html.find("<table class=" + cls + ">");
+  if (a == std::string::npos) return "";
+  return html.substr(a, html.find("</table>", a) - a);
+}
+
+}  // namespace
+
+TEST(ReportCalibration, BestSetAcceptableSetMorrisMapAndProfileFromACalibrationFolder) {
+  const fs::path d = temp_dir("calibration");
+  calibration_results::make(d / "cal");
+  const nlohmann::json sj = nlohmann::json::parse(std::ifstream(d / "cal" / "summary.json"));
+  const CalibrationPart p = calibration_part(d / "cal", sj, "cal", "cal_");
+  ASSERT_TRUE(p.present);
+  // The overview: the best score and T, and each parameter's best value in the user's terms.
+  ASSERT_EQ(p.headline.size(), 4u);
+  EXPECT_EQ(p.headline[0].value, "0.1514");
+  EXPECT_EQ(p.headline[1].value, "0.9931");
+  EXPECT_EQ(p.headline[2].label, "calibration: best n Manning roughness");
+  EXPECT_EQ(p.headline[2].value, "0.0517 s/m^(1/3)");
+  // The best set: values, search boxes, acceptable ranges; the config ready to run.
+  const std::string best = table_of(p.html, "calibration-best");
+  EXPECT_NE(best.find("<td class=v>model.icr</td><td class=v>0.1707</td>"), std::string::npos) << best;
+  EXPECT_NE(best.find("0.03 s/m^(1/3) – 0.12 s/m^(1/3) (log)"), std::string::npos) << best;
+  EXPECT_NE(best.find("0.1689 – 0.1726"), std::string::npos) << best;
+  EXPECT_NE(p.html.find("href=\"cal/best.toml\""), std::string::npos);
+  EXPECT_NE(table_of(p.html, "calibration-misfit").find("deposit RMSE"), std::string::npos);
+  EXPECT_EQ(table_of(p.html, "calibration-misfit").find("observed deposit volume"), std::string::npos);  // none
+  // The acceptable set: the best 20 of 25 rows, best first, and where the rest are.
+  const std::string acc = table_of(p.html, "calibration-acceptable");
+  EXPECT_EQ(count(acc, "<tr>"), 1u + 20u);
+  EXPECT_LT(acc.find("<td>37</td>"), acc.find("<td>38</td>"));
+  EXPECT_EQ(acc.find("<td>57</td>"), std::string::npos);  // the 21st
+  EXPECT_NE(p.html.find("25 successful member(s) with J ≤"), std::string::npos);
+  EXPECT_NE(p.html.find("the best 20 shown"), std::string::npos);
+  // Morris: ranked by μ*, bars proportional to μ* (120 px for the largest).
+  const std::string morris = table_of(p.html, "calibration-morris");
+  EXPECT_LT(morris.find("i_cr critical slope"), morris.find("n Manning roughness"));
+  EXPECT_NE(morris.find("width:120px"), std::string::npos);
+  EXPECT_NE(morris.find("width:6px"), std::string::npos);  // 120 × 0.17 / 3.66 = 5.6
+  // The comparison map in three colours, the score plot, the thalweg profiles.
+  EXPECT_NE(p.html.find("src=\"cal/comparison.png\""), std::string::npos);
+  EXPECT_NE(p.html.find("src=\"cal/acceptable.svg\""), std::string::npos);
+  for (const char* colour : {"#2ca02c", "#d62728", "#1f77b4"}) EXPECT_NE(p.html.find(colour), std::string::npos);
+  EXPECT_EQ(p.html.find("map-problem"), std::string::npos);  // legend, ticks, scale bar present
+  ASSERT_EQ(p.plots.size(), 2u);
+  EXPECT_EQ(p.plots[0].first, "cal_thalweg_width.svg");
+  EXPECT_EQ(p.plots[1].first, "cal_thalweg_deposit.svg");
+  for (const char* label : {"observed width", "modelled width"})
+    EXPECT_NE(p.plots[0].second.find(label), std::string::npos);
+  for (const char* label : {"observed max deposit", "modelled max deposit"})
+    EXPECT_NE(p.plots[1].second.find(label), std::string::npos);
+  EXPECT_NE(p.html.find("src=\"report_files/cal_thalweg_width.svg\""), std::string::npos);
+  EXPECT_EQ(p.shown.size(), 3u);
+  // Not a calibration: no part. A calibration summary without its best set: InputError.
+  EXPECT_FALSE(calibration_part(d / "cal", nlohmann::json{{"model", "debris-runout"}}, "cal", "cal_").present);
+  nlohmann::json broken = sj;
+  broken.erase("best");
+  EXPECT_THROW(calibration_part(d / "cal", broken, "cal", "cal_"), geohaz::InputError);
   fs::remove_all(d);
 }

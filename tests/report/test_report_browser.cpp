@@ -5,6 +5,7 @@
 // attributes); --dump-dom prints the DOM after load, so the test reads the marks there. Chromium's
 // own log (--enable-logging=stderr) must hold no console message. A screenshot is taken and must
 // show the page. As a control, one picture is then deleted and the page must report it.
+// A geohaz-calibrate folder's back-analysis part is checked the same way.
 // Skipped (with a message) only when no chromium is installed; scripts/setup installs it.
 #include <gtest/gtest.h>
 
@@ -15,6 +16,7 @@
 #include <memory>
 #include <string>
 
+#include "calibration_results.hpp"
 #include "geohaz/core/app.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
@@ -246,6 +248,65 @@ TEST(ReportInBrowser, EveryImageDecodesWithoutErrorsAndTheScreenshotShowsThePage
   EXPECT_GE(page_mark(broken.output, "data-errors"), 1);
   EXPECT_NE(broken.output.find("cracks_sigma3_10MPa.png"), std::string::npos);
 
+  std::error_code ec;
+  fs::remove_all(root, ec);
+}
+
+// Issue #31: a geohaz-calibrate folder in the page — the best set, the acceptable-set table and
+// score plot, the Morris ranking, the comparison map and the observed-against-modelled thalweg
+// profile, all in the run's section; every picture decodes in Chromium, no error, no map problem.
+TEST(ReportInBrowser, CalibrationShowsBestSetAcceptableSetMorrisMapAndProfile) {
+  const fs::path root = fs::temp_directory_path() /
+                        ("geohaz_report_cal_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+  fs::remove_all(root);
+  const fs::path results = root / "results";
+  calibration_results::make(results / "calibrate-alr");
+  const auto gen = run_command(std::string("'") + GEOHAZ_REPORT_EXE + "' '" + results.string() + "'");
+  ASSERT_EQ(gen.code, 0) << gen.output;
+  const std::string html = slurp(results / "report.html");
+  const auto section = html.find("<section id=\"calibrate-alr\">");
+  ASSERT_NE(section, std::string::npos);
+  // In reading order inside the run's section: best set, misfit, acceptable set, Morris, the score
+  // plot, the map, the profile plots.
+  std::size_t at = section;
+  for (const char* part :
+       {"<h2>Back-analysis (geohaz-calibrate)</h2>", "<table class=calibration-best>",
+        "<table class=calibration-misfit>", "<table class=calibration-acceptable>", "<table class=calibration-morris>",
+        "src=\"calibrate-alr/acceptable.svg\"", "src=\"calibrate-alr/comparison.png\"",
+        "src=\"report_files/calibrate-alr_thalweg_width.svg\"",
+        "src=\"report_files/calibrate-alr_thalweg_deposit.svg\"", "</section>"}) {
+    const auto next = html.find(part, at);
+    EXPECT_NE(next, std::string::npos) << part;
+    if (next != std::string::npos) at = next;
+  }
+  // The overview carries the best set; nothing is shown twice (the map and the profile CSV are
+  // the part's, not repeated by the generic pictures and plots).
+  EXPECT_NE(html.find("calibration: best i_cr critical slope</td><td class=v>0.1707"), std::string::npos);
+  std::size_t images = 0;
+  for (auto p = html.find("<img"); p != std::string::npos; p = html.find("<img", p + 1)) ++images;
+  EXPECT_EQ(images, 4u);
+  EXPECT_FALSE(fs::exists(results / "report_files" / "calibrate-alr_thalweg_profile.svg"));
+  EXPECT_TRUE(fs::exists(results / "report_files" / "calibrate-alr_thalweg_width.svg"));
+
+  const std::string chromium = find_chromium();
+  if (chromium.empty()) GTEST_SKIP() << "chromium is not installed (scripts/setup installs the Debian package)";
+  const auto dom = run_command(
+      "DBUS_SESSION_BUS_ADDRESS=disabled: '" + chromium + "' --headless --no-sandbox --disable-gpu --user-data-dir='" +
+      (root / "profile").string() + "' --virtual-time-budget=10000 --enable-logging=stderr --v=0 --dump-dom 'file://" +
+      (results / "report.html").string() + "'");
+  ASSERT_EQ(dom.code, 0) << dom.output;
+  EXPECT_EQ(page_mark(dom.output, "data-images"), static_cast<int>(images)) << dom.output;
+  EXPECT_EQ(page_mark(dom.output, "data-decoded"), static_cast<int>(images)) << dom.output;
+  EXPECT_EQ(page_mark(dom.output, "data-errors"), 0) << dom.output;
+  EXPECT_EQ(page_mark(dom.output, "data-map-problems"), 0) << dom.output;
+  EXPECT_EQ(dom.output.find(":CONSOLE"), std::string::npos) << dom.output;
+  // Control: the score plot gone, the page says so.
+  fs::remove(results / "calibrate-alr" / "acceptable.svg");
+  const auto broken =
+      run_command("DBUS_SESSION_BUS_ADDRESS=disabled: '" + chromium +
+                  "' --headless --no-sandbox --disable-gpu --user-data-dir='" + (root / "profile").string() +
+                  "' --virtual-time-budget=10000 --dump-dom 'file://" + (results / "report.html").string() + "'");
+  EXPECT_EQ(page_mark(broken.output, "data-decoded"), static_cast<int>(images) - 1) << broken.output;
   std::error_code ec;
   fs::remove_all(root, ec);
 }

@@ -243,6 +243,61 @@ TEST(CalibrationIdentifiability, FootprintErodedOrDilatedByOneCellShiftsTheFitBy
   fs::remove_all(c.dir);
 }
 
+TEST(Calibration, ObservedRunoutFromTheFootprintAPointOrALine) {
+  // The observed run-out s_obs: by default the footprint's farthest cell along the thalweg; a
+  // run-out point: its own coordinate; a run-out line (e.g. the mapped deposit front): its vertex
+  // farthest along the thalweg, so a line between two thalweg vertices, either way round, gives
+  // exactly the point at the farther one. Point and line together, or a line off the DSM: exit 2.
+  const auto c = calibration_case::make(work_dir("runout_line"), kManningModel, {});
+  const std::string params = "[[calibration.parameter]]\nkey = \"model.n\"\nmin = 0.03\nmax = 0.12\n";
+  const auto read = [&](const std::string& observation) {
+    ConfigReader cfg = ConfigReader::from_string(calibration_case::config(c, params) + observation,
+                                                 (c.dir / "calibrate.toml").string());
+    return read_calibration(cfg).observation;
+  };
+  const Observation by_footprint = read("");
+  EXPECT_EQ(by_footprint.runout_from, "footprint");
+  double farthest = 0.0;
+  for (std::size_t k = 0; k < by_footprint.s.size(); ++k)
+    if (by_footprint.footprint[k]) farthest = std::max(farthest, by_footprint.s[k]);
+  EXPECT_EQ(by_footprint.runout_s, farthest);
+  const Vec2 near = by_footprint.thalweg.at(20), far = by_footprint.thalweg.at(30);
+  std::ostringstream point;
+  point << std::setprecision(17) << "runout_point = [" << far.x() << ", " << far.y() << "]\n";
+  const Observation by_point = read(point.str());
+  EXPECT_EQ(by_point.runout_from, "runout_point");
+  EXPECT_NEAR(by_point.runout_s, along_thalweg(by_point.thalweg, far), 1e-9);
+  const auto line_file = [&](const std::string& name, const Vec2& a, const Vec2& b) {
+    std::ofstream f(c.dir / name);
+    f << std::setprecision(17)
+      << "{\"type\": \"FeatureCollection\", \"crs\": {\"type\": \"name\", \"properties\": {\"name\": "
+         "\"urn:ogc:def:crs:EPSG::32654\"}}, \"features\": [{\"type\": \"Feature\", \"properties\": {}, "
+         "\"geometry\": {\"type\": \"LineString\", \"coordinates\": [["
+      << a.x() << ", " << a.y() << "], [" << b.x() << ", " << b.y() << "]]}}]}\n";
+    return "runout_line = \"" + (c.dir / name).string() + "\"\n";
+  };
+  for (const auto& [a, b] : {std::pair{near, far}, std::pair{far, near}}) {
+    const Observation by_line = read(line_file("front.geojson", a, b));
+    EXPECT_EQ(by_line.runout_from, "runout_line");
+    EXPECT_NEAR(by_line.runout_s, by_point.runout_s, 1e-9);
+  }
+  EXPECT_LT(by_point.runout_s, by_footprint.runout_s);  // the check has teeth: not the default
+  const std::string both = point.str() + line_file("front.geojson", near, far);
+  try {
+    read(both);
+    ADD_FAILURE() << "point and line accepted together";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("observation.runout_line"), std::string::npos) << e.what();
+  }
+  try {
+    read(line_file("off.geojson", near, Vec2(near.x() + 1e5, near.y())));
+    ADD_FAILURE() << "a line off the DSM accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("leaves the DSM"), std::string::npos) << e.what();
+  }
+  fs::remove_all(c.dir);
+}
+
 TEST(Calibration, ModelledVolumeIsTheDepositIntegralSoMassConservationZeroesTheVolumeTerm) {
   // One member at the truth's parameters (bounds 1e-10 wide) against the observed volume = the
   // integral of the event's deposit raster: the flow stops by the kinetic-energy criterion, which

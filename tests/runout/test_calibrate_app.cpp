@@ -6,38 +6,26 @@
 //  - the best set is a debris-runout config that reads back with the best values;
 //  - bad input (bounds reversed, unknown key, observation outside the DSM, on another grid or CRS):
 //    exit 2 naming the key, nothing written.
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
-#include <thread>
 
 #include "calibration_case.hpp"
 #include "geohaz/core/config.hpp"
 #include "geohaz/core/raster.hpp"
 #include "geohaz/runout/run.hpp"
+#include "member_app_support.hpp"
 #include "run_command.hpp"
 
 namespace fs = std::filesystem;
+using member_app::slurp;
+using member_app::summary;
 
 namespace {
-
-fs::path work_dir(const std::string& name) {
-  const fs::path d = fs::path(GEOHAZ_BINARY_DIR) / "tests" / "runout" / "calibrate_app_work" /
-                     (name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
 
 const char* const kModel = "friction = \"manning\"\nn = 0.06\nicr = 0.15\nd0 = 5.0\nh0 = 0.5\ndensity = 1800.0";
 const char* const kParameters =
@@ -48,41 +36,26 @@ const char* const kSearch =
     "\"bobyqa\"\n";
 
 calibration_case::Case make_case(const std::string& name, const std::string& extra = "") {
-  auto c = calibration_case::make(work_dir(name), kModel, {"model.n=0.06", "model.icr=0.15"});
+  auto c = calibration_case::make(member_app::work_dir("calibrate_app_work", name), kModel,
+                                  {"model.n=0.06", "model.icr=0.15"});
   std::ofstream(c.dir / "cal.toml") << calibration_case::config(c, kParameters, std::string(kSearch) + extra);
   return c;
 }
 
 std::string app(const std::string& args) {
-  return std::string(GEOHAZ_CALIBRATE_EXE) + " " + args;
-}
-
-std::string mpirun(int np, const std::string& args) {
-  std::string cmd = std::string(GEOHAZ_MPIEXEC) + " --oversubscribe -np " + std::to_string(np) + " ";
-  if (::geteuid() == 0) cmd += "--allow-run-as-root ";
-  return cmd + app(args);
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-nlohmann::json summary(const fs::path& out) {
-  return nlohmann::json::parse(slurp(out / "summary.json"));
+  return member_app::command(GEOHAZ_CALIBRATE_EXE, args);
 }
 
 }  // namespace
 
 TEST(CalibrateApp, OneAndTwoRanksGiveTheSameMembersAndBestSet) {
-  if (std::string(GEOHAZ_MPIEXEC).empty()) GTEST_SKIP() << "built without MPI";
+  if (!member_app::have_mpi()) GTEST_SKIP() << "built without MPI";
   const auto c = make_case("ranks");
   const std::string args = (c.dir / "cal.toml").string() + " --threads 1 --quiet --out ";
   const auto r1 = geohaz::testing::run_command(app(args + (c.dir / "one").string()));
   ASSERT_EQ(r1.code, 0) << r1.output;
-  const auto r2 = geohaz::testing::run_command(mpirun(2, args + (c.dir / "two").string()));
+  const auto r2 =
+      geohaz::testing::run_command(member_app::mpirun(GEOHAZ_CALIBRATE_EXE, 2, args + (c.dir / "two").string()));
   ASSERT_EQ(r2.code, 0) << r2.output;
   // members.csv holds every member's values, score and misfit terms at full precision.
   EXPECT_EQ(slurp(c.dir / "one" / "members.csv"), slurp(c.dir / "two" / "members.csv"));
@@ -103,16 +76,6 @@ TEST(CalibrateApp, KilledAndResumedRunGivesTheUninterruptedResultWithoutRerunnin
   const fs::path whole = c.dir / "whole", resumed = c.dir / "resumed";
   const auto r = geohaz::testing::run_command(app(cfg + " --threads 1 --quiet --out " + whole.string()));
   ASSERT_EQ(r.code, 0) << r.output;
-  const pid_t pid = ::fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    const int null = ::open("/dev/null", O_WRONLY);
-    ::dup2(null, 1), ::dup2(null, 2);
-    const std::string out_arg = resumed.string();
-    ::execl(GEOHAZ_CALIBRATE_EXE, GEOHAZ_CALIBRATE_EXE, cfg.c_str(), "--threads", "1", "--quiet", "--out",
-            out_arg.c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
   const auto done = [&] {
     std::map<std::string, std::string> m;
     if (!fs::exists(resumed / "members")) return m;
@@ -121,13 +84,9 @@ TEST(CalibrateApp, KilledAndResumedRunGivesTheUninterruptedResultWithoutRerunnin
         m[e.path().filename().string()] = slurp(e.path() / "member.json") + slurp(e.path() / "misfit.json");
     return m;
   };
-  const auto t0 = std::chrono::steady_clock::now();
-  while (done().size() < 8 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(120))
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  ::kill(pid, SIGKILL);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  EXPECT_TRUE(WIFSIGNALED(status)) << "the run ended before it was killed";
+  EXPECT_TRUE(member_app::kill_when(GEOHAZ_CALIBRATE_EXE, {cfg, "--threads", "1", "--quiet", "--out", resumed.string()},
+                                    [&] { return done().size() >= 8; }))
+      << "the run ended before it was killed";
   const auto before = done();
   EXPECT_GE(before.size(), 8u);
   const auto r2 = geohaz::testing::run_command(app(cfg + " --threads 1 --out " + resumed.string()));
@@ -170,6 +129,25 @@ TEST(CalibrateApp, FailedMemberIsRecordedWithItsParametersAndPenalised) {
   int tp = 0;
   for (double v : cmp.data) tp += v == 1.0;
   EXPECT_NEAR(tp * 25.0, j["best"]["misfit"]["tp_m2"].get<double>(), 1e-6);
+#ifdef GEOHAZ_REPORT_EXE
+  // The report page of this folder (issue #31: "all in the report page"): the back-analysis part
+  // with the best member, the failed one counted, the acceptable set, the Morris table, the map
+  // (which passes the page's map check) and the two thalweg profile plots.
+  const auto rep = geohaz::testing::run_command(std::string(GEOHAZ_REPORT_EXE) + " " + out.string());
+  ASSERT_EQ(rep.code, 0) << rep.output;
+  const std::string html = slurp(out / "report.html");
+  EXPECT_NE(html.find("<h2>Back-analysis (geohaz-calibrate)</h2>"), std::string::npos);
+  EXPECT_NE(html.find("<p>Member " + std::to_string(j["best"]["member"].get<int>()) + " ("), std::string::npos);
+  EXPECT_NE(html.find("local; 1 failed)"), std::string::npos);
+  EXPECT_NE(html.find(std::to_string(j["acceptable_members"].get<int>()) + " successful member(s) with J"),
+            std::string::npos);
+  for (const char* part : {"<table class=calibration-acceptable>", "<table class=calibration-morris>",
+                           "src=\"comparison.png\"", "src=\"acceptable.svg\"", "href=\"best.toml\""})
+    EXPECT_NE(html.find(part), std::string::npos) << part;
+  EXPECT_EQ(html.find("class=map-problem"), std::string::npos);
+  EXPECT_TRUE(fs::exists(out / "report_files" / "out_thalweg_width.svg"));
+  EXPECT_TRUE(fs::exists(out / "report_files" / "out_thalweg_deposit.svg"));
+#endif
   fs::remove_all(c.dir);
 }
 

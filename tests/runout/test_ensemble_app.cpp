@@ -10,27 +10,24 @@
 //  - A member forced to fail is reported and the maps use the others.
 //  - A killed and resumed ensemble gives the same maps as an uninterrupted one.
 //  - Bad input: exit 2 naming the key, nothing written.
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "geohaz/core/raster.hpp"
 #include "geohaz/runout/synthetic_terrain.hpp"
+#include "member_app_support.hpp"
 #include "run_command.hpp"
 
 namespace fs = std::filesystem;
+using member_app::summary;
 
 namespace {
 
@@ -39,9 +36,7 @@ constexpr double kCell = 0.5, kX0 = -25.0, kYTop = 5.0;
 constexpr int kNx = 140, kNy = 20;
 
 fs::path work_dir() {
-  const fs::path d = fs::path(GEOHAZ_BINARY_DIR) / "tests" / "runout" / "ensemble_work" / std::to_string(::getpid());
-  fs::create_directories(d);
-  return d;
+  return member_app::work_dir("ensemble_work", "ensemble");
 }
 
 /// The slope-to-flat DSM, the one-cell release and the base debris-runout config in `d`.
@@ -78,22 +73,11 @@ void write_ensemble(const fs::path& path, int members, const std::string& sampli
 }
 
 std::string app(const std::string& args) {
-  return std::string(GEOHAZ_ENSEMBLE_EXE) + " " + args;
-}
-
-std::string mpirun(int np, const std::string& args) {
-  std::string cmd = std::string(GEOHAZ_MPIEXEC) + " --oversubscribe -np " + std::to_string(np) + " ";
-  if (::geteuid() == 0) cmd += "--allow-run-as-root ";
-  return cmd + app(args);
+  return member_app::command(GEOHAZ_ENSEMBLE_EXE, args);
 }
 
 geohaz::Raster read(const fs::path& p) {
   return geohaz::read_raster(p, geohaz::CrsPolicy::Any);
-}
-
-nlohmann::json summary(const fs::path& out) {
-  std::ifstream in(out / "summary.json");
-  return nlohmann::json::parse(in);
 }
 
 /// Every product raster of two output folders, value for value.
@@ -171,14 +155,14 @@ TEST(EnsembleApp, ExceedanceMatchesTheAnalyticStoppingDistribution) {
 }
 
 TEST(EnsembleApp, OneAndTwoRanksGiveIdenticalRasters) {
-  if (std::string(GEOHAZ_MPIEXEC).empty()) GTEST_SKIP() << "built without MPI";
+  if (!member_app::have_mpi()) GTEST_SKIP() << "built without MPI";
   const fs::path d = work_dir();
   make_case(d);
   write_ensemble(d / "ens.toml", 12, "latin_hypercube");
   const std::string args = (d / "ens.toml").string() + " --threads 1 --quiet --out ";
   auto r1 = geohaz::testing::run_command(app(args + (d / "one").string()));
   ASSERT_EQ(r1.code, 0) << r1.output;
-  auto r2 = geohaz::testing::run_command(mpirun(2, args + (d / "two").string()));
+  auto r2 = geohaz::testing::run_command(member_app::mpirun(GEOHAZ_ENSEMBLE_EXE, 2, args + (d / "two").string()));
   ASSERT_EQ(r2.code, 0) << r2.output;
   EXPECT_EQ(summary(d / "two")["ranks"].get<int>(), 2);
   expect_same_products(d / "one", d / "two");
@@ -220,17 +204,6 @@ TEST(EnsembleApp, KilledAndResumedEnsembleGivesTheUninterruptedResult) {
   const auto r = geohaz::testing::run_command(app(cfg + " --threads 1 --quiet --out " + whole.string()));
   ASSERT_EQ(r.code, 0) << r.output;
   // Start, wait until some members are on disk, kill -9, then rerun to completion.
-  const pid_t pid = ::fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    // The app itself (no shell), so that the kill below hits it.
-    const int null = ::open("/dev/null", O_WRONLY);
-    ::dup2(null, 1), ::dup2(null, 2);
-    const std::string out_arg = resumed.string();
-    ::execl(GEOHAZ_ENSEMBLE_EXE, GEOHAZ_ENSEMBLE_EXE, cfg.c_str(), "--threads", "1", "--quiet", "--out",
-            out_arg.c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
   const auto count_done = [&] {
     int k = 0;
     for (int i = 0; i < 16; ++i) {
@@ -240,13 +213,9 @@ TEST(EnsembleApp, KilledAndResumedEnsembleGivesTheUninterruptedResult) {
     }
     return k;
   };
-  const auto t0 = std::chrono::steady_clock::now();
-  while (count_done() < 3 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(120))
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  ::kill(pid, SIGKILL);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  EXPECT_TRUE(WIFSIGNALED(status)) << "the run ended before it was killed";
+  EXPECT_TRUE(member_app::kill_when(GEOHAZ_ENSEMBLE_EXE, {cfg, "--threads", "1", "--quiet", "--out", resumed.string()},
+                                    [&] { return count_done() >= 3; }))
+      << "the run ended before it was killed";
   const int before = count_done();
   const auto r2 = geohaz::testing::run_command(app(cfg + " --threads 1 --out " + resumed.string()));
   ASSERT_EQ(r2.code, 0) << r2.output;

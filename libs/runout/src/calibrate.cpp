@@ -150,6 +150,15 @@ Misfit compute_misfit(const Observation& obs, const ScoreSettings& s, const std:
 
 namespace {
 
+/// The observation's keys as read (paths resolved), before the files are read.
+struct ObservationKeys {
+  std::string footprint;
+  double threshold = 0.0;
+  std::string deposit;
+  std::vector<double> point;
+  std::string line, thalweg;
+};
+
 struct Keys {
   // Every key declared once: describe mode (--help-config) and reading go through these calls.
   static void calibration(ConfigReader& cfg, CalibrationSetup& s) {
@@ -204,8 +213,8 @@ struct Keys {
                      {"", "linear, or log (searched in ln: for coefficients spanning decades, min > 0)"}) == "log";
   }
 
-  static void observation(ConfigReader& cfg, std::string& footprint, double& threshold, std::string& deposit,
-                          std::vector<double>& point, double& volume, std::string& thalweg) {
+  static void observation(ConfigReader& cfg, ObservationKeys& o, double& volume) {
+    auto& [footprint, threshold, deposit, point, line, thalweg] = o;
     footprint = resolve_path(
         cfg, cfg.require_string("observation.footprint", {"",
                                                           "mapped footprint: polygons (Shapefile, GeoJSON, GPKG) or a "
@@ -220,6 +229,11 @@ struct Keys {
                           {"m",
                            "observed run-out point [x, y] in the DSM's CRS (optional; default: the footprint's "
                            "farthest cell along the thalweg)"});
+    line = resolve_path(cfg, cfg.get_string("observation.runout_line", "",
+                                            {"",
+                                             "observed run-out as a line file (e.g. the mapped deposit front, any "
+                                             "CRS); its vertex farthest along the thalweg sets the run-out "
+                                             "(optional; not with runout_point)"}));
     volume = cfg.get("observation.volume", 0.0, Range::non_negative(),
                      {"m^3", "observed deposit volume (optional; 0: not used)"});
     thalweg = resolve_path(
@@ -261,10 +275,9 @@ void describe_calibration(ConfigReader& cfg) {
     CalibrationParameter p;
     Keys::parameter(t, p);
   }
-  std::string a, c, f;
-  double th = 0, v = 0;
-  std::vector<double> pt;
-  Keys::observation(cfg, a, th, c, pt, v, f);
+  ObservationKeys o;
+  double v = 0;
+  Keys::observation(cfg, o, v);
   Keys::score(cfg, s.score);
 }
 
@@ -302,10 +315,9 @@ CalibrationSetup read_calibration(ConfigReader& cfg) {
   if (s.search.local_algorithm == "bobyqa" && s.parameters.size() < 2 && s.search.local_starts > 0)
     throw InputError("bobyqa needs two or more parameters (use sbplx or neldermead for one)", src,
                      "calibration.local_algorithm", "bobyqa");
-  std::string footprint, deposit, thalweg;
-  double threshold = 0.0;
-  std::vector<double> point;
-  Keys::observation(cfg, footprint, threshold, deposit, point, s.observation.volume, thalweg);
+  ObservationKeys keys;
+  Keys::observation(cfg, keys, s.observation.volume);
+  const auto& [footprint, threshold, deposit, point, line, thalweg] = keys;
   Keys::score(cfg, s.score);
   cfg.finish();
   s.resolved_config = cfg.resolved();
@@ -397,6 +409,9 @@ CalibrationSetup read_calibration(ConfigReader& cfg) {
     for (std::size_t k = 0; k < cells; ++k)
       ob.deposit[k] = d.is_nodata(d.data[k]) || !std::isfinite(d.data[k]) ? 0.0 : std::max(0.0, d.data[k]);
   }
+  if (!point.empty() && !line.empty())
+    throw InputError("give the observed run-out as a point or as a line, not both", src, "observation.runout_line",
+                     line);
   if (!point.empty()) {
     if (point.size() != 2)
       throw InputError("the run-out point is [x, y]", src, "observation.runout_point",
@@ -406,7 +421,18 @@ CalibrationSetup read_calibration(ConfigReader& cfg) {
       throw InputError("the run-out point lies outside the DSM", src, "observation.runout_point",
                        fmt(p.x(), 10) + ", " + fmt(p.y(), 10));
     ob.runout_s = along_thalweg(ob.thalweg, p);
-    ob.runout_from_point = true;
+    ob.runout_from = "runout_point";
+  } else if (!line.empty()) {
+    if (!fs::exists(line)) throw InputError("run-out line file not found", src, "observation.runout_line", line);
+    ob.runout_s = 0.0;
+    for (const auto& l : read_lines(line, "", dsm.crs_wkt))
+      for (const Vec2& v : l.vertices) {
+        if (!inside(dsm, v))
+          throw InputError("the run-out line leaves the DSM (vertex " + fmt(v.x(), 10) + ", " + fmt(v.y(), 10) + ")",
+                           src, "observation.runout_line", line);
+        ob.runout_s = std::max(ob.runout_s, along_thalweg(ob.thalweg, v));
+      }
+    ob.runout_from = "runout_line";
   } else {
     for (std::size_t k = 0; k < cells; ++k)
       if (ob.footprint[k]) ob.runout_s = std::max(ob.runout_s, ob.s[k]);

@@ -396,7 +396,7 @@ void write_calibration_outputs(const CalibrationSetup& s, const CalibrationResul
   j["best"]["misfit"] = mj;
   j["observation"] = {{"footprint_area_m2", ob.footprint_area()},
                       {"runout_s_m", ob.runout_s},
-                      {"runout_from", ob.runout_from_point ? "runout_point" : "footprint"},
+                      {"runout_from", ob.runout_from},
                       {"deposit_raster", !ob.deposit.empty()},
                       {"volume_m3", ob.volume}};
   j["score"] = {{"definition",

@@ -74,11 +74,11 @@ struct Observation {
   GridGeometry grid;
   std::vector<std::uint8_t> footprint;  ///< 1 = affected (per DSM cell)
   std::vector<double> deposit;          ///< m, vertical (empty: none observed)
-  double runout_s = 0.0;                ///< m along the thalweg (the run-out point, or the footprint's farthest cell)
-  bool runout_from_point = false;
-  double volume = 0.0;        ///< m³ deposited (0: none observed)
-  std::vector<Vec2> thalweg;  ///< polyline in the DSM's CRS
-  std::vector<double> s;      ///< m along the thalweg of every cell centre
+  double runout_s = 0.0;  ///< m along the thalweg (run-out point or line, or the footprint's farthest cell)
+  std::string runout_from = "footprint";  ///< where runout_s comes from: "runout_point", "runout_line", "footprint"
+  double volume = 0.0;                    ///< m³ deposited (0: none observed)
+  std::vector<Vec2> thalweg;              ///< polyline in the DSM's CRS
+  std::vector<double> s;                  ///< m along the thalweg of every cell centre
   double footprint_area() const noexcept;
 };
 
