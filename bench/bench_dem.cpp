@@ -3,7 +3,8 @@
 //     bench/peers/in.discs2d, run beside it by bench/peers/dem_vs_lammps.sh;
 //  2. an N-disc bonded sample (parallel bonds on the regular-triangulation edges) compressed
 //     between platens.
-// Usage: bench_dem [N=100000] [steps=300] [threads=0: both 1 and 2]. Prints rates; never asserts.
+// Usage: bench_dem [N=100000] [steps=300] [threads=0: both 1 and 2] [case: settling | bonded | both (default)].
+// Prints rates; never asserts.
 //  3. `bench_dem avalanche [N=100000] [runout_s=300] [threads=2]`: a rock avalanche of about N
 //     bonded, jointed discs (the material of data/dem/avalanche.toml) on a 3 km profile (35°
 //     slope 1 km high onto a 1.57 km floor), run with the library's run_avalanche to rest or for
@@ -189,13 +190,14 @@ int main(int argc, char** argv) {
   const std::size_t n = argc > 1 ? std::strtoull(argv[1], nullptr, 10) : 100000;
   const int steps = argc > 2 ? std::atoi(argv[2]) : 300;
   const int only_threads = argc > 3 ? std::atoi(argv[3]) : 0;  // 0: 1 and 2 threads
+  const std::string only_case = argc > 4 ? argv[4] : "both";
   const double rmax = 1e-3;
   const auto nx = static_cast<std::size_t>(std::sqrt(static_cast<double>(n)));
   std::printf("bench_dem: %zu discs, %d timed steps\n", n, steps);
   for (int threads : {1, 2}) {
     if (only_threads > 0 && threads != only_threads) continue;
     omp_set_num_threads(threads);
-    {
+    if (only_case != "bonded") {
       DemSolver s;
       // LAMMPS's problem (bench/peers/in.discs2d, gran/hooke/history): kn 1e8, kt 4e7 N/m, μ 0.5,
       // e 0.5; its γ_t = γ_n/2 tangential dashpot is c_t = ½ c_n = f_t c_n √(k_t/k_n), so
@@ -220,7 +222,7 @@ int main(int argc, char** argv) {
           "%lld list builds; state %016llx)\n",
           threads, r, rc, s.contact_count(), s.time_step(), static_cast<long long>(s.rebuild_count()), state_hash(s));
     }
-    {
+    if (only_case != "settling") {
       DemSolver s;
       s.settings.gravity = Vec2::Zero();
       s.settings.local_damping = 0.7;

@@ -43,7 +43,7 @@ lammps_rate() {  # threads -> particle-steps/s of the timed run (LAMMPS's second
   awk '/^Loop time of/ {loop = $4; s = $9; atoms = $12} END {printf "%.4g\n", atoms * s / loop}' "$log"
 }
 geohaz_rate() {  # threads -> particle-steps/s of bench_dem's first case
-  "$bench" "$n" "$steps" "$1" | awk '/unbonded settling/ {print $5}'
+  "$bench" "$n" "$steps" "$1" settling | awk '/unbonded settling/ {print $5}'
 }
 
 echo "dem_vs_lammps: $n discs, $steps timed steps, $repeats alternating repeats; $(lmp -h | awk '/^Large-scale/ {print "LAMMPS" substr($0, index($0, " - ")); exit}')"
