@@ -1,8 +1,10 @@
 // Throughput of the bonded-disc DEM (particle-steps per second), 1 and 2 threads:
-//  1. N unbonded discs settling under gravity in a box (contacts only);
+//  1. N unbonded discs settling under gravity in a box (contacts only): the problem of LAMMPS's
+//     bench/peers/in.discs2d, run beside it by bench/peers/dem_vs_lammps.sh;
 //  2. an N-disc bonded sample (parallel bonds on the regular-triangulation edges) compressed
 //     between platens.
-// Usage: bench_dem [N=100000] [steps=300] [threads=0: both 1 and 2]. Prints rates; never asserts.
+// Usage: bench_dem [N=100000] [steps=300] [threads=0: both 1 and 2] [case: settling | bonded | both (default)].
+// Prints rates; never asserts.
 //  3. `bench_dem avalanche [N=100000] [runout_s=300] [threads=2]`: a rock avalanche of about N
 //     bonded, jointed discs (the material of data/dem/avalanche.toml) on a 3 km profile (35°
 //     slope 1 km high onto a 1.57 km floor), run with the library's run_avalanche to rest or for
@@ -188,24 +190,31 @@ int main(int argc, char** argv) {
   const std::size_t n = argc > 1 ? std::strtoull(argv[1], nullptr, 10) : 100000;
   const int steps = argc > 2 ? std::atoi(argv[2]) : 300;
   const int only_threads = argc > 3 ? std::atoi(argv[3]) : 0;  // 0: 1 and 2 threads
+  const std::string only_case = argc > 4 ? argv[4] : "both";
   const double rmax = 1e-3;
   const auto nx = static_cast<std::size_t>(std::sqrt(static_cast<double>(n)));
   std::printf("bench_dem: %zu discs, %d timed steps\n", n, steps);
   for (int threads : {1, 2}) {
     if (only_threads > 0 && threads != only_threads) continue;
     omp_set_num_threads(threads);
-    {
+    if (only_case != "bonded") {
       DemSolver s;
+      // LAMMPS's problem (bench/peers/in.discs2d, gran/hooke/history): kn 1e8, kt 4e7 N/m, μ 0.5,
+      // e 0.5; its γ_t = γ_n/2 tangential dashpot is c_t = ½ c_n = f_t c_n √(k_t/k_n), so
+      // f_t = ½/√0.4; its skin 0.2 mm and fixed Δt 2 µs (docs/performance.md, "DEM beside LAMMPS").
       s.law = LinearSpringCoulomb{1e8, 4e7};
       s.contact.friction = 0.5;
       s.contact.restitution = 0.5;
+      s.contact.tangential_damping = 0.5 / std::sqrt(0.4);
+      s.settings.skin = 0.2e-3;
+      s.settings.fixed_time_step = 2e-6;
       // Lattice spacing = mean diameter (radii 0.8–1 R_max): about half the neighbours touch, the rest
       // close up as the pile settles under gravity.
       lattice(s, n, rmax, 1.0 / 0.9, 1);
       const double w = (nx + 1) * 2 * rmax * 0.9;
       box(s, w, 2 * w);
       s.initialise();
-      // Let the pile form so contacts exist, then time.
+      // Let the pile form so contacts exist, then time (LAMMPS: `run 220`, then the timed run).
       for (int k = 0; k < 200; ++k) s.step();
       const auto [r, rc] = rate(s, steps);
       std::printf(
@@ -213,7 +222,7 @@ int main(int argc, char** argv) {
           "%lld list builds; state %016llx)\n",
           threads, r, rc, s.contact_count(), s.time_step(), static_cast<long long>(s.rebuild_count()), state_hash(s));
     }
-    {
+    if (only_case != "settling") {
       DemSolver s;
       s.settings.gravity = Vec2::Zero();
       s.settings.local_damping = 0.7;

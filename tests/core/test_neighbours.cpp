@@ -100,6 +100,39 @@ TEST(NeighbourList, Periodic3DOneThread) {
   check<3>(Layout::Clustered, true, 1);
 }
 
+TEST(NeighbourList, HalfListHoldsEachPairOnceFromItsLowerIndex) {
+  // The half list (the DEM's contact pass) is the full list's j > i entries, in the same order.
+  for (bool periodic : {false, true})
+    for (int threads : {1, 2}) {
+      auto x = make_points<2>(2500, Layout::Clustered, 7, 1.0);
+      Periodicity<2> p;
+      if (periodic) {
+        p.axis = {true, true};
+        p.lo.setZero();
+        p.hi.setConstant(1.0);
+        for (auto& xi : x) xi = p.wrap(xi);
+      }
+      const int saved = omp_get_max_threads();
+      omp_set_num_threads(threads);
+      NeighbourList<2> full, half;
+      full.build(x, 0.09, p);
+      half.build(x, 0.09, p, true);
+      omp_set_num_threads(saved);
+      std::size_t kept = 0;
+      for (std::size_t i = 0; i < x.size(); ++i) {
+        std::vector<std::uint32_t> upper;
+        for (std::uint32_t j : full.neighbours(i))
+          if (j > i) upper.push_back(j);
+        const auto h = half.neighbours(i);
+        EXPECT_EQ(std::vector<std::uint32_t>(h.begin(), h.end()), upper) << "particle " << i;
+        kept += upper.size();
+      }
+      EXPECT_EQ(2 * half.pair_count(), full.pair_count());
+      EXPECT_EQ(half.pair_count(), kept);
+      EXPECT_GT(kept, x.size());  // not vacuous
+    }
+}
+
 TEST(NeighbourList, ShortPeriodicAxisHasNoDuplicates) {
   // Period 2.5 × cutoff: only two cells fit; the ±1 neighbour cells coincide and must be visited once.
   std::vector<Vec2> x;
@@ -418,6 +451,11 @@ TEST(Neighbours, BadSettingsAreRejected) {
   s.skin = 0.1;
   s.storage = PairStorage::scan;  // a scan keeps no list to reuse
   EXPECT_THROW(Neighbours<2>{s}, std::invalid_argument);
+  s.skin = 0.0;
+  s.half_list = true;  // nor half of one
+  EXPECT_THROW(Neighbours<2>{s}, std::invalid_argument);
+  s.half_list = false;
+  s.skin = 0.1;
   s.storage = PairStorage::list;
   s.reorder_every = -1;
   EXPECT_THROW(Neighbours<2>{s}, std::invalid_argument);

@@ -125,7 +125,8 @@ std::array<int, Dim> CellList<Dim>::cell_coords(std::uint32_t c) const noexcept 
 }
 
 template <int Dim>
-void NeighbourList<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const Periodicity<Dim>& periodic) {
+void NeighbourList<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const Periodicity<Dim>& periodic,
+                               bool half) {
   // Cells of edge cutoff/R scanned R deep: the scanned volume shrinks from (3 rc)^Dim to
   // ((2R+1)/R rc)^Dim, which cuts the distance checks by a third in 2D and almost half in 3D.
   constexpr int R = kReach;
@@ -170,7 +171,7 @@ void NeighbourList<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const
       for (int q = 0; q < nranges; ++q)
         for (std::uint32_t s = ranges[q][0]; s < ranges[q][1]; ++s) {
           const Vec<Dim> d = periodic_any_ ? per.min_image(xi - sorted_x_[s]) : Vec<Dim>(xi - sorted_x_[s]);
-          if (d.squaredNorm() < rc2 && sorted[s] != i) buf.push_back(sorted[s]);
+          if (d.squaredNorm() < rc2 && (half ? sorted[s] > i : sorted[s] != i)) buf.push_back(sorted[s]);
         }
       offsets_[i + 1] = static_cast<std::uint32_t>(buf.size() - before);
     }
@@ -242,6 +243,8 @@ void Neighbours<Dim>::configure(const NeighbourSettings<Dim>& s) {
   if (s.reorder_every < 0) throw std::invalid_argument("Neighbours: reorder_every must be >= 0");
   if (s.storage == PairStorage::scan && s.skin > 0.0)
     throw std::invalid_argument("Neighbours: a cell scan keeps no list, so it cannot have a skin");
+  if (s.storage == PairStorage::scan && s.half_list)
+    throw std::invalid_argument("Neighbours: a cell scan keeps no list, so it cannot keep half of one");
   s_ = s;
   periodic_any_ = s.periodic.any();
   valid_ = false;
@@ -265,7 +268,7 @@ void Neighbours<Dim>::build(std::span<const Vec<Dim>> x) {
     scan_.build(x, s_.cutoff, s_.periodic);
     blocks_ = PairBlocks::choose(x.size(), scan_.forward_reach());
   } else {
-    list_.build(x, list_cutoff(), s_.periodic);
+    list_.build(x, list_cutoff(), s_.periodic, s_.half_list);
   }
   size_ = x.size();
   valid_ = true;

@@ -189,6 +189,7 @@ void DemSolver::initialise() {
   ns.cutoff = 2.0 * rmax;  // list cut-off 2 R_max + skin, as cutoff_
   ns.skin = skin_;
   ns.reorder_every = settings.reorder_every;
+  ns.half_list = true;  // each pair once, from its lower index (pair_forces)
   nb_.configure(ns);
   double reach = rmax;
   terrain.build(reach);
@@ -211,6 +212,8 @@ void DemSolver::update_neighbours(double max_drift) {
   if (!u.rebuilt) return;
   if (u.reordered()) reorder(u.permutation);
   same_layout_ = false;
+  // The reaction window of the half-pair pass: the largest j − i of a listed pair (all j > i).
+  pair_blocks_ = nb_.blocks_for([](std::uint32_t, std::uint32_t) { return true; });
 }
 
 void DemSolver::reorder(std::span<const std::uint32_t> order) {
@@ -260,7 +263,7 @@ void DemSolver::pair_forces(const Law& law) {
   const auto off = nb_.list().offsets();
   const auto nbr = nb_.list().indices();
   const std::size_t n = discs.size();
-  hist_next_.offsets.assign(off.begin(), off.end());
+  if (!same_layout_) hist_next_.offsets.assign(off.begin(), off.end());
   hist_next_.partner.resize(nbr.size());
   hist_next_.shear.resize(nbr.size());
   hist_next_.roll.resize(nbr.size());
@@ -273,84 +276,130 @@ void DemSolver::pair_forces(const Law& law) {
   const double mu_joint = settings.joint_friction;
   const bool same = same_layout_ && hist_.offsets.size() == n + 1;
   const bool any_joints = !joints_.empty();
-
+  // Each pair once, from its lower index i (the list is a half list): disc j's share (−F on j, its
+  // own lever and the opposite rolling moment, the same stiffnesses) goes to the reaction buffer
+  // of i's block and is added in fixed block order after the pass (core PairBlocks, as in the SPH
+  // and runout pair passes), so the sums do not depend on the thread count. Evaluated from j, a
+  // contact gives the same F_s and the opposite M_r to the last bit (the relative velocity and
+  // the normal flip sign exactly), so this is the result of evaluating both sides up to the order
+  // of the sums. The dashpot mass m* of a pair of two kinematic discs (a grip against itself) is
+  // the two-body one, so their forces cancel exactly in the grip's reaction.
+  const PairBlocks& pb = pair_blocks_;
+  reactions_.resize(pb.slots());
+  const auto nblocks = static_cast<std::int64_t>(pb.count());
 #pragma omp parallel for schedule(static) if (parallel_worth(n))
-  for (std::int64_t ii = 0; ii < static_cast<std::int64_t>(n); ++ii) {
-    const auto i = static_cast<std::size_t>(ii);
-    const Vec2 xi = x[i];
-    const double Ri = R[i];
-    Vec2 f = Vec2::Zero();
-    double tq = 0.0, ktr = 0.0, krot = 0.0;
-    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
-      const std::uint32_t j = nbr[k];
-      const Vec2 d = xi - x[j];
-      const double r2 = d.squaredNorm();
-      const double Rs = Ri + R[j];
-      if (r2 >= Rs * Rs || r2 == 0.0) {
-        hist_next_.partner[k] = -1;
-        continue;
-      }
-      const double r = std::sqrt(r2);
-      const double delta = Rs - r;
-      Vec2 nrm = d / r;
-      double mu_c = mu, mu_rc = mu_r;
-      if (any_joints) {
-        for (std::uint32_t q = joint_offsets_[id[i]]; q < joint_offsets_[id[i] + 1]; ++q) {
-          const JointPair& jp = joints_[joint_entries_[q]];
-          if (jp.id_a == id[j] || jp.id_b == id[j]) {
-            nrm = jp.normal.dot(nrm) >= 0 ? jp.normal : Vec2(-jp.normal);
-            mu_c = mu_joint;
-            mu_rc = 0.0;
-            break;
+  for (std::int64_t bb = 0; bb < nblocks; ++bb) {
+    const auto b = static_cast<std::size_t>(bb);
+    PairReaction* react = pb.buffer(reactions_.data(), b);  // react[j]: the reactions on disc j
+    std::fill(react + pb.first(b), react + pb.window_end(b), PairReaction{});
+    for (std::size_t i = pb.first(b); i < pb.last(b); ++i) {
+      const Vec2 xi = x[i];
+      const double Ri = R[i];
+      Vec2 f = Vec2::Zero();
+      double tq = 0.0, ktr = 0.0, krot = 0.0;
+      for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+        const std::uint32_t j = nbr[k];
+        const Vec2 d = xi - x[j];
+        const double r2 = d.squaredNorm();
+        const double Rs = Ri + R[j];
+        if (r2 >= Rs * Rs || r2 == 0.0) {
+          hist_next_.partner[k] = -1;
+          continue;
+        }
+        const double r = std::sqrt(r2);
+        const double delta = Rs - r;
+        Vec2 nrm = d / r;
+        double mu_c = mu, mu_rc = mu_r;
+        if (any_joints) {
+          for (std::uint32_t q = joint_offsets_[id[i]]; q < joint_offsets_[id[i] + 1]; ++q) {
+            const JointPair& jp = joints_[joint_entries_[q]];
+            if (jp.id_a == id[j] || jp.id_b == id[j]) {
+              nrm = jp.normal.dot(nrm) >= 0 ? jp.normal : Vec2(-jp.normal);
+              mu_c = mu_joint;
+              mu_rc = 0.0;
+              break;
+            }
           }
         }
-      }
-      const Vec2 t = perp(nrm);
-      const double meff = kin[j] ? m[i] : (kin[i] ? m[j] : m[i] * m[j] / (m[i] + m[j]));
-      const double reff = Ri * R[j] / Rs;
-      const ContactResponse c = law.evaluate(delta, meff, reff, Rs, zeta);
-      // Levers to the common contact point (mid-overlap), so the pair of shear forces is a zero
-      // net couple and angular momentum is conserved exactly.
-      const double li = Ri - 0.5 * delta, lj = R[j] - 0.5 * delta;
-      const Vec2 vrel = v[i] - v[j] - (w[i] * li + w[j] * lj) * t;
-      const double vn = vrel.dot(nrm);
-      const double vt = vrel.dot(t);
-      const double fn = c.fn_elastic - c.cn * vn;
-      // History by partner id: same slot when the list is unchanged, else a scan of the old segment.
-      double fs = 0.0, mr = 0.0;
-      const std::int64_t pj = id[j];
-      if (same && hist_.partner[k] == pj) {
-        fs = hist_.shear[k];
-        mr = hist_.roll[k];
-      } else if (!same) {
-        for (std::uint32_t q = hist_.offsets[i]; q < hist_.offsets[i + 1]; ++q)
-          if (hist_.partner[q] == pj) {
-            fs = hist_.shear[q];
-            mr = hist_.roll[q];
-            break;
+        const Vec2 t = perp(nrm);
+        const double meff = kin[j] == kin[i] ? m[i] * m[j] / (m[i] + m[j]) : (kin[j] ? m[i] : m[j]);
+        const double reff = Ri * R[j] / Rs;
+        const ContactResponse c = law.evaluate(delta, meff, reff, Rs, zeta);
+        // Levers to the common contact point (mid-overlap), so the pair of shear forces is a zero
+        // net couple and angular momentum is conserved exactly.
+        const double li = Ri - 0.5 * delta, lj = R[j] - 0.5 * delta;
+        const Vec2 vrel = v[i] - v[j] - (w[i] * li + w[j] * lj) * t;
+        const double vn = vrel.dot(nrm);
+        const double vt = vrel.dot(t);
+        const double fn = c.fn_elastic - c.cn * vn;
+        double fs = 0.0, mr = 0.0;
+        const std::int64_t pj = id[j];
+        if (same) {
+          if (hist_.partner[k] == pj) {
+            fs = hist_.shear[k];
+            mr = hist_.roll[k];
           }
+        } else {
+          lookup_history(i, j, fs, mr);
+        }
+        // Tangential dashpot: the normal damping ratio (× f_t) on the tangential spring, same m*.
+        const double ct = f_t > 0.0 ? f_t * c.cn * std::sqrt(c.kt / c.kn) : 0.0;
+        const auto fr = CoulombFrictionRolling::update(
+            fs, mr, c.kt, c.kn, vt, fn, reff, w[i] - w[j], mu_c, mu_rc, eta_r, dt,
+            [&] { return rolling_inertia(I[i], m[i], Ri, I[j], m[j], R[j]); }, ct);
+        fs = fr.shear;
+        mr = fr.roll;
+        const double shear = fs + fr.shear_damping, roll = mr + fr.roll_damping;
+        const Vec2 fc = fn * nrm + shear * t;
+        const double k_tr = std::max(c.kn, c.kt);
+        f += fc;
+        tq += -li * shear + roll;
+        ktr += k_tr;
+        krot += c.kt * Ri * Ri + fr.kr;
+        PairReaction& rj = react[j];
+        rj.f -= fc;
+        rj.tq += -lj * shear - roll;
+        rj.ktr += k_tr;
+        rj.krot += c.kt * R[j] * R[j] + fr.kr;
+        hist_next_.partner[k] = pj;
+        hist_next_.shear[k] = fs;
+        hist_next_.roll[k] = mr;
       }
-      // Tangential dashpot: the normal damping ratio (× f_t) on the tangential spring, same m*.
-      const double ct = f_t > 0.0 ? f_t * c.cn * std::sqrt(c.kt / c.kn) : 0.0;
-      const auto fr = CoulombFrictionRolling::update(
-          fs, mr, c.kt, c.kn, vt, fn, reff, w[i] - w[j], mu_c, mu_rc, eta_r, dt,
-          [&] { return rolling_inertia(I[i], m[i], Ri, I[j], m[j], R[j]); }, ct);
-      fs = fr.shear;
-      mr = fr.roll;
-      f += fn * nrm + (fs + fr.shear_damping) * t;
-      tq += -li * (fs + fr.shear_damping) + mr + fr.roll_damping;
-      ktr += std::max(c.kn, c.kt);
-      krot += c.kt * Ri * Ri + fr.kr;
-      hist_next_.partner[k] = pj;
-      hist_next_.shear[k] = fs;
-      hist_next_.roll[k] = mr;
+      F[i] = f;
+      T[i] = tq;
+      K[i] = Eigen::Vector2d(ktr, krot);
     }
-    F[i] = f;
-    T[i] = tq;
-    K[i] = Eigen::Vector2d(ktr, krot);
   }
+  pb.gather(
+      reactions_.data(), [](std::size_t) { return true; },
+      [&](std::size_t a, const PairReaction& r) {
+        F[a] += r.f;
+        T[a] += r.tq;
+        K[a] += Eigen::Vector2d(r.ktr, r.krot);
+      },
+      [](std::size_t) {});
   std::swap(hist_, hist_next_);
+  if (!same_layout_) hist_next_.offsets = hist_.offsets;
   same_layout_ = true;
+}
+
+void DemSolver::lookup_history(std::size_t i, std::size_t j, double& fs, double& mr) const {
+  // By partner id: the pair's entry is in the segment of the disc that was its lower index when it
+  // was written (i's, or j's before a reordering swapped them; seen from j, M_r has the other sign).
+  const auto& id = discs.get<ParticleId>();
+  const std::int64_t pj = id[j], pi = id[i];
+  for (std::uint32_t q = hist_.offsets[i]; q < hist_.offsets[i + 1]; ++q)
+    if (hist_.partner[q] == pj) {
+      fs = hist_.shear[q];
+      mr = hist_.roll[q];
+      return;
+    }
+  for (std::uint32_t q = hist_.offsets[j]; q < hist_.offsets[j + 1]; ++q)
+    if (hist_.partner[q] == pi) {
+      fs = hist_.shear[q];
+      mr = -hist_.roll[q];
+      return;
+    }
 }
 
 void DemSolver::bond_forces() {
@@ -520,6 +569,17 @@ void DemSolver::wall_forces(const Law& law) {
       const double Ri = R[i];
       const WallContacts::type& old = WC[i];
       const bool had = old(0, 0) >= 0.0;  // slots are filled from the first one
+      // Most discs are far from every wall and terrain segment and had no wall contact: nothing
+      // to do (decided before the contact table is set up; the same result as the full pass).
+      const auto in_box = [&](std::size_t k) {
+        return walls[k].active && (xi.array() >= box_lo[k].array()).all() && (xi.array() <= box_hi[k].array()).all();
+      };
+      const auto [tb, te] = terrain.size() > 0
+                                ? terrain.candidates(xi.x())
+                                : std::pair<const std::uint32_t*, const std::uint32_t*>{nullptr, nullptr};
+      bool candidate = had || tb != te;
+      for (std::size_t k = 0; k < nw && !candidate; ++k) candidate = in_box(k);
+      if (!candidate) continue;
       WallContacts::type now;
       now.row(0).setConstant(-1.0);
       now.row(1).setZero();
@@ -602,14 +662,9 @@ void DemSolver::wall_forces(const Law& law) {
         }
       };
       for (std::size_t k = 0; k < nw; ++k)
-        if (walls[k].active && (xi.array() >= box_lo[k].array()).all() && (xi.array() <= box_hi[k].array()).all())
-          touch(walls[k], k, k, wall_damping_[k]);
-      if (terrain.size() > 0) {
-        auto [b, e] = terrain.candidates(xi.x());
-        for (auto p = b; p != e; ++p) {
-          if (owns_contact(terrain, *p, xi)) touch(terrain.segment(*p), nw + *p, SIZE_MAX, terrain_damping_[*p]);
-        }
-      }
+        if (in_box(k)) touch(walls[k], k, k, wall_damping_[k]);
+      for (auto p = tb; p != te; ++p)
+        if (owns_contact(terrain, *p, xi)) touch(terrain.segment(*p), nw + *p, SIZE_MAX, terrain_damping_[*p]);
       if (used == 0 && !had) continue;  // no wall contact before or now: nothing to write
       WC[i] = now;
       F[i] += f;

@@ -162,9 +162,10 @@ class NeighbourList {
   /// Cells per cut-off length: the grid has cells of edge cutoff/kReach, scanned kReach cells deep.
   static constexpr int kReach = 2;
 
-  /// Find, for every particle, all others closer than cutoff (strictly). Parallel (OpenMP).
+  /// Find, for every particle, all others closer than cutoff (strictly); half: only those of a
+  /// higher index, so every unordered pair is stored once, from its lower index. Parallel (OpenMP).
   /// Throws std::invalid_argument if a periodic axis is shorter than 2 × cutoff.
-  void build(std::span<const Vec<Dim>> x, double cutoff, const Periodicity<Dim>& periodic = {});
+  void build(std::span<const Vec<Dim>> x, double cutoff, const Periodicity<Dim>& periodic = {}, bool half = false);
 
   std::size_t size() const noexcept { return offsets_.empty() ? 0 : offsets_.size() - 1; }
   double cutoff() const noexcept { return cutoff_; }
@@ -431,6 +432,9 @@ struct NeighbourSettings {
   /// locality); 0: never.
   int reorder_every = 0;
   PairStorage storage = PairStorage::list;
+  /// Storage list only: keep each unordered pair once, from its lower index (j > i), for pair
+  /// passes that evaluate a pair once and send the partner its share (the DEM contacts).
+  bool half_list = false;
   Periodicity<Dim> periodic;
 };
 

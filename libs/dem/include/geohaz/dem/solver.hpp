@@ -5,7 +5,8 @@
 ///  1. half kick  v += ½Δt F/m, ω += ½Δt T/I (free discs), drift x += vΔt, θ += ωΔt, walls move;
 ///  2. neighbour list (core NeighbourList, cut-off 2R_max + skin) rebuilt when a disc has moved
 ///     more than skin/2 since the last build; every few rebuilds the store is sorted by cell;
-///  3. forces: disc–disc contacts (full list, each disc computes its own side, no atomics),
+///  3. forces: disc–disc contacts (each pair once from its lower index, the partner's share through
+///     fixed-order block reactions, no atomics),
 ///     parallel bonds (one loop over bonds, then gathered per disc), walls and terrain, gravity,
 ///     Cundall local damping F ← F − α|F| sign(v) (Cundall 1987);
 ///  4. second half kick (velocity Verlet), servo walls, next critical time step
@@ -124,6 +125,15 @@ class DemSolver {
   };
   PairHistory hist_, hist_next_;
   bool same_layout_ = false;  ///< hist_ was written with the current neighbour list
+  /// The history (F_s, M_r as seen from i) of the contact of discs i < j after a list rebuild.
+  void lookup_history(std::size_t i, std::size_t j, double& fs, double& mr) const;
+  /// Disc j's share of a pair evaluated from i (half-pair pass), in its block's buffer.
+  struct PairReaction {
+    Vec2 f = Vec2::Zero();
+    double tq = 0.0, ktr = 0.0, krot = 0.0;
+  };
+  std::vector<PairReaction> reactions_;
+  PairBlocks pair_blocks_;  ///< block layout of the reactions, chosen at each list build
 
   Neighbours<2> nb_;  // core neighbour object: list, skin, rebuilds, reordering
   double cutoff_ = 0, skin_ = 0, rmax_ = 0;
