@@ -2,11 +2,10 @@
 process on one rank (issue #20; the MPI app runs the same library code, docs/ensemble.md).
 """
 import os
-import tempfile
 
 from . import _geohaz
 from ._overrides import set_overrides
-from .results import read_run
+from .results import read_run, run_in_folder
 
 
 def run(config, *, set=None, out=None, threads=0, quiet=True, progress=None, progress_every=1):
@@ -31,14 +30,8 @@ def run(config, *, set=None, out=None, threads=0, quiet=True, progress=None, pro
     "units", "geotransform", "crs_wkt", and "out" (the folder, None for a temporary one).
     Raises geohaz.InputError (nothing written), geohaz.IoError.
     """
-    if out is None:
-        with tempfile.TemporaryDirectory(prefix="geohaz-ensemble-") as tmp:
-            result = _run_into(config, set, os.path.join(tmp, "out"), threads, quiet, progress, progress_every)
-        result["out"] = None
-        return result
-    result = _run_into(config, set, os.fspath(out), threads, quiet, progress, progress_every)
-    result["out"] = os.fspath(out)
-    return result
+    return run_in_folder(
+        out, "geohaz-ensemble-", lambda folder: _run_into(config, set, folder, threads, quiet, progress, progress_every))
 
 
 def _run_into(config, set, out, threads, quiet, progress, progress_every):

@@ -2,6 +2,7 @@
 import csv
 import json
 import os
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -84,3 +85,17 @@ def read_run(folder):
 
 
 __all__ = ["read_run", "read_raster", "read_table", "canonical"]
+
+
+def run_in_folder(out, prefix, run_into):
+    """Run `run_into(folder)` (which returns read_run of it) in `out`, or, when out is None, in a
+    temporary folder named with `prefix` that is deleted afterwards; the result's "out" is the
+    folder (None for a temporary one). Shared by ensemble.run and calibrate.run."""
+    if out is None:
+        with tempfile.TemporaryDirectory(prefix=prefix) as tmp:
+            result = run_into(os.path.join(tmp, "out"))
+        result["out"] = None
+        return result
+    result = run_into(os.fspath(out))
+    result["out"] = os.fspath(out)
+    return result
