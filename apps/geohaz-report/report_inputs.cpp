@@ -3,10 +3,12 @@
 
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
 #include "geohaz/core/errors.hpp"
+#include "geohaz/runout/run.hpp"
 #include "report.hpp"
 
 namespace fs = std::filesystem;
@@ -123,6 +125,16 @@ std::vector<Row> input_parameters(const fs::path& resolved_config) {
     const std::string v = toml_value_text(*n.node(), p.unit);
     if (!v.empty()) rows.push_back({key, p.label, v});
   }
+  // The debris-runout law's coefficients not labelled above (the rheologies of issue 34): label
+  // and unit from the law's key declarations in the runout config reader, not a second table here.
+  if (const auto law = t.at_path("model.friction").value<std::string>())
+    for (const runout::FrictionKey& k : runout::friction_keys(*law)) {
+      if (std::any_of(rows.begin(), rows.end(), [&](const Row& r) { return r.key == k.key; })) continue;
+      const auto n = t.at_path(k.key);
+      if (!n) continue;
+      const std::string v = toml_value_text(*n.node(), k.unit);
+      if (!v.empty()) rows.push_back({k.key, k.label, v});
+    }
   return rows;
 }
 

@@ -148,6 +148,27 @@ TEST(ReportInputs, ParametersInTheUsersTermsForTheChosenLawOnly) {
   EXPECT_NE(find_row(r, "model.icr"), nullptr);
   EXPECT_EQ(find_row(r, "model.mu"), nullptr);  // Voellmy's coefficients do not apply to Manning
   EXPECT_EQ(find_row(r, "model.xi"), nullptr);
+  // The rheologies' coefficients are labelled from the law's key declarations (runout config).
+  write_file(d / "hb.toml",
+             "[model]\nfriction = 'herschel_bulkley'\ntau_y = 1907.0\nconsistency = 572.0\nflow_index = 0.3333\n"
+             "n = 0.06\n");
+  const auto h = input_parameters(d / "hb.toml");
+  const Row* tau = find_row(h, "model.tau_y");
+  ASSERT_NE(tau, nullptr);
+  EXPECT_EQ(tau->label, "yield stress τ_y");
+  EXPECT_EQ(tau->value, "1.907 kPa");
+  const Row* k = find_row(h, "model.consistency");
+  ASSERT_NE(k, nullptr);
+  EXPECT_EQ(k->label, "consistency K of τ = τ_y + K γ̇^n");
+  EXPECT_NE(k->value.find("Pa*s^n"), std::string::npos) << k->value;
+  EXPECT_NE(find_row(h, "model.flow_index"), nullptr);
+  EXPECT_EQ(find_row(h, "model.n"), nullptr);  // Manning's n is not a Herschel–Bulkley coefficient
+  write_file(d / "pf.toml", "[model]\nfriction = 'pouliquen'\ndelta1 = 20.9\nhstop_length = 0.00065\n");
+  const auto pf = input_parameters(d / "pf.toml");
+  const Row* d1 = find_row(pf, "model.delta1");
+  ASSERT_NE(d1, nullptr);
+  EXPECT_EQ(d1->label, "δ₁: slope below which no layer flows");
+  EXPECT_NE(find_row(pf, "model.hstop_length"), nullptr);
   write_file(d / "slope.toml",
              "[[material]]\nname = 'colluvium'\ncohesion = 20000.0\nfriction = 35.0\ndilatancy = 0.0\n"
              "young = 2e8\npoisson = 0.3\n");

@@ -7,6 +7,7 @@
 #include <omp.h>
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -18,9 +19,12 @@
 
 #include "geohaz/core/config.hpp"
 #include "geohaz/core/errors.hpp"
+#include "geohaz/core/raster.hpp"
+#include "geohaz/runout/calibrate.hpp"
 #include "geohaz/runout/ensemble.hpp"
 #include "geohaz/runout/processes.hpp"
 #include "geohaz/runout/solver.hpp"
+#include "geohaz/runout/synthetic_terrain.hpp"
 
 using namespace geohaz;
 using namespace geohaz::runout;
@@ -236,6 +240,48 @@ TEST(RheologyStep, BinghamCubicMatchesHerschelBulkleyWithIndexOne) {
     }
 }
 
+TEST(RheologyStep, HerschelBulkleyWarmStartGivesTheColdAnswer) {
+  // The solver hands the HB step the particle's last (ζ, (ζ/K)^{1/n}) (StepMemory); started from
+  // there, from a stale state or from another particle's, the step must land on the cold-start
+  // root to the iteration's tolerance, and leave the new state consistent: ζ = K γ̇_b^n.
+  std::mt19937 rng(3434);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (const HerschelBulkleyFriction& law :
+       {kHerschel, HerschelBulkleyFriction{0.0, 20.0, 0.5}, HerschelBulkleyFriction{200.0, 5.0, 1.6},
+        HerschelBulkleyFriction{50.0, 0.5, 0.1}}) {
+    double zeta = 0.0, rate = 0.0;  // the memory of one particle over a sequence of steps
+    for (int k = 0; k < 300; ++k) {
+      const double h = 0.05 * std::pow(100.0, u(rng)), dt = 1e-4 * std::pow(1e4, u(rng));
+      const double s_star = k % 50 < 40 ? 5.0 + 0.05 * (k % 50) : 50.0 * u(rng) * u(rng);  // smooth, then jumps
+      HerschelBulkleyTerms cold = law.terms(kG, kG, h, s_star, kRho), warm = cold;
+      warm.memory = {&zeta, &rate};
+      const double s_cold = speed_after_friction(s_star, dt, cold), s_warm = speed_after_friction(s_star, dt, warm);
+      ASSERT_NEAR(s_warm, s_cold, 1e-10 * std::max(1.0, s_star)) << "n " << law.flow_index << " step " << k;
+      if (s_warm > 0.0) {
+        ASSERT_GT(rate, 0.0);
+        EXPECT_NEAR(zeta, law.consistency * std::pow(rate, law.flow_index), 1e-11 * zeta);
+      } else {
+        EXPECT_EQ(zeta, 0.0);  // at rest: no memory
+      }
+    }
+  }
+}
+
+TEST(RheologyZones, AConsistencyOrFlowIndexFieldSwitchesTheHerschelBulkleyMemoryOff) {
+  // (ζ, γ̇_b) kept under one K would be inconsistent after a particle crosses into a field of
+  // another K or n; a field of τ_y leaves it valid (ζ = K γ̇_b^n does not involve τ_y).
+  std::array<std::vector<double>, kFrictionParameters> fields;
+  EXPECT_TRUE(step_memory_valid(kHerschel, fields));
+  fields[kYieldStress].assign(4, 100.0);
+  EXPECT_TRUE(step_memory_valid(kHerschel, fields));
+  fields[kFlowIndex].assign(4, 0.5);
+  EXPECT_FALSE(step_memory_valid(kHerschel, fields));
+  fields[kFlowIndex].clear();
+  fields[kConsistency].assign(4, 10.0);
+  EXPECT_FALSE(step_memory_valid(kHerschel, fields));
+  EXPECT_TRUE(step_memory_valid(kBingham, fields));  // the laws without memory
+}
+
 TEST(RheologyStep, VoellmyCohesionWithoutCohesionIsVoellmy) {
   const VoellmyCohesionFriction c{0.2, 400.0, 0.0};
   const VoellmyFriction v{0.2, 400.0};
@@ -404,6 +450,64 @@ TEST(RheologyEnsemble, YieldStressAndFlowIndexAreSampledAndCheckedPerMember) {
     ConfigReader bad = ConfigReader::from_file(dir / "ens.toml");
     try {
       (void)read_ensemble(bad);
+      ADD_FAILURE() << key << ": no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
+  fs::remove_all(dir);
+}
+
+TEST(RheologyCalibration, TheNewLawsKeysCanBeFittedAndTheirBoundsAreChecked) {
+  // geohaz-calibrate fits any numeric debris-runout key: the plastic law's τ_y (log scale) and n
+  // are accepted; a bound outside the key's range, or a key the base case's law does not use, is
+  // bad input naming the key before any run.
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("geohaz_rheology_calibration_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  {
+    // A 100 m × 50 m plane at 5 m (EPSG:32654), an observed footprint on it and a thalweg along it:
+    // what read_calibration reads before any run.
+    Raster dsm;
+    dsm.nx = 20, dsm.ny = 10;
+    dsm.geotransform = {500000.0, 5.0, 0.0, 4000050.0, 0.0, -5.0};
+    dsm.crs_wkt = kSyntheticValleyCrsWkt;
+    dsm.nodata = -9999.0;
+    dsm.data.resize(200);
+    for (int k = 0; k < 200; ++k) dsm.data[static_cast<std::size_t>(k)] = 100.0 - 1.5 * (k % 20);
+    Raster fp = dsm.like(0.0, -9999.0);
+    for (int c = 2; c < 12; ++c) fp.at(c, 5) = 1.0;
+    write_geotiff(dir / "dsm.tif", dsm);
+    write_geotiff(dir / "fp.tif", fp);
+    std::ofstream(dir / "thalweg.geojson")
+        << "{\"type\": \"FeatureCollection\", \"crs\": {\"type\": \"name\", \"properties\": {\"name\": "
+           "\"urn:ogc:def:crs:EPSG::32654\"}}, \"features\": [{\"type\": \"Feature\", \"properties\": {}, "
+           "\"geometry\": {\"type\": \"LineString\", \"coordinates\": [[500005.0, 4000025.0], [500095.0, "
+           "4000025.0]]}}]}\n";
+    std::ofstream base(dir / "base.toml");
+    base << "[terrain]\ndsm = \"dsm.tif\"\n[release]\nfile = \"fp.tif\"\n"
+         << "[model]\nfriction = \"herschel_bulkley\"\ntau_y = 500.0\n";
+  }
+  const auto setup = [&](const std::string& key2, double hi2) {
+    {
+      std::ofstream c(dir / "cal.toml");
+      c << "[calibration]\nbase = \"base.toml\"\n"
+        << "[[calibration.parameter]]\nkey = \"model.tau_y\"\nmin = 50.0\nmax = 5000.0\nscale = \"log\"\n"
+        << "[[calibration.parameter]]\nkey = \"" << key2 << "\"\nmin = 0.2\nmax = " << hi2 << "\n"
+        << "[observation]\nfootprint = \"fp.tif\"\nthalweg = \"thalweg.geojson\"\n";
+    }
+    ConfigReader cfg = ConfigReader::from_file(dir / "cal.toml");
+    return read_calibration(cfg);
+  };
+  const CalibrationSetup ok = setup("model.flow_index", 0.8);
+  ASSERT_EQ(ok.parameters.size(), 2u);
+  EXPECT_EQ(ok.parameters[0].key, "model.tau_y");
+  EXPECT_TRUE(ok.parameters[0].log_scale);
+  EXPECT_EQ(ok.parameters[1].key, "model.flow_index");
+  for (const auto& [key, hi] : {std::pair{std::string("model.flow_index"), 3.0},     // n > 2
+                                std::pair{std::string("model.viscosity"), 10.0}}) {  // Bingham's, not HB's
+    try {
+      (void)setup(key, hi);
       ADD_FAILURE() << key << ": no error";
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();

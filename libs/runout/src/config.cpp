@@ -2,11 +2,14 @@
 // RunoutCase. Defaults come from the structs of run.hpp / solver.hpp / basal_friction.hpp.
 #include "geohaz/core/config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <initializer_list>
 #include <numbers>
 #include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/runout/run.hpp"
@@ -14,6 +17,41 @@
 namespace geohaz::runout {
 
 namespace {
+
+/// Which laws read each model.* coefficient key (a key given for another law is an error; the
+/// report labels a run's coefficients from this and the keys' declarations below).
+const std::vector<std::pair<const char*, std::vector<const char*>>>& friction_key_laws() {
+  const char* const manning = ModifiedManningFriction::name;
+  const char* const voellmy = VoellmyFriction::name;
+  const char* const coulomb = CoulombFriction::name;
+  const char* const vc = VoellmyCohesionFriction::name;
+  const char* const bingham = BinghamFriction::name;
+  const char* const hb = HerschelBulkleyFriction::name;
+  const char* const oj = OBrienJulienFriction::name;
+  const char* const pf = PouliquenForterreFriction::name;
+  static const std::vector<std::pair<const char*, std::vector<const char*>>> table{{"model.n", {manning, oj}},
+                                                                                   {"model.icr", {manning}},
+                                                                                   {"model.m", {manning}},
+                                                                                   {"model.mu", {voellmy, coulomb, vc}},
+                                                                                   {"model.xi", {voellmy, vc}},
+                                                                                   {"model.cohesion", {vc}},
+                                                                                   {"model.tau_y", {bingham, hb, oj}},
+                                                                                   {"model.viscosity", {bingham, oj}},
+                                                                                   {"model.consistency", {hb}},
+                                                                                   {"model.flow_index", {hb}},
+                                                                                   {"model.laminar_k", {oj}},
+                                                                                   {"model.cv", {oj}},
+                                                                                   {"model.yield_alpha", {oj}},
+                                                                                   {"model.yield_beta", {oj}},
+                                                                                   {"model.viscosity_alpha", {oj}},
+                                                                                   {"model.viscosity_beta", {oj}},
+                                                                                   {"model.delta1", {pf}},
+                                                                                   {"model.delta2", {pf}},
+                                                                                   {"model.hstop_length", {pf}},
+                                                                                   {"model.flow_rule_beta", {pf}},
+                                                                                   {"model.flow_rule_gamma", {pf}}};
+  return table;
+}
 
 /// The friction law named in the config, with its coefficients (defaults from the law structs).
 /// Each law's keys are model.<coefficient>; a key given for a law that does not use it is an error.
@@ -31,24 +69,25 @@ BasalFriction read_friction(ConfigReader& cfg) {
   const auto deg_of = [](double t) { return std::round(std::atan(t) * 18000.0 / std::numbers::pi) / 100.0; };
   const double n = cfg.get("model.n", manning.n, Range::closed(0.005, 0.5),
                            {"s/m^(1/3)",
-                            "Manning roughness (manning; 0.02–0.1 for natural channels) or turbulent-dispersive n_td "
-                            "(obrien_julien)"});
+                            "Manning roughness n, or the turbulent-dispersive n_td of obrien_julien (manning, "
+                            "obrien_julien; 0.02–0.1 for natural channels)"});
   const double icr = cfg.get("model.icr", manning.i_cr, Range::closed(0.0, 2.0),
                              {"1", "critical slope gradient i_cr (manning; tan of the stopping angle)"});
   const double m =
       cfg.get("model.m", manning.m, Range::closed(0.0, 2.0), {"1", "exponent of |v| in the yield term (manning)"});
   const double mu = cfg.get("model.mu", voellmy.mu, Range::closed(0.0, 2.0),
-                            {"1", "Coulomb coefficient (voellmy, coulomb, voellmy_cohesion)"});
+                            {"1", "Coulomb friction coefficient μ (voellmy, coulomb, voellmy_cohesion)"});
   const double xi = cfg.get("model.xi", voellmy.xi, Range::open_closed(0.0, 1e5),
-                            {"m/s^2", "Voellmy turbulence coefficient (voellmy, voellmy_cohesion)"});
-  const double cohesion = cfg.get("model.cohesion", 0.0, Range::closed(0.0, 1e6),
-                                  {"Pa", "cohesion C of the RAMMS form (voellmy_cohesion; debris flows 0–2000)"});
+                            {"m/s^2", "Voellmy turbulence coefficient ξ (voellmy, voellmy_cohesion)"});
+  const double cohesion =
+      cfg.get("model.cohesion", 0.0, Range::closed(0.0, 1e6),
+              {"Pa", "cohesion C of the RAMMS form (voellmy_cohesion; no published range for debris, docs/runout.md)"});
   const double tau_y =
       cfg.get("model.tau_y", bingham.tau_y, Range::closed(0.0, 1e6),
-              {"Pa", "yield stress τ_y (bingham, herschel_bulkley, obrien_julien; mudflows 10^1–10^3)"});
+              {"Pa", "yield stress τ_y (bingham, herschel_bulkley, obrien_julien; mud matrices 0.1 Pa to a few kPa)"});
   const double viscosity =
       cfg.get("model.viscosity", bingham.viscosity, Range::open_closed(1e-6, 1e6),
-              {"Pa*s", "Bingham (plastic) viscosity (bingham, obrien_julien; mudflows 10^-1–10^3)"});
+              {"Pa*s", "Bingham (plastic) viscosity μ_B, η (bingham, obrien_julien; mud matrices 0.01–100)"});
   const double consistency = cfg.get("model.consistency", hb.consistency, Range::open_closed(1e-6, 1e6),
                                      {"Pa*s^n", "consistency K of τ = τ_y + K γ̇^n (herschel_bulkley)"});
   const double flow_index = cfg.get("model.flow_index", hb.flow_index, Range::closed(0.1, 2.0),
@@ -56,11 +95,12 @@ BasalFriction read_friction(ConfigReader& cfg) {
   const double laminar_k =
       cfg.get("model.laminar_k", oj.laminar_k, Range::closed(1.0, 1e5),
               {"1", "laminar resistance K of the viscous slope Kη U/(8ρ g h²) (obrien_julien; 24 smooth plane)"});
-  const double cv = cfg.get("model.cv", 0.0, Range::closed(0.0, 0.65),
-                            {"1",
-                             "volumetric sediment concentration C_v: τ_y = yield_alpha·exp(yield_beta·C_v), η = "
-                             "viscosity_alpha·exp(viscosity_beta·C_v) (obrien_julien, O'Brien & Julien 1988); 0: "
-                             "model.tau_y and model.viscosity"});
+  const double cv =
+      cfg.get("model.cv", 0.0, Range::closed(0.0, 0.65),
+              {"1",
+               "volumetric sediment concentration C_v (obrien_julien: τ_y = yield_alpha·exp(yield_beta·C_v), η = "
+               "viscosity_alpha·exp(viscosity_beta·C_v), O'Brien & Julien 1988; 0: model.tau_y and "
+               "model.viscosity)"});
   // Defaults: Aspen Pit 1 of O'Brien & Julien (1988), 0.181 dyn/cm² and 0.036 P in SI.
   const double ya = cfg.get("model.yield_alpha", 0.0181, Range::open_closed(0.0, 1e6),
                             {"Pa", "α₂ of τ_y = α₂ exp(β₂ C_v) (obrien_julien with model.cv)"});
@@ -82,7 +122,7 @@ BasalFriction read_friction(ConfigReader& cfg) {
   const double gamma = cfg.get("model.flow_rule_gamma", pf.gamma, Range::closed(0.0, 10.0),
                                {"1", "γ of the flow rule u/√(g h cos θ) = β h/h_stop − γ (pouliquen)"});
   // A coefficient the chosen law does not use is a mistake, not something to ignore silently.
-  const auto used_by = [&](const char* key, std::initializer_list<const char*> laws) {
+  const auto used_by = [&](const char* key, const std::vector<const char*>& laws) {
     if (!cfg.has(key)) return;
     for (const char* l : laws)
       if (law == l) return;
@@ -92,23 +132,8 @@ BasalFriction read_friction(ConfigReader& cfg) {
                          names + "; set model.friction or --friction)",
                      where, key);
   };
+  for (const auto& [key, laws] : friction_key_laws()) used_by(key, laws);
   const char* const vc = VoellmyCohesionFriction::name;
-  used_by("model.n", {ModifiedManningFriction::name, OBrienJulienFriction::name});
-  used_by("model.icr", {ModifiedManningFriction::name});
-  used_by("model.m", {ModifiedManningFriction::name});
-  used_by("model.mu", {VoellmyFriction::name, CoulombFriction::name, vc});
-  used_by("model.xi", {VoellmyFriction::name, vc});
-  used_by("model.cohesion", {vc});
-  used_by("model.tau_y", {BinghamFriction::name, HerschelBulkleyFriction::name, OBrienJulienFriction::name});
-  used_by("model.viscosity", {BinghamFriction::name, OBrienJulienFriction::name});
-  used_by("model.consistency", {HerschelBulkleyFriction::name});
-  used_by("model.flow_index", {HerschelBulkleyFriction::name});
-  for (const char* k : {"model.laminar_k", "model.cv", "model.yield_alpha", "model.yield_beta", "model.viscosity_alpha",
-                        "model.viscosity_beta"})
-    used_by(k, {OBrienJulienFriction::name});
-  for (const char* k :
-       {"model.delta1", "model.delta2", "model.hstop_length", "model.flow_rule_beta", "model.flow_rule_gamma"})
-    used_by(k, {PouliquenForterreFriction::name});
   if (law == vc && cohesion > 0.0 && mu > 1.0)
     throw InputError("voellmy_cohesion needs model.mu ≤ 1 with a cohesion (the RAMMS term (1 − μ) C would be negative)",
                      where, "model.mu", std::to_string(mu));
@@ -392,6 +417,30 @@ RunoutCase read_case(ConfigReader& cfg) {
   it.strong_pressure = classes[1];
   read_map_settings(cfg, o);
   return c;
+}
+
+std::vector<FrictionKey> friction_keys(std::string_view law) {
+  ConfigReader d = ConfigReader::describe();
+  (void)read_case(d);
+  const std::vector<KeyReference> refs = d.reference();
+  const std::vector<std::string> names = BasalFrictionNames::choices();
+  std::vector<FrictionKey> out;
+  for (const auto& [key, laws] : friction_key_laws()) {
+    if (std::find_if(laws.begin(), laws.end(), [&](const char* l) { return law == l; }) == laws.end()) continue;
+    const auto r = std::find_if(refs.begin(), refs.end(), [&](const KeyReference& k) { return k.key == key; });
+    if (r == refs.end()) continue;
+    // The help text is "<label> (<laws>[; notes])": the label ends where the list of laws begins.
+    std::string label = r->help;
+    for (std::size_t at = label.find(" ("); at != std::string::npos; at = label.find(" (", at + 1)) {
+      const std::string_view rest = std::string_view(label).substr(at + 2);
+      if (std::any_of(names.begin(), names.end(), [&](const std::string& n) { return rest.rfind(n, 0) == 0; })) {
+        label.resize(at);
+        break;
+      }
+    }
+    out.push_back({key, label, r->unit});
+  }
+  return out;
 }
 
 }  // namespace geohaz::runout

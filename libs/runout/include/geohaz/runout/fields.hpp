@@ -123,10 +123,25 @@ struct Leaving {
   static constexpr const char* unit = "1";
 };
 
+/// Memory of the Herschel–Bulkley step (friction/herschel_bulkley.hpp), whose Newton iteration
+/// starts from the particle's last basal state: the excess basal shear stress ζ = τ_b − τ_y of its
+/// last moving step (Pa) and the shear rate at the bed there, γ̇_b = (ζ/K)^{1/n} (1/s). Zero (no
+/// memory: a cold start) for the other laws, at rest and for new particles.
+struct BasalExcessStress {
+  using type = double;
+  static constexpr const char* label = "basal_excess_stress";
+  static constexpr const char* unit = "Pa";
+};
+struct BasalShearRate {
+  using type = double;
+  static constexpr const char* label = "basal_shear_rate";
+  static constexpr const char* unit = "1/s";
+};
+
 /// The particle store of the debris-runout model.
-using RunoutStore =
-    ParticleStore<Position<2>, Velocity<2>, ParticleId, Volume, FlowDepth, Speed, Elevation, StartElevation,
-                  StartPosition, PathLength, SurfaceGradient, SurfaceCurvature, BedCos, VerticalVelocity, MeanVelocity,
-                  HeadAcceleration, VelocityCorrection, ListPosition, Moving, Leaving>;
+using RunoutStore = ParticleStore<Position<2>, Velocity<2>, ParticleId, Volume, FlowDepth, Speed, Elevation,
+                                  StartElevation, StartPosition, PathLength, SurfaceGradient, SurfaceCurvature, BedCos,
+                                  VerticalVelocity, MeanVelocity, HeadAcceleration, VelocityCorrection, ListPosition,
+                                  Moving, Leaving, BasalExcessStress, BasalShearRate>;
 
 }  // namespace geohaz::runout

@@ -96,6 +96,19 @@ inline bool has_parameter(const BasalFriction& f, int k) noexcept {
   return std::visit([k](auto l) { return set_parameter(l, k, 1.0); }, f);
 }
 
+/// Whether a law's per-particle step memory (friction_terms.hpp, StepMemory) stays valid under the
+/// friction fields `friction` (by FrictionParameter; empty: none): Herschel–Bulkley keeps
+/// (ζ, (ζ/K)^{1/n}), which a field of K or n would make inconsistent when a particle crosses into
+/// it; the other laws keep none.
+template <class Law, class Fields>
+bool step_memory_valid(const Law& /*law*/, const Fields& /*friction*/) noexcept {
+  return true;
+}
+template <class Fields>
+bool step_memory_valid(const HerschelBulkleyFriction& /*law*/, const Fields& friction) noexcept {
+  return friction[kConsistency].empty() && friction[kFlowIndex].empty();
+}
+
 /// How the bed is eroded (docs/runout.md, "Entrainment").
 enum class EntrainmentLaw {
   None,

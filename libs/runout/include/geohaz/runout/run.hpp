@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "geohaz/core/raster.hpp"
@@ -145,6 +146,16 @@ struct RunoutCase {
 /// Does not call cfg.finish(). Relative paths are resolved against the config file's folder when
 /// they do not exist as given.
 RunoutCase read_case(ConfigReader& cfg);
+
+/// A coefficient key of a basal law as read_case declares it.
+struct FrictionKey {
+  std::string key;    ///< "model.tau_y"
+  std::string label;  ///< the key's help text up to its list of laws ("yield stress τ_y")
+  std::string unit;   ///< "Pa"
+};
+/// The model.* coefficient keys the basal law `law` (a model.friction value) reads, in
+/// declaration order; empty for an unknown law. For tools that show a run's parameters (the report).
+std::vector<FrictionKey> friction_keys(std::string_view law);
 
 /// The DSM and the release, read and checked.
 struct RunoutInputs {

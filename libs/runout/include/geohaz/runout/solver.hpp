@@ -587,6 +587,10 @@ class RunoutSolver {
     const auto& ap = store_.get<HeadAcceleration>();
     const auto& dv = store_.get<VelocityCorrection>();
     const auto& vmean = store_.get<MeanVelocity>();
+    auto& memory_stress = store_.get<BasalExcessStress>();
+    auto& memory_rate = store_.get<BasalShearRate>();
+    // An iterative law starts from the particle's last state unless the fields change what it means.
+    const bool memory = step_memory_valid(law, proc_.friction);
     const double g = p_.gravity, mix = p_.lateral_mixing;
     const bool curvature = p_.curvature;
     const bool periodic = periodic_.any();
@@ -655,6 +659,8 @@ class RunoutSolver {
       auto t = local.terms(g, std::max(g + kv, 0.0) * cos_theta, h_n, s_star, p_.density);
       if (forest && cell != SpatialProcesses::npos && proc_.forest_drag[cell] > 0.0)
         t.extra_drag = proc_.forest_drag[cell];
+      if constexpr (requires { t.memory; })
+        if (memory) t.memory = {&memory_stress[i], &memory_rate[i]};
       double s = speed_after_friction(s_star, dt, t);
       //    Erosion the particle asks for over the step (granted in entrain(), capped by the layer).
       if (erode && s > 0.0 && cell != SpatialProcesses::npos && proc_.erodible_depth[cell] > 0.0) {

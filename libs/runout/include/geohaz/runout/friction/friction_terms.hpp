@@ -19,10 +19,20 @@
 /// deceleration is evaluated at the new speed). Laws whose a_move is a polynomial of degree ≤ 2
 /// return FrictionTerms (closed-form root); the others return their own terms type with the same
 /// members `rest`, `extra_drag` and `acceleration(s)` and their own speed_after_friction overload.
+/// A terms type with a member `memory` (StepMemory) solves its step iteratively and starts from the
+/// particle's state of its last step, which the solver points it to (the store's per-particle
+/// fields); without it (null pointers, as in the unit tests) the step starts cold. The answer is
+/// the same to the iteration's tolerance either way.
 
 #include <cmath>
 
 namespace geohaz::runout {
+
+/// Where an iterative law keeps a particle's state between steps (see above); null: none.
+struct StepMemory {
+  double* stress = nullptr;  ///< a stress of the last step (Pa), 0: none
+  double* rate = nullptr;    ///< a shear rate of the last step (1/s), 0: none
+};
 
 /// Deceleration a(s) = rest + visc·s + drag·s² (m/s²), plus the drag of the surroundings
 /// (forest) added by the solver in extra_drag: a law's own shear is acceleration(s).

@@ -13,11 +13,13 @@
 /// used; the yield is at τ_b = τ_y exactly.
 ///
 /// Implicit step: s = s* − Δt τ_b/(ρ h) with s = U(τ_b), i.e. G(ζ) = U(ζ) + Δt ζ/(ρ h) − b = 0,
-/// b = s* − Δt τ_y/(ρ h) (stop when b ≤ 0). G increases with ζ; it is solved by Newton's method in
-/// ln ζ (U is close to a power of ζ at both ends) from the larger of the two asymptotic inverses
-/// (both below the root of U = b), safeguarded by bisection, to a relative 1e-12; ζ and
-/// (ζ/K)^{1/n} are updated by factors e^{−δ}, e^{−δ/n} from a Taylor polynomial once the steps δ
-/// are small (about 4 iterations and 3 libm pows per particle-step). Forest drag
+/// b = s* − Δt τ_y/(ρ h) (stop when b ≤ 0). G increases with ζ; it is solved by Halley's method
+/// in ln ζ (U is close to a power of ζ at both ends), safeguarded by Newton steps and bisection, to
+/// an estimated 1e-13 in ln ζ. The iteration starts from the particle's (ζ, (ζ/K)^{1/n}) of its last
+/// step, kept by the solver in the store (BasalExcessStress, BasalShearRate; a warm start: one or
+/// two iterations and no libm call), else from the larger of the two asymptotic inverses (both
+/// below the root of U = b; three pows). ζ and (ζ/K)^{1/n} are updated by the factors e^{−δ},
+/// e^{−δ/n} from Padé approximants while the steps are small. Forest drag
 /// (extra_drag) follows as a second implicit drag step (operator splitting).
 
 #include <algorithm>
@@ -32,6 +34,7 @@ struct HerschelBulkleyTerms {
   double rest;  ///< τ_y/(ρ h) (m/s²)
   double tau_y, consistency, n, h, rho;
   double extra_drag = 0.0;  ///< forest drag (1/m)
+  StepMemory memory{};      ///< the particle's last (ζ, (ζ/K)^{1/n}), given by the solver
 
   /// Mean speed of the steady layer at excess basal stress ζ > 0 (m/s).
   double mean_speed(double zeta) const noexcept {
@@ -39,57 +42,96 @@ struct HerschelBulkleyTerms {
     return n * h / (n + 1.0) * std::pow(zeta / consistency, 1.0 / n) * zeta *
            ((n + 1.0) / (2.0 * n + 1.0) * zeta + tau_y) / (tau * tau);
   }
-  /// e^x for |x| ≤ 1/4 by its Taylor polynomial (degree 6 for |x| < 1e-3, else 14; truncation
-  /// < 1e-20, below round-off): the Newton updates below are small, and this costs a fraction of
-  /// a libm exp.
+  /// e^x for |x| ≤ 1/4 to round-off (truncation < 5e-17 relative) without libm: its Taylor
+  /// polynomial of degree 3 for |x| < 1e-4, else the diagonal Padé approximant P_m(x)/P_m(−x) of
+  /// order m = 3 (|x| < 0.02), 4 (|x| < 0.1) or 5, whose error is about
+  /// (m!)²/((2m)! (2m + 1)!) |x|^{2m+1}. The updates of the iteration below are small, and this
+  /// costs a fraction of a libm exp.
   static double small_exp(double x) noexcept {
-    if (std::abs(x) < 1e-3)
-      return 1.0 + x * (1.0 + x * (1.0 / 2 + x * (1.0 / 6 + x * (1.0 / 24 + x * (1.0 / 120 + x * (1.0 / 720))))));
-    double p = 1.0 / 87178291200.0;  // 1/14!
-    constexpr double inv_fact[14] = {
-        1.0,        1.0,         1.0 / 2,      1.0 / 6,       1.0 / 24,       1.0 / 120,       1.0 / 720,
-        1.0 / 5040, 1.0 / 40320, 1.0 / 362880, 1.0 / 3628800, 1.0 / 39916800, 1.0 / 479001600, 1.0 / 6227020800};
-    for (int k = 13; k >= 0; --k) p = inv_fact[k] + x * p;
-    return p;
+    const double ax = std::abs(x), x2 = x * x;
+    if (ax < 1e-4) return 1.0 + x * (1.0 + x * (1.0 / 2 + x * (1.0 / 6)));
+    double even, odd;  // the even and odd parts of P_m
+    if (ax < 0.02) {
+      even = 1.0 + x2 * (1.0 / 10), odd = x * (1.0 / 2 + x2 * (1.0 / 120));
+    } else if (ax < 0.1) {
+      even = 1.0 + x2 * (3.0 / 28 + x2 * (1.0 / 1680)), odd = x * (1.0 / 2 + x2 * (1.0 / 84));
+    } else {
+      even = 1.0 + x2 * (1.0 / 9 + x2 * (1.0 / 1008)), odd = x * (1.0 / 2 + x2 * (1.0 / 72 + x2 * (1.0 / 30240)));
+    }
+    return (even + odd) / (even - odd);
   }
-  /// Root of U(ζ) + c ζ = b (b > 0, c ≥ 0): ζ and U(ζ).
+  /// Root of U(ζ) + c ζ = b (b > 0, c ≥ 0): ζ, U(ζ) and the basal shear rate (ζ/K)^{1/n}.
   struct Root {
-    double zeta, speed;
+    double zeta, speed, rate;
   };
-  Root excess_stress(double b, double c) const noexcept {
-    const double a = (n + 1.0) / (2.0 * n + 1.0), inv_n = 1.0 / n, c0 = n * h / (n + 1.0);
-    // Start at the larger asymptotic inverse: U ≈ a c0 q for ζ ≫ τ_y, U ≈ c0 q ζ/τ_y for ζ ≪ τ_y,
-    // q = (ζ/K)^{1/n}; both lie above U, so the start is below the root. Each gives q without a pow.
-    double q = b / (a * c0), zeta = consistency * std::pow(q, n);
+  /// From (ζ₀, (ζ₀/K)^{1/n}) = (zeta0, rate0) when both are > 0 (a warm start: the particle's last
+  /// step), else from the cold start below.
+  Root excess_stress(double b, double c, double zeta0 = 0.0, double rate0 = 0.0) const noexcept {
+    double zeta = zeta0, q = rate0;
+    const double u = solve(b, c, zeta, q);
+    return {zeta, u, q};
+  }
+  /// The cold start at the larger asymptotic inverse: U ≈ a c0 q for ζ ≫ τ_y, U ≈ c0 q ζ/τ_y for
+  /// ζ ≪ τ_y, q = (ζ/K)^{1/n}; both lie above U, so the start is below the root. Each gives q
+  /// without a pow. Out of line: the warm start is the common case.
+  [[gnu::noinline]] void cold_start(double b, double& zeta, double& q) const noexcept {
+    const double a = (n + 1.0) / (2.0 * n + 1.0), c0 = n * h / (n + 1.0);
+    q = b / (a * c0), zeta = consistency * std::pow(q, n);
     if (tau_y > 0.0) {
-      const double zb = std::pow(b * tau_y * std::pow(consistency, inv_n) / c0, n / (n + 1.0));
+      const double zb = std::pow(b * tau_y * std::pow(consistency, 1.0 / n) / c0, n / (n + 1.0));
       if (zb > zeta) zeta = zb, q = b * tau_y / (c0 * zb);
     }
-    // Newton in y = ln(ζ/ζ₀) (U is close to a power of ζ at both ends), bracketed.
-    const double zeta0 = zeta, q0 = q;
+  }
+  /// excess_stress in place: (zeta, q) from the start to the root; returns U at the root.
+  double solve(double b, double c, double& zeta_io, double& q_io) const noexcept {
+    const double a = (n + 1.0) / (2.0 * n + 1.0), inv_n = 1.0 / n, c0 = n * h / (n + 1.0), k1 = 1.0 + inv_n;
+    const double m = std::max(1.0, inv_n);  // |δ| m bounds both exponents of the updates
+    double zeta = zeta_io, q = q_io;
+    if (!(zeta > 0.0 && q > 0.0 && zeta < HUGE_VAL && q < HUGE_VAL)) cold_start(b, zeta, q);
+    // Halley's method in y = ln(ζ/ζ₀) (U is close to a power of ζ at both ends). With w = aζ + τ_y,
+    // τ = τ_y + ζ, f_a = aζ/w, f_z = ζ/τ and G(y) = U + cζ − b, U = c0 q f_z w/τ:
+    //   G' = U p + cζ,  G'' = U (p² + f_a (1 − f_a) − 2 f_z (1 − f_z)) + cζ,  p = 1 + 1/n + f_a − 2 f_z
+    // (p > 1/n). The step is Halley's δ = 2 G G'/(2 G'² − G G'') where that corrects Newton's G/G'
+    // by a factor in (1/2, 2), else Newton's; bisection where a large step would leave the bracket
+    // of the root. A Halley step δ leaves an error ≈ (p²/12) δ³ in ln ζ (as for U ∝ e^{p y}), a
+    // Newton step ≈ (p/2) δ²: the iteration stops when that is below 1e-13. ζ and q are updated by
+    // e^{−δ}, e^{−δ/n} from small_exp while the steps are small (libm exp else).
+    const double z0 = zeta, q0 = q;
     double y = 0.0, lo = -HUGE_VAL, hi = HUGE_VAL, u = 0.0;
     for (int it = 0; it < 60; ++it) {
-      const double tau = tau_y + zeta;
-      u = c0 * q * zeta * (a * zeta + tau_y) / (tau * tau);
-      const double gval = u + c * zeta - b;
-      (gval > 0.0 ? hi : lo) = y;
-      // dG/d ln ζ = U (1 + 1/n + aζ/(aζ + τ_y) − 2ζ/τ) + c ζ  (> 0).
-      const double slope = u * (1.0 + inv_n + a * zeta / (a * zeta + tau_y) - 2.0 * zeta / tau) + c * zeta;
-      double step = gval / slope;
-      if (!(y - step > lo && y - step < hi) && lo > -HUGE_VAL && hi < HUGE_VAL) step = y - 0.5 * (lo + hi);
-      y -= step;
-      if (std::abs(step * inv_n) <= 0.25 && std::abs(step) <= 0.25) {
-        zeta *= small_exp(-step);
-        q *= small_exp(-step * inv_n);
-      } else {
-        zeta = zeta0 * std::exp(y);
-        q = q0 * std::exp(y * inv_n);
+      const double az = a * zeta, w = az + tau_y, tau = tau_y + zeta;
+      const double iw = 1.0 / w, itau = 1.0 / tau;
+      const double fa = az * iw, fz = zeta * itau;
+      const double cz = c * zeta;
+      u = c0 * q * fz * (w * itau);
+      const double g = u + cz - b, p = k1 + fa - 2.0 * fz;
+      const double g1 = u * p + cz, g2 = u * (p * p + fa * (1.0 - fa) - 2.0 * fz * (1.0 - fz)) + cz;
+      const double den = 2.0 * g1 * g1 - g * g2;
+      const bool halley = den > g1 * g1;
+      double delta = halley ? 2.0 * g * g1 / den : g / g1;
+      const double ad = std::abs(delta);
+      if (ad * m <= 0.25) {
+        // Small step (the converging regime): updates without libm.
+        zeta *= small_exp(-delta);
+        q *= small_exp(-delta * inv_n);
+        y -= delta;
+        if (halley ? p * p * ad * ad * ad < 1.2e-12 : p * ad * ad < 2e-13) break;
+        continue;
       }
-      // Quadratic convergence: after a step δ the error is O(δ²), here < 1e-12 in ln ζ.
-      if (std::abs(step) < 1e-6) break;
+      // Large step: bracket the root with the points seen here (a valid, if loose, bracket) and
+      // bisect where the step would leave it.
+      (g > 0.0 ? hi : lo) = y;
+      if (!(y - delta > lo && y - delta < hi) && lo > -HUGE_VAL && hi < HUGE_VAL) {
+        if (hi - lo < 2e-13) break;
+        delta = y - 0.5 * (lo + hi);
+      }
+      y -= delta;
+      zeta = z0 * std::exp(y);
+      q = q0 * std::exp(y * inv_n);
     }
     const double tau = tau_y + zeta;
-    return {zeta, c0 * q * zeta * (a * zeta + tau_y) / (tau * tau)};
+    zeta_io = zeta, q_io = q;
+    return c0 * q * zeta * (a * zeta + tau_y) / (tau * tau);
   }
   /// τ_b(s)/(ρ h) of the steady layer at mean speed s.
   double acceleration(double s) const noexcept {
@@ -100,9 +142,15 @@ struct HerschelBulkleyTerms {
 /// Speed after the implicit Herschel–Bulkley step (header comment), then the forest drag.
 inline double speed_after_friction(double s_star, double dt, const HerschelBulkleyTerms& t) noexcept {
   const double b = s_star - dt * t.rest;
-  if (b <= 0.0) return 0.0;
+  double* const zeta = t.memory.stress;
+  double* const rate = t.memory.rate;
+  if (b <= 0.0) {
+    if (zeta) *zeta = *rate = 0.0;  // at rest: no memory
+    return 0.0;
+  }
   // s = U(ζ) rather than b − Δt ζ/(ρ h), which cancels as the particle comes to rest.
-  const double s = t.excess_stress(b, dt / (t.rho * t.h)).speed;
+  double z = 0.0, q = 0.0;
+  const double s = t.solve(b, dt / (t.rho * t.h), zeta ? *zeta : z, zeta ? *rate : q);
   return speed_after_drag(std::min(s, b), t.extra_drag * dt);
 }
 
