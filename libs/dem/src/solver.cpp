@@ -517,6 +517,21 @@ void DemSolver::update_wall_damping(const Law& law) {
     }
 }
 
+void DemSolver::reset_walls() {
+  // Bounding boxes of the walls grown by the largest radius: a cheap reject before the distance.
+  const std::size_t nw = walls.size();
+  wall_box_lo_.resize(nw);
+  wall_box_hi_.resize(nw);
+  for (std::size_t k = 0; k < nw; ++k) {
+    auto& wl = walls[k];
+    wl.force.setZero();
+    wl.stiffness = 0.0;
+    wl.contacts = 0;
+    wall_box_lo_[k] = wl.a.cwiseMin(wl.b) - Vec2::Constant(1.1 * rmax_);  // 10 %: radii grow while packing
+    wall_box_hi_[k] = wl.a.cwiseMax(wl.b) + Vec2::Constant(1.1 * rmax_);
+  }
+}
+
 template <class Law>
 void DemSolver::wall_forces(const Law& law) {
   const std::size_t nw = walls.size();
@@ -541,16 +556,9 @@ void DemSolver::wall_forces(const Law& law) {
   const bool frag_mass = contact.fragment_damping_mass, frag_roll = contact.fragment_rolling;
   if (frag_mass || frag_roll) update_fragments();
   if (frag_roll) roll_moment_.assign(discs.size(), 0.0);
-  // Bounding boxes of the walls grown by the largest radius: a cheap reject before the distance.
-  std::vector<Vec2> box_lo(nw), box_hi(nw);
-  for (std::size_t k = 0; k < nw; ++k) {
-    auto& wl = walls[k];
-    wl.force.setZero();
-    wl.stiffness = 0.0;
-    wl.contacts = 0;
-    box_lo[k] = wl.a.cwiseMin(wl.b) - Vec2::Constant(1.1 * rmax_);  // 10 %: radii grow while packing
-    box_hi[k] = wl.a.cwiseMax(wl.b) + Vec2::Constant(1.1 * rmax_);
-  }
+  reset_walls();
+  const auto& box_lo = wall_box_lo_;
+  const auto& box_hi = wall_box_hi_;
 #pragma omp parallel if (parallel_worth(n))
   {
     std::vector<Vec2> wf(nw, Vec2::Zero());

@@ -110,6 +110,9 @@ class DemSolver {
   template <class Law>
   void update_wall_damping(const Law& law);
   void bond_forces();
+  /// Zero the walls' force sums for this step and set their bounding boxes (grown by 1.1 R_max).
+  void reset_walls();
+  std::vector<Vec2> wall_box_lo_, wall_box_hi_;
   void update_neighbours(double max_drift);  // max_drift < 0: computed
   void reorder(std::span<const std::uint32_t> order);
   void rebuild_id_index();
