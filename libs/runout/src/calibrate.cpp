@@ -281,6 +281,45 @@ void describe_calibration(ConfigReader& cfg) {
   Keys::score(cfg, s.score);
 }
 
+namespace {
+
+/// The observed run-out along the thalweg (ob.runout_s, ob.runout_from): from the run-out point,
+/// the farthest vertex of the run-out line, or else the farthest footprint cell.
+void observed_runout(Observation& ob, const Raster& dsm, const std::vector<double>& point, const std::string& line,
+                     const std::string& src) {
+  const std::size_t cells = ob.grid.cells();
+  if (!point.empty() && !line.empty())
+    throw InputError("give the observed run-out as a point or as a line, not both", src, "observation.runout_line",
+                     line);
+  if (!point.empty()) {
+    if (point.size() != 2)
+      throw InputError("the run-out point is [x, y]", src, "observation.runout_point",
+                       std::to_string(point.size()) + " numbers");
+    const Vec2 p(point[0], point[1]);
+    if (!inside(dsm, p))
+      throw InputError("the run-out point lies outside the DSM", src, "observation.runout_point",
+                       fmt(p.x(), 10) + ", " + fmt(p.y(), 10));
+    ob.runout_s = along_thalweg(ob.thalweg, p);
+    ob.runout_from = "runout_point";
+  } else if (!line.empty()) {
+    if (!fs::exists(line)) throw InputError("run-out line file not found", src, "observation.runout_line", line);
+    ob.runout_s = 0.0;
+    for (const auto& l : read_lines(line, "", dsm.crs_wkt))
+      for (const Vec2& v : l.vertices) {
+        if (!inside(dsm, v))
+          throw InputError("the run-out line leaves the DSM (vertex " + fmt(v.x(), 10) + ", " + fmt(v.y(), 10) + ")",
+                           src, "observation.runout_line", line);
+        ob.runout_s = std::max(ob.runout_s, along_thalweg(ob.thalweg, v));
+      }
+    ob.runout_from = "runout_line";
+  } else {
+    for (std::size_t k = 0; k < cells; ++k)
+      if (ob.footprint[k]) ob.runout_s = std::max(ob.runout_s, ob.s[k]);
+  }
+}
+
+}  // namespace
+
 CalibrationSetup read_calibration(ConfigReader& cfg) {
   CalibrationSetup s;
   const std::string src = origin(cfg);
@@ -409,34 +448,7 @@ CalibrationSetup read_calibration(ConfigReader& cfg) {
     for (std::size_t k = 0; k < cells; ++k)
       ob.deposit[k] = d.is_nodata(d.data[k]) || !std::isfinite(d.data[k]) ? 0.0 : std::max(0.0, d.data[k]);
   }
-  if (!point.empty() && !line.empty())
-    throw InputError("give the observed run-out as a point or as a line, not both", src, "observation.runout_line",
-                     line);
-  if (!point.empty()) {
-    if (point.size() != 2)
-      throw InputError("the run-out point is [x, y]", src, "observation.runout_point",
-                       std::to_string(point.size()) + " numbers");
-    const Vec2 p(point[0], point[1]);
-    if (!inside(dsm, p))
-      throw InputError("the run-out point lies outside the DSM", src, "observation.runout_point",
-                       fmt(p.x(), 10) + ", " + fmt(p.y(), 10));
-    ob.runout_s = along_thalweg(ob.thalweg, p);
-    ob.runout_from = "runout_point";
-  } else if (!line.empty()) {
-    if (!fs::exists(line)) throw InputError("run-out line file not found", src, "observation.runout_line", line);
-    ob.runout_s = 0.0;
-    for (const auto& l : read_lines(line, "", dsm.crs_wkt))
-      for (const Vec2& v : l.vertices) {
-        if (!inside(dsm, v))
-          throw InputError("the run-out line leaves the DSM (vertex " + fmt(v.x(), 10) + ", " + fmt(v.y(), 10) + ")",
-                           src, "observation.runout_line", line);
-        ob.runout_s = std::max(ob.runout_s, along_thalweg(ob.thalweg, v));
-      }
-    ob.runout_from = "runout_line";
-  } else {
-    for (std::size_t k = 0; k < cells; ++k)
-      if (ob.footprint[k]) ob.runout_s = std::max(ob.runout_s, ob.s[k]);
-  }
+  observed_runout(ob, dsm, point, line, src);
   return s;
 }
 
