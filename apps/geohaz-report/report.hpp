@@ -136,7 +136,7 @@ struct Marker {
   std::string name;
   double value;
 };
-/// An SVG histogram of `values` (equal-width bins over nice limits, about √N of them, at least 5)
+/// An SVG histogram of `values` (bins of a nice width on multiples of it, at least √N and 5 of them)
 /// with the empirical CDF (right axis, 0–1) and a dashed line at each marker; the axis titled
 /// "quantity (unit)". Each bar is a <rect class="bin" data-count="…">, the root carries
 /// data-members (N).

@@ -220,7 +220,18 @@ void maps(std::ostringstream& o, RunPart& part, const fs::path& run_dir, const j
     if (f == "mean_max_depth.png" || (f.front() == 'p' && f.ends_with("_max_depth.png") && f.rfind("prob_", 0) != 0))
       depth.push_back(f);
   }
-  std::sort(prob.begin(), prob.end());
+  // In the order of the summary's products (depth, speed, pressure thresholds, intensity), else by name.
+  const json& products = s.value("products", json::array());
+  const auto product_rank = [&](const std::string& f) {
+    const std::string tif = fs::path(f).stem().string() + ".tif";
+    for (std::size_t k = 0; k < products.size(); ++k)
+      if (products[k].is_string() && products[k].get<std::string>() == tif) return k;
+    return products.size();
+  };
+  std::sort(prob.begin(), prob.end(), [&](const std::string& a, const std::string& b) {
+    const auto ra = product_rank(a), rb = product_rank(b);
+    return ra != rb ? ra < rb : a < b;
+  });
   // The mean first, then the percentiles in rising order.
   std::sort(depth.begin(), depth.end(), [](const std::string& a, const std::string& b) {
     const auto rank = [](const std::string& f) { return f[0] == 'm' ? -1.0 : std::strtod(f.c_str() + 1, nullptr); };
@@ -328,7 +339,8 @@ std::string svg_distribution(std::vector<double> v, const Quantity& q, const std
   const std::size_t n = v.size();
   double lo = n ? v.front() : 0.0, hi = n ? v.back() : 1.0;
   for (const auto& m : markers) lo = std::min(lo, m.value), hi = std::max(hi, m.value);
-  // Bins of a nice width (1, 2, 5 × 10^k), about √N of them (5 to 25), edges on multiples of it.
+  // Bins of a nice width (1, 2, 5 × 10^k), at least √N of them (at least 5, 25 × 2.5 at most), edges
+  // on multiples of it.
   const int target = std::clamp(static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n)))), 5, 25);
   if (!(hi > lo)) {  // one value (or none): a range of 10 % of it around it
     const double d = std::max(1e-9, 0.05 * std::abs(lo));
@@ -336,9 +348,9 @@ std::string svg_distribution(std::vector<double> v, const Quantity& q, const std
     hi += d;
   }
   const double raw = (hi - lo) / target, decade = std::pow(10.0, std::floor(std::log10(raw)));
-  double width = 10.0 * decade;
-  for (double m : {1.0, 2.0, 5.0})
-    if (m * decade >= raw) {
+  double width = decade;  // the largest nice width not above raw: at least `target` bins
+  for (double m : {5.0, 2.0})
+    if (m * decade <= raw) {
       width = m * decade;
       break;
     }
