@@ -164,192 +164,6 @@ std::string format_quantity(double value, const std::string& unit) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// CSV and SVG plots
-
-Csv read_csv(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("cannot open the CSV file", path.string());
-  Csv c;
-  std::string line;
-  if (!std::getline(in, line)) return c;
-  if (!line.empty() && line.back() == '\r') line.pop_back();
-  c.names = split(line, ',');
-  c.columns.assign(c.names.size(), {});
-  c.numeric.assign(c.names.size(), true);
-  while (std::getline(in, line)) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty()) continue;
-    const auto cells = split(line, ',');
-    for (std::size_t k = 0; k < c.names.size(); ++k) {
-      double v = std::numeric_limits<double>::quiet_NaN();
-      if (k < cells.size()) {
-        char* end = nullptr;
-        v = std::strtod(cells[k].c_str(), &end);
-        if (end == cells[k].c_str() || *end != '\0') {
-          v = std::numeric_limits<double>::quiet_NaN();
-          if (cells[k] != "nan" && cells[k] != "NaN") c.numeric[k] = false;
-        }
-      } else {
-        c.numeric[k] = false;
-      }
-      c.columns[k].push_back(v);
-    }
-  }
-  return c;
-}
-
-bool is_plottable(const Csv& csv) {
-  if (csv.names.size() < 2 || csv.columns.front().size() < 2) return false;
-  static const char* kAbscissae[] = {"time_s", "x_m", "s_m", "distance_m"};
-  if (std::find(std::begin(kAbscissae), std::end(kAbscissae), csv.names.front()) == std::end(kAbscissae)) return false;
-  return std::all_of(csv.numeric.begin(), csv.numeric.end(), [](bool b) { return b; });
-}
-
-namespace {
-
-/// Tick values at a nice step (1, 2, 5 × 10^k) within [lo, hi].
-std::vector<double> ticks(double lo, double hi, int n) {
-  std::vector<double> t;
-  if (!(hi > lo)) return t;
-  const double raw = (hi - lo) / n, p = std::pow(10.0, std::floor(std::log10(raw)));
-  double step = 10 * p;
-  for (double m : {1.0, 2.0, 5.0})
-    if (m * p >= raw) {
-      step = m * p;
-      break;
-    }
-  for (double k = std::ceil(lo / step - 1e-9); k * step <= hi + 1e-9 * step; k += 1) t.push_back(k * step);
-  return t;
-}
-
-std::string tick_text(double v, double span) {
-  if (std::abs(v) < 1e-12 * span) v = 0;
-  char buf[32];
-  std::snprintf(buf, sizeof buf, std::abs(v) < 1e6 ? "%.6g" : "%.4g", v);
-  return buf;
-}
-
-/// A word for the axis of a panel holding several quantities of one unit.
-std::string unit_word(const std::string& unit) {
-  static const std::pair<const char*, const char*> kWords[] = {{"m", "length"},         {"m/s", "speed"},
-                                                               {"m³", "volume"},        {"m²", "area"},
-                                                               {"s", "time"},           {"Pa", "stress"},
-                                                               {"N", "force"},          {"N/m", "force per metre"},
-                                                               {"J", "energy"},         {"J/m", "energy per metre"},
-                                                               {"m/s²", "acceleration"}};
-  for (const auto& [u, w] : kWords)
-    if (unit == u) return w;
-  return unit.empty() ? "value" : "";
-}
-
-/// Round a range out to nice ticks.
-void nice_range(double& lo, double& hi) {
-  if (!(hi > lo)) {
-    const double d = std::max(1e-9, std::abs(lo) * 0.05 + (lo == 0 ? 1 : 0));
-    lo -= d;
-    hi += d;
-  }
-  const auto t = ticks(lo, hi, 5);
-  if (t.size() >= 2) {
-    const double step = t[1] - t[0];
-    lo = std::floor(lo / step + 1e-9) * step;
-    hi = std::ceil(hi / step - 1e-9) * step;
-  }
-}
-
-constexpr const char* kLineColours[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#17becf"};
-
-}  // namespace
-
-std::string svg_plot(const Csv& csv, const std::string& title) {
-  // Panels: columns grouped by unit, in order of first appearance.
-  struct Panel {
-    std::string unit;
-    std::vector<std::size_t> cols;
-  };
-  std::vector<Panel> panels;
-  for (std::size_t k = 1; k < csv.names.size(); ++k) {
-    const std::string& n = csv.names[k];
-    if (n == "step" || (n.size() >= 3 && (n.ends_with("x_m") || n.ends_with("y_m")))) continue;
-    const auto& col = csv.columns[k];
-    if (std::all_of(col.begin(), col.end(), [](double v) { return v == 0.0 || std::isnan(v); })) continue;
-    const Quantity q = quantity_from_name(n);
-    auto it = std::find_if(panels.begin(), panels.end(), [&](const Panel& p) { return p.unit == q.unit; });
-    if (it == panels.end()) {
-      panels.push_back({q.unit, {}});
-      it = panels.end() - 1;
-    }
-    it->cols.push_back(k);
-  }
-  const int W = 760, ml = 80, mr = 200, ph = 200, gap = 50, top = 36;
-  const int H = top + static_cast<int>(std::max<std::size_t>(panels.size(), 1)) * (ph + gap) + 10;
-  const Quantity xq = quantity_from_name(csv.names.front());
-  const auto& x = csv.columns.front();
-  double x0 = *std::min_element(x.begin(), x.end()), x1 = *std::max_element(x.begin(), x.end());
-  nice_range(x0, x1);
-  std::ostringstream s;
-  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H << "\" viewBox=\"0 0 " << W
-    << ' ' << H << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
-    << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-    << "<text x=\"" << W / 2 << "\" y=\"20\" text-anchor=\"middle\" font-size=\"15\">" << escape_html(title)
-    << "</text>\n";
-  const int pw = W - ml - mr;
-  for (std::size_t p = 0; p < panels.size(); ++p) {
-    const int y0 = top + static_cast<int>(p) * (ph + gap);  // panel top
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (auto k : panels[p].cols)
-      for (double v : csv.columns[k])
-        if (std::isfinite(v)) {
-          lo = std::min(lo, v);
-          hi = std::max(hi, v);
-        }
-    if (lo > 0 && lo < 0.3 * hi) lo = 0;  // start positive quantities at zero when it costs little
-    nice_range(lo, hi);
-    auto px = [&](double v) { return ml + (v - x0) / (x1 - x0) * pw; };
-    auto py = [&](double v) { return y0 + ph - (v - lo) / (hi - lo) * ph; };
-    s << "<g>\n";
-    for (double t : ticks(x0, x1, 8)) {
-      s << "<line x1=\"" << px(t) << "\" y1=\"" << y0 << "\" x2=\"" << px(t) << "\" y2=\"" << y0 + ph
-        << "\" stroke=\"#e4e4e4\"/>";
-      s << "<text x=\"" << px(t) << "\" y=\"" << y0 + ph + 15 << "\" text-anchor=\"middle\">" << tick_text(t, x1 - x0)
-        << "</text>\n";
-    }
-    for (double t : ticks(lo, hi, 5)) {
-      s << "<line x1=\"" << ml << "\" y1=\"" << py(t) << "\" x2=\"" << ml + pw << "\" y2=\"" << py(t)
-        << "\" stroke=\"#e4e4e4\"/>";
-      s << "<text x=\"" << ml - 6 << "\" y=\"" << py(t) + 4 << "\" text-anchor=\"end\">" << tick_text(t, hi - lo)
-        << "</text>\n";
-    }
-    s << "<rect x=\"" << ml << "\" y=\"" << y0 << "\" width=\"" << pw << "\" height=\"" << ph
-      << "\" fill=\"none\" stroke=\"black\"/>\n";
-    // Axis titles: y from the panel's unit (and the quantity when alone), x from the abscissa.
-    const std::string& u = panels[p].unit;
-    std::string ytitle =
-        panels[p].cols.size() == 1 ? quantity_from_name(csv.names[panels[p].cols[0]]).label : unit_word(u);
-    ytitle += u.empty() ? "" : (ytitle.empty() ? "" : " ") + std::string("(") + u + ")";
-    s << "<text transform=\"translate(" << 18 << ',' << y0 + ph / 2 << ") rotate(-90)\" text-anchor=\"middle\">"
-      << escape_html(ytitle) << "</text>\n";
-    s << "<text x=\"" << ml + pw / 2 << "\" y=\"" << y0 + ph + 32 << "\" text-anchor=\"middle\">"
-      << escape_html(xq.label) << (xq.unit.empty() ? "" : " (" + xq.unit + ")") << "</text>\n";
-    for (std::size_t c = 0; c < panels[p].cols.size(); ++c) {
-      const auto& y = csv.columns[panels[p].cols[c]];
-      const char* colour = kLineColours[c % std::size(kLineColours)];
-      s << "<polyline fill=\"none\" stroke=\"" << colour << "\" stroke-width=\"1.6\" points=\"";
-      for (std::size_t i = 0; i < y.size(); ++i)
-        if (std::isfinite(x[i]) && std::isfinite(y[i])) s << px(x[i]) << ',' << py(y[i]) << ' ';
-      s << "\"/>\n";
-      const int ly = y0 + 12 + static_cast<int>(c) * 16;
-      s << "<line x1=\"" << ml + pw + 10 << "\" y1=\"" << ly - 4 << "\" x2=\"" << ml + pw + 30 << "\" y2=\"" << ly - 4
-        << "\" stroke=\"" << colour << "\" stroke-width=\"2\"/><text x=\"" << ml + pw + 34 << "\" y=\"" << ly << "\">"
-        << escape_html(quantity_from_name(csv.names[panels[p].cols[c]]).label) << "</text>\n";
-    }
-    s << "</g>\n";
-  }
-  s << "</svg>\n";
-  return s.str();
-}
-
-// ---------------------------------------------------------------------------------------------
 // summary.json
 
 namespace {
@@ -580,6 +394,11 @@ void flatten(const json& j, const std::string& prefix, Summary& out, std::vector
 
 }  // namespace
 
+Quantity summary_label(const std::string& key) {
+  const KeyLabel* kl = find_key(key);
+  return {kl ? kl->label : label_from_key(key).first, kl && kl->unit ? kl->unit : unit_of_key(key)};
+}
+
 Summary summarise(const json& summary) {
   Summary s;
   std::vector<Row> groups[kGroups];
@@ -781,7 +600,7 @@ struct Run {
   std::vector<Row> inputs;
   std::vector<std::pair<std::string, std::string>> plots;  // SVG file name, SVG text
   std::vector<fs::path> pngs, files;
-  CalibrationPart calibration;
+  RunPart calibration, ensemble;
 };
 
 Run read_run(const fs::path& dir, const fs::path& root) {
@@ -799,18 +618,22 @@ Run read_run(const fs::path& dir, const fs::path& root) {
   r.summary = summarise(sj);
   r.inputs = input_parameters(dir / "config.resolved.toml");
   r.calibration = calibration_part(dir, sj, fs::relative(dir, root).generic_string(), svg_prefix(r.name));
-  if (r.calibration.present) {  // the part shows the best set, its misfit and the Morris table
-    r.summary.headline = r.calibration.headline;
-    for (auto& t : r.summary.tables) t.folded = true;
-  }
+  r.ensemble = ensemble_part(dir, sj, fs::relative(dir, root).generic_string(), svg_prefix(r.name));
+  for (const RunPart* part : {&r.calibration, &r.ensemble})
+    if (part->present) {  // the part shows the key numbers and the summary's arrays its own way
+      r.summary.headline = part->headline;
+      for (auto& t : r.summary.tables) t.folded = true;
+    }
   std::vector<fs::path> csvs;
   for (const auto& e : fs::directory_iterator(dir)) {
     if (!e.is_regular_file()) continue;
     const std::string fname = e.path().filename().string();
     if (fname == "report.html" || fname == "report.pdf" || fname == kOutputManifest) continue;  // ours
     const auto ext = e.path().extension();
-    const auto& shown = r.calibration.shown;
-    if (std::find(shown.begin(), shown.end(), fname) != shown.end()) {
+    const auto shown = [&](const RunPart& p) {
+      return std::find(p.shown.begin(), p.shown.end(), fname) != p.shown.end();
+    };
+    if (shown(r.calibration) || shown(r.ensemble)) {
       r.files.push_back(e.path());
       continue;
     }
@@ -839,6 +662,16 @@ Run read_run(const fs::path& dir, const fs::path& root) {
 }
 
 }  // namespace
+
+std::string map_check_html(const fs::path& png) {
+  // A map drawn by write_quicklook_png must carry its legend, coordinate ticks and scale bar
+  // (check_map_png probes the pixels where its recorded layout puts them).
+  std::string o;
+  const auto problems = check_map_png(png);
+  if (problems.empty() || problems.front().rfind("records no map layout", 0) != 0)
+    for (const auto& m : problems) o += "<br><span class=map-problem>map check: " + escape_html(m) + "</span>";
+  return o;
+}
 
 std::string find_chromium() {
   for (const char* dir : {"/usr/bin", "/usr/local/bin", "/snap/bin"})
@@ -906,7 +739,8 @@ fs::path write_report(const fs::path& root, const std::string& title, const fs::
     for (const auto& row : r.summary.headline)
       head << "<tr><td><a href=\"#" << escape_html(r.name) << "\">" << escape_html(r.name) << "</a></td><td>"
            << escape_html(row.label) << "</td><td class=v>" << escape_html(row.value) << "</td></tr>\n";
-    body << "<section id=\"" << escape_html(r.name) << "\"><h2>" << escape_html(r.name) << "</h2>\n<div class=row>\n";
+    body << "<section id=\"" << escape_html(r.name) << "\"><h2>" << escape_html(r.name) << "</h2>\n"
+         << r.ensemble.html << "<div class=row>\n";
     for (const auto& g : r.summary.groups) {
       if (g.title == std::string(kGroupTitles[kOther])) continue;
       body << "<div><h3>" << escape_html(g.title) << "</h3>\n";
@@ -940,12 +774,7 @@ fs::path write_report(const fs::path& root, const std::string& title, const fs::
            << escape_html(fs::relative(p, root).generic_string()) << "\"><figcaption><b>"
            << escape_html(p.filename().string()) << "</b> " << escape_html(caption);
       if (stem.rfind("cracks_", 0) == 0) body << "<br>" << kCrackLegend;
-      // A map drawn by write_quicklook_png must carry its legend, coordinate ticks and scale bar
-      // (check_map_png probes the pixels where its recorded layout puts them).
-      const auto problems = check_map_png(p);
-      if (problems.empty() || problems.front().rfind("records no map layout", 0) != 0)
-        for (const auto& m : problems) body << "<br><span class=map-problem>map check: " << escape_html(m) << "</span>";
-      body << "</figcaption></figure>\n";
+      body << map_check_html(p) << "</figcaption></figure>\n";
     }
     for (const auto& [name, svg] : r.plots)
       body << "<figure><img alt=\"" << escape_html(name) << "\" src=\"report_files/" << escape_html(name)
@@ -968,7 +797,8 @@ fs::path write_report(const fs::path& root, const std::string& title, const fs::
 
   for (const auto& r : all) {
     for (const auto& [name, svg] : r.plots) write_text_file(files_dir / name, svg);
-    for (const auto& [name, svg] : r.calibration.plots) write_text_file(files_dir / name, svg);
+    for (const RunPart* part : {&r.calibration, &r.ensemble})
+      for (const auto& [name, svg] : part->plots) write_text_file(files_dir / name, svg);
   }
   std::ostringstream html;
   html << "<!DOCTYPE html>\n<html lang=en><head><meta charset=utf-8><title>" << escape_html(title)
@@ -983,7 +813,8 @@ fs::path write_report(const fs::path& root, const std::string& title, const fs::
   std::vector<std::string> written{"report.html"};
   for (const auto& r : all) {
     for (const auto& p : r.plots) written.push_back("report_files/" + p.first);
-    for (const auto& p : r.calibration.plots) written.push_back("report_files/" + p.first);
+    for (const RunPart* part : {&r.calibration, &r.ensemble})
+      for (const auto& p : part->plots) written.push_back("report_files/" + p.first);
   }
   if (!pdf.empty()) {
     print_pdf(out, pdf);

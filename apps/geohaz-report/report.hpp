@@ -42,6 +42,13 @@ Csv read_csv(const std::filesystem::path& path);
 /// lists with a text column, such as the acoustic-emission files, are left to the files).
 bool is_plottable(const Csv& csv);
 
+/// Tick values at a nice step (1, 2, 5 × 10^k) within [lo, hi], about n of them (report_plots.cpp).
+std::vector<double> nice_ticks(double lo, double hi, int n);
+/// [lo, hi] rounded out to nice ticks (widened first when empty).
+void nice_range(double& lo, double& hi);
+/// A tick's number (6 significant digits; 0 when within 1e-12 of the span).
+std::string tick_text(double v, double span);
+
 /// An SVG plot of a plottable CSV: one panel per unit of the other columns (columns sharing a unit
 /// share a panel, with a legend), axes with nice ticks and labels "quantity (unit)" from the
 /// column names. Step counters, map coordinates (…x_m, …y_m) and columns that are zero throughout
@@ -84,27 +91,65 @@ std::vector<Row> input_parameters(const std::filesystem::path& resolved_config);
 /// The text with <, >, & and " escaped for HTML.
 std::string escape_html(const std::string& s);
 
-/// A debris-runout config key in the user's terms, from the input parameter table ("model.n" →
-/// {"n Manning roughness", "s/m^(1/3)"}); {key, ""} when the table does not name it.
+/// A debris-runout, ensemble or calibration parameter key in the user's terms with its unit for
+/// display: from the declarations of the runout config reader (runout::parameter_key: "model.xi" →
+/// {"Voellmy turbulence coefficient ξ", "m/s²"}), else from the input parameter table of the other
+/// apps; {key, ""} when neither names it.
 std::pair<std::string, std::string> parameter_label(const std::string& key);
+
+/// A declared unit as a reader writes it: "kg/m^3" → "kg/m³", "m/s^2" → "m/s²", "Pa*s" → "Pa·s",
+/// "1" (dimensionless) → "".
+std::string display_unit(const std::string& declared);
 
 /// The back-analysis of a geohaz-calibrate output folder (docs/calibration.md) as a part of the
 /// page: the best set (values, search bounds, acceptable ranges, link to best.toml) and its misfit;
 /// the acceptable set as a table and its score/scatter plot (acceptable.svg); the Morris ranking;
 /// the comparison map (true positive, false positive, false negative over the hillshade) and the
 /// thalweg profile, observed against modelled width and deposit, as SVG plots.
-struct CalibrationPart {
-  bool present = false;                                    ///< whether the run folder holds a calibration
-  std::vector<Row> headline;                               ///< best score, T, and the best value of each parameter
+struct RunPart {
+  bool present = false;                                    ///< whether the run folder is of that kind
+  std::vector<Row> headline;                               ///< the numbers for the page's overview
   std::string html;                                        ///< the part (img and link paths relative to the page)
   std::vector<std::pair<std::string, std::string>> plots;  ///< SVG file name (in report_files/), SVG text
   std::vector<std::string> shown;  ///< files of the run folder the part shows (not repeated elsewhere)
 };
+using CalibrationPart = RunPart;
 /// The part of `run_dir` (whose summary.json is `summary`; empty unless its model is
 /// geohaz-calibrate). `page_dir` is run_dir relative to the page, `svg_prefix` names its plots.
 /// InputError when a table the summary lists does not read.
 CalibrationPart calibration_part(const std::filesystem::path& run_dir, const nlohmann::json& summary,
                                  const std::string& page_dir, const std::string& svg_prefix);
+
+/// The ensemble of a geohaz-ensemble output folder (docs/ensemble.md) as the top of its section
+/// (report_ensemble.cpp): an overview (members run, succeeded and failed, sampling, the largest
+/// area reached), the parameters varied with their distributions (labels and units from the
+/// declarations, parameter_label), the run-out, H/L and area P10/P50/P90 with mean, min and max
+/// as summary.json gives them; the probability maps (prob_*.png) and the mean and percentile maps
+/// of the peak depth; the run-out and H/L distributions of the successful members (members.csv)
+/// as histogram and CDF with the summary's P10/P50/P90 marked (svg_distribution). Empty unless
+/// the summary's model is geohaz-ensemble. InputError when members.csv does not read.
+RunPart ensemble_part(const std::filesystem::path& run_dir, const nlohmann::json& summary, const std::string& page_dir,
+                      const std::string& svg_prefix);
+
+/// A marked value on a distribution plot ("P50", 2608).
+struct Marker {
+  std::string name;
+  double value;
+};
+/// An SVG histogram of `values` (bins of a nice width on multiples of it, at least √N and 5 of them)
+/// with the empirical CDF (right axis, 0–1) and a dashed line at each marker; the axis titled
+/// "quantity (unit)". Each bar is a <rect class="bin" data-count="…">, the root carries
+/// data-members (N).
+std::string svg_distribution(std::vector<double> values, const Quantity& quantity, const std::vector<Marker>& markers,
+                             const std::string& title);
+
+/// The label and unit a summary.json key gets in the key-number tables: the label table's label
+/// (else words from the name) and the unit from the key's name (report.cpp).
+Quantity summary_label(const std::string& key);
+
+/// The red "map check" lines under a map drawn by write_quicklook_png that lacks its legend,
+/// ticks or scale bar ("" when it has them or is not such a map).
+std::string map_check_html(const std::filesystem::path& png);
 
 /// Write RESULTS/report.html and RESULTS/report_files/*.svg from every run folder (RESULTS itself
 /// or a sub-folder, up to two levels deep, holding a summary.json); with `pdf` not empty, print

@@ -59,7 +59,7 @@ double number(const std::string& s) {
   return end == s.c_str() ? std::nan("") : v;
 }
 
-/// "n Manning roughness (s/m^(1/3))", the key itself when the input table does not name it.
+/// "Manning roughness n (s/m^(1/3))", the key itself when no declaration names it.
 std::string parameter_heading(const std::string& key) {
   const auto [label, unit] = parameter_label(key);
   return unit.empty() ? label : label + " (" + unit + ")";

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "geohaz/core/errors.hpp"
+#include "geohaz/runout/ensemble.hpp"
 #include "geohaz/runout/run.hpp"
 #include "report.hpp"
 
@@ -17,13 +18,11 @@ namespace geohaz::report {
 
 namespace {
 
-/// A config key in the user's terms. `when` = "key=value" limits it to runs where another key has
-/// that value (the friction law's own coefficients).
+/// A config key of sph-slope or dem-avalanche in the user's terms.
 struct ParamLabel {
   const char* key;  ///< TOML path; "material[]." for each table of the [[material]] array
   const char* label;
   const char* unit;
-  const char* when = nullptr;
 };
 
 const ParamLabel kParams[] = {
@@ -40,18 +39,7 @@ const ParamLabel kParams[] = {
     {"earthquake.amplitude", "earthquake amplitude", "m/s²"},
     {"earthquake.frequency", "earthquake frequency", "Hz"},
     {"earthquake.duration", "earthquake duration", "s"},
-    // debris-runout
-    {"model.friction", "basal friction law", ""},
-    {"model.density", "ρ flow density", "kg/m³"},
-    {"model.n", "n Manning roughness", "s/m^(1/3)", "model.friction=manning"},
-    {"model.icr", "i_cr critical slope", "", "model.friction=manning"},
-    {"model.m", "m speed exponent of the yield term", "", "model.friction=manning"},
-    {"model.mu", "μ Coulomb friction coefficient", "", "model.friction=voellmy"},
-    {"model.mu", "μ Coulomb friction coefficient", "", "model.friction=coulomb"},
-    {"model.xi", "ξ Voellmy turbulence coefficient", "m/s²", "model.friction=voellmy"},
-    {"release.from", "release from", ""},
-    {"release.file", "release polygons", ""},
-    {"run.duration", "longest simulated time", "s"},
+    // debris-runout: labels and units from the runout config reader's declarations (kRunoutKeys)
     // dem-avalanche
     {"test", "test", ""},
     {"material.density", "ρ rock density", "kg/m³"},
@@ -66,6 +54,11 @@ const ParamLabel kParams[] = {
     {"biaxial.confining_stresses", "σ3 confining stresses", "Pa"},
     {"avalanche.runout_time", "simulated time after release", "s"},
 };
+
+/// The debris-runout keys shown besides the friction law's own coefficients (labels and units
+/// from runout::case_key: the config reader's declarations, not a table here).
+constexpr const char* kRunoutKeys[] = {"model.friction", "model.density", "release.from", "release.file",
+                                       "run.duration"};
 
 std::string toml_value_text(const toml::node& n, const std::string& unit) {
   if (const auto* v = n.as_floating_point()) return format_quantity(v->get(), unit);
@@ -92,16 +85,9 @@ std::vector<Row> input_parameters(const fs::path& resolved_config) {
     throw InputError(std::string("config.resolved.toml does not parse: ") + std::string(e.description()),
                      resolved_config.string());
   }
-  const auto holds = [&](const char* when) {
-    if (!when) return true;
-    const std::string w = when;
-    const auto eq = w.find('=');
-    const auto n = t.at_path(w.substr(0, eq));
-    return n && n.value<std::string>() == w.substr(eq + 1);
-  };
+
   bool materials_done = false;
   for (const auto& p : kParams) {
-    if (!holds(p.when)) continue;
     const std::string key = p.key;
     if (key.rfind("material[].", 0) == 0) {
       // Each material's parameters together, in the table's order.
@@ -125,23 +111,39 @@ std::vector<Row> input_parameters(const fs::path& resolved_config) {
     const std::string v = toml_value_text(*n.node(), p.unit);
     if (!v.empty()) rows.push_back({key, p.label, v});
   }
-  // The debris-runout law's coefficients not labelled above (the rheologies of issue 34): label
-  // and unit from the law's key declarations in the runout config reader, not a second table here.
-  if (const auto law = t.at_path("model.friction").value<std::string>())
-    for (const runout::FrictionKey& k : runout::friction_keys(*law)) {
-      if (std::any_of(rows.begin(), rows.end(), [&](const Row& r) { return r.key == k.key; })) continue;
+  // A debris-runout config (it names its basal law): a few general keys and the law's own
+  // coefficients, label and unit from the runout config reader's declarations.
+  if (const auto law = t.at_path("model.friction").value<std::string>()) {
+    std::vector<runout::FrictionKey> keys;
+    for (const char* key : kRunoutKeys)
+      if (const auto k = runout::case_key(key)) keys.push_back(*k);
+    for (const runout::FrictionKey& k : runout::friction_keys(*law)) keys.push_back(k);
+    for (const runout::FrictionKey& k : keys) {
       const auto n = t.at_path(k.key);
       if (!n) continue;
-      const std::string v = toml_value_text(*n.node(), k.unit);
+      const std::string v = toml_value_text(*n.node(), display_unit(k.unit));
       if (!v.empty()) rows.push_back({k.key, k.label, v});
     }
+  }
   return rows;
 }
 
 std::pair<std::string, std::string> parameter_label(const std::string& key) {
+  if (const auto k = runout::parameter_key(key)) return {k->label, display_unit(k->unit)};
   for (const auto& p : kParams)
     if (key == p.key) return {p.label, p.unit};
   return {key, ""};
+}
+
+std::string display_unit(const std::string& declared) {
+  if (declared == "1") return "";
+  static const std::pair<const char*, const char*> kShown[] = {
+      {"^2", "²"}, {"^3", "³"}, {"^-1", "⁻¹"}, {"*", "·"}, {"deg", "°"}};
+  std::string u = declared;
+  for (const auto& [from, to] : kShown)
+    for (std::size_t at = u.find(from); at != std::string::npos; at = u.find(from, at + std::string(to).size()))
+      u.replace(at, std::string(from).size(), to);
+  return u;
 }
 
 }  // namespace geohaz::report

@@ -143,7 +143,7 @@ TEST(ReportInputs, ParametersInTheUsersTermsForTheChosenLawOnly) {
   const auto r = input_parameters(d / "runout.toml");
   const Row* n = find_row(r, "model.n");
   ASSERT_NE(n, nullptr);
-  EXPECT_EQ(n->label, "n Manning roughness");
+  EXPECT_EQ(n->label, "Manning roughness n");  // the declaration's help text up to its laws
   EXPECT_EQ(n->value, "0.06 s/m^(1/3)");
   EXPECT_NE(find_row(r, "model.icr"), nullptr);
   EXPECT_EQ(find_row(r, "model.mu"), nullptr);  // Voellmy's coefficients do not apply to Manning
@@ -160,7 +160,7 @@ TEST(ReportInputs, ParametersInTheUsersTermsForTheChosenLawOnly) {
   const Row* k = find_row(h, "model.consistency");
   ASSERT_NE(k, nullptr);
   EXPECT_EQ(k->label, "consistency K of τ = τ_y + K γ̇^n");
-  EXPECT_NE(k->value.find("Pa*s^n"), std::string::npos) << k->value;
+  EXPECT_NE(k->value.find("Pa·s^n"), std::string::npos) << k->value;  // declared "Pa*s^n"
   EXPECT_NE(find_row(h, "model.flow_index"), nullptr);
   EXPECT_EQ(find_row(h, "model.n"), nullptr);  // Manning's n is not a Herschel–Bulkley coefficient
   write_file(d / "pf.toml", "[model]\nfriction = 'pouliquen'\ndelta1 = 20.9\nhstop_length = 0.00065\n");
@@ -212,7 +212,7 @@ TEST(ReportCalibration, BestSetAcceptableSetMorrisMapAndProfileFromACalibrationF
   ASSERT_EQ(p.headline.size(), 4u);
   EXPECT_EQ(p.headline[0].value, "0.1514");
   EXPECT_EQ(p.headline[1].value, "0.9931");
-  EXPECT_EQ(p.headline[2].label, "calibration: best n Manning roughness");
+  EXPECT_EQ(p.headline[2].label, "calibration: best Manning roughness n");
   EXPECT_EQ(p.headline[2].value, "0.0517 s/m^(1/3)");
   // The best set: values, search boxes, acceptable ranges; the config ready to run.
   const std::string best = table_of(p.html, "calibration-best");
@@ -231,7 +231,7 @@ TEST(ReportCalibration, BestSetAcceptableSetMorrisMapAndProfileFromACalibrationF
   EXPECT_NE(p.html.find("the best 20 shown"), std::string::npos);
   // Morris: ranked by μ*, bars proportional to μ* (120 px for the largest).
   const std::string morris = table_of(p.html, "calibration-morris");
-  EXPECT_LT(morris.find("i_cr critical slope"), morris.find("n Manning roughness"));
+  EXPECT_LT(morris.find("critical slope gradient i_cr"), morris.find("Manning roughness n"));
   EXPECT_NE(morris.find("width:120px"), std::string::npos);
   EXPECT_NE(morris.find("width:6px"), std::string::npos);  // 120 × 0.17 / 3.66 = 5.6
   // The comparison map in three colours, the score plot, the thalweg profiles.

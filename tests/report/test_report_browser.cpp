@@ -5,7 +5,9 @@
 // attributes); --dump-dom prints the DOM after load, so the test reads the marks there. Chromium's
 // own log (--enable-logging=stderr) must hold no console message. A screenshot is taken and must
 // show the page. As a control, one picture is then deleted and the page must report it.
-// A geohaz-calibrate folder's back-analysis part is checked the same way.
+// A geohaz-calibrate folder's back-analysis part is checked the same way, and a geohaz-ensemble
+// folder made by the app on a small case (its overview, maps and distributions, the percentiles
+// recomputed from its members.csv).
 // Skipped (with a message) only when no chromium is installed; scripts/setup installs it.
 #include <gtest/gtest.h>
 
@@ -14,13 +16,20 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "calibration_results.hpp"
+#ifdef GEOHAZ_ENSEMBLE_EXE
+#include "ensemble_case.hpp"
+#endif
 #include "geohaz/core/app.hpp"
+#include "geohaz/core/config.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
 #include "geohaz/core/raster_extra.hpp"
+#include "geohaz/runout/run.hpp"
 #include "report.hpp"
 #include "run_command.hpp"
 
@@ -139,7 +148,7 @@ TEST(ReportInBrowser, EveryImageDecodesWithoutErrorsAndTheScreenshotShowsThePage
   EXPECT_TRUE(fs::exists(results / "report_files" / "1-runout_series.svg"));
   EXPECT_TRUE(fs::exists(results / "report_files" / "1-runout_barrier_forces.svg"));
   EXPECT_TRUE(fs::exists(results / "report_files" / "2-rock-biaxial_curve_sigma3_5MPa.svg"));
-  EXPECT_NE(html.find("μ Coulomb friction coefficient"), std::string::npos);
+  EXPECT_NE(html.find("Coulomb friction coefficient μ"), std::string::npos);
   EXPECT_NE(html.find("barrier peak force"), std::string::npos);    // an unknown key still shows
   EXPECT_EQ(html.find("http://"), html.find("http://www.w3.org"));  // no network (SVG namespace only)
   EXPECT_EQ(html.find("https://"), std::string::npos);
@@ -281,7 +290,7 @@ TEST(ReportInBrowser, CalibrationShowsBestSetAcceptableSetMorrisMapAndProfile) {
   }
   // The overview carries the best set; nothing is shown twice (the map and the profile CSV are
   // the part's, not repeated by the generic pictures and plots).
-  EXPECT_NE(html.find("calibration: best i_cr critical slope</td><td class=v>0.1707"), std::string::npos);
+  EXPECT_NE(html.find("calibration: best critical slope gradient i_cr</td><td class=v>0.1707"), std::string::npos);
   std::size_t images = 0;
   for (auto p = html.find("<img"); p != std::string::npos; p = html.find("<img", p + 1)) ++images;
   EXPECT_EQ(images, 4u);
@@ -388,3 +397,159 @@ TEST(ReportInRunFolder, NamesTheRunAfterItsFolderAndTheNextRunAcceptsTheFolder) 
   std::error_code ec;
   fs::remove_all(root, ec);
 }
+
+#ifdef GEOHAZ_ENSEMBLE_EXE
+namespace {
+
+/// The numbers of a members.csv column over the members with status ok (the test's own reading:
+/// no quoted cell before the columns it reads).
+std::vector<double> ok_column(const fs::path& csv, const std::string& name) {
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> head;
+  std::stringstream hs(line);
+  for (std::string c; std::getline(hs, c, ',');) head.push_back(c);
+  const auto col = static_cast<std::size_t>(std::find(head.begin(), head.end(), name) - head.begin());
+  const auto st = static_cast<std::size_t>(std::find(head.begin(), head.end(), "status") - head.begin());
+  std::vector<double> v;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::stringstream ls(line);
+    for (std::string c; std::getline(ls, c, ',');) cells.push_back(c);
+    if (cells.size() > std::max(col, st) && cells[st] == "ok") v.push_back(std::stod(cells[col]));
+  }
+  return v;
+}
+
+/// The number in data-value of the page's cell data-key="KEY" (NaN when absent).
+double page_value(const std::string& html, const std::string& key) {
+  const std::string k = "data-key=\"" + key + "\" data-value=\"";
+  const auto at = html.find(k);
+  return at == std::string::npos ? std::nan("") : std::stod(html.substr(at + k.size()));
+}
+
+/// The text of the page's cell data-key="KEY".
+std::string page_text(const std::string& html, const std::string& key) {
+  const auto at = html.find("data-key=\"" + key + "\"");
+  if (at == std::string::npos) return "";
+  const auto open = html.find('>', at) + 1;
+  return html.substr(open, html.find('<', open) - open);
+}
+
+}  // namespace
+
+// Issue #33 item 4: the ensemble's section draws the ensemble. A real geohaz-ensemble folder (the
+// one-particle case of tests/runout/ensemble_case.hpp: 7 Monte Carlo members, one failing on
+// purpose, μ uniform, the density fixed) → geohaz-report → Chromium.
+TEST(ReportInBrowser, EnsembleSectionDrawsMapsAndDistributionsOfTheMembers) {
+  const fs::path root = fs::temp_directory_path() /
+                        ("geohaz_report_ens_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+  fs::remove_all(root);
+  const fs::path work = root / "case", results = root / "results", out = results / "ens";
+  fs::create_directories(work);
+  ensemble_case::make_case(work);
+  ensemble_case::write_ensemble(work / "ens.toml", 7, "monte_carlo", "inject_failure = [2]",
+                                "[[ensemble.parameter]]\nkey = \"model.density\"\ndistribution = \"fixed\"\n"
+                                "value = 2000.0\n");
+  const auto ens = run_command(std::string("'") + GEOHAZ_ENSEMBLE_EXE + "' '" + (work / "ens.toml").string() +
+                               "' --threads 1 --quiet --out '" + out.string() + "'");
+  ASSERT_EQ(ens.code, 0) << ens.output;
+  const auto gen = run_command(std::string("'") + GEOHAZ_REPORT_EXE + "' '" + results.string() + "'");
+  ASSERT_EQ(gen.code, 0) << gen.output;
+  const std::string html = slurp(results / "report.html");
+  const auto section = html.find("<section id=\"ens\">");
+  ASSERT_NE(section, std::string::npos);
+  // In reading order: the overview, the parameters, the percentiles, the probability maps (every
+  // one), the mean and percentile maps, the two distributions.
+  std::size_t at = section;
+  for (const char* part :
+       {"<div class=ensemble>", "<table class=ensemble-overview>", "members that failed</td><td class=v>1",
+        "<table class=ensemble-parameters>", "<table class=ensemble-stats>", "src=\"ens/prob_max_depth_gt_1e-06m.png\"",
+        "src=\"ens/prob_max_pressure_gt_1000Pa.png\"", "src=\"ens/prob_intensity_ge_2.png\"",
+        "src=\"ens/mean_max_depth.png\"", "src=\"ens/p10_max_depth.png\"", "src=\"ens/p50_max_depth.png\"",
+        "src=\"ens/p90_max_depth.png\"", "src=\"report_files/ens_runout_m_distribution.svg\"",
+        "src=\"report_files/ens_H_over_L_distribution.svg\"", "</section>"}) {
+    const auto next = html.find(part, at);
+    EXPECT_NE(next, std::string::npos) << part;
+    if (next != std::string::npos) at = next;
+  }
+  std::size_t images = 0;
+  for (auto p = html.find("<img"); p != std::string::npos; p = html.find("<img", p + 1)) ++images;
+  EXPECT_EQ(images, 3u + 4u + 2u);  // no picture shown twice
+
+  // P10/P50/P90 in the page = the nearest-rank percentiles of the members' CSV, recomputed here.
+  const auto nearest_rank = [](std::vector<double> v, double q) {
+    std::sort(v.begin(), v.end());
+    const auto k = static_cast<std::size_t>(std::ceil(q / 100.0 * static_cast<double>(v.size()) - 1e-9));
+    return v[std::max<std::size_t>(k, 1) - 1];
+  };
+  for (const auto& [column, key, unit] :
+       {std::tuple<const char*, const char*, const char*>{"runout_m", "runout_length_along_path_m", "m"},
+        {"H_over_L", "fahrboeschung_ratio_H_over_L", ""}}) {
+    const std::vector<double> v = ok_column(out / "members.csv", column);
+    ASSERT_EQ(v.size(), 6u) << column;
+    std::vector<double> sorted = v;
+    std::sort(sorted.begin(), sorted.end());
+    ASSERT_LT(sorted[0], sorted[1]) << column;  // an interpolating P10 would differ from the nearest rank
+    for (const double q : {10.0, 50.0, 90.0}) {
+      const std::string k = std::string(key) + ".p" + std::to_string(static_cast<int>(q));
+      const double want = nearest_rank(v, q);
+      EXPECT_NEAR(page_value(html, k), want, 1e-8 * std::max(1.0, std::abs(want))) << k;
+      EXPECT_EQ(page_text(html, k), geohaz::report::format_quantity(want, unit)) << k;
+    }
+    // The histogram counts every member that ran once; P10, P50, P90 marked.
+    const std::string svg = slurp(results / "report_files" / (std::string("ens_") + column + "_distribution.svg"));
+    int total = 0;
+    for (auto p = svg.find(" data-count=\""); p != std::string::npos; p = svg.find(" data-count=\"", p + 1))
+      total += std::stoi(svg.substr(p + 13));
+    EXPECT_EQ(total, 6) << column;
+    EXPECT_NE(svg.find("data-members=\"6\""), std::string::npos);
+    std::size_t markers = 0;
+    for (auto p = svg.find("class=\"marker\""); p != std::string::npos; p = svg.find("class=\"marker\"", p + 1))
+      ++markers;
+    EXPECT_EQ(markers, 3u) << column;
+  }
+  // The parameters' labels and units are the config reader's declarations (read here from it).
+  geohaz::ConfigReader d = geohaz::ConfigReader::describe();
+  (void)geohaz::runout::read_case(d);
+  for (const auto& r : d.reference())
+    if (r.key == "model.density" || r.key == "model.mu") {
+      const auto row = html.find("<td title=\"" + r.key + "\">");
+      ASSERT_NE(row, std::string::npos) << r.key;
+      const auto label_end = html.find("</td>", row);
+      const std::string label = html.substr(html.find('>', row) + 1, label_end - html.find('>', row) - 1);
+      EXPECT_EQ(r.help.rfind(label, 0), 0u) << label << " | " << r.help;
+      const std::string unit_cell = "<td class=unit>" + geohaz::report::display_unit(r.unit) + "</td>";
+      EXPECT_EQ(html.find(unit_cell, label_end), label_end + 5) << r.key << " " << r.unit;
+    }
+
+  const std::string chromium = find_chromium();
+  if (chromium.empty()) GTEST_SKIP() << "chromium is not installed (scripts/setup installs the Debian package)";
+  const fs::path shot = root / "ensemble.png";
+  const auto dom = run_command("DBUS_SESSION_BUS_ADDRESS=disabled: '" + chromium +
+                               "' --headless --no-sandbox --disable-gpu --hide-scrollbars --user-data-dir='" +
+                               (root / "profile").string() +
+                               "' --virtual-time-budget=10000 --enable-logging=stderr --v=0 --window-size=1280,2400 "
+                               "--dump-dom --screenshot='" +
+                               shot.string() + "' 'file://" + (results / "report.html").string() + "'");
+  ASSERT_EQ(dom.code, 0) << dom.output;
+  EXPECT_EQ(page_mark(dom.output, "data-images"), static_cast<int>(images)) << dom.output;
+  EXPECT_EQ(page_mark(dom.output, "data-decoded"), static_cast<int>(images)) << dom.output;
+  EXPECT_EQ(page_mark(dom.output, "data-errors"), 0) << dom.output;
+  EXPECT_EQ(page_mark(dom.output, "data-map-problems"), 0) << dom.output;
+  EXPECT_EQ(dom.output.find(":CONSOLE"), std::string::npos) << dom.output;
+  // The screenshot shows the section: its text and the first map's hillshade.
+  const geohaz::Image img = geohaz::read_image(shot);
+  int dark = 0, mid_grey = 0;
+  for (std::size_t i = 0; i < img.rgb.size(); i += 3) {
+    const int r = img.rgb[i], g = img.rgb[i + 1], b = img.rgb[i + 2];
+    dark += r < 60 && g < 60 && b < 60;
+    mid_grey += r == g && g == b && r > 80 && r < 200;
+  }
+  EXPECT_GT(dark, 2000);
+  EXPECT_GT(mid_grey, 2000);
+  std::error_code ec;
+  fs::remove_all(root, ec);
+}
+#endif

@@ -69,8 +69,8 @@ BasalFriction read_friction(ConfigReader& cfg) {
   const auto deg_of = [](double t) { return std::round(std::atan(t) * 18000.0 / std::numbers::pi) / 100.0; };
   const double n = cfg.get("model.n", manning.n, Range::closed(0.005, 0.5),
                            {"s/m^(1/3)",
-                            "Manning roughness n, or the turbulent-dispersive n_td of obrien_julien (manning, "
-                            "obrien_julien; 0.02–0.1 for natural channels)"});
+                            "Manning roughness n (manning, obrien_julien: there the turbulent-dispersive n_td; "
+                            "0.02–0.1 for natural channels)"});
   const double icr = cfg.get("model.icr", manning.i_cr, Range::closed(0.0, 2.0),
                              {"1", "critical slope gradient i_cr (manning; tan of the stopping angle)"});
   const double m =

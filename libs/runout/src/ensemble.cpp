@@ -551,6 +551,9 @@ EnsembleSetup read_ensemble(ConfigReader& cfg) {
     s.base_resolved = base.resolved();
     s.dsm = c.dsm;
     a.intensity = c.output.intensity;
+    a.map_depth_classes = c.output.map_depth_classes;
+    a.map_margin = c.output.map_margin;
+    a.attribution = c.output.attribution;
   }
   s.values = sample_plan(plan);
   for (int i = 0; i < plan.members; ++i) {
@@ -661,64 +664,130 @@ double sample_quantile(const std::vector<double>& sorted, double q) {
   return sorted[std::min(n, k) - 1];
 }
 
-std::string xml_escape(const std::string& s) {
-  std::string o;
-  for (char c : s) o += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : std::string(1, c);
-  return o;
-}
-
-/// Histogram and empirical CDF of a sample as an SVG plot.
-void write_distribution_svg(const fs::path& path, std::vector<double> v, const std::string& label,
-                            const std::string& title) {
-  std::sort(v.begin(), v.end());
-  const double W = 640, H = 400, ml = 60, mr = 60, mt = 40, mb = 50;
-  const double pw = W - ml - mr, ph = H - mt - mb;
-  std::ostringstream s;
-  s << std::setprecision(6);
-  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H
-    << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  s << "<text x=\"" << W / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"14\">" << xml_escape(title)
-    << " (N = " << v.size() << ")</text>\n";
-  if (!v.empty()) {
-    double lo = v.front(), hi = v.back();
-    if (!(hi > lo)) lo -= 0.5 * std::max(1e-9, std::abs(lo)), hi += 0.5 * std::max(1e-9, std::abs(hi));
-    const int nb = std::clamp(static_cast<int>(std::sqrt(static_cast<double>(v.size()))), 5, 40);
-    std::vector<int> cnt(static_cast<std::size_t>(nb), 0);
-    for (double x : v) cnt[static_cast<std::size_t>(std::min(nb - 1, static_cast<int>((x - lo) / (hi - lo) * nb)))]++;
-    const int cmax = *std::max_element(cnt.begin(), cnt.end());
-    const auto X = [&](double x) { return ml + (x - lo) / (hi - lo) * pw; };
-    for (int b = 0; b < nb; ++b) {
-      const double bh = ph * cnt[static_cast<std::size_t>(b)] / cmax;
-      s << "<rect x=\"" << ml + b * pw / nb << "\" y=\"" << mt + ph - bh << "\" width=\"" << pw / nb * 0.95
-        << "\" height=\"" << bh << "\" fill=\"#9ecae1\" stroke=\"#3182bd\"/>\n";
-    }
-    s << "<polyline fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\" points=\"";
-    for (std::size_t k = 0; k < v.size(); ++k) {
-      const double y0 = mt + ph * (1.0 - static_cast<double>(k) / v.size());
-      const double y1 = mt + ph * (1.0 - static_cast<double>(k + 1) / v.size());
-      s << X(v[k]) << ',' << y0 << ' ' << X(v[k]) << ',' << y1 << ' ';
-    }
-    s << "\"/>\n";
-    for (int t = 0; t <= 4; ++t) {
-      const double x = lo + t * (hi - lo) / 4;
-      s << "<text x=\"" << X(x) << "\" y=\"" << mt + ph + 18 << "\" text-anchor=\"middle\">" << fmt(x, 4)
-        << "</text>\n";
-      s << "<text x=\"" << W - mr + 6 << "\" y=\"" << mt + ph * (1 - t / 4.0) + 4 << "\">" << t * 25 << " %</text>\n";
-    }
-    s << "<text x=\"" << 12 << "\" y=\"" << mt + ph / 2 << "\" transform=\"rotate(-90 12 " << mt + ph / 2
-      << ")\" text-anchor=\"middle\">members per bin (bars; max " << cmax << ")</text>\n";
-  }
-  s << "<rect x=\"" << ml << "\" y=\"" << mt << "\" width=\"" << pw << "\" height=\"" << ph
-    << "\" fill=\"none\" stroke=\"black\"/>\n";
-  s << "<text x=\"" << ml + pw / 2 << "\" y=\"" << H - 10 << "\" text-anchor=\"middle\">" << xml_escape(label)
-    << "; red: empirical CDF (right axis)</text>\n</svg>\n";
-  write_text_file(path, s.str());
-}
-
 std::string threshold_name(double t) {
   std::ostringstream o;
   o << t;
   return o.str();
+}
+
+/// The product rasters on the DSM grid with description, unit, nodata and a QGIS style beside
+/// each, and the maps for the report (docs/ensemble.md "Products"). Returns the GeoTIFFs' names.
+std::vector<std::string> write_products(const AggregationSettings& a, const EnsembleAggregator& agg, const Raster& dsm,
+                                        const fs::path& out) {
+  std::vector<std::string> products;
+  const std::vector<double> probability_classes{0.1, 0.3, 0.5, 0.7, 0.9};
+  const auto put = [&](const std::string& name, const std::vector<double>& v, const std::string& description,
+                       const std::string& unit, ColourRamp ramp, const std::vector<double>& breaks) {
+    Raster r = dsm.like(0.0, -9999.0);
+    double vmax = 0.0;
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      r.data[k] = dsm.is_nodata(dsm.data[k]) ? -9999.0 : v[k];
+      if (r.data[k] != -9999.0) vmax = std::max(vmax, r.data[k]);
+    }
+    r.description = description;
+    r.unit = unit;
+    write_geotiff(out / (name + ".tif"), r);
+    if (!breaks.empty())  // the classes and colours of its map
+      write_qgis_classed_style(out / (name + ".qml"), ramp, breaks, unit, 0.0);
+    else
+      write_qgis_ramp_style(out / (name + ".qml"), ramp, 0.0, vmax > 0.0 ? vmax : 1.0, unit, 0.0);
+    products.push_back(name + ".tif");
+    return r;
+  };
+  const std::string of_n = " over " + std::to_string(agg.members()) + " members";
+  struct Map {
+    std::string name, title, unit;
+    Raster raster;
+  };
+  std::vector<Map> maps;  // drawn below, every one on the same extent
+  const auto prob = [&](int field, double t, const std::string& name, std::string what) {
+    Raster r = put(name, agg.exceedance(field, t), what + of_n, "1", ColourRamp::Viridis, probability_classes);
+    for (std::size_t k; (k = what.find(" >= ")) != std::string::npos;) what.replace(k, 4, " \u2265 ");
+    maps.push_back({name, what, "", std::move(r)});
+  };
+  for (double t : a.depth_thresholds)
+    prob(0, t, "prob_max_depth_gt_" + threshold_name(t) + "m", "probability peak depth > " + threshold_name(t) + " m");
+  for (double t : a.speed_thresholds)
+    prob(1, t, "prob_max_speed_gt_" + threshold_name(t) + "m_per_s",
+         "probability peak speed > " + threshold_name(t) + " m/s");
+  for (double t : a.pressure_thresholds)
+    prob(2, t, "prob_max_pressure_gt_" + threshold_name(t) + "Pa",
+         "probability peak pressure > " + threshold_name(t) + " Pa");
+  for (int k : a.intensity_classes)
+    prob(3, k, "prob_intensity_ge_" + std::to_string(k),
+         "probability intensity class >= " + std::to_string(k) + " (" + to_string(a.intensity.scheme) + ")");
+  Raster any_reached;  // the sum of the members' peak depths (N × the mean)
+  for (int f = 0; f < 3; ++f) {
+    const ColourRamp ramp = f == 0 ? ColourRamp::Viridis : ColourRamp::Magma;
+    const std::vector<double> none, &breaks = f == 0 ? a.map_depth_classes : none;
+    Raster mean = put(std::string("mean_") + kFieldNames[f], agg.mean(f),
+                      std::string("mean ") + kFieldDescriptions[f] + of_n, kFieldUnits[f], ramp, breaks);
+    if (f == 0) {
+      any_reached = mean;
+      for (double& v : any_reached.data) v = v == -9999.0 ? v : v * agg.members();
+      maps.push_back({"mean_max_depth", "mean peak flow depth" + of_n, "m", std::move(mean)});
+    }
+    for (double q : a.percentiles) {
+      std::string name = "p";  // built step by step: GCC 12 warns (-Wrestrict, a false positive) on "p" + string
+      name += threshold_name(q);
+      name += '_';
+      name += kFieldNames[f];
+      Raster pr =
+          put(name, agg.percentile(f, q),
+              "percentile " + threshold_name(q) + " of the " + kFieldDescriptions[f] + of_n + " (log-binned histogram)",
+              kFieldUnits[f], ramp, breaks);
+      if (f == 0) maps.push_back({name, "percentile " + threshold_name(q) + " of peak flow depth", "m", std::move(pr)});
+    }
+  }
+  if (agg.members() == 0) return products;
+  // The maps on one extent: the cells where the members' peak depths add up to more than 1 cm
+  // (every cell a member reached with 1 cm, as the single runs' maps), the base case's
+  // output.map_margin around; probabilities in classes of 0.1 … 0.9 on a sequential ramp, depths
+  // in the base case's depth classes (issue #33).
+  QuicklookOptions o;
+  o.ramp = ColourRamp::Viridis;
+  o.extent = map_extent(any_reached, 0.01, a.map_margin);
+  o.scale_bar = true;
+  o.north_arrow = true;
+  o.attribution = !a.attribution.empty()     ? a.attribution
+                  : !dsm.attribution.empty() ? "Terrain: " + dsm.attribution
+                                             : "";
+  for (const Map& m : maps) {
+    QuicklookOptions d = o;
+    d.title = m.title;
+    d.unit = m.unit;
+    const bool probability = m.name.rfind("prob_", 0) == 0;
+    d.overlay_min = probability ? 1e-9 : 0.01;
+    d.vmin = 0.0;
+    d.vmax = probability ? 1.0 : 0.0;
+    d.class_breaks = probability ? probability_classes : a.map_depth_classes;
+    write_quicklook_png(out / (m.name + ".png"), dsm, &m.raster, d);
+  }
+  return products;
+}
+
+/// members.csv: one row per member.
+void write_members_csv(const EnsembleSetup& s, const std::vector<MemberRecord>& recs, const fs::path& out) {
+  AtomicTextFile csv(out / "members.csv");
+  csv << "member,status";
+  for (const auto& p : s.plan.parameters) csv << ',' << p.key;
+  csv << ",runout_m,drop_height_m,reach_m,H_over_L,angle_deg,release_m3,deposited_m3,mobile_m3,lost_m3,max_speed_m_"
+         "s,area_affected_m2,simulated_time_s,steps,ended_by,unfinished,wall_time_s,cpu_time_s,rank,threads,"
+         "diagnosis\n";
+  csv.stream() << std::setprecision(10);
+  for (const auto& r : recs) {
+    csv << r.index << ',' << (r.ok ? "ok" : "failed");
+    for (double v : r.values) csv << ',' << v;
+    std::string diag = r.diagnosis;
+    std::replace(diag.begin(), diag.end(), '"', '\'');
+    std::replace(diag.begin(), diag.end(), '\n', ' ');
+    csv << ',' << r.runout_m << ',' << r.drop_height_m << ',' << r.reach_m << ',' << r.hl << ',' << r.hl_deg << ','
+        << r.release_m3 << ',' << r.deposited_m3 << ',' << r.mobile_m3 << ',' << r.lost_m3 << ',' << r.max_speed << ','
+        << r.affected_area_m2 << ',' << r.simulated_time_s << ',' << r.steps << ",\"" << r.ended_by << "\","
+        << (r.unfinished ? 1 : 0) << ',' << r.wall_time_s << ',' << r.cpu_time_s << ',' << r.rank << ',' << r.threads
+        << ",\"" << diag << "\"\n";
+  }
+  csv.commit();
 }
 
 }  // namespace
@@ -754,117 +823,10 @@ void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, 
   for (const MemberRecord& r : recs)
     if (r.ok) agg.add(read_member_peaks(member_dir(out, r.index) / "peaks.bin"));
 
-  // 3. Rasters on the DSM grid with description, unit, nodata and a QGIS style beside each.
-  std::vector<std::string> products;
-  const auto put = [&](const std::string& name, const std::vector<double>& v, const std::string& description,
-                       const std::string& unit, ColourRamp ramp, double vmax_fixed) {
-    Raster r = dsm.like(0.0, -9999.0);
-    double vmax = 0.0;
-    for (std::size_t k = 0; k < v.size(); ++k) {
-      r.data[k] = dsm.is_nodata(dsm.data[k]) ? -9999.0 : v[k];
-      if (r.data[k] != -9999.0) vmax = std::max(vmax, r.data[k]);
-    }
-    r.description = description;
-    r.unit = unit;
-    write_geotiff(out / (name + ".tif"), r);
-    write_qgis_ramp_style(out / (name + ".qml"), ramp, 0.0, vmax_fixed > 0.0 ? vmax_fixed : (vmax > 0.0 ? vmax : 1.0),
-                          unit, 0.0);
-    products.push_back(name + ".tif");
-    return r;
-  };
-  const AggregationSettings& a = s.aggregation;
-  const std::string of_n = " over " + std::to_string(agg.members()) + " members";
-  Raster first_probability;
-  std::string first_label;
-  const auto prob = [&](int field, double t, const std::string& name, const std::string& what) {
-    Raster r = put(name, agg.exceedance(field, t), what + of_n, "1", ColourRamp::BlueRed, 1.0);
-    if (first_probability.data.empty()) {
-      first_probability = r, first_label = what;
-      for (std::size_t k; (k = first_label.find(" >= ")) != std::string::npos;) first_label.replace(k, 4, " \u2265 ");
-    }
-  };
-  for (double t : a.depth_thresholds)
-    prob(0, t, "prob_max_depth_gt_" + threshold_name(t) + "m", "probability peak depth > " + threshold_name(t) + " m");
-  for (double t : a.speed_thresholds)
-    prob(1, t, "prob_max_speed_gt_" + threshold_name(t) + "m_per_s",
-         "probability peak speed > " + threshold_name(t) + " m/s");
-  for (double t : a.pressure_thresholds)
-    prob(2, t, "prob_max_pressure_gt_" + threshold_name(t) + "Pa",
-         "probability peak pressure > " + threshold_name(t) + " Pa");
-  for (int k : a.intensity_classes)
-    prob(3, k, "prob_intensity_ge_" + std::to_string(k),
-         "probability intensity class >= " + std::to_string(k) + " (" + to_string(a.intensity.scheme) + ")");
-  std::vector<std::pair<std::string, Raster>> depth_maps;  // mean and percentiles of the peak depth, drawn below
-  for (int f = 0; f < 3; ++f) {
-    const ColourRamp ramp = f == 0 ? ColourRamp::Viridis : ColourRamp::Magma;
-    Raster mean = put(std::string("mean_") + kFieldNames[f], agg.mean(f),
-                      std::string("mean ") + kFieldDescriptions[f] + of_n, kFieldUnits[f], ramp, 0.0);
-    if (f == 0) depth_maps.emplace_back(std::string("mean_") + kFieldNames[f], std::move(mean));
-    for (double q : a.percentiles) {
-      std::string name = "p";  // built step by step: GCC 12 warns (-Wrestrict, a false positive) on "p" + string
-      name += threshold_name(q);
-      name += '_';
-      name += kFieldNames[f];
-      Raster pr =
-          put(name, agg.percentile(f, q),
-              "percentile " + threshold_name(q) + " of the " + kFieldDescriptions[f] + of_n + " (log-binned histogram)",
-              kFieldUnits[f], ramp, 0.0);
-      if (f == 0) depth_maps.emplace_back(name, std::move(pr));
-    }
-  }
-  if (!first_probability.data.empty()) {
-    // The first probability map over the cells any member reached (200 m around), in classes of a
-    // sequential ramp, with coordinates, scale bar and north arrow (issue #33).
-    QuicklookOptions o;
-    o.ramp = ColourRamp::Viridis;
-    o.title = first_label;
-    o.overlay_min = 1e-9;
-    o.vmin = 0.0;
-    o.vmax = 1.0;
-    o.class_breaks = {0.1, 0.3, 0.5, 0.7, 0.9};
-    o.extent = map_extent(first_probability, 1e-9, 200.0);
-    o.scale_bar = true;
-    o.north_arrow = true;
-    if (!dsm.attribution.empty()) o.attribution = "Terrain: " + dsm.attribution;
-    write_quicklook_png(out / "probability.png", dsm, &first_probability, o);
-    // The mean and percentile maps of the peak depth on the same extent, in the depth classes of
-    // the single runs (0.5, 1, 2 m).
-    for (const auto& [name, r] : depth_maps) {
-      QuicklookOptions d = o;
-      d.title = name.rfind("mean", 0) == 0 ? "mean peak flow depth" + of_n
-                                           : "percentile " + name.substr(1, name.find('_') - 1) + " of peak flow depth";
-      d.unit = "m";
-      d.overlay_min = 0.01;
-      d.vmin = d.vmax = 0.0;
-      d.class_breaks = OutputSettings{}.map_depth_classes;
-      write_quicklook_png(out / (name + ".png"), dsm, &r, d);
-    }
-  }
-
-  // 4. The member table, the distributions of run-out and H/L, the summary.
-  {
-    AtomicTextFile csv(out / "members.csv");
-    csv << "member,status";
-    for (const auto& p : s.plan.parameters) csv << ',' << p.key;
-    csv << ",runout_m,drop_height_m,reach_m,H_over_L,angle_deg,release_m3,deposited_m3,mobile_m3,lost_m3,max_speed_m_"
-           "s,area_affected_m2,simulated_time_s,steps,ended_by,unfinished,wall_time_s,cpu_time_s,rank,threads,"
-           "diagnosis\n";
-    csv.stream() << std::setprecision(10);
-    for (const auto& r : recs) {
-      csv << r.index << ',' << (r.ok ? "ok" : "failed");
-      for (double v : r.values) csv << ',' << v;
-      std::string diag = r.diagnosis;
-      std::replace(diag.begin(), diag.end(), '"', '\'');
-      std::replace(diag.begin(), diag.end(), '\n', ' ');
-      csv << ',' << r.runout_m << ',' << r.drop_height_m << ',' << r.reach_m << ',' << r.hl << ',' << r.hl_deg << ','
-          << r.release_m3 << ',' << r.deposited_m3 << ',' << r.mobile_m3 << ',' << r.lost_m3 << ',' << r.max_speed
-          << ',' << r.affected_area_m2 << ',' << r.simulated_time_s << ',' << r.steps << ",\"" << r.ended_by << "\","
-          << (r.unfinished ? 1 : 0) << ',' << r.wall_time_s << ',' << r.cpu_time_s << ',' << r.rank << ',' << r.threads
-          << ",\"" << diag << "\"\n";
-    }
-    csv.commit();
-  }
-  std::vector<double> runout, hl, member_wall, member_cpu;
+  // 3. The products and their maps; 4. the member table, the summary.
+  const std::vector<std::string> products = write_products(s.aggregation, agg, dsm, out);
+  write_members_csv(s, recs, out);
+  std::vector<double> runout, hl, area, member_wall, member_cpu;
   nlohmann::json failed = nlohmann::json::array();
   int unfinished = 0;
   for (const auto& r : recs) {
@@ -876,11 +838,9 @@ void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, 
     }
     runout.push_back(r.runout_m);
     hl.push_back(r.hl);
+    area.push_back(r.affected_area_m2);
     unfinished += r.unfinished ? 1 : 0;
   }
-  write_distribution_svg(out / "runout_distribution.svg", runout, "run-out length along the path (m)",
-                         "Run-out length of the members");
-  write_distribution_svg(out / "hl_distribution.svg", hl, "fahrböschung H/L (1)", "H/L of the members");
   const auto stats = [](std::vector<double> v) {
     std::sort(v.begin(), v.end());
     nlohmann::json j;
@@ -921,12 +881,14 @@ void aggregate_ensemble(const EnsembleSetup& s, const fs::path& out, int ranks, 
   j["release_alternatives"] = s.plan.release_alternatives;
   j["runout_length_along_path_m"] = stats(runout);
   j["fahrboeschung_ratio_H_over_L"] = stats(hl);
+  j["area_affected_m2"] = stats(area);
   j["member_wall_time_s"] = stats(member_wall);
   j["member_cpu_time_s"] = stats(member_cpu);
   double cpu_total = 0.0;
   for (double c : member_cpu) cpu_total += c;
   j["members_cpu_time_total_s"] = cpu_total;
   j["products"] = products;
+  const AggregationSettings& a = s.aggregation;
   const auto ratio = [&](HistogramRange r) { return std::pow(r.hi / r.lo, 1.0 / a.bins) - 1.0; };
   j["percentile_accuracy"] = {{"method", "log-binned histogram per cell, clamped to the cell's exact extremes"},
                               {"bins", a.bins},

@@ -23,11 +23,14 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "geohaz/core/raster.hpp"
 #include "geohaz/runout/hazard_maps.hpp"
+#include "geohaz/runout/run.hpp"
 
 namespace geohaz {
 class ConfigReader;
@@ -67,6 +70,11 @@ inline constexpr const char* kThicknessFactorKey = "release.thickness_factor";
 /// The ensemble parameter that picks one of the alternative release files.
 inline constexpr const char* kReleaseAlternativeKey = "release.alternative";
 
+/// A parameter key of an ensemble (or a calibration) with its label and unit from the
+/// declarations: the two keys above as declared here (key_labels.cpp; unit "1"), any other as
+/// case_key gives it (run.hpp). std::nullopt for a key neither declares.
+std::optional<FrictionKey> parameter_key(std::string_view key);
+
 enum class SamplingMethod { LatinHypercube, MonteCarlo };
 
 /// What an ensemble varies and how it samples.
@@ -93,6 +101,11 @@ struct AggregationSettings {
   std::vector<double> percentiles{10.0, 50.0, 90.0};
   int bins = 96;             ///< log-spaced histogram bins per field and cell
   IntensityTable intensity;  ///< class thresholds (those of the base case)
+  /// The maps as the base case draws its own (run.hpp OutputSettings): depth classes (m), margin
+  /// around the affected area (m), attribution ("" : the DSM's metadata).
+  std::vector<double> map_depth_classes{0.5, 1.0, 2.0};
+  double map_margin = 200.0;
+  std::string attribution;
 };
 
 /// Log-binned histogram ranges of the three fields (values below the low end go into one bin,

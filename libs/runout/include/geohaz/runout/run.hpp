@@ -18,6 +18,7 @@
 #include <array>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -156,6 +157,12 @@ struct FrictionKey {
 /// The model.* coefficient keys the basal law `law` (a model.friction value) reads, in
 /// declaration order; empty for an unknown law. For tools that show a run's parameters (the report).
 std::vector<FrictionKey> friction_keys(std::string_view law);
+/// Any debris-runout key as read_case declares it (key_labels.cpp): a basal law's coefficient as
+/// friction_keys gives it, any other key labelled by its help text up to the first " (", ": ",
+/// "; " or ", " ("mixture density ρ"), with the declared unit ("kg/m^3"; "1" dimensionless, ""
+/// for a string). std::nullopt for a key read_case does not declare. For tools that show a run's
+/// or an ensemble's parameters (the report), so labels and units have one source.
+std::optional<FrictionKey> case_key(std::string_view key);
 
 /// The DSM and the release, read and checked.
 struct RunoutInputs {
