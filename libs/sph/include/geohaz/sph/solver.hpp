@@ -161,7 +161,7 @@ struct GeostaticReport {
 
 /// The solver's own state beyond the particle fields. A snapshot holding it and every field that
 /// decides the next step (PositionAtBuild included, for the neighbour list) lets a restarted run
-/// continue bit for bit like the uninterrupted one (run.cpp writes it with every snapshot).
+/// continue bit for bit like the uninterrupted one (run_state.cpp writes it with every snapshot).
 struct SolverState {
   double time = 0.0;                  ///< s
   std::int64_t step = 0;              ///< steps so far (geostatic phase included)
