@@ -1,15 +1,18 @@
 // run.analysis = limit_equilibrium and the limit-equilibrium parts of the other analyses: the
 // section of a 2D slope with its pore water and seismic coefficients, the checks of [water] and
-// [seismic], the Newmark report (docs/sph.md, "Pore pressure and seismic coefficients").
+// [seismic], the Newmark report (docs/sph.md, "Pore pressure and seismic coefficients"), and the
+// static Bishop check beside the dynamic run and the strength reduction.
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numbers>
 #include <string>
+#include <variant>
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
 #include "geohaz/sph/newmark.hpp"
-#include "simulation_model.hpp"
+#include "run_support.hpp"
 
 namespace geohaz::sph {
 
@@ -274,6 +277,85 @@ class LimitEquilibriumRun final : public SimulationModel {
 };
 
 }  // namespace
+
+// ---- The static Bishop check beside the dynamic run and the strength reduction (run_support.hpp)
+
+namespace {
+
+/// The limit-equilibrium section of a 2D slope or DSM-section scenario, at peak strength or with the
+/// residual strengths of a softening soil; a slope with the config's pore water and seismic
+/// coefficients.
+SlopeSection section_of(const RunConfig& c, bool residual = false) {
+  ProfileDomain d;
+  if (c.scenario == ScenarioType::Slope) {
+    d = c.slope.profile();
+    if (!c.layer_materials.empty()) {
+      d.layer_tops = c.layer_tops;
+      d.layer_materials = c.layer_materials;
+    } else {
+      d.layer_tops.clear();
+      d.layer_materials.clear();
+    }
+  } else {
+    d = section_profile(c);
+  }
+  std::vector<LimitEquilibriumSoil> soils;
+  for (std::size_t k = 0; k < c.materials.size(); ++k) {
+    const auto& m = c.materials[k];
+    const double sat = k < c.saturated_densities.size() ? c.saturated_densities[k] : 0.0;
+    soils.push_back({m.density * c.numerics.gravity, residual ? m.residual_cohesion : m.cohesion,
+                     residual ? m.residual_friction : m.friction, sat * c.numerics.gravity});
+  }
+  auto s = SlopeSection::from_profile(d, soils);
+  if (c.scenario == ScenarioType::Slope) {
+    // The pore water (clipped to the ground as the SPH's) and the pseudo-static coefficients of the
+    // strength reduction (a dynamic run has none: its earthquake is the record).
+    const auto le = limit_equilibrium_section(c, true);
+    s.water = le.water;
+    s.seismic = le.seismic;
+  }
+  return s;
+}
+
+}  // namespace
+
+BishopResult bishop_of(const RunConfig& c, bool residual) {
+  if (c.dimension != 2 || (c.scenario != ScenarioType::Slope && c.scenario != ScenarioType::Section)) return {};
+  return bishop_critical_circle(section_of(c, residual));
+}
+
+StaticBishop StaticBishop::of(const RunConfig& c) {
+  StaticBishop b;
+  const bool frictional =
+      std::holds_alternative<DruckerPrager>(c.model) || std::holds_alternative<DruckerPragerSoftening>(c.model);
+  if (c.dimension != 2 || !frictional || (c.scenario != ScenarioType::Slope && c.scenario != ScenarioType::Section))
+    return b;
+  try {
+    b.peak = bishop_of(c);
+    if (std::holds_alternative<DruckerPragerSoftening>(c.model)) b.residual = bishop_of(c, true);
+    if (c.scenario == ScenarioType::Section) b.cover = infinite_slope_minimum(section_of(c));
+  } catch (const InputError& e) {
+    b.note = e.reason();
+  }
+  return b;
+}
+
+nlohmann::json StaticBishop::circle_json(const BishopResult& r) {
+  const auto& C = r.circle;
+  return {{"factor", r.factor},   {"centre_x_m", C.xc},     {"centre_z_m", C.zc},
+          {"radius_m", C.radius}, {"entry_x_m", r.x_entry}, {"exit_x_m", r.x_exit}};
+}
+
+void StaticBishop::add_to(nlohmann::json& s) const {
+  if (!note.empty()) s["bishop_note"] = note;
+  if (peak.admissible()) s["bishop"] = circle_json(peak);
+  if (residual.admissible()) s["bishop_residual"] = circle_json(residual);
+  if (std::isfinite(cover.factor))
+    s["infinite_slope"] = {{"factor", cover.factor},
+                           {"x_m", cover.x},
+                           {"angle_deg", cover.angle * 180.0 / std::numbers::pi},
+                           {"window_m", cover.window}};
+}
 
 std::unique_ptr<SimulationModel> make_limit_equilibrium_run(const RunConfig& c, bool quiet) {
   return std::make_unique<LimitEquilibriumRun>(c, quiet);

@@ -1,7 +1,8 @@
 #pragma once
-// Private to libs/sph/src: the interface every sph-slope analysis implements (run.cpp: the dynamic
-// run and the strength reduction; limit_equilibrium_run.cpp: Bishop's method with water and
-// seismic coefficients), and the limit-equilibrium helpers run.cpp shares.
+// Private to libs/sph/src: the interface every sph-slope analysis implements (run_dynamic.cpp: the
+// dynamic run; run_strength_reduction.cpp: the strength reduction; limit_equilibrium_run.cpp:
+// Bishop's method with water and seismic coefficients), and the limit-equilibrium helpers the
+// analyses share. What the files of a run share besides: run_support.hpp.
 
 #include <array>
 #include <filesystem>
@@ -86,5 +87,11 @@ nlohmann::json newmark_report(const RunConfig& c);
 
 /// The analysis run.analysis = limit_equilibrium.
 std::unique_ptr<SimulationModel> make_limit_equilibrium_run(const RunConfig& c, bool quiet);
+
+/// The analysis run.analysis = dynamic (run_dynamic.cpp) in the config's dimension.
+std::unique_ptr<SimulationModel> make_dynamic_run(const RunConfig& c, bool quiet);
+
+/// The analysis run.analysis = strength_reduction (run_strength_reduction.cpp) in the config's dimension.
+std::unique_ptr<SimulationModel> make_strength_reduction_run(const RunConfig& c, bool quiet);
 
 }  // namespace geohaz::sph

@@ -16,7 +16,7 @@
 namespace geohaz::sph {
 
 /// What a particle is. Soil particles carry the continuum; the others are boundary particles
-/// (Bui et al. 2008) that act in each pair as the soil particle's mirror image (solver.cpp, step 1).
+/// (Bui et al. 2008) that act in each pair as the soil particle's mirror image (solver_passes.cpp, step 1).
 enum class Kind : std::uint8_t {
   Soil = 0,
   FixedWall = 1,   ///< full fixity (no slip): velocity 2 v_wall − v_i, stress σ_i extrapolated along ν
@@ -78,7 +78,7 @@ struct WallNormal {
 /// Unit normal of the soil layering next to a fixed boundary particle (zero for soil). The stress a
 /// boundary particle carries in a pair is extrapolated from the soil particle assuming it varies
 /// along this direction only, as in a layered deposit: vertical for walls under flat-lying soil, the smoothed
-/// surface normal for bedrock under a DSM-section cover (see solver.cpp, step 1).
+/// surface normal for bedrock under a DSM-section cover (see solver_passes.cpp, step 1).
 template <int Dim>
 struct LayerNormal {
   using type = Vec<Dim>;
@@ -119,7 +119,7 @@ struct ArtificialStress {
 };
 
 /// Scratch for the pair sums: a soil particle's in-plane stress after its update (Pa); a boundary
-/// particle's stress-extrapolation matrix ḡ_n I + ḡ_t ⊗ ν + ν ⊗ ḡ_t (m/s², solver.cpp step 1).
+/// particle's stress-extrapolation matrix ḡ_n I + ḡ_t ⊗ ν + ν ⊗ ḡ_t (m/s², solver_passes.cpp step 1).
 template <int Dim>
 struct PairStress {
   using type = Mat<Dim>;

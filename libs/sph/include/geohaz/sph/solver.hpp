@@ -1,8 +1,8 @@
 #pragma once
 /// \file solver.hpp
 /// The SPH solver for elasto-plastic soil (2D plane strain and 3D), after Bui et al. (2008) and
-/// the three source documents (docs/references.md). One step (step_impl in solver.cpp: one function per item, in this
-/// order):
+/// the three source documents (docs/references.md). One step (step_impl in solver_passes.cpp: one function per item, in
+/// this order):
 ///   0. update_neighbours: neighbour list (rebuilt every step, or with a Verlet skin only when a
 ///      particle has moved more than half the skin; store reordered by cell at every
 ///      `reorder_every`-th rebuild);
@@ -42,7 +42,7 @@
 /// With `total_lagrangian` (elastic bodies only) one step is instead: F_i from the displacements and
 /// the corrected gradients of the reference configuration (built once), St Venant–Kirchhoff stress,
 /// the pair force Σ_j V⁰_i V⁰_j (P_i g⁰_ij − P_j g⁰_ji) and the Ganzenmüller (2015) hourglass force,
-/// then steps 5 and 6 (solver.cpp, "Total-Lagrangian formulation"; docs/sph.md).
+/// then steps 5 and 6 (solver_total_lagrangian.cpp; docs/sph.md).
 /// The pair sums of steps 2 and 4 are grouped alike on any thread count, and SolverState + resume
 /// restart a run bit for bit (docs/sph.md, "Determinism: thread count and restart").
 /// Units: SI throughout (m, s, kg, Pa).
@@ -116,7 +116,7 @@ struct NumericalSettings {
   /// a = c_p² ((r0/r)⁴ − (r0/r)²) x/r² (Monaghan 1994 form); 0 switches it off.
   double wall_repulsion = 0.5;
   /// Kernel gradients exact for linear and quadratic fields (Bonet & Lok 1999; Randles & Libersky
-  /// 1996, extended to second order) in the velocity-gradient and momentum sums (solver.cpp, steps
+  /// 1996, extended to second order) in the velocity-gradient and momentum sums (solver_passes.cpp, steps
   /// 2 and 4); false: the plain kernel gradient. One Dim × (Dim + Dim(Dim+1)/2) matrix per particle
   /// and one extra pair pass (docs/performance.md).
   /// sph-slope's `numerics.kernel_correction = "auto"` keeps this default except for the
@@ -135,7 +135,7 @@ struct NumericalSettings {
   bool total_lagrangian = false;
   /// Ganzenmüller (2015) hourglass coefficient α (dimensionless) of the total-Lagrangian
   /// formulation, in [0, 100], at most 1 with quadratic_correction; 0 switches the hourglass force
-  /// off. Its stiffness is in the time step (solver.cpp, tl_setup). Above 1 the force itself drives
+  /// off. Its stiffness is in the time step (solver_total_lagrangian.cpp, tl_setup). Above 1 the force itself drives
   /// a growing mode with the quadratic-complete gradient, whatever the step (test
   /// HourglassControlStaysBoundedWithItsTimeStep).
   double hourglass = 0.1;
@@ -161,7 +161,7 @@ struct GeostaticReport {
 
 /// The solver's own state beyond the particle fields. A snapshot holding it and every field that
 /// decides the next step (PositionAtBuild included, for the neighbour list) lets a restarted run
-/// continue bit for bit like the uninterrupted one (run.cpp writes it with every snapshot).
+/// continue bit for bit like the uninterrupted one (run_state.cpp writes it with every snapshot).
 struct SolverState {
   double time = 0.0;                  ///< s
   std::int64_t step = 0;              ///< steps so far (geostatic phase included)
@@ -258,7 +258,7 @@ class SphSolver {
   double bytes_per_particle() const;
 
  private:
-  // One step (solver.cpp), the numbered passes of the file comment:
+  // One step (solver_passes.cpp; 0, 5 and 6 in solver.cpp), the numbered passes of the file comment:
   template <class Kernel, class Model>
   void step_impl(const Model& model);
   void update_neighbours(double cutoff);  // 0
@@ -275,7 +275,7 @@ class SphSolver {
   template <class T, class Add, class Finish>
   void gather_reactions(const std::vector<T>& buffer, Add&& add, Finish&& finish);  // 2, 4
   template <class Kernel, bool Corrected>
-  auto momentum_pair_term();  // step 4's pair term, shared by 4 and 4b (solver.cpp)
+  auto momentum_pair_term();  // step 4's pair term, shared by 4 and 4b (solver_passes.cpp)
   template <class Kernel, bool Corrected>
   void momentum();  // 4
   template <class Kernel, bool Corrected>
@@ -283,7 +283,7 @@ class SphSolver {
   void integrate(const Vec<Dim>& gbar);  // 5
   void check_state() const;              // 6
   void update_dt();                      // 6
-  // The total-Lagrangian step (settings_.total_lagrangian; solver.cpp, "Total-Lagrangian formulation"):
+  // The total-Lagrangian step (settings_.total_lagrangian; solver_total_lagrangian.cpp):
   template <class Kernel>
   void tl_step();
   template <class Kernel>
@@ -332,7 +332,7 @@ class SphSolver {
   std::vector<Vec<Dim>> pair_acc_;
   // Scratch of the velocity-gradient pass: reactions of the soil–soil pairs, as pair_acc_.
   // With the kernel-gradient correction L holds Σ V_i (v_i − v_j) ⊗ b_ji, b the Dim + Dim(Dim+1)/2
-  // components of the quadratic-complete basis (solver.cpp, step 2); without it Σ V_i (v_i − v_j) ⊗ ∇W_ji.
+  // components of the quadratic-complete basis (solver_passes.cpp, step 2); without it Σ V_i (v_i − v_j) ⊗ ∇W_ji.
   static constexpr int kBasis = Dim + Dim * (Dim + 1) / 2;
   template <int Cols>
   struct GradientReactionT {
@@ -351,7 +351,7 @@ class SphSolver {
   std::vector<StructureLoad<Dim>> structure_loads_;
   std::vector<StructureLoad<Dim>> structure_block_loads_;
   // Scratch of the kernel-gradient correction (steps 2 and 4, `kernel_correction` only): A_i of
-  // every particle, the first Dim rows of B_i⁻¹ (solver.cpp, step 2), so that the corrected
+  // every particle, the first Dim rows of B_i⁻¹ (solver_passes.cpp, step 2), so that the corrected
   // gradient vector is g_ij = A_i b_ij ([I 0] for boundary particles; empty when the correction is off).
   std::vector<Eigen::Matrix<double, Dim, kBasis>> correction_;
   // Total-Lagrangian formulation: reference positions X and volumes V⁰ = m/ρ₀, the reference

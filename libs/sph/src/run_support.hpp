@@ -1,0 +1,142 @@
+#pragma once
+// Private to libs/sph/src: what the files of an sph-slope run share.
+//   run.cpp                     the simulation object (SphSimulation) and the files of a run
+//   run_scenario.cpp            the particles, solver settings and reported structures of a config
+//   run_state.cpp               the geostatic phase, the snapshots and the restart from them
+//   run_outputs.cpp             quick-look pictures, CSV tables, the head of summary.json
+//   run_dynamic.cpp             run.analysis = dynamic
+//   run_strength_reduction.cpp  run.analysis = strength_reduction
+//   run_validate.cpp            the checks before anything is built (validate)
+//   limit_equilibrium_run.cpp   run.analysis = limit_equilibrium and the static Bishop check
+// The templates below are instantiated for Dim = 2 and 3 in the file that defines them.
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "geohaz/core/snapshot.hpp"
+#include "geohaz/sph/diagnostics.hpp"
+#include "geohaz/sph/limit_equilibrium.hpp"
+#include "geohaz/sph/run.hpp"
+#include "simulation_model.hpp"
+
+namespace geohaz::sph {
+
+constexpr std::uint8_t kSoil = static_cast<std::uint8_t>(Kind::Soil);
+
+// ---- run_scenario.cpp ------------------------------------------------------------------------
+
+/// The name of a scenario in run.scenario ("slope", "column", ...).
+const char* scenario_name(ScenarioType t);
+
+/// A scenario as built and the frame its diagnostics are measured in.
+template <int Dim>
+struct Built {
+  Scenario<Dim> sc;
+  DiagnosticFrame frame;
+};
+
+/// Width of a 3D DSM strip as built: a whole number of spacings (the builder's ny·Δx), centred on
+/// the polyline. The builder and the release export must agree on it.
+double strip_width(const RunConfig& c);
+
+/// The profile domain of a DSM cross-section (surface, extent, layers, bedrock; walls left default).
+ProfileDomain section_profile(const RunConfig& c);
+
+/// The particles of the configured scenario.
+template <int Dim>
+Built<Dim> build(const RunConfig& c);
+
+/// The solver settings of a config for its built scenario (the main phase).
+template <int Dim>
+SolverSettings<Dim> settings_for(const RunConfig& c, const Scenario<Dim>& sc);
+
+/// The structures a run reports (`output.structures`, all when empty), as indices into the
+/// scenario's table. InputError naming the key, the unknown name and the names that exist.
+template <int Dim>
+std::vector<std::size_t> reported_structures(const RunConfig& c, const std::vector<Structure<Dim>>& table);
+
+// ---- run_state.cpp ---------------------------------------------------------------------------
+
+/// The fields written to snapshots: the state a restart needs plus what the issue asks to see.
+/// position_at_build (the positions of the last neighbour-list build) is restart state: the list,
+/// hence the Verlet-skin decisions and the order of the pair sums, is rebuilt from it.
+template <int Dim>
+void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int64_t step);
+
+/// A snapshot of the solver's store and, as a root attribute, its solver state (SolverState).
+template <int Dim>
+void write_snapshot(SnapshotWriter& w, const SphSolver<Dim>& solver, std::int64_t step);
+
+/// What a restart file gives besides the particles.
+struct Restart {
+  double time = 0.0;
+  std::int64_t step = 0;             ///< the snapshot's step
+  std::optional<SolverState> state;  ///< absent in files written before it existed
+};
+
+/// Replace the store by the last snapshot of a file written by sph-slope.
+template <int Dim>
+Restart load_restart(const std::filesystem::path& path, SphStore<Dim>& s);
+
+/// The fields of a store as flat arrays (ParticleFields).
+template <int Dim>
+ParticleFields fields_of(const SphStore<Dim>& s);
+
+/// The geostatic phase's duration (s): geostatic.duration, or 20 H/c_p when it is 0 (20 transits of
+/// a P wave through the slope height let the loading waves die out under Cundall damping).
+/// InputError (key geostatic.duration) above 100 times that default: 2000 wave transits is a
+/// loading that has settled long before or never will (the phase's rest check says which), and
+/// nothing a user means; a value of 1e9 s ran for hours (issue #29).
+double geostatic_duration(const RunConfig& c, double href, double cmax);
+
+/// The geostatic phase of `solver` over `dur` seconds, the observer told at the start, every 50
+/// steps and at the end (phase "geostatic").
+template <int Dim>
+GeostaticReport geostatic_with_progress(SphSolver<Dim>& solver, double dur, const RunConfig& c,
+                                        const SphSimulation& self, RunObserver* obs);
+
+// ---- run_outputs.cpp -------------------------------------------------------------------------
+
+/// A number as the CSV files and the error messages write it (9 significant digits).
+std::string csv_number(double v);
+
+/// Quick-look picture: particles in the x–z plane coloured by `value` (soil) on a ramp, boundary grey,
+/// with a colour bar numbered from 0 to vmax and titled `title` ("displacement (m)").
+/// `overlay` (optional): a polyline in (x, z) drawn in red over the particles (a slip circle).
+template <int Dim>
+void draw_particles(const std::filesystem::path& path, const SphStore<Dim>& s, const std::vector<double>& value,
+                    double vmax, double dx, const std::string& title,
+                    const std::vector<std::array<double, 2>>& overlay = {});
+
+/// The table of a list of (x, z) points ("x_m,z_m": a surface or a circle).
+Table xz_table(const std::vector<std::array<double, 2>>& points);
+
+/// The summary's description of the run's particles and materials (both analyses).
+template <int Dim>
+nlohmann::json summary_header(const RunConfig& c, const SphSolver<Dim>& solver, std::size_t soil_count);
+
+// ---- limit_equilibrium_run.cpp ---------------------------------------------------------------
+
+/// Bishop's critical circle of a 2D slope or DSM section (none otherwise), at peak strength or with
+/// the residual strengths of a softening soil.
+BishopResult bishop_of(const RunConfig& c, bool residual = false);
+
+/// The Bishop cross-check beside a dynamic run of a 2D slope or section of frictional soil: the
+/// static factor of the critical circle (with the run's pore water, if any) at peak strength (and, for a softening
+/// soil, at residual strength), or a note saying why there is none.
+struct StaticBishop {
+  BishopResult peak, residual;
+  InfiniteSlopeResult cover;  // the translational slide of a DSM section's soil cover
+  std::string note;
+
+  static StaticBishop of(const RunConfig& c);
+  static nlohmann::json circle_json(const BishopResult& r);
+  void add_to(nlohmann::json& s) const;
+};
+
+}  // namespace geohaz::sph
