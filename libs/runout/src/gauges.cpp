@@ -125,7 +125,7 @@ void GaugeRecorder::step(const RunoutStore& store, const HazardMaps& maps, doubl
   remember(store);
   if (t >= next_ - 1e-9 || last) {
     take_rows(store, maps, t);
-    while (next_ <= t + 1e-9) next_ += interval_;
+    if (next_ <= t + 1e-9) next_ += interval_ * (std::floor((t + 1e-9 - next_) / interval_) + 1.0);
   }
 }
 
