@@ -115,6 +115,7 @@ void HazardMaps::record(const RunoutStore& store, double t) {
     }
   }
   const int rc = static_cast<int>(std::ceil(radius_ / g_.dx)), rr = static_cast<int>(std::ceil(radius_ / g_.dy));
+  const double r2 = radius_ * radius_;
   const std::int64_t n = static_cast<std::int64_t>(store.size());
   // Threads own bands of grid rows, split so that each has about as many particles; every thread
   // runs over all particles and paints only the rows of its band. Maxima and the first arrival
@@ -150,7 +151,7 @@ void HazardMaps::record(const RunoutStore& store, double t) {
       const bool arrives = moving[i] || t == 0.0;
       for (int r = r_first; r <= r_last; ++r)
         for (int c = std::max(0, c0 - rc); c <= std::min(g_.nx - 1, c0 + rc); ++c) {
-          if (!paints(x[i], c0, r0, c, r)) continue;
+          if (!paints(x[i], c0, r0, c, r, r2)) continue;
           const std::size_t k = g_.index(c, r);
           max_depth_[k] = std::max(max_depth_[k], hi);
           max_speed_[k] = std::max(max_speed_[k], si);
@@ -185,7 +186,7 @@ void HazardMaps::painted_at(const RunoutStore& store, const std::vector<std::siz
     if (c0 < c_lo - rc || c0 > c_hi + rc || r0 < r_lo - rr || r0 > r_hi + rr) continue;
     for (std::size_t k = 0; k < cells.size(); ++k) {
       const int c = static_cast<int>(cells[k] % nx), r = static_cast<int>(cells[k] / nx);
-      if (std::abs(c - c0) > rc || std::abs(r - r0) > rr || !paints(x[i], c0, r0, c, r)) continue;
+      if (std::abs(c - c0) > rc || std::abs(r - r0) > rr || !paints(x[i], c0, r0, c, r, radius_ * radius_)) continue;
       depth[k] = std::max(depth[k], paint_[i]);
       speed[k] = std::max(speed[k], s[i]);
     }

@@ -97,9 +97,9 @@ class HazardMaps {
 
  private:
   /// Whether a particle at x in cell (c0, r0) paints cell (c, r): its own cell always, any other
-  /// whose centre lies within radius_ (the one rule of record() and painted_at()).
-  bool paints(const Vec2& x, int c0, int r0, int c, int r) const noexcept {
-    return (c == c0 && r == r0) || (g_.centre(c, r) - x).squaredNorm() <= radius_ * radius_;
+  /// whose centre lies within radius_ (r2 = radius_²; the one rule of record() and painted_at()).
+  bool paints(const Vec2& x, int c0, int r0, int c, int r, double r2) const noexcept {
+    return (c == c0 && r == r0) || (g_.centre(c, r) - x).squaredNorm() <= r2;
   }
 
   GridGeometry g_;
