@@ -470,6 +470,7 @@ const Caption kCaptions[] = {
     {"profile",
      "Thalweg long profile along the flow's centreline: terrain, peak depth above it (exaggerated), "
      "the α line from the top of the release to the run-out point; peak speed below."},
+    {"gauges", "Gauges (output.gauges): flow depth, speed and discharge across the sections against time."},
     {"probability", "Probability over the ensemble, in classes, on the cells any member reached."},
     {"mean_max_depth", "Mean of the members' peak flow depth."},
     {"p*_max_depth", "Percentile of the members' peak flow depth (log-binned histogram)."},

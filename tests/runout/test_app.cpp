@@ -702,3 +702,100 @@ TEST(DebrisRunoutApp, BadBarrierInputsExitTwoAndWriteNothing) {
   EXPECT_NE(r.output.find("barriers.height"), std::string::npos) << r.output;
   EXPECT_FALSE(dir_has_files(out));
 }
+
+// Gauges and a profile path (issue #33): a point and a cross-section across the channel, the
+// profile along a straight line down the valley. gauges.csv in long format with a row per gauge
+// every second; the section's cumulative volume is the summary's net volume and at most the
+// release; profile.csv starts at the given path.
+TEST(DebrisRunoutApp, GaugesAndProfilePathWriteTheirFiles) {
+  const fs::path dsm = tiny_dsm(), d = work_dir();
+  const fs::path cfg = d / "gauges.toml", out = d / "gauges_out";
+  {
+    std::ofstream f(cfg);
+    f << "[output]\ngauge_interval = 1.0\nprofile_path = [480020.0, 4309875.0, 480480.0, 4309875.0]\n"
+      << "[[output.gauges]]\nname = \"channel\"\npoint = [480200.0, 4309875.0]\n"
+      << "[[output.gauges]]\nname = \"section\"\nline = [480250.0, 4309780.0, 480250.0, 4309970.0]\n";
+  }
+  fs::remove_all(out);
+  const auto r = run(dsm.string() + " --release " + (d / "tiny_release.tif").string() + " --config " + cfg.string() +
+                     " --d0 2.5 --h0 0.75 --duration 60 --out " + out.string() + " --quiet --threads 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_TRUE(fs::exists(out / "gauges.png"));
+  std::ifstream csv(out / "gauges.csv");
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "gauge,t_s,depth_m,speed_m_per_s,discharge_m3_per_s,cumulative_volume_m3");
+  int channel = 0, section = 0;
+  double last_cumulative = 0.0, hmax = 0.0;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+    if (cells[0] == "channel") {
+      ++channel;
+      hmax = std::max(hmax, std::stod(cells[2]));
+    } else {
+      ++section;
+      ASSERT_EQ(cells.size(), 6u) << line;
+      last_cumulative = std::stod(cells[5]);
+    }
+  }
+  EXPECT_GE(channel, 60);  // t = 0 … 60 s every second
+  EXPECT_EQ(section, channel);
+  EXPECT_GT(hmax, 0.0);
+  std::ifstream in(out / "summary.json");
+  const auto j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["gauges"].size(), 2u);
+  EXPECT_EQ(j["gauges"][1]["kind"], "line");
+  const double net = j["gauges"][1]["net_volume_m3"], read = j["volumes_m3"]["release_read"];
+  EXPECT_NEAR(last_cumulative, net, 1e-6 * read);
+  EXPECT_GT(net, 0.0);  // the flow went down the valley, across the section from west to east
+  EXPECT_LE(net, read * (1.0 + 1e-9));
+  std::ifstream prof(out / "profile.csv");
+  std::getline(prof, line);
+  std::getline(prof, line);
+  EXPECT_EQ(line.rfind("0,480020,4309875,", 0), 0u) << line;
+}
+
+// Bad gauges and profile paths: exit 2 naming the file, the key and the value, nothing written.
+TEST(DebrisRunoutApp, BadGaugeInputsExitTwoAndWriteNothing) {
+  const fs::path dsm = tiny_dsm(), d = work_dir();
+  const std::string base = dsm.string() + " --release " + (d / "tiny_release.tif").string();
+  struct Case {
+    std::string toml;
+    std::vector<std::string> expect;
+  };
+  const std::vector<Case> cases = {
+      {"[[output.gauges]]\nname = \"far\"\npoint = [490000.0, 4309875.0]\n",
+       {"output.gauges[0].point", "490000.0", "x in [480000.0, 480500.0]", "off the terrain"}},
+      {"[[output.gauges]]\nname = \"short\"\nline = [480250.0, 4309780.0]\n",
+       {"output.gauges[0].line", "2 numbers", "two or more vertices"}},
+      {"[[output.gauges]]\nname = \"odd\"\nline = [480250.0, 4309780.0, 480250.0]\n", {"output.gauges[0].line"}},
+      {"[output]\ngauge_interval = 0.0\n", {"output.gauge_interval", "(0, 1e+06]"}},
+      {"[output]\ngauge_interval = -1.0\n", {"output.gauge_interval"}},
+      {"[[output.gauges]]\nname = \"x\"\npoint = [480200.0, 4309875.0]\nradius = 3\n", {"radius"}},
+      {"[[output.gauges]]\nname = \"both\"\npoint = [480200.0, 4309875.0]\nline = [480250.0, 4309780.0, 480250.0, "
+       "4309970.0]\n",
+       {"output.gauges[0]", "not both"}},
+      {"[[output.gauges]]\npoint = [480200.0, 4309875.0]\n", {"output.gauges[0].name"}},
+      {"[[output.gauges]]\nname = \"a\"\npoint = [480200.0, 4309875.0]\n[[output.gauges]]\nname = \"a\"\npoint = "
+       "[480210.0, 4309875.0]\n",
+       {"output.gauges[1].name", "unique"}},
+      {"[output]\nprofile_path = [480020.0, 4309875.0, 481000.0, 4309875.0]\n",
+       {"output.profile_path", "leaves the terrain", "x in [480000.0, 480500.0]"}},
+      {"[output]\nprofile_path = [480020.0, 4309875.0]\n", {"output.profile_path", "two or more vertices"}},
+  };
+  const fs::path cfg = d / "bad_gauges.toml", out = d / "bad_gauges_out";
+  for (const auto& c : cases) {
+    {
+      std::ofstream f(cfg);
+      f << c.toml;
+    }
+    fs::remove_all(out);
+    const auto r = run(base + " --config " + cfg.string() + " --out " + out.string() + " --quiet");
+    EXPECT_EQ(r.code, 2) << c.toml << "\n" << r.output;
+    EXPECT_NE(r.output.find("bad_gauges.toml"), std::string::npos) << c.toml << "\n" << r.output;
+    for (const auto& e : c.expect) EXPECT_NE(r.output.find(e), std::string::npos) << e << " in\n" << r.output;
+    EXPECT_FALSE(dir_has_files(out)) << c.toml;
+  }
+}

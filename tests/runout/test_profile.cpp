@@ -133,3 +133,64 @@ TEST(ThalwegProfile, ArrivalCentrelineFollowsTheBulkOfTheFlow) {
   }
   EXPECT_EQ(off_axis, 1);
 }
+
+// Issue #33 item 3: a path beside the flow (a centreline cutting a bend runs so). The strip of the
+// first test (h, v on rows 15–24, x = 100–600 m) and a second strip twice as deep 115 m south of
+// the path; the path runs 20 m north of the first strip. Read under the path only (half-width 0)
+// every station is 0 — the gaps of the Alplehner profile. Across ±30 m the stations beside the
+// strip read its h, v and ρv² and the others 0; the second strip, beyond the half-width, is not
+// read. Across ±130 m it is (its 2h), so the half-width is what limits the section.
+TEST(ThalwegProfile, PeaksAcrossThePathFillTheGapsBesideTheFlow) {
+  const Raster dsm = plane();
+  Raster depth = dsm.like(0.0, -9999.0), speed = depth, pressure = depth;
+  const double h = 1.2, v = 8.0, rho = 2000.0;
+  for (int col = 20; col < 120; ++col) {
+    for (int row = 15; row < 25; ++row) {
+      depth.at(col, row) = h;
+      speed.at(col, row) = v;
+      pressure.at(col, row) = rho * v * v;
+    }
+    for (int row = 34; row < 39; ++row) {
+      depth.at(col, row) = 2.0 * h;
+      speed.at(col, row) = v;
+      pressure.at(col, row) = rho * v * v;
+    }
+  }
+  const double y = kY0 - 55.0;  // the strip's north edge is at kY0 − 75 m
+  const std::vector<Vec2> path{{kX0 + 50.0, y}, {kX0 + 700.0, y}};
+  const ThalwegProfile under = thalweg_profile(dsm, depth, speed, pressure, path, 1.0, 0.01, 0.0);
+  EXPECT_FALSE(under.reached);
+  for (const ProfileRow& r : under.rows) EXPECT_EQ(r.depth, 0.0);
+  const ThalwegProfile across = thalweg_profile(dsm, depth, speed, pressure, path, 1.0, 0.01, 30.0);
+  ASSERT_TRUE(across.reached);
+  for (const ProfileRow& r : across.rows) {
+    const double x = r.x - kX0;
+    const bool beside = x >= 100.0 && x < 600.0;
+    EXPECT_DOUBLE_EQ(r.depth, beside ? h : 0.0) << x;
+    EXPECT_DOUBLE_EQ(r.speed, beside ? v : 0.0) << x;
+    EXPECT_DOUBLE_EQ(r.pressure, beside ? rho * v * v : 0.0) << x;
+  }
+  EXPECT_DOUBLE_EQ(across.s_runout, 549.0);
+  EXPECT_NEAR(across.alpha_deg, 30.0, 1e-9);
+  const ThalwegProfile wide = thalweg_profile(dsm, depth, speed, pressure, path, 1.0, 0.01, 130.0);
+  for (const ProfileRow& r : wide.rows) {
+    const double x = r.x - kX0;
+    EXPECT_DOUBLE_EQ(r.depth, x >= 100.0 && x < 600.0 ? 2.0 * h : 0.0) << x;
+  }
+}
+
+// A user's path off the terrain is an InputError naming the key, the point and the extent; a path
+// without length too.
+TEST(ThalwegProfile, UserPathOffTheTerrainIsRefusedBeforeTheRun) {
+  const Raster dsm = plane();
+  try {
+    check_profile_path({{kX0 + 50.0, kY0 - 50.0}, {kX0 + 1500.0, kY0 - 50.0}}, dsm, "case.toml", "output.profile_path");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    for (const char* part : {"case.toml", "output.profile_path", "5199950.0)", "x in [500000.0, 501000.0]"})
+      EXPECT_NE(m.find(part), std::string::npos) << part << " in " << m;
+  }
+  EXPECT_THROW(check_profile_path({{kX0 + 50.0, kY0 - 50.0}, {kX0 + 50.0, kY0 - 50.0}}, dsm, "c", "k"), InputError);
+  EXPECT_NO_THROW(check_profile_path({{kX0 + 50.0, kY0 - 50.0}, {kX0 + 900.0, kY0 - 150.0}}, dsm, "c", "k"));
+}

@@ -317,6 +317,70 @@ void read_map_settings(ConfigReader& cfg, OutputSettings& o) {
                                   "for it); empty: the DSM's own metadata (TIFFTAG_COPYRIGHT), if any"});
 }
 
+/// The gauges and the profile path (docs/runout.md "Gauges", "Thalweg profile"). The checks that
+/// need the DSM (on its data, a name and a point or line given) are check_gauges() and
+/// check_profile_path(), at load_inputs().
+void read_gauges_and_profile(ConfigReader& cfg, OutputSettings& o) {
+  const std::string file = cfg.source().empty() ? "command line" : cfg.source();
+  const auto count = [](std::size_t n) { return std::to_string(n) + " number" + (n == 1 ? "" : "s"); };
+  const auto vertices = [](const std::vector<double>& v) {
+    std::vector<Vec2> out;
+    for (std::size_t k = 0; k + 1 < v.size(); k += 2) out.emplace_back(v[k], v[k + 1]);
+    return out;
+  };
+  o.gauge_interval = cfg.get("output.gauge_interval", o.gauge_interval, Range::open_closed(0.0, 1e6),
+                             {"s", "simulated time between the rows of gauges.csv"});
+  std::vector<ConfigReader> tables =
+      cfg.tables("output.gauges", {"", "gauges ([[output.gauges]]): name and point = [x, y] or line = [x1, y1, ...]"});
+  for (std::size_t k = 0; k < tables.size(); ++k) {
+    ConfigReader& t = tables[k];
+    const std::string key = "output.gauges[" + std::to_string(k) + "]";
+    GaugeSpec g;
+    g.name = t.get_string("name", "", {"", "the gauge's name in gauges.csv and gauges.png"});
+    const std::vector<double> point =
+        t.get_array("point", {}, Range::closed(-1e8, 1e8),
+                    {"m", "point gauge [x, y] in the DSM's CRS: flow depth (m) and speed (m/s) over time"});
+    const std::vector<double> line = t.get_array(
+        "line", {}, Range::closed(-1e8, 1e8),
+        {"m",
+         "cross-section [x1, y1, x2, y2, ...] in the DSM's CRS: discharge (m^3/s, + to the right walking from "
+         "the first vertex), cumulative volume (m^3), mean depth and speed over time"});
+    if (!point.empty() && !line.empty())
+      throw InputError("a gauge is either a point or a line: give point = [x, y] or line = [x1, y1, ...], not both",
+                       file, key);
+    if (!point.empty() && point.size() != 2)
+      throw InputError("point must be [x, y] (m, the DSM's CRS)", file, key + ".point", count(point.size()));
+    if (!line.empty() && (line.size() < 4 || line.size() % 2 != 0))
+      throw InputError("line needs two or more vertices [x1, y1, x2, y2, ...]: an even count of at least 4 numbers (m)",
+                       file, key + ".line", count(line.size()));
+    g.vertices = vertices(point.empty() ? line : point);
+    o.gauges.push_back(std::move(g));
+  }
+  const std::vector<double> path = cfg.get_array(
+      "output.profile_path", {}, Range::closed(-1e8, 1e8),
+      {"m",
+       "the thalweg profile along this polyline [x1, y1, x2, y2, ...] (DSM's CRS) instead of the flow's own "
+       "centreline"});
+  if (!path.empty() && (path.size() < 4 || path.size() % 2 != 0))
+    throw InputError(
+        "output.profile_path needs two or more vertices [x1, y1, x2, y2, ...]: an even count of at "
+        "least 4 numbers (m)",
+        file, "output.profile_path", count(path.size()));
+  o.profile_path = vertices(path);
+  o.profile_path_file =
+      resolve(cfg, "output.profile_path_file",
+              cfg.get_string("output.profile_path_file", "",
+                             {"", "the profile along the first line of this file (Shapefile/GeoPackage/GeoJSON)"}));
+  if (!o.profile_path.empty() && !o.profile_path_file.empty())
+    throw InputError("give output.profile_path or output.profile_path_file, not both", file, "output.profile_path_file",
+                     o.profile_path_file);
+  o.profile_half_width =
+      cfg.get("output.profile_half_width", o.profile_half_width, Range::closed(0.0, 1e4),
+              {"m",
+               "the profile's peak values are the largest within this distance across the path (0: the cell "
+               "under the path only)"});
+}
+
 }  // namespace
 
 RunoutCase read_case(ConfigReader& cfg) {
@@ -416,6 +480,7 @@ RunoutCase read_case(ConfigReader& cfg) {
   it.medium_pressure = classes[0];
   it.strong_pressure = classes[1];
   read_map_settings(cfg, o);
+  read_gauges_and_profile(cfg, o);
   return c;
 }
 

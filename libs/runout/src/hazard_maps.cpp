@@ -151,13 +151,44 @@ void HazardMaps::record(const RunoutStore& store, double t) {
       const bool arrives = moving[i] || t == 0.0;
       for (int r = r_first; r <= r_last; ++r)
         for (int c = std::max(0, c0 - rc); c <= std::min(g_.nx - 1, c0 + rc); ++c) {
-          if ((c != c0 || r != r0) && (g_.centre(c, r) - x[i]).squaredNorm() > r2) continue;
+          if (!paints(x[i], c0, r0, c, r, r2)) continue;
           const std::size_t k = g_.index(c, r);
           max_depth_[k] = std::max(max_depth_[k], hi);
           max_speed_[k] = std::max(max_speed_[k], si);
           max_momentum_[k] = std::max(max_momentum_[k], hi * si);
           if (arrives && std::isnan(arrival_[k])) arrival_[k] = t;
         }
+    }
+  }
+}
+
+void HazardMaps::painted_at(const RunoutStore& store, const std::vector<std::size_t>& cells, std::vector<double>& depth,
+                            std::vector<double>& speed) const {
+  depth.assign(cells.size(), 0.0);
+  speed.assign(cells.size(), 0.0);
+  const auto& x = store.get<Position<2>>();
+  const auto& s = store.get<Speed>();
+  if (paint_.size() != store.size()) return;  // no record() of this state
+  if (cells.empty()) return;
+  const int rc = static_cast<int>(std::ceil(radius_ / g_.dx)), rr = static_cast<int>(std::ceil(radius_ / g_.dy));
+  // The cells' bounding box grown by the painting reach: a particle outside it paints none of them.
+  const auto nx = static_cast<std::size_t>(g_.nx);
+  int c_lo = g_.nx, c_hi = -1, r_lo = g_.ny, r_hi = -1;
+  for (std::size_t cell : cells) {
+    c_lo = std::min(c_lo, static_cast<int>(cell % nx));
+    c_hi = std::max(c_hi, static_cast<int>(cell % nx));
+    r_lo = std::min(r_lo, static_cast<int>(cell / nx));
+    r_hi = std::max(r_hi, static_cast<int>(cell / nx));
+  }
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    int c0, r0;
+    if (detached_now_[i] || !g_.cell_of(x[i], c0, r0)) continue;
+    if (c0 < c_lo - rc || c0 > c_hi + rc || r0 < r_lo - rr || r0 > r_hi + rr) continue;
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+      const int c = static_cast<int>(cells[k] % nx), r = static_cast<int>(cells[k] / nx);
+      if (std::abs(c - c0) > rc || std::abs(r - r0) > rr || !paints(x[i], c0, r0, c, r, radius_ * radius_)) continue;
+      depth[k] = std::max(depth[k], paint_[i]);
+      speed[k] = std::max(speed[k], s[i]);
     }
   }
 }

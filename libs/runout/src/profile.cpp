@@ -6,10 +6,12 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <sstream>
 #include <string>
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
+#include "plot_support.hpp"
 
 namespace geohaz::runout {
 
@@ -68,15 +70,30 @@ std::vector<Vec2> arrival_centreline(const Raster& arrival_time, const Raster& m
 
 ThalwegProfile thalweg_profile(const Raster& dsm, const Raster& max_depth, const Raster& max_speed,
                                const Raster& max_pressure, const std::vector<Vec2>& path, double spacing,
-                               double min_depth) {
-  if (path.size() < 2 || !(spacing > 0.0))
+                               double min_depth, double half_width) {
+  if (path.size() < 2 || !(spacing > 0.0) || !(half_width >= 0.0))
     throw InputError("a profile needs a path of at least two points and a positive spacing", "profile");
   for (const Raster* m : {&max_depth, &max_speed, &max_pressure})
     if (m->nx != dsm.nx || m->ny != dsm.ny)
       throw InputError("the peak maps of a profile must be on the DSM's grid", "profile");
   const Terrain terrain(dsm);
   ThalwegProfile p;
+  p.half_width = half_width;
   double s0 = 0.0;
+  // Offsets across the path: 0, then ±k·step out to the half-width (step ≤ half a cell).
+  std::vector<double> across{0.0};
+  if (half_width > 0.0) {
+    const double cell = std::min(dsm.cell_size_x(), dsm.cell_size_y());
+    const int n = static_cast<int>(std::ceil(half_width / (0.5 * cell) - 1e-9));
+    for (int k = 1; k <= n; ++k)
+      for (double sign : {1.0, -1.0}) across.push_back(sign * half_width * k / n);
+  }
+  Vec2 normal(0.0, 0.0);  // of the current segment
+  const auto peak = [&](const Raster& m, const Vec2& q) {
+    double v = 0.0;
+    for (double w : across) v = std::max(v, cell_value(m, q.x() + w * normal.x(), q.y() + w * normal.y()));
+    return v;
+  };
   const auto add = [&](const Vec2& q, double s) {
     const double z = terrain.elevation(q.x(), q.y());
     if (!std::isfinite(z))
@@ -88,16 +105,24 @@ ThalwegProfile thalweg_profile(const Raster& dsm, const Raster& max_depth, const
     r.x = q.x();
     r.y = q.y();
     r.z = z;
-    r.depth = cell_value(max_depth, q.x(), q.y());
-    r.speed = cell_value(max_speed, q.x(), q.y());
-    r.pressure = cell_value(max_pressure, q.x(), q.y());
+    r.depth = peak(max_depth, q);
+    r.speed = peak(max_speed, q);
+    r.pressure = peak(max_pressure, q);
     p.rows.push_back(r);
   };
+  for (std::size_t k = 1; k < path.size(); ++k) {  // the first station takes the first segment's normal
+    const Vec2 e = path[k] - path[k - 1];
+    if (e.norm() > 0.0) {
+      normal = Vec2(e.y(), -e.x()) / e.norm();
+      break;
+    }
+  }
   add(path.front(), 0.0);
   for (std::size_t k = 1; k < path.size(); ++k) {
     const Vec2 a = path[k - 1], b = path[k];
     const double len = (b - a).norm();
     if (!(len > 0.0)) continue;
+    normal = Vec2(b.y() - a.y(), a.x() - b.x()) / len;
     const int n = std::max(1, static_cast<int>(std::ceil(len / spacing - 1e-9)));
     for (int i = 1; i <= n; ++i) add(a + (b - a) * (double(i) / n), s0 + len * double(i) / n);
     s0 += len;
@@ -123,6 +148,32 @@ ThalwegProfile thalweg_profile(const Raster& dsm, const Raster& max_depth, const
   return p;
 }
 
+void check_profile_path(const std::vector<Vec2>& path, const Raster& dsm, const std::string& source,
+                        const std::string& key) {
+  double length = 0.0;
+  for (std::size_t k = 1; k < path.size(); ++k) length += (path[k] - path[k - 1]).norm();
+  if (path.size() < 2 || !(length > 0.0))
+    throw InputError("a profile path needs two or more distinct vertices [x1, y1, x2, y2, ...] (m)", source, key);
+  const Terrain terrain(dsm);
+  const double step = std::min(dsm.cell_size_x(), dsm.cell_size_y());
+  const auto ext = dsm.extent();
+  const auto check = [&](const Vec2& q) {
+    if (std::isfinite(terrain.elevation(q.x(), q.y()))) return;
+    std::ostringstream m, at;
+    at << std::fixed << std::setprecision(1) << "(" << q.x() << ", " << q.y() << ")";
+    m << std::fixed << std::setprecision(1) << "the profile path leaves the terrain's data at " << at.str()
+      << "; allowed: on the DSM's data, inside x in [" << ext[0].x() << ", " << ext[1].x() << "] m, y in ["
+      << ext[0].y() << ", " << ext[1].y() << "] m (the DSM's CRS)";
+    throw InputError(m.str(), source, key, at.str());
+  };
+  check(path.front());
+  for (std::size_t k = 1; k < path.size(); ++k) {
+    const double len = (path[k] - path[k - 1]).norm();
+    const int n = std::max(1, static_cast<int>(std::ceil(len / step)));
+    for (int i = 1; i <= n; ++i) check(path[k - 1] + (path[k] - path[k - 1]) * (double(i) / n));
+  }
+}
+
 void write_profile_csv(const std::filesystem::path& path, const ThalwegProfile& p) {
   AtomicTextFile csv(path);
   csv << "s_along_path_m,x_m,y_m,terrain_elevation_m,max_depth_m,max_speed_m_per_s,max_pressure_Pa,"
@@ -134,48 +185,7 @@ void write_profile_csv(const std::filesystem::path& path, const ThalwegProfile& 
   csv.commit();
 }
 
-namespace {
-
-/// A panel of a plot: data range and its pixel box.
-struct Panel {
-  double x0, x1, y0, y1;  // data
-  int left, top, width, height;
-  double px(double x) const { return left + (x - x0) / (x1 - x0) * width; }
-  double py(double y) const { return top + height - (y - y0) / (y1 - y0) * height; }
-};
-
-void axes(Image& img, const Panel& f, const std::string& x_title, const std::string& y_title, int s) {
-  const std::array<std::uint8_t, 3> black{0, 0, 0}, grid{225, 225, 225};
-  for (double v : nice_ticks(f.x0, f.x1, 8)) {
-    const double x = f.px(v);
-    img.line(x, f.top, x, f.top + f.height, grid);
-    img.line(x, f.top + f.height, x, f.top + f.height + 6, black);
-    const std::string t = format_tick(v);
-    draw_text(img, static_cast<int>(x) - text_width(t, s) / 2, f.top + f.height + 10, t, s);
-  }
-  for (double v : nice_ticks(f.y0, f.y1, 5)) {
-    const double y = f.py(v);
-    img.line(f.left, y, f.left + f.width, y, grid);
-    img.line(f.left - 6, y, f.left, y, black);
-    const std::string t = format_tick(v);
-    draw_text(img, f.left - 10 - text_width(t, s), static_cast<int>(y) - 7 * s / 2, t, s);
-  }
-  img.line(f.left, f.top, f.left, f.top + f.height, black);
-  img.line(f.left, f.top + f.height, f.left + f.width, f.top + f.height, black);
-  img.line(f.left, f.top, f.left + f.width, f.top, black);
-  img.line(f.left + f.width, f.top, f.left + f.width, f.top + f.height, black);
-  draw_text(img, f.left + (f.width - text_width(x_title, s)) / 2, f.top + f.height + 20 + 7 * s, x_title, s);
-  draw_text(img, f.left, f.top - 12 - 7 * s, y_title, s);
-}
-
-void thick_polyline(Image& img, const Panel& f, const std::vector<double>& x, const std::vector<double>& y,
-                    std::array<std::uint8_t, 3> c, int width) {
-  for (std::size_t k = 1; k < x.size(); ++k)
-    for (int o = -width / 2; o <= width / 2; ++o)
-      img.line(f.px(x[k - 1]), f.py(y[k - 1]) + o, f.px(x[k]), f.py(y[k]) + o, c);
-}
-
-}  // namespace
+using detail::Panel;
 
 void write_profile_png(const std::filesystem::path& path, const ThalwegProfile& p) {
   const int W = 1800, H = 1250, s = 3;
@@ -210,23 +220,25 @@ void write_profile_png(const std::filesystem::path& path, const ThalwegProfile& 
   // The flow (depth above the terrain) filled, then the terrain, the α line, the run-out point.
   for (std::size_t k = 0; k < sv.size(); ++k)
     if (top[k] > z[k]) img.line(upper.px(sv[k]), upper.py(z[k]), upper.px(sv[k]), upper.py(top[k]), {70, 130, 200});
-  axes(img, upper, "horizontal distance along the path (m)", "elevation (m)", s);
-  thick_polyline(img, upper, sv, top, {40, 90, 170}, 2);
-  thick_polyline(img, upper, sv, z, {30, 30, 30}, 3);
+  detail::axes(img, upper, "horizontal distance along the path (m)", "elevation (m)", s);
+  detail::thick_polyline(img, upper, sv, top, {40, 90, 170}, 2);
+  detail::thick_polyline(img, upper, sv, z, {30, 30, 30}, 3);
   if (p.reached) {
     const std::vector<double> as{p.s_top, p.s_runout}, az{p.z_top, p.z_runout};
-    thick_polyline(img, upper, as, az, {200, 40, 40}, 2);
+    detail::thick_polyline(img, upper, as, az, {200, 40, 40}, 2);
     img.fill_circle(upper.px(p.s_runout), upper.py(p.z_runout), 9, {200, 40, 40});
     img.fill_circle(upper.px(p.s_top), upper.py(p.z_top), 7, {200, 40, 40});
   }
-  const std::string legend1 = "terrain (black), peak depth x " + format_tick(ex) + " above it (blue)";
+  const std::string legend1 =
+      "terrain (black), peak depth x " + format_tick(ex) + " above it (blue)" +
+      (p.half_width > 0.0 ? "; peaks: the largest within " + format_tick(p.half_width) + " m across the path" : "");
   char buf[160];
   std::snprintf(buf, sizeof buf, "alpha line (red): alpha = %.1f deg, run-out point at s = %.0f m", p.alpha_deg,
                 p.s_runout);
   draw_text(img, upper.left + 20, upper.top + 20, legend1, 2);
   draw_text(img, upper.left + 20, upper.top + 50, p.reached ? buf : "the flow did not reach the path", 2);
-  axes(img, lower, "horizontal distance along the path (m)", "peak speed (m/s)", s);
-  thick_polyline(img, lower, sv, speed, {150, 60, 150}, 2);
+  detail::axes(img, lower, "horizontal distance along the path (m)", "peak speed (m/s)", s);
+  detail::thick_polyline(img, lower, sv, speed, {150, 60, 150}, 2);
   write_png(path, img);
 }
 

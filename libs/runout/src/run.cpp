@@ -16,7 +16,7 @@
 #include "geohaz/core/output.hpp"
 #include "geohaz/core/progress.hpp"
 #include "geohaz/core/snapshot.hpp"
-#include "geohaz/runout/profile.hpp"
+#include "run_outputs.hpp"
 
 namespace fs = std::filesystem;
 
@@ -430,10 +430,12 @@ RunoutInputs load_inputs(const RunoutCase& c) {
     in.source = c.processes.hydrograph;
     in.description = "inflow hydrograph " + c.processes.hydrograph;
     load_barriers_into(c, in);
+    detail::load_output_geometry(c, in);
     return in;
   }
   read_release(c.release, in.dsm, in);
   load_barriers_into(c, in);
+  detail::load_output_geometry(c, in);
   return in;
 }
 
@@ -480,6 +482,10 @@ RunoutSimulation::RunoutSimulation(const RunoutInputs& in, RunoutParameters para
   }
   series_.push_back(series_row(store, solver_.budget(), 0.0, 0));
   next_series_ = output_.series_interval;
+  if (!output_.gauges.empty()) {
+    gauges_ = GaugeRecorder(output_.gauges, in.grid(), output_.gauge_interval);
+    gauges_.start(store, maps_, 0.0);
+  }
 }
 
 void RunoutSimulation::run(RunObserver* observer) {
@@ -490,6 +496,7 @@ void RunoutSimulation::run(RunObserver* observer) {
     solver_.step();
     maps_.record(store, solver_.time());
     const bool last = solver_.finished();
+    gauges_.step(store, maps_, solver_.time(), last);  // returns at once without gauges
     if (solver_.time() >= next_series_ - 1e-9 || last) {
       series_.push_back(series_row(store, solver_.budget(), solver_.time(), solver_.step_count()));
       record_barrier_rows();
@@ -748,44 +755,13 @@ std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int t
                   {"series", "barriers/" + r.name + ".csv"}});
   }
   j["barriers"] = jb;
+  if (!sim.gauges().empty()) j["gauges"] = detail::gauges_summary(sim);
   if (!bres.empty())
     j["barrier_law"] = {{"restitution", sim.inputs().wall_law.restitution},
                         {"wall_friction", sim.inputs().wall_law.friction},
                         {"retention_distance_m", sim.inputs().wall_law.retention_distance},
                         {"force_window_s", c.output.series_interval}};
   return j.dump(2);
-}
-
-/// The thalweg profile along the flow's own centreline (profile.hpp): from the highest cell of the
-/// release through the depth-weighted centroids of the arrival fronts (arrival_centreline, one per
-/// output.series_interval); points off the DSM's data are skipped.
-void write_flow_profile(const RunoutCase& c, const RunoutSimulation& sim, const Raster& depth, const Raster& speed,
-                        const Raster& pressure, const Raster& arrival, const fs::path& out) {
-  const Raster& dsm = sim.inputs().dsm;
-  const Terrain terrain(dsm);
-  Vec2 start(std::numeric_limits<double>::quiet_NaN(), 0.0);
-  double z_top = -std::numeric_limits<double>::infinity();
-  const auto& thick = sim.inputs().thickness;
-  for (int row = 0; row < dsm.ny; ++row)
-    for (int col = 0; col < dsm.nx; ++col) {
-      const std::size_t k = static_cast<std::size_t>(row) * dsm.nx + col;
-      if (k >= thick.size() || !(thick[k] > 0.0)) continue;
-      const Vec2 q = dsm.cell_centre(col, row);
-      const double z = terrain.elevation(q.x(), q.y());
-      if (std::isfinite(z) && z > z_top) {
-        z_top = z;
-        start = q;
-      }
-    }
-  if (!std::isfinite(start.x())) return;  // no release on the grid (a hand-off outside it): no profile
-  std::vector<Vec2> path;
-  for (const Vec2& q : arrival_centreline(arrival, depth, start, c.output.series_interval, dsm.cell_size_x()))
-    if (std::isfinite(terrain.elevation(q.x(), q.y()))) path.push_back(q);
-  if (path.size() < 2) return;
-  const double min_depth = std::max(c.output.intensity.min_depth, 0.01);
-  const ThalwegProfile p = thalweg_profile(dsm, depth, speed, pressure, path, dsm.cell_size_x(), min_depth);
-  write_profile_csv(out / "profile.csv", p);
-  if (c.output.pngs) write_profile_png(out / "profile.png", p);
 }
 
 void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::path& out, int threads) {
@@ -917,7 +893,8 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
     map_png("intensity", r_int, ColourRamp::Intensity, "intensity class", "", 0.5, intensity_classes_legend);
   }
 
-  write_flow_profile(c, sim, r_depth, r_speed, r_pressure, r_arrival, out);
+  detail::write_profile_outputs(c, sim, r_depth, r_speed, r_pressure, r_arrival, out);
+  detail::write_gauge_outputs(c, sim, out);
 
   {
     AtomicTextFile csv(out / "series.csv");

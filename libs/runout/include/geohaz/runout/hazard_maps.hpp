@@ -69,6 +69,13 @@ class HazardMaps {
   /// The depth (m) each particle of `store` paints the maps with now: h_i, or V_i/s_i² for a sparse
   /// particle, 0 for a detached one (see the file comment).
   std::vector<double> painted_depth(const RunoutStore& store);
+  /// The depth (m) and speed (m/s) the last record() painted each cell of `cells` (grid indices)
+  /// with: the largest painted depth and the largest speed of the particles that painted it at that
+  /// step, 0 where none did (the maps are the maxima of these over the recorded steps; the gauges,
+  /// gauges.hpp, read them). `store` must be unchanged since that record(); depth and speed are
+  /// resized to cells.size() (no allocation once they have the capacity).
+  void painted_at(const RunoutStore& store, const std::vector<std::size_t>& cells, std::vector<double>& depth,
+                  std::vector<double>& speed) const;
   /// The detached particles so far and the particles that left the raster (by comparing the
   /// particles recorded with those in `store`).
   DetachedReport detached_report(const RunoutStore& store) const;
@@ -89,6 +96,12 @@ class HazardMaps {
   std::vector<double> deposit(const RunoutStore& store, ParticleSelection which = ParticleSelection::All) const;
 
  private:
+  /// Whether a particle at x in cell (c0, r0) paints cell (c, r): its own cell always, any other
+  /// whose centre lies within radius_ (r2 = radius_²; the one rule of record() and painted_at()).
+  bool paints(const Vec2& x, int c0, int r0, int c, int r, double r2) const noexcept {
+    return (c == c0 && r == r0) || (g_.centre(c, r) - x).squaredNorm() <= r2;
+  }
+
   GridGeometry g_;
   double d0_, density_, radius_, self_weight_, sparse_min_depth_;
   std::vector<double> paint_;               // depth painted per particle (scratch)

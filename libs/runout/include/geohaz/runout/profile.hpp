@@ -7,8 +7,13 @@
 /// Definitions, as implemented:
 /// - s is the horizontal distance along the path (m), sampled every `spacing` metres and at the
 ///   vertices; z is the DSM's bilinear elevation there (core Terrain).
-/// - The peak values are those of the map cell holding the point (the maps are cell values;
-///   interpolating would smear a depth into the dry cells next to it).
+/// - The peak values at a station are the largest of the map cells across the path there: the
+///   cells under the points of the path's normal within ±`half_width` (no more than half a cell
+///   apart), each map on its own (the maps' peaks may come from different cells, as they come from
+///   different times). A path that cuts a bend of the flow, or runs beside it, still reads the
+///   flow's peak values; a station with no flow within the half-width reads 0, which there is the
+///   true peak (the flow did not pass). `half_width` = 0: the cell holding the point only. The
+///   values are cell values, not interpolated (that would smear a depth into dry cells).
 /// - The reached part of the path is where the peak depth exceeds `min_depth`. Its highest point is
 ///   the top (s_top, z_top), its farthest point the run-out point (s_runout, z_runout).
 /// - tan α = (z_top − z_runout) / (s_runout − s_top), and the α line is
@@ -16,6 +21,7 @@
 ///   and at the run-out point).
 
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "geohaz/core/raster.hpp"
@@ -41,13 +47,21 @@ struct ThalwegProfile {
   double s_top = 0.0, z_top = 0.0;        ///< highest reached point (m)
   double s_runout = 0.0, z_runout = 0.0;  ///< farthest reached point (m)
   double alpha_deg = 0.0;                 ///< Fahrböschung angle α (degrees)
+  double half_width = 0.0;                ///< the peaks are the largest within this distance across the path (m)
 };
 
-/// Sample the DSM and the peak maps (same grid as the DSM; nodata and NaN read as 0) along `path`.
-/// InputError when the path has fewer than two distinct points or leaves the DSM's data.
+/// Sample the DSM and the peak maps (same grid as the DSM; nodata and NaN read as 0) along `path`,
+/// the peaks over ±`half_width` metres across it (m, ≥ 0). InputError when the path has fewer than
+/// two distinct points or leaves the DSM's data.
 ThalwegProfile thalweg_profile(const Raster& dsm, const Raster& max_depth, const Raster& max_speed,
                                const Raster& max_pressure, const std::vector<Vec2>& path, double spacing,
-                               double min_depth);
+                               double min_depth, double half_width = 0.0);
+
+/// The path of a profile given by the user, checked against the DSM before a run writes anything:
+/// InputError naming `source`, `key`, the first point off the terrain's data and the DSM's extent,
+/// or a path without two distinct vertices.
+void check_profile_path(const std::vector<Vec2>& path, const Raster& dsm, const std::string& source,
+                        const std::string& key);
 
 /// Thin a polyline that moves away from `start`: `start`, then the points in order, each kept only
 /// when it lies at least `min_spacing` farther from `start` than the last one kept (so a centroid

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "geohaz/core/raster.hpp"
+#include "geohaz/runout/gauges.hpp"
 #include "geohaz/runout/hazard_maps.hpp"
 #include "geohaz/runout/processes.hpp"
 #include "geohaz/runout/release.hpp"
@@ -128,6 +129,11 @@ struct OutputSettings {
   /// A particle alone within 2·d0 paints the peak maps only where the depth it stands for exceeds
   /// this (m); below it is detached (hazard_maps.hpp). AvaFrame com1DFA's hmin.
   double sparse_min_depth = 0.05;
+  std::vector<GaugeSpec> gauges;     ///< points and cross-section lines (gauges.hpp); none: no gauges.csv
+  double gauge_interval = 1.0;       ///< s between the rows of gauges.csv
+  std::vector<Vec2> profile_path;    ///< the profile along this path (m, DSM CRS); empty: the flow's centreline
+  std::string profile_path_file;     ///< or along the first line of this vector file
+  double profile_half_width = 50.0;  ///< m across the path over which the profile takes the peaks
 };
 
 /// Everything a run needs, in SI units. Defaults are those of the structs it holds.
@@ -178,6 +184,9 @@ struct RunoutInputs {
   std::vector<Barrier> barriers;
   WallLaw wall_law;
   std::string barrier_source;  ///< the barrier file ("" for none)
+  /// The profile's path given by the user (output.profile_path or the line of
+  /// output.profile_path_file, in the DSM's CRS), checked; empty: the flow's own centreline.
+  std::vector<Vec2> profile_path;
 
   const GridGeometry& grid() const noexcept { return surface.geometry(); }
 };
@@ -249,6 +258,8 @@ class RunoutSimulation {
   const std::vector<SeriesRow>& series() const noexcept { return series_; }
   /// Per barrier, its time series (a row with every row of series()).
   const std::vector<std::vector<BarrierRow>>& barrier_series() const noexcept { return barrier_series_; }
+  /// The gauges of output.gauges (rows every output.gauge_interval).
+  const GaugeRecorder& gauges() const noexcept { return gauges_; }
   /// Per barrier, its figures now.
   std::vector<BarrierResult> barrier_results() const;
   const SeedReport& seeded() const noexcept { return seeded_; }
@@ -273,6 +284,7 @@ class RunoutSimulation {
   ReleaseTop top_;
   std::vector<SeriesRow> series_;
   std::vector<std::vector<BarrierRow>> barrier_series_;
+  GaugeRecorder gauges_;
   std::vector<double> last_impulse_;
   double last_row_time_ = 0.0;
   void record_barrier_rows();
