@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -755,6 +756,53 @@ TEST(DebrisRunoutApp, GaugesAndProfilePathWriteTheirFiles) {
   std::getline(prof, line);
   std::getline(prof, line);
   EXPECT_EQ(line.rfind("0,480020,4309875,", 0), 0u) << line;
+}
+
+// The profile path from a vector file (output.profile_path_file): its first line, here a GeoJSON
+// LineString in the tiny valley's CRS, gives the same profile as the same vertices written in the
+// config (output.profile_path), station for station; both paths together exit 2.
+TEST(DebrisRunoutApp, ProfilePathFromALineFileEqualsTheSameVerticesInTheConfig) {
+  const fs::path dsm = tiny_dsm(), d = work_dir();
+  const fs::path line_file = d / "profile_line.geojson";
+  {
+    std::ofstream f(line_file);
+    f << R"({"type":"FeatureCollection","crs":{"type":"name","properties":{"name":"urn:ogc:def:crs:EPSG::32654"}},)"
+      << R"("features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":)"
+      << "[[480020.0,4309875.0],[480250.0,4309900.0],[480480.0,4309875.0]]}}]}";
+  }
+  const std::string base = dsm.string() + " --release " + (d / "tiny_release.tif").string() +
+                           " --d0 2.5 --h0 0.75 --duration 30 --quiet --threads 1";
+  auto read_all = [](const fs::path& p) {
+    std::ifstream f(p);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+  };
+  const fs::path out_file = d / "profile_file_out", out_list = d / "profile_list_out";
+  fs::remove_all(out_file);
+  fs::remove_all(out_list);
+  const auto a = run(base + " --set output.profile_path_file=" + line_file.string() + " --out " + out_file.string());
+  ASSERT_EQ(a.code, 0) << a.output;
+  const fs::path cfg = d / "profile_list.toml";
+  {
+    std::ofstream f(cfg);
+    f << "[output]\nprofile_path = [480020.0, 4309875.0, 480250.0, 4309900.0, 480480.0, 4309875.0]\n";
+  }
+  const auto b = run(base + " --config " + cfg.string() + " --out " + out_list.string());
+  ASSERT_EQ(b.code, 0) << b.output;
+  const std::string pa = read_all(out_file / "profile.csv"), pb = read_all(out_list / "profile.csv");
+  EXPECT_GT(std::count(pa.begin(), pa.end(), '\n'), 10);
+  EXPECT_EQ(pa, pb);
+  EXPECT_EQ(pa.find("0,480020,4309875,", pa.find('\n') + 1), pa.find('\n') + 1) << pa.substr(0, 200);
+  // Both forms at once: exit 2 naming the key, nothing written.
+  const fs::path out_both = d / "profile_both_out";
+  fs::remove_all(out_both);
+  const auto c =
+      run(dsm.string() + " --release " + (d / "tiny_release.tif").string() + " --config " + cfg.string() +
+          " --set output.profile_path_file=" + line_file.string() + " --out " + out_both.string() + " --quiet");
+  EXPECT_EQ(c.code, 2) << c.output;
+  EXPECT_NE(c.output.find("output.profile_path_file"), std::string::npos) << c.output;
+  EXPECT_FALSE(dir_has_files(out_both));
 }
 
 // Bad gauges and profile paths: exit 2 naming the file, the key and the value, nothing written.
