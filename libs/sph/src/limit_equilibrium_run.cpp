@@ -20,13 +20,7 @@ SlopeSection limit_equilibrium_section(const RunConfig& c, bool with_water_and_s
   if (c.scenario != ScenarioType::Slope || c.dimension != 2)
     throw InputError("the limit-equilibrium analysis needs the 2D slope scenario", c.config_source, "run.scenario");
   ProfileDomain d = c.slope.profile();
-  if (!c.layer_materials.empty()) {
-    d.layer_tops = c.layer_tops;
-    d.layer_materials = c.layer_materials;
-  } else {
-    d.layer_tops.clear();
-    d.layer_materials.clear();
-  }
+  apply_layers(d, c);
   const double g = c.numerics.gravity;
   std::vector<LimitEquilibriumSoil> soils;
   for (std::size_t m = 0; m < c.materials.size(); ++m) {
@@ -289,13 +283,7 @@ SlopeSection section_of(const RunConfig& c, bool residual = false) {
   ProfileDomain d;
   if (c.scenario == ScenarioType::Slope) {
     d = c.slope.profile();
-    if (!c.layer_materials.empty()) {
-      d.layer_tops = c.layer_tops;
-      d.layer_materials = c.layer_materials;
-    } else {
-      d.layer_tops.clear();
-      d.layer_materials.clear();
-    }
+    apply_layers(d, c);
   } else {
     d = section_profile(c);
   }

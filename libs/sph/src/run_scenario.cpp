@@ -70,6 +70,16 @@ void clamp_regions(const RunConfig& c, SphStore<Dim>& S) {
 
 }  // namespace
 
+void apply_layers(ProfileDomain& d, const RunConfig& c) {
+  if (!c.layer_materials.empty()) {
+    d.layer_tops = c.layer_tops;
+    d.layer_materials = c.layer_materials;
+  } else {
+    d.layer_tops.clear();
+    d.layer_materials.clear();
+  }
+}
+
 ProfileDomain section_profile(const RunConfig& c) {
   const auto& P = c.section.profile;
   if (P.size() < 2)
@@ -105,13 +115,7 @@ Built<Dim> build(const RunConfig& c) {
       d.bottom = c.bottom_wall;
       d.width = c.width;
       d.periodic_width = c.periodic_width;
-      if (!c.layer_materials.empty()) {
-        d.layer_tops = c.layer_tops;
-        d.layer_materials = c.layer_materials;
-      } else {
-        d.layer_tops.clear();
-        d.layer_materials.clear();
-      }
+      apply_layers(d, c);
       if (c.piles.enabled) {
         if (Dim != 3)
           throw InputError("pile rows need dimension = 3 (a pile row in plane strain is a wall)", c.config_source,

@@ -47,6 +47,10 @@ double strip_width(const RunConfig& c);
 /// The profile domain of a DSM cross-section (surface, extent, layers, bedrock; walls left default).
 ProfileDomain section_profile(const RunConfig& c);
 
+/// The configured soil layers (layer_tops, layer_materials) on a profile domain, or none (one
+/// material) when the config gives no layers.
+void apply_layers(ProfileDomain& d, const RunConfig& c);
+
 /// The particles of the configured scenario.
 template <int Dim>
 Built<Dim> build(const RunConfig& c);
