@@ -597,6 +597,113 @@ RunoutResult RunoutSimulation::result() const {
   return r;
 }
 
+namespace {
+
+/// summary.json's "processes": the entrainment law and its figures, the friction zones, the
+/// forest and the inflow in force (docs/runout.md, "Processes").
+nlohmann::json processes_json(const RunoutCase& c, const RunoutSimulation& sim, const VolumeBudget& b) {
+  const auto& solver = sim.solver();
+  const EntrainmentParameters& ent = sim.parameters().entrainment;
+  const SpatialProcesses& proc = solver.processes();
+  nlohmann::json jp;
+  jp["entrainment"] = {{"law", to_string(ent.law)}};
+  if (ent.law == EntrainmentLaw::GrowthRate) jp["entrainment"]["growth_rate_per_m"] = ent.growth_rate;
+  if (ent.law == EntrainmentLaw::ShearStress) {
+    jp["entrainment"]["critical_shear_pa"] = ent.critical_shear;
+    jp["entrainment"]["coefficient_m_per_s_pa"] = ent.erosion_coefficient;
+  }
+  if (ent.law != EntrainmentLaw::None) {
+    double eroded_max = 0.0;
+    for (double e : solver.eroded_depth()) eroded_max = std::max(eroded_max, e);
+    jp["entrainment"]["file"] = c.processes.erodible;
+    jp["entrainment"]["entrained_volume_m3"] = b.entrained;
+    jp["entrainment"]["growth_factor"] = b.initial + b.injected > 0.0 ? b.total_in() / (b.initial + b.injected) : 0.0;
+    jp["entrainment"]["max_eroded_depth_m"] = eroded_max;
+    jp["entrainment"]["terrain"] = "fixed (the DSM is not lowered by the eroded depth)";
+  }
+  nlohmann::json zones = nlohmann::json::array();
+  for (int k = 0; k < kFrictionParameters; ++k)
+    if (!proc.friction[static_cast<std::size_t>(k)].empty())
+      zones.push_back(kFrictionParameterNames[static_cast<std::size_t>(k)]);
+  jp["friction_zones"] = {{"file", c.processes.zones}, {"coefficients", zones}};
+  if (!proc.forest_drag.empty()) {
+    double area = 0.0, kmax = 0.0;
+    for (double k : proc.forest_drag)
+      if (k > 0.0) {
+        area += sim.inputs().grid().cell_area();
+        kmax = std::max(kmax, k);
+      }
+    jp["forest"] = {{"file", c.processes.forest},
+                    {"area_m2", area},
+                    {"max_drag_per_m", kmax},
+                    {"drag_coefficient", c.processes.drag_coefficient}};
+  }
+  if (!proc.inflows.empty()) {
+    const Hydrograph& q = proc.inflows.front();
+    jp["inflow"] = {{"hydrograph", q.source},    {"volume_of_table_m3", q.volume()},
+                    {"injected_m3", b.injected}, {"end_time_s", q.end_time()},
+                    {"speed_m_per_s", q.speed},  {"direction_xy", {q.direction.x(), q.direction.y()}}};
+  }
+  return jp;
+}
+
+/// summary.json's "barriers": the figures of each barrier and its line in map coordinates (the
+/// maps draw them).
+nlohmann::json barriers_json(const RunoutSimulation& sim, const std::vector<BarrierResult>& bres) {
+  nlohmann::json jb = nlohmann::json::array();
+  for (std::size_t b = 0; b < bres.size(); ++b) {
+    const BarrierResult& r = bres[b];
+    nlohmann::json verts = nlohmann::json::array();
+    for (const Vec2& v : sim.inputs().barriers[b].vertices) verts.push_back({v.x(), v.y()});
+    jb.push_back({{"name", r.name},
+                  {"file", sim.inputs().barrier_source},
+                  {"crest_height_m", r.height},
+                  {"permeability", r.permeability},
+                  {"length_m", r.length},
+                  {"peak_force_n", r.peak_force},
+                  {"peak_force_per_m_n_m", r.peak_force_per_m},
+                  {"peak_pressure_pa", r.peak_pressure},
+                  {"retained_volume_m3", r.retained},
+                  {"overtopped_volume_m3", r.overtopped},
+                  {"impulse_n_s", r.impulse},
+                  {"vertices_xy_m", verts},
+                  {"series", "barriers/" + r.name + ".csv"}});
+  }
+  return jb;
+}
+
+/// series.csv (the run's time series) and barriers/<name>.csv (each barrier's load history).
+void write_series_tables(const RunoutSimulation& sim, const fs::path& out) {
+  {
+    AtomicTextFile csv(out / "series.csv");
+    csv << "time_s,step,particles,front_x_m,front_y_m,front_travel_m,front_drop_m,mean_speed_m_per_s,max_speed_m_per_s,"
+           "mobile_volume_m3,deposited_volume_m3,lost_volume_m3,balance_error_m3,entrained_volume_m3,injected_volume_"
+           "m3\n";
+    csv.stream() << std::setprecision(10);
+    for (const auto& r : sim.series())
+      csv << r.time << ',' << r.step << ',' << r.particles << ',' << r.front.x() << ',' << r.front.y() << ','
+          << r.front_travel << ',' << r.front_drop << ',' << r.mean_speed << ',' << r.max_speed << ','
+          << r.volumes.mobile << ',' << r.volumes.deposited << ',' << r.volumes.lost << ',' << r.volumes.balance_error()
+          << ',' << r.volumes.entrained << ',' << r.volumes.injected << '\n';
+    csv.commit();
+  }
+
+  if (!sim.barrier_series().empty()) {
+    fs::create_directories(out / "barriers");
+    for (std::size_t b = 0; b < sim.barrier_series().size(); ++b) {
+      AtomicTextFile csv(out / "barriers" / (sim.inputs().barriers[b].name + ".csv"));
+      csv << "time_s,force_N,force_per_m_N_m,wetted_length_m,depth_at_wall_m,pressure_Pa,overtopped_volume_m3\n";
+      csv.stream() << std::setprecision(10);
+      for (const BarrierRow& r : sim.barrier_series()[b])
+        csv << r.time << ',' << r.force << ',' << r.force_per_m << ',' << r.wetted_length << ',' << r.depth << ','
+            << r.pressure << ',' << r.passed << '\n';
+      csv.commit();
+    }
+  }
+}
+
+}  // namespace
+
 std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int threads) {
   const IntensityTable& itab = c.output.intensity;
   const auto& solver = sim.solver();
@@ -690,71 +797,9 @@ std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int t
           {{"medium_pressure_pa", itab.medium_pressure}, {"strong_pressure_pa", itab.strong_pressure}});
   }
   j["mass_balance_error_relative"] = b.total_in() > 0.0 ? b.balance_error() / b.total_in() : 0.0;
-  // The processes in force (docs/runout.md, "Processes").
-  const EntrainmentParameters& ent = sim.parameters().entrainment;
-  const SpatialProcesses& proc = solver.processes();
-  nlohmann::json jp;
-  jp["entrainment"] = {{"law", to_string(ent.law)}};
-  if (ent.law == EntrainmentLaw::GrowthRate) jp["entrainment"]["growth_rate_per_m"] = ent.growth_rate;
-  if (ent.law == EntrainmentLaw::ShearStress) {
-    jp["entrainment"]["critical_shear_pa"] = ent.critical_shear;
-    jp["entrainment"]["coefficient_m_per_s_pa"] = ent.erosion_coefficient;
-  }
-  if (ent.law != EntrainmentLaw::None) {
-    double eroded_max = 0.0;
-    for (double e : solver.eroded_depth()) eroded_max = std::max(eroded_max, e);
-    jp["entrainment"]["file"] = c.processes.erodible;
-    jp["entrainment"]["entrained_volume_m3"] = b.entrained;
-    jp["entrainment"]["growth_factor"] = b.initial + b.injected > 0.0 ? b.total_in() / (b.initial + b.injected) : 0.0;
-    jp["entrainment"]["max_eroded_depth_m"] = eroded_max;
-    jp["entrainment"]["terrain"] = "fixed (the DSM is not lowered by the eroded depth)";
-  }
-  nlohmann::json zones = nlohmann::json::array();
-  for (int k = 0; k < kFrictionParameters; ++k)
-    if (!proc.friction[static_cast<std::size_t>(k)].empty())
-      zones.push_back(kFrictionParameterNames[static_cast<std::size_t>(k)]);
-  jp["friction_zones"] = {{"file", c.processes.zones}, {"coefficients", zones}};
-  if (!proc.forest_drag.empty()) {
-    double area = 0.0, kmax = 0.0;
-    for (double k : proc.forest_drag)
-      if (k > 0.0) {
-        area += sim.inputs().grid().cell_area();
-        kmax = std::max(kmax, k);
-      }
-    jp["forest"] = {{"file", c.processes.forest},
-                    {"area_m2", area},
-                    {"max_drag_per_m", kmax},
-                    {"drag_coefficient", c.processes.drag_coefficient}};
-  }
-  if (!proc.inflows.empty()) {
-    const Hydrograph& q = proc.inflows.front();
-    jp["inflow"] = {{"hydrograph", q.source},    {"volume_of_table_m3", q.volume()},
-                    {"injected_m3", b.injected}, {"end_time_s", q.end_time()},
-                    {"speed_m_per_s", q.speed},  {"direction_xy", {q.direction.x(), q.direction.y()}}};
-  }
-  j["processes"] = jp;
-  // Barriers: the figures of each and its line in map coordinates (the maps draw them).
-  nlohmann::json jb = nlohmann::json::array();
+  j["processes"] = processes_json(c, sim, b);
   const std::vector<BarrierResult> bres = sim.barrier_results();
-  for (std::size_t b = 0; b < bres.size(); ++b) {
-    const BarrierResult& r = bres[b];
-    nlohmann::json verts = nlohmann::json::array();
-    for (const Vec2& v : sim.inputs().barriers[b].vertices) verts.push_back({v.x(), v.y()});
-    jb.push_back({{"name", r.name},
-                  {"file", sim.inputs().barrier_source},
-                  {"crest_height_m", r.height},
-                  {"permeability", r.permeability},
-                  {"length_m", r.length},
-                  {"peak_force_n", r.peak_force},
-                  {"peak_force_per_m_n_m", r.peak_force_per_m},
-                  {"peak_pressure_pa", r.peak_pressure},
-                  {"retained_volume_m3", r.retained},
-                  {"overtopped_volume_m3", r.overtopped},
-                  {"impulse_n_s", r.impulse},
-                  {"vertices_xy_m", verts},
-                  {"series", "barriers/" + r.name + ".csv"}});
-  }
-  j["barriers"] = jb;
+  j["barriers"] = barriers_json(sim, bres);
   if (!sim.gauges().empty()) j["gauges"] = detail::gauges_summary(sim);
   if (!bres.empty())
     j["barrier_law"] = {{"restitution", sim.inputs().wall_law.restitution},
@@ -896,32 +941,7 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
   detail::write_profile_outputs(c, sim, r_depth, r_speed, r_pressure, r_arrival, out);
   detail::write_gauge_outputs(c, sim, out);
 
-  {
-    AtomicTextFile csv(out / "series.csv");
-    csv << "time_s,step,particles,front_x_m,front_y_m,front_travel_m,front_drop_m,mean_speed_m_per_s,max_speed_m_per_s,"
-           "mobile_volume_m3,deposited_volume_m3,lost_volume_m3,balance_error_m3,entrained_volume_m3,injected_volume_"
-           "m3\n";
-    csv.stream() << std::setprecision(10);
-    for (const auto& r : sim.series())
-      csv << r.time << ',' << r.step << ',' << r.particles << ',' << r.front.x() << ',' << r.front.y() << ','
-          << r.front_travel << ',' << r.front_drop << ',' << r.mean_speed << ',' << r.max_speed << ','
-          << r.volumes.mobile << ',' << r.volumes.deposited << ',' << r.volumes.lost << ',' << r.volumes.balance_error()
-          << ',' << r.volumes.entrained << ',' << r.volumes.injected << '\n';
-    csv.commit();
-  }
-
-  if (!sim.barrier_series().empty()) {
-    fs::create_directories(out / "barriers");
-    for (std::size_t b = 0; b < sim.barrier_series().size(); ++b) {
-      AtomicTextFile csv(out / "barriers" / (sim.inputs().barriers[b].name + ".csv"));
-      csv << "time_s,force_N,force_per_m_N_m,wetted_length_m,depth_at_wall_m,pressure_Pa,overtopped_volume_m3\n";
-      csv.stream() << std::setprecision(10);
-      for (const BarrierRow& r : sim.barrier_series()[b])
-        csv << r.time << ',' << r.force << ',' << r.force_per_m << ',' << r.wetted_length << ',' << r.depth << ','
-            << r.pressure << ',' << r.passed << '\n';
-      csv.commit();
-    }
-  }
+  write_series_tables(sim, out);
 
   write_text_file(out / "summary.json", summary_json(c, sim, threads) + "\n");
 }

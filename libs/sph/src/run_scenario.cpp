@@ -70,6 +70,19 @@ void clamp_regions(const RunConfig& c, SphStore<Dim>& S) {
 
 }  // namespace
 
+namespace {
+
+/// The configured end and bottom walls and the 3D width on a profile domain.
+void apply_walls(ProfileDomain& d, const RunConfig& c) {
+  d.left = c.left_wall;
+  d.right = c.right_wall;
+  d.bottom = c.bottom_wall;
+  d.width = c.width;
+  d.periodic_width = c.periodic_width;
+}
+
+}  // namespace
+
 void apply_layers(ProfileDomain& d, const RunConfig& c) {
   if (!c.layer_materials.empty()) {
     d.layer_tops = c.layer_tops;
@@ -110,11 +123,7 @@ Built<Dim> build(const RunConfig& c) {
   switch (c.scenario) {
     case ScenarioType::Slope: {
       ProfileDomain d = c.slope.profile();
-      d.left = c.left_wall;
-      d.right = c.right_wall;
-      d.bottom = c.bottom_wall;
-      d.width = c.width;
-      d.periodic_width = c.periodic_width;
+      apply_walls(d, c);
       apply_layers(d, c);
       if (c.piles.enabled) {
         if (Dim != 3)
@@ -137,11 +146,7 @@ Built<Dim> build(const RunConfig& c) {
       d.surface = {{0.0, H}, {a, H}, {a, 0.0}, {a + c.floor_length, 0.0}};
       d.x_left = 0.0;
       d.x_right = a + c.floor_length;
-      d.left = c.left_wall;
-      d.right = c.right_wall;
-      d.bottom = c.bottom_wall;
-      d.width = c.width;
-      d.periodic_width = c.periodic_width;
+      apply_walls(d, c);
       b.sc = build_profile<Dim>(d, dx, rho, hf);
       b.frame.toe_x = a;
       b.frame.base_length = a;
@@ -153,11 +158,7 @@ Built<Dim> build(const RunConfig& c) {
       d.surface = {{0.0, c.block_height}, {c.block_length, c.block_height}};
       d.x_left = 0.0;
       d.x_right = c.block_length;
-      d.left = c.left_wall;
-      d.right = c.right_wall;
-      d.bottom = c.bottom_wall;
-      d.width = c.width;
-      d.periodic_width = c.periodic_width;
+      apply_walls(d, c);
       b.sc = build_profile<Dim>(d, dx, rho, hf);
       b.frame.toe_x = c.block_length;
       b.frame.base_length = c.block_length;
