@@ -5,8 +5,8 @@
 //     release (d0 = 5 m, h0 = 1 m, 2 m thick over 300 m × 200 m) on the synthetic 5 km valley DSM of 2000 × 1000 cells
 //     at 2.5 m, n = 0.06, i_cr = 0.15 (target < 10 s), with the hazard maps recorded every step as the app does.
 // Prints rates; never asserts. Usage: bench_runout [particles=100000] [steps=40]
-// [all|plane|seed|processes|barrier|laws|law=<name>] [threads] [skin] (the third argument runs one case only, the
-// fourth one thread count only, the fifth sets numerics.skin in units of d0: for profiling and for comparing list
+// [all|plane|seed|processes|barrier|laws|law_steps|law=<name>] [threads] [skin] (the third argument runs one case only,
+// the fourth one thread count only, the fifth sets numerics.skin in units of d0: for profiling and for comparing list
 // strategies).
 #include <omp.h>
 
@@ -126,6 +126,32 @@ const std::vector<BasalFriction>& bench_laws() {
                                                CoulombFriction{0.15}};
   return laws;
 }
+/// The latency of one law's friction step alone (terms + speed_after_friction) in a dependent
+/// chain, as in the solver's particle loop, where the next particle's work cannot overlap much
+/// with this one's: ns per step, best of 5 runs of 2e6 steps. An accelerating 2 m layer
+/// (tan θ ≈ 0.3, Δt = 0.01 s) restarted every 200 steps; an iterative law keeps its memory.
+/// Small working set, CPU time: far less sensitive to a shared machine than the plane's rates.
+double law_step_ns(const BasalFriction& friction) {
+  return std::visit(
+      [](const auto& law) {
+        const int n = 2000000;
+        const double dt = 0.01, h = 2.0, g = 9.81;
+        double zeta = 0.0, rate = 0.0, s = 1.0, sum = 0.0, best = HUGE_VAL;
+        for (int rep = 0; rep < 5; ++rep) {
+          const double c0 = cpu();
+          for (int k = 0; k < n; ++k) {
+            const double s_star = (k % 200 == 0 ? 0.5 : s) + dt * g * 0.287;
+            auto t = law.terms(g, g * 0.958, h + 1e-3 * (k & 7), s_star, 2000.0);
+            if constexpr (requires { t.memory; }) t.memory = {&zeta, &rate};
+            s = speed_after_friction(s_star, dt, t);
+            sum += s;
+          }
+          best = std::min(best, (cpu() - c0) / n * 1e9);
+        }
+        return sum > 0.0 ? best : -best;  // keeps the chain
+      },
+      friction);
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -156,6 +182,12 @@ int main(int argc, char** argv) {
       }
     std::fprintf(stderr, "bench_runout: unknown law %s\n", which.c_str() + 4);
     return 2;
+  }
+  if (which == "law_steps") {
+    std::printf("bench_runout: one friction step of each law alone, dependent chain (ns, CPU, best of 5)\n");
+    for (const BasalFriction& law : bench_laws())
+      std::printf("  %-17s %.1f ns\n", friction_name(law).c_str(), law_step_ns(law));
+    return 0;
   }
   if (which == "laws") {
     // Each basal law against Voellmy on the plane, back to back, best of 3 each (issue 34: no law

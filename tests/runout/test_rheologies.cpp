@@ -230,7 +230,7 @@ TEST(RheologyStep, EachLawSolvesItsBackwardEulerEquationAndNeverReverses) {
 }
 
 TEST(RheologyStep, BinghamCubicMatchesHerschelBulkleyWithIndexOne) {
-  // Two independent solutions (the trigonometric root of the cubic, Newton on the HB mean speed).
+  // Two independent solutions (Halley on the plug cubic, Halley on the HB mean speed in ln ζ).
   const BinghamFriction b{300.0, 40.0};
   const HerschelBulkleyFriction hb{300.0, 40.0, 1.0};
   for (double h : {0.1, 0.7, 3.0})
@@ -238,6 +238,26 @@ TEST(RheologyStep, BinghamCubicMatchesHerschelBulkleyWithIndexOne) {
       const double ab = b.terms(kG, kG, h, s, kRho).acceleration(s), ah = hb.terms(kG, kG, h, s, kRho).acceleration(s);
       EXPECT_NEAR(ab, ah, 1e-9 * ab);
     }
+}
+
+TEST(RheologyStep, BinghamStepSatisfiesThePlugFlowRelationDownToTheYield) {
+  // The speed s after a Bingham step and the basal stress it implies, τ_b = ρ h (s* − s)/Δt, must
+  // satisfy the forward plug-flow relation U(τ_b) = (h τ_b/(6 μ_B)) (1 − r)² (2 + r), r = τ_y/τ_b,
+  // written here independently of the solver, from fast flow down to s* a hair above the yield
+  // (s* − Δt a_rest = 1e-12 s*), where the trigonometric root of the cubic lost up to 20 %.
+  const double tau_y = 300.0, mu_b = 40.0;
+  const BinghamFriction law{tau_y, mu_b};
+  for (double h : {0.1, 0.7, 3.0})
+    for (double dt : {1e-3, 0.05})
+      for (double excess : {1e-12, 1e-8, 1e-4, 0.1, 1.0, 30.0}) {
+        const BinghamTerms t = law.terms(kG, kG, h, 0.0, kRho);
+        const double s_star = dt * t.rest * (1.0 + excess);
+        const double s = speed_after_friction(s_star, dt, t);
+        ASSERT_GT(s, 0.0) << "h " << h << " excess " << excess;
+        const double tau_b = kRho * h * (s_star - s) / dt, r = tau_y / tau_b;
+        const double u = h * tau_b / (6.0 * mu_b) * (1.0 - r) * (1.0 - r) * (2.0 + r);
+        EXPECT_NEAR(s, u, 1e-9 * s + 1e-15) << "h " << h << " dt " << dt << " excess " << excess;
+      }
 }
 
 TEST(RheologyStep, HerschelBulkleyWarmStartGivesTheColdAnswer) {

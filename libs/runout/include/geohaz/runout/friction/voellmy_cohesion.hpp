@@ -21,6 +21,14 @@
 
 namespace geohaz::runout {
 
+/// φ(x) = (1 − e^{−x})/x for x ≥ 0 to ~1e-14 relative: its Taylor polynomial of degree 5 below
+/// x = 0.01 (truncation x⁶/720 < 2e-15), else with libm's exp, which is faster than expm1 and
+/// loses at most ~1e-16/x to the subtraction there.
+inline double one_minus_exp_ratio(double x) noexcept {
+  if (x < 1e-2) return 1.0 - x * (1.0 / 2 - x * (1.0 / 6 - x * (1.0 / 24 - x * (1.0 / 120 - x * (1.0 / 720)))));
+  return (1.0 - std::exp(-x)) / x;
+}
+
 struct VoellmyCohesionFriction {
   double mu = 0.15;       ///< Coulomb coefficient μ (1)
   double xi = 500.0;      ///< turbulence coefficient ξ (m/s²)
@@ -29,9 +37,9 @@ struct VoellmyCohesionFriction {
   static constexpr const char* summary =
       "Voellmy with cohesion, S = muN + rho g v^2/xi + (1-mu)C(1-exp(-N/C)) (mu, xi, cohesion; RAMMS)";
   FrictionTerms terms(double g, double g_n, double h_n, double /*speed*/, double rho) const noexcept {
-    double rest = g_n * mu;
-    if (cohesion > 0.0) rest -= (1.0 - mu) * (cohesion / (rho * h_n)) * std::expm1(-rho * g_n * h_n / cohesion);
-    return {rest, g / (xi * h_n)};
+    if (cohesion <= 0.0) return {g_n * mu, g / (xi * h_n)};
+    // a_rest = g_n (μ + (1 − μ) φ(x)), φ(x) = (1 − e^{−x})/x, x = N/C.
+    return {g_n * (mu + (1.0 - mu) * one_minus_exp_ratio(rho * g_n * h_n / cohesion)), g / (xi * h_n)};
   }
 };
 
