@@ -443,6 +443,45 @@ TEST(SphSlopeApp, StrengthReductionOnTwoLayerSlopeAgreesWithBishop) {
   EXPECT_LT(s["bishop"]["centre_z_m"].get<double>() - s["bishop"]["radius_m"].get<double>(), 1.0);
 }
 
+// The same two-layer slope as a von Mises (undrained, total-stress) material: σ_y = √3 c_u per
+// layer is the same plane-strain strength (constitutive.hpp, VonMises::plane_strain_strength), so the
+// strength reduction, which now divides σ_y by F, must bracket the same factor as Bishop's on c_u
+// (0.989). Before, σ_y was not reduced, every trial stood and the bracket hit f_max. About 7 s.
+TEST(SphSlopeApp, StrengthReductionOfAVonMisesSlopeReducesTheYieldStress) {
+  const fs::path out = kWork / "srm_von_mises";
+  fs::remove_all(out);
+  const double root3 = std::sqrt(3.0);
+  const auto r =
+      run("--config " + (kData / "griffiths_lane_two_layer_srm.toml").string() + " --out " + out.string() +
+              " --set model.constitutive=von_mises --set 'material[0].yield_stress=" + std::to_string(30e3 * root3) +
+              "' --set 'material[1].yield_stress=" + std::to_string(50e3 * root3) +
+              "' --set strength_reduction.f_min=0.85 --set strength_reduction.f_max=1.1"
+              " --set strength_reduction.tolerance=0.04 --quiet",
+          "srm_von_mises");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto s = summary(out);
+  EXPECT_EQ(s["outcome"], "bracketed");
+  const double F = s["factor_of_safety"].get<double>(), Fb = s["bishop"]["factor"].get<double>();
+  EXPECT_NEAR(Fb, 0.989, 0.005);
+  EXPECT_NEAR(F, Fb, 0.05 * Fb);
+}
+
+// A model without a shear strength has nothing to reduce: exit 2 naming model.constitutive and the
+// models that have one, nothing written (the analysis used to run and report a factor of nothing).
+TEST(SphSlopeApp, StrengthReductionRefusesAModelWithoutStrength) {
+  const fs::path out = kWork / "srm_elastic";
+  fs::remove_all(out);
+  for (const char* model : {"linear_elastic", "newtonian_fluid"}) {
+    const auto r = run("--config " + (kData / "acads_1a_srm.toml").string() + " --out " + out.string() +
+                           " --set model.constitutive=" + model,
+                       "srm_elastic");
+    EXPECT_EQ(r.code, 2) << model << ": " << r.err;
+    EXPECT_NE(r.err.find("model.constitutive"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("von_mises, drucker_prager, drucker_prager_softening"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
 TEST(SphSlopeApp, StrengthReductionBadRangeExitsTwoNamingTheKey) {
   const fs::path out = kWork / "srm_bad";
   fs::remove_all(out);

@@ -25,6 +25,52 @@ double J2(const Mat3& s) {
   return 0.5 * d.squaredNorm();
 }
 
+TEST(StrengthReduction, EachModelReducesItsOwnStrength) {
+  // The strength reduction's trial material (constitutive.hpp, reduce_strength): Drucker–Prager
+  // c/F and tan φ/F, tan ψ/F; the softening model its residual strength as well; von Mises its
+  // yield stress (an undrained strength). Elastic and fluid models have none and are refused.
+  MaterialParams p;
+  p.cohesion = 12e3, p.friction = 35 * kDeg, p.dilatancy = 5 * kDeg, p.yield_stress = 90e3;
+  p.residual_cohesion = 3e3, p.residual_friction = 25 * kDeg;
+  const double F = 1.6;
+  const auto dp = reduced_strength(DruckerPrager{}, {p}, F).front();
+  EXPECT_DOUBLE_EQ(dp.cohesion, 12e3 / F);
+  EXPECT_NEAR(std::tan(dp.friction), std::tan(35 * kDeg) / F, 1e-15);
+  EXPECT_NEAR(std::tan(dp.dilatancy), std::tan(5 * kDeg) / F, 1e-15);
+  EXPECT_EQ(dp.residual_cohesion, p.residual_cohesion);  // not a softening model's parameter
+  EXPECT_EQ(dp.yield_stress, p.yield_stress);
+  const auto soft = reduced_strength(DruckerPragerSoftening{}, {p}, F).front();
+  EXPECT_DOUBLE_EQ(soft.cohesion, dp.cohesion);
+  EXPECT_DOUBLE_EQ(soft.residual_cohesion, 3e3 / F);
+  EXPECT_NEAR(std::tan(soft.residual_friction), std::tan(25 * kDeg) / F, 1e-15);
+  const auto vm = reduced_strength(VonMises{}, {p}, F).front();
+  EXPECT_DOUBLE_EQ(vm.yield_stress, 90e3 / F);
+  EXPECT_EQ(vm.cohesion, p.cohesion);
+  EXPECT_EQ(vm.friction, p.friction);
+  EXPECT_THROW(reduced_strength(LinearElastic{}, {p}, F), std::invalid_argument);
+  EXPECT_THROW(reduced_strength(NewtonianFluid{}, {p}, F), std::invalid_argument);
+  EXPECT_EQ(models_with_shear_strength(), "von_mises, drucker_prager, drucker_prager_softening");
+}
+
+TEST(StrengthReduction, PlaneStrainStrengthForBishop) {
+  // Bishop's (c, φ) of each model: von Mises in plane strain is Tresca with c_u = σ_y/√3, checked
+  // here on a stress state at yield: σ_zz = (σ1 + σ3)/2 (plane strain, associated flow) and
+  // σ1 − σ3 = 2 c_u puts √J2 exactly on σ_y/√3.
+  MaterialParams p;
+  p.cohesion = 12e3, p.friction = 35 * kDeg, p.yield_stress = 90e3;
+  p.residual_cohesion = 3e3, p.residual_friction = 25 * kDeg;
+  const auto [cu, phi_u] = *plane_strain_strength(VonMises{}, p);
+  EXPECT_EQ(phi_u, 0.0);
+  Mat3 s = Mat3::Zero();
+  s(0, 0) = -200e3, s(1, 1) = -200e3 + 2.0 * cu, s(2, 2) = -200e3 + cu;
+  EXPECT_NEAR(std::sqrt(J2(s)), p.yield_stress / std::sqrt(3.0), 1e-9);
+  EXPECT_EQ(*plane_strain_strength(DruckerPrager{}, p), std::make_pair(12e3, 35 * kDeg));
+  EXPECT_EQ(*plane_strain_strength(DruckerPragerSoftening{}, p, true), std::make_pair(3e3, 25 * kDeg));
+  EXPECT_FALSE(plane_strain_strength(LinearElastic{}, p).has_value());
+  EXPECT_FALSE(has_shear_strength(NewtonianFluid{}));
+  EXPECT_TRUE(has_shear_strength(VonMises{}));
+}
+
 TEST(DruckerPragerConstants, PlaneStrainHandValues) {
   // φ = 30°, c = 10 kPa: tanφ = 1/√3, √(9 + 12 tan²φ) = √13 (Bui et al. 2010, eqs. 18–19).
   const auto k = drucker_prager_constants(10e3, 30 * kDeg, 0.0, DruckerPragerFit::PlaneStrain);

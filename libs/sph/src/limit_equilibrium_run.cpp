@@ -16,6 +16,17 @@
 
 namespace geohaz::sph {
 
+namespace {
+
+/// The plane-strain (c, φ) of a material under the run's model (constitutive.hpp), for Bishop.
+std::pair<double, double> shear_strength_of(const RunConfig& c, const MaterialParams& p, bool residual) {
+  if (const auto s = plane_strain_strength(c.model, p, residual)) return *s;
+  throw InputError("has no shear strength for Bishop's method; use one of " + models_with_shear_strength(),
+                   c.config_source, "model.constitutive", std::string(constitutive_model_name(c.model)));
+}
+
+}  // namespace
+
 SlopeSection limit_equilibrium_section(const RunConfig& c, bool with_water_and_seismic) {
   if (c.scenario != ScenarioType::Slope || c.dimension != 2)
     throw InputError("the limit-equilibrium analysis needs the 2D slope scenario", c.config_source, "run.scenario");
@@ -26,7 +37,8 @@ SlopeSection limit_equilibrium_section(const RunConfig& c, bool with_water_and_s
   for (std::size_t m = 0; m < c.materials.size(); ++m) {
     const auto& p = c.materials[m];
     const double sat = m < c.saturated_densities.size() ? c.saturated_densities[m] : 0.0;
-    soils.push_back({p.density * g, p.cohesion, p.friction, with_water_and_seismic ? sat * g : 0.0});
+    const auto [coh, phi] = shear_strength_of(c, p, false);
+    soils.push_back({p.density * g, coh, phi, with_water_and_seismic ? sat * g : 0.0});
   }
   auto s = SlopeSection::from_profile(d, soils);
   if (with_water_and_seismic) {
@@ -291,8 +303,8 @@ SlopeSection section_of(const RunConfig& c, bool residual = false) {
   for (std::size_t k = 0; k < c.materials.size(); ++k) {
     const auto& m = c.materials[k];
     const double sat = k < c.saturated_densities.size() ? c.saturated_densities[k] : 0.0;
-    soils.push_back({m.density * c.numerics.gravity, residual ? m.residual_cohesion : m.cohesion,
-                     residual ? m.residual_friction : m.friction, sat * c.numerics.gravity});
+    const auto [coh, phi] = shear_strength_of(c, m, residual);
+    soils.push_back({m.density * c.numerics.gravity, coh, phi, sat * c.numerics.gravity});
   }
   auto s = SlopeSection::from_profile(d, soils);
   if (c.scenario == ScenarioType::Slope) {
@@ -314,9 +326,8 @@ BishopResult bishop_of(const RunConfig& c, bool residual) {
 
 StaticBishop StaticBishop::of(const RunConfig& c) {
   StaticBishop b;
-  const bool frictional =
-      std::holds_alternative<DruckerPrager>(c.model) || std::holds_alternative<DruckerPragerSoftening>(c.model);
-  if (c.dimension != 2 || !frictional || (c.scenario != ScenarioType::Slope && c.scenario != ScenarioType::Section))
+  if (c.dimension != 2 || !has_shear_strength(c.model) ||
+      (c.scenario != ScenarioType::Slope && c.scenario != ScenarioType::Section))
     return b;
   try {
     b.peak = bishop_of(c);

@@ -16,19 +16,6 @@ namespace geohaz::sph {
 
 namespace {
 
-/// Every material with c/F, atan(tan φ/F) and atan(tan ψ/F) (strength reduction).
-std::vector<MaterialParams> reduced_strength(const std::vector<MaterialParams>& mats, double F) {
-  auto r = mats;
-  for (auto& p : r) {
-    p.cohesion /= F;
-    p.friction = std::atan(std::tan(p.friction) / F);
-    p.dilatancy = std::atan(std::tan(p.dilatancy) / F);
-    p.residual_cohesion /= F;
-    p.residual_friction = std::atan(std::tan(p.residual_friction) / F);
-  }
-  return r;
-}
-
 template <int Dim>
 double max_soil_displacement(const SphStore<Dim>& s) {
   double u = 0.0;
@@ -169,7 +156,7 @@ bool StrengthReductionRun<Dim>::trial(double F, const SphSimulation& self, RunOb
   const double T = trial_duration_;
   SrmTrial t;
   t.factor = F;
-  SphSolver<Dim> s(*initial_, reduced_strength(c_.materials, F), c_.model, settings_);
+  SphSolver<Dim> s(*initial_, reduced_strength(c_.model, c_.materials, F), c_.model, settings_);
   RunProgress p{"trial", 0.0, T, 0, s.store().size(), F, false};
   double u75 = -1.0;
   try {

@@ -117,8 +117,15 @@ void validate(const RunConfig& c) {
     if (c.scenario == ScenarioType::Biaxial)
       throw InputError("strength reduction needs a slope, column or section scenario (gravity-loaded)", c.config_source,
                        "run.analysis", "strength_reduction");
+    if (!has_shear_strength(c.model))
+      throw InputError(
+          "has no shear strength to reduce; the strength reduction needs one of " + models_with_shear_strength(),
+          c.config_source, "model.constitutive", std::string(constitutive_model_name(c.model)));
   }
   validate_water_and_seismic(c);
+  if (c.analysis == Analysis::LimitEquilibrium && !has_shear_strength(c.model))
+    throw InputError("has no shear strength for Bishop's method; use one of " + models_with_shear_strength(),
+                     c.config_source, "model.constitutive", std::string(constitutive_model_name(c.model)));
   if (c.analysis == Analysis::LimitEquilibrium) return;  // no particles to build
   if (c.initial_velocity.type == InitialVelocity::Type::Uniform &&
       c.initial_velocity.value.size() != static_cast<std::size_t>(c.dimension))

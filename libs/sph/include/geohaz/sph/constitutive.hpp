@@ -43,6 +43,13 @@
 ///                              its internal variables in the order of InternalVariables; returns
 ///                              the plastic multiplier Δλ of the step (0 if elastic) for the step
 ///                              statistics.
+/// A model with a shear strength also declares (both or neither; `HasShearStrength` below):
+///   reduce_strength(p, F)      p with its strength divided by the factor F (the strength
+///                              reduction's trial material: c/F and tan φ/F, or σ_y/F);
+///   plane_strain_strength(p, residual)  the Mohr–Coulomb (c, φ) of the material in plane strain,
+///                              for Bishop's method beside the SPH run (residual: the softened one).
+/// A model without them (an elastic solid, a fluid) has nothing to reduce: the strength reduction
+/// and the limit-equilibrium checks refuse it by name.
 /// A new model (say Drucker–Prager with c and φ softening over a plastic-strain range) is a struct
 /// like DruckerPrager below, with update reading its PlasticStrain argument, plus its entry in
 /// ConstitutiveModel (the name table); parameters it adds go into MaterialParams and the app's
@@ -54,10 +61,13 @@
 #include <concepts>
 #include <limits>
 #include <optional>
+#include <stdexcept>
+#include <string>
 #include <string_view>
 #include <type_traits>
 #include <utility>
 #include <variant>
+#include <vector>
 
 #include "geohaz/core/name_table.hpp"
 #include "geohaz/core/vec.hpp"
@@ -259,6 +269,13 @@ struct VonMises {
   /// No floor: von Mises has no tension cut-off.
   static double min_density(const MaterialParams& /*p*/) noexcept { return 0.0; }
   static constexpr bool elastic_loading = true;
+  /// An undrained (total-stress) strength: σ_y/F.
+  static void reduce_strength(MaterialParams& p, double F) noexcept { p.yield_stress /= F; }
+  /// In plane strain with associated flow σ_zz = (σ1 + σ3)/2, so √J2 = (σ1 − σ3)/2 and the yield
+  /// √J2 = σ_y/√3 is Tresca's with c_u = σ_y/√3, φ = 0.
+  static std::pair<double, double> plane_strain_strength(const MaterialParams& p, bool /*residual*/) noexcept {
+    return {p.yield_stress / std::sqrt(3.0), 0.0};
+  }
 };
 
 /// Elastic–perfectly plastic Drucker–Prager, non-associated (dilatancy ψ), Jaumann rate,
@@ -287,6 +304,15 @@ struct DruckerPrager {
     return p.density / (1.0 + p.dp.kc / (3.0 * p.dp.alpha_phi * p.bulk));
   }
   static constexpr bool elastic_loading = true;
+  /// c/F, atan(tan φ/F), atan(tan ψ/F) (Griffiths & Lane 1999; ψ with φ keeps ψ ≤ φ).
+  static void reduce_strength(MaterialParams& p, double F) noexcept {
+    p.cohesion /= F;
+    p.friction = std::atan(std::tan(p.friction) / F);
+    p.dilatancy = std::atan(std::tan(p.dilatancy) / F);
+  }
+  static std::pair<double, double> plane_strain_strength(const MaterialParams& p, bool /*residual*/) noexcept {
+    return {p.cohesion, p.friction};
+  }
 };
 
 /// Drucker–Prager with strain softening: as DruckerPrager, but cohesion and friction fall linearly
@@ -326,6 +352,15 @@ struct DruckerPragerSoftening {
   }
   static double min_density(const MaterialParams& p) noexcept { return DruckerPrager::min_density(p); }
   static constexpr bool elastic_loading = true;
+  /// The peak and the residual strength alike.
+  static void reduce_strength(MaterialParams& p, double F) noexcept {
+    DruckerPrager::reduce_strength(p, F);
+    p.residual_cohesion /= F;
+    p.residual_friction = std::atan(std::tan(p.residual_friction) / F);
+  }
+  static std::pair<double, double> plane_strain_strength(const MaterialParams& p, bool residual) noexcept {
+    return residual ? std::pair{p.residual_cohesion, p.residual_friction} : std::pair{p.cohesion, p.friction};
+  }
 };
 
 /// Weakly compressible Newtonian fluid: σ = −p I + 2μ ė, p = K (ρ/ρ0 − 1) (linear equation of
@@ -366,6 +401,13 @@ concept ConstitutiveLaw = requires(const MaterialParams& p, double h) {
   { M::elastic_loading } -> std::convertible_to<bool>;
 };
 
+/// A model with a shear strength to reduce and to use in Bishop's method (see the file comment).
+template <class M>
+concept HasShearStrength = requires(MaterialParams& p, const MaterialParams& cp) {
+  M::reduce_strength(p, 1.0);
+  { M::plane_strain_strength(cp, false) } -> std::same_as<std::pair<double, double>>;
+};
+
 /// The run-time choice of model (one per run; all materials of a run share the model type), and
 /// the one name table of the models: its alternatives' `name`s are the values of
 /// `model.constitutive`. A model is added here and nowhere else in the solver or the app.
@@ -392,6 +434,54 @@ inline std::optional<ConstitutiveModel> constitutive_model_from_name(std::string
 /// Name of a model.
 inline std::string_view constitutive_model_name(const ConstitutiveModel& m) noexcept {
   return constitutive_model_names[m.index()];
+}
+
+/// Whether the run's model has a shear strength (HasShearStrength): what the strength reduction
+/// and Bishop's method need.
+inline bool has_shear_strength(const ConstitutiveModel& m) noexcept {
+  return std::visit([](const auto& law) { return HasShearStrength<std::decay_t<decltype(law)>>; }, m);
+}
+
+/// The config names of the models with a shear strength, comma-separated (for messages).
+inline std::string models_with_shear_strength() {
+  std::string names;
+  auto add = [&]<class... M>(std::type_identity<std::variant<M...>>) {
+    ((HasShearStrength<M> ? (names += (names.empty() ? "" : ", ") + std::string(M::name), 0) : 0), ...);
+  };
+  add(std::type_identity<ConstitutiveModel>{});
+  return names;
+}
+
+/// The materials with their strength divided by F, each as the run's model reduces it. The model
+/// must have a shear strength (the config check refuses the others by name).
+inline std::vector<MaterialParams> reduced_strength(const ConstitutiveModel& m, std::vector<MaterialParams> mats,
+                                                    double F) {
+  std::visit(
+      [&](const auto& law) {
+        using M = std::decay_t<decltype(law)>;
+        if constexpr (HasShearStrength<M>) {
+          for (auto& p : mats) M::reduce_strength(p, F);
+        } else {
+          throw std::invalid_argument(std::string("the constitutive model ") + M::name + " has no strength to reduce");
+        }
+      },
+      m);
+  return mats;
+}
+
+/// The plane-strain Mohr–Coulomb (c, φ) of a material under the run's model (residual: the
+/// softened strength); a model without a shear strength has none (std::nullopt).
+inline std::optional<std::pair<double, double>> plane_strain_strength(const ConstitutiveModel& m,
+                                                                      const MaterialParams& p, bool residual = false) {
+  return std::visit(
+      [&](const auto& law) -> std::optional<std::pair<double, double>> {
+        using M = std::decay_t<decltype(law)>;
+        if constexpr (HasShearStrength<M>)
+          return M::plane_strain_strength(p, residual);
+        else
+          return std::nullopt;
+      },
+      m);
 }
 
 }  // namespace geohaz::sph
