@@ -422,8 +422,11 @@ void write_calibration_outputs(const CalibrationSetup& s, const CalibrationResul
   j["design_members"] = r.design_members;
   j["morris_members"] = r.morris_members;
   j["local_members"] = static_cast<int>(r.evaluations.size()) - r.design_members - r.morris_members;
-  j["local_search"] = {
-      {"algorithm", s.search.local_algorithm}, {"starts", s.search.local_starts}, {"stops", r.local_stops}};
+  j["local_search"] = {{"algorithm", s.search.local_algorithm},
+                       {"starts", s.search.local_starts},
+                       {"restarts", s.search.local_restarts},
+                       {"searches", r.local_stops.size()},
+                       {"stops", r.local_stops}};
   j["failed"] = fj;
   j["acceptable_members"] = acceptable.size();
   nlohmann::json range = nlohmann::json::object();
