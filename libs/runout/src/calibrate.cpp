@@ -619,6 +619,7 @@ class Evaluator {
   std::vector<double> evaluate(const std::vector<std::vector<double>>& us, const std::vector<std::string>& stages) {
     std::vector<int> idx;
     std::vector<int> fresh;
+    const int first_new = next_;
     for (std::size_t k = 0; k < us.size(); ++k) {
       const std::vector<double> v = values_of(us[k]);
       const auto it = known_.find(v);
@@ -633,6 +634,7 @@ class Evaluator {
       if (values.size() <= static_cast<std::size_t>(i)) values.resize(static_cast<std::size_t>(i) + 1);
       values[static_cast<std::size_t>(i)] = v;
       stage_[i] = stages[k];
+      batch_[i] = batches_;
       if (member_done(out_, i)) {
         // A member of an earlier (killed) run: it must be the same point, or the folder is another search's.
         const MemberRecord rec = parse_member_json(slurp(member_dir(out_, i) / "member.json"));
@@ -647,6 +649,7 @@ class Evaluator {
       }
     }
     if (!fresh.empty()) run_(fresh);
+    if (next_ > first_new) ++batches_;
     std::vector<double> f;
     for (int i : idx) {
       if (r_.evaluations.size() <= static_cast<std::size_t>(i)) r_.evaluations.resize(static_cast<std::size_t>(i) + 1);
@@ -654,6 +657,7 @@ class Evaluator {
       if (e.stage.empty()) {
         e = read_evaluation(s_, out_, i);
         e.stage = stage_[i];
+        e.batch = batch_[i];
         if (!quiet_) {
           std::ostringstream o;
           o << "geohaz-calibrate: member " << i << " (" << e.stage << ")";
@@ -683,7 +687,8 @@ class Evaluator {
   bool quiet_;
   std::map<std::vector<double>, int> known_;
   std::map<int, std::string> stage_;
-  int next_ = 0, resumed_ = 0;
+  std::map<int, int> batch_;
+  int next_ = 0, resumed_ = 0, batches_ = 0;
 };
 
 /// Local searches in lockstep: each NLopt search runs in its own thread and blocks in its objective

@@ -38,14 +38,14 @@ std::string csv_text(std::string s) {
 
 void member_table(const fs::path& path, const CalibrationSetup& s, const std::vector<const Evaluation*>& rows) {
   AtomicTextFile csv(path);
-  csv << "member,stage,status";
+  csv << "member,stage,batch,status";
   for (const auto& p : s.parameters) csv << ',' << p.key;
   csv << ",score,tversky,tp_m2,fp_m2,fn_m2,runout_s_m,runout_diff_m,depth_rmse_m,volume_m3,term_footprint,term_"
          "runout,term_depth,term_volume,diagnosis\n";
   csv.stream() << std::setprecision(17);
   for (const Evaluation* e : rows) {
     const Misfit& m = e->misfit;
-    csv << e->index << ',' << e->stage << ',' << (e->ok ? "ok" : "failed");
+    csv << e->index << ',' << e->stage << ',' << e->batch << ',' << (e->ok ? "ok" : "failed");
     for (double v : e->values) csv << ',' << v;
     csv << ',' << m.score << ',' << m.tversky << ',' << m.tp << ',' << m.fp << ',' << m.fn << ',' << m.runout_s << ','
         << m.runout_diff << ',' << m.depth_rmse << ',' << m.volume << ',' << m.term_footprint << ',' << m.term_runout

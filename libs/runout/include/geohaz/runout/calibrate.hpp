@@ -140,6 +140,7 @@ void describe_calibration(ConfigReader& cfg);
 struct Evaluation {
   int index = 0;
   std::string stage;  ///< "design", "morris", "local<k>"
+  int batch = 0;      ///< the batch it was run in (0: the global stage), fixed by the search alone
   std::vector<double> values;
   bool ok = false;
   std::string diagnosis;
