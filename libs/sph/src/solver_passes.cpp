@@ -242,27 +242,43 @@ void SphSolver<Dim>::step_impl(const Model& model) {
   const Vec<Dim> gbar = body_acceleration();  //    ḡ = g + a_earthquake of this step
   prepare_boundary_pairs(gbar);               // 1. volumes; the walls' stress extrapolation
   const bool corrected = settings_.kernel_correction;
-  if (corrected) {                  // 2. A_i (consistent kernel gradients)
-    gradient_correction<Kernel>();  //    L, dρ/dt, ρ̃, XSPH
-    if (settings_.quadratic_correction)
-      velocity_gradient<Kernel, true>();
+  // The pair passes over several ranks (Ghosts) or on one process.
+  const auto passes_2 = [&](auto ghosts) {
+    constexpr bool G = decltype(ghosts)::value;
+    if (corrected && settings_.quadratic_correction)
+      velocity_gradient<Kernel, true, G>();
     else
-      velocity_gradient<Kernel, false>();  // with L_i ← L_i C_iᵀ at the end
-  } else {
-    velocity_gradient<Kernel, false>();
-  }
+      velocity_gradient<Kernel, false, G>();  // with L_i ← L_i C_iᵀ at the end if corrected
+  };
+  const auto pass_4 = [&](auto ghosts) {
+    constexpr bool G = decltype(ghosts)::value;
+    if (corrected)
+      momentum<Kernel, true, G>();
+    else
+      momentum<Kernel, false, G>();
+  };
+  if (corrected) gradient_correction<Kernel>();  // 2. A_i (consistent kernel gradients)
+  if (domain_)                                   //    L, dρ/dt, ρ̃, XSPH
+    passes_2(std::true_type{});
+  else
+    passes_2(std::false_type{});
   update_stress(model);  // 3. density, constitutive model, artificial stress
-  if (corrected) {       // 4. pair forces → acceleration
-    momentum<Kernel, true>();
-    structure_forces<Kernel, true>();  // 4b. loads on tracked walls and piles (read only)
-  } else {
-    momentum<Kernel, false>();
+  if (domain_)           // 4. pair forces → acceleration
+    pass_4(std::true_type{});
+  else
+    pass_4(std::false_type{});
+  if (corrected)  // 4b. loads on tracked walls and piles (read only)
+    structure_forces<Kernel, true>();
+  else
     structure_forces<Kernel, false>();
-  }
   integrate(gbar);  // 5. body force, damping, leap-frog
-  time_ += dt_;     // 6. clock, state check, next Δt
+  if (domain_) domain_->template update_ghosts<Position<Dim>, Velocity<Dim>>(store_);
+  time_ += dt_;  // 6. clock, state check, next Δt
   ++step_;
-  check_state();
+  if (domain_)
+    reduce_over_ranks();  // the maxima and sums of every rank, the state check of all
+  else
+    check_state();
   update_dt();
 }
 
@@ -318,7 +334,7 @@ void SphSolver<Dim>::prepare_boundary_pairs(const Vec<Dim>& gbar) {
 template <int Dim>
 template <class T, class Add, class Finish>
 void SphSolver<Dim>::gather_reactions(const std::vector<T>& buffer, Add&& add, Finish&& finish) {
-  const PairBlocks blocks{block_size_, block_reach_, store_.size()};
+  const PairBlocks blocks{block_size_, block_reach_, owned_count()};  // the ghosts' sums are their owners'
   const std::uint8_t* kind = field<ParticleKind>();
   blocks.gather(
       buffer.data(), [kind](std::size_t i) { return kind[i] == kSoil; }, add, finish);
@@ -364,13 +380,13 @@ void SphSolver<Dim>::gradient_correction() {
   constexpr int N = kBasis;
   const PairKernel<Kernel> K(h_);
   const MinimumImage<Dim> image(settings_.periodic);
-  const std::int64_t n = static_cast<std::int64_t>(store_.size());
+  const std::int64_t n = static_cast<std::int64_t>(owned_count());  // ghosts: from their owners, below
   const Vec<Dim>* x = field<Position<Dim>>();
   const double* vol = field<Volume>();
   const std::uint8_t* kind = field<ParticleKind>();
   const std::uint32_t* off = nb_.list().offsets().data();
   const std::uint32_t* idx = nb_.list().indices().data();
-  correction_.resize(static_cast<std::size_t>(n));
+  correction_.resize(store_.size());
   auto* A = correction_.data();
   const bool quadratic = settings_.quadratic_correction;
   // f(j, x_ij, r) for every neighbour j of i within the support, i itself excluded.
@@ -393,6 +409,7 @@ void SphSolver<Dim>::gradient_correction() {
     }
     A[i] = correction_matrix<Dim, N, Kernel>(K, quadratic, [&](auto&& f) { support_pairs(i, f); });
   }
+  if (domain_) domain_->update_ghost_array(correction_);
 }
 
 // 2. Velocity gradient, continuity, summation density, XSPH (soil particles):
@@ -406,14 +423,15 @@ void SphSolver<Dim>::gradient_correction() {
 //    of its block's buffer, and multiplied by A_iᵀ once complete (the gather's finish). Continuity,
 //    ρ̃ and XSPH keep the plain kernel.
 template <int Dim>
-template <class Kernel, bool Corrected>
+template <class Kernel, bool Corrected, bool Ghosts>
 void SphSolver<Dim>::velocity_gradient() {
   constexpr int Cols = Corrected ? kBasis : Dim;
   using Reaction = GradientReactionT<Cols>;
   using Sum = Eigen::Matrix<double, Dim, Cols>;
   const PairKernel<Kernel> K(h_);
   const MinimumImage<Dim> image(settings_.periodic);
-  const std::int64_t n = static_cast<std::int64_t>(store_.size());
+  const std::int64_t n = static_cast<std::int64_t>(owned_count());
+  const std::uint32_t nown = static_cast<std::uint32_t>(n);  // a ghost's reaction is its owner's
   const Vec<Dim>* x = field<Position<Dim>>();
   const Vec<Dim>* v = field<Velocity<Dim>>();
   const double* m = field<Mass>();
@@ -473,7 +491,7 @@ void SphSolver<Dim>::velocity_gradient() {
         dr -= m[j] * dvgw;
         rs += m[j] * w;
         xi_sum += (Vj * w) * dv;
-        if (soil_j) {
+        if (soil_j && (!Ghosts || j < nown)) {
           Reaction& g = mine[j];
           if constexpr (Corrected) {
             g.L.template leftCols<Dim>().noalias() += Vi * dvg.template leftCols<Dim>();
@@ -544,7 +562,7 @@ void SphSolver<Dim>::velocity_gradient() {
 template <int Dim>
 template <class Model>
 void SphSolver<Dim>::update_stress(const Model& /*model*/) {
-  const std::int64_t n = static_cast<std::int64_t>(store_.size());
+  const std::int64_t n = static_cast<std::int64_t>(owned_count());
   const double dt = dt_;
   const double eps_as = settings_.artificial_stress;
   const double sf_frac = settings_.stress_free_fraction;
@@ -571,7 +589,7 @@ void SphSolver<Dim>::update_stress(const Model& /*model*/) {
   double* upore = field<PorePressure>();
   // The model's internal variables (fields of the store), passed per particle to its update.
   const auto iv = field_arrays(typename Model::InternalVariables{});
-  has_as_.resize(static_cast<std::size_t>(n));
+  has_as_.resize(store_.size());
   std::uint8_t* has_as = has_as_.data();
   // Σ Δλ by blocks of particles, then over the blocks in order: the same sum on any thread count.
   const PairBlocks blocks{block_size_, block_reach_, static_cast<std::size_t>(n)};
@@ -617,6 +635,7 @@ void SphSolver<Dim>::update_stress(const Model& /*model*/) {
   }
   stats_.plastic_increment = 0.0;
   for (const double p : block_sums_) stats_.plastic_increment += p;
+  if (domain_) update_stress_ghosts();
 }
 
 // 4. Momentum: a_i = Σ_j m_j [(σ_i + σ_j)/(ρ_i ρ_j) − Π_ij I + f_ij^n (R_i + R_j)] ∇W_ij + ḡ
@@ -641,10 +660,11 @@ void SphSolver<Dim>::update_stress(const Model& /*model*/) {
 //    than r0 = wall_repulsion·Δx to a boundary particle feels it — nothing in a normal configuration
 //    (spacing ≈ Δx) — and it stops particles from being squeezed through walls.
 template <int Dim>
-template <class Kernel, bool Corrected>
+template <class Kernel, bool Corrected, bool Ghosts>
 void SphSolver<Dim>::momentum() {
   const auto P = momentum_pair_term<Kernel, Corrected>();
-  const std::int64_t n = static_cast<std::int64_t>(store_.size());
+  const std::int64_t n = static_cast<std::int64_t>(owned_count());
+  const std::uint32_t nown = static_cast<std::uint32_t>(n);  // a ghost's reaction is its owner's
   const double* rho = P.rho;
   const std::uint8_t* kind = P.kind;
   Vec<Dim>* acc = field<Acceleration<Dim>>();
@@ -673,10 +693,18 @@ void SphSolver<Dim>::momentum() {
         const double r = std::sqrt(r2);
         const Vec<Dim> Tg = P(I, i, j, soil_j, xij, r);
         ai.noalias() += P.vol[j] * Tg;
-        if (soil_j)
-          mine[j].noalias() -= I.V * Tg;
-        else if (r < P.r_rep)
-          ai.noalias() += P.repulsion(I, xij, r2);
+        if constexpr (Ghosts) {  // (the one-process branch below as it was: any change to it cost 13 %)
+          if (soil_j) {
+            if (j < nown) mine[j].noalias() -= I.V * Tg;
+          } else if (r < P.r_rep) {
+            ai.noalias() += P.repulsion(I, xij, r2);
+          }
+        } else {
+          if (soil_j)
+            mine[j].noalias() -= I.V * Tg;
+          else if (r < P.r_rep)
+            ai.noalias() += P.repulsion(I, xij, r2);
+        }
       }
       acc[i] = ai;
     }
@@ -702,7 +730,7 @@ template <class Kernel, bool Corrected>
 void SphSolver<Dim>::structure_forces() {
   if (structure_base_.empty()) return;
   const auto P = momentum_pair_term<Kernel, Corrected>();
-  const std::int64_t n = static_cast<std::int64_t>(store_.size());
+  const std::int64_t n = static_cast<std::int64_t>(owned_count());
   const std::uint8_t* kind = P.kind;
   const std::int32_t* sid = field<StructureId>();
   const std::uint32_t* off = nb_.list().offsets().data();
