@@ -9,6 +9,7 @@
 #include "geohaz/core/errors.hpp"
 #include "geohaz/sph/solver.hpp"
 #include "solver_kernels.hpp"
+#include "solver_pair_passes.hpp"
 
 namespace geohaz::sph {
 
@@ -127,5 +128,33 @@ template void SphSolver<2>::reduce_over_ranks();
 template void SphSolver<3>::reduce_over_ranks();
 template SphStore<2> SphSolver<2>::gathered_store() const;
 template SphStore<3> SphSolver<3>::gathered_store() const;
+
+// Passes 2 and 4 with ghosts (a soil pair with a ghost has no reaction: its owner sums it).
+template <int Dim>
+template <class Kernel>
+void SphSolver<Dim>::distributed_velocity_gradient() {
+  if (settings_.kernel_correction && settings_.quadratic_correction)
+    velocity_gradient<Kernel, true, true>();
+  else
+    velocity_gradient<Kernel, false, true>();
+}
+
+template <int Dim>
+template <class Kernel>
+void SphSolver<Dim>::distributed_momentum() {
+  if (settings_.kernel_correction)
+    momentum<Kernel, true, true>();
+  else
+    momentum<Kernel, false, true>();
+}
+
+template void SphSolver<2>::distributed_velocity_gradient<CubicSpline<2>>();
+template void SphSolver<2>::distributed_velocity_gradient<WendlandC2<2>>();
+template void SphSolver<3>::distributed_velocity_gradient<CubicSpline<3>>();
+template void SphSolver<3>::distributed_velocity_gradient<WendlandC2<3>>();
+template void SphSolver<2>::distributed_momentum<CubicSpline<2>>();
+template void SphSolver<2>::distributed_momentum<WendlandC2<2>>();
+template void SphSolver<3>::distributed_momentum<CubicSpline<3>>();
+template void SphSolver<3>::distributed_momentum<WendlandC2<3>>();
 
 }  // namespace geohaz::sph

@@ -304,6 +304,11 @@ class SphSolver {
   auto momentum_pair_term();  // step 4's pair term, shared by 4 and 4b (solver_passes.cpp)
   template <class Kernel, bool Corrected, bool Ghosts>
   void momentum();  // 4
+  // Passes 2 and 4 over several ranks, in their own translation unit (solver_distributed.cpp).
+  template <class Kernel>
+  void distributed_velocity_gradient();
+  template <class Kernel>
+  void distributed_momentum();
   template <class Kernel, bool Corrected>
   void structure_forces();               // 4b (tracked structures only)
   void integrate(const Vec<Dim>& gbar);  // 5
