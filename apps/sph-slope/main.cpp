@@ -1,6 +1,19 @@
 // sph-slope: SPH simulation of slope failure, large deformation and post-failure flow of
 // elasto-plastic soil under gravity and earthquake shaking (libs/sph, docs/sph.md).
 // This file parses the command line, reads the config (libs/sph/src/config.cpp), then runs.
+// Built as sph-slope-mpi (GEOHAZ_SPH_MPI, CMake option GEOHAZ_MPI) it runs alone or under mpirun,
+// the particles spread over the ranks (docs/sph.md, "Domain decomposition"): every rank reads the
+// config and runs the same simulation, rank 0 writes the output folder.
+#ifdef GEOHAZ_SPH_MPI
+#include <omp.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdlib>
+
+#include "geohaz/core/errors.hpp"
+#include "geohaz/mpi/mpi_communicator.hpp"
+#endif
 #include "geohaz/core/app.hpp"
 #include "geohaz/core/config.hpp"
 #include "geohaz/sph/config.hpp"
@@ -9,7 +22,26 @@
 using namespace geohaz;
 using namespace geohaz::sph;
 
+#ifdef GEOHAZ_SPH_MPI
+namespace {
+/// Ranks on this node (Open MPI, MPICH or Slurm; 1 when none is set): the cores are shared between
+/// them unless --threads says otherwise.
+int local_ranks() {
+  for (const char* v : {"OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS", "SLURM_NTASKS_PER_NODE"})
+    if (const char* s = std::getenv(v)) {
+      const int n = std::atoi(s);
+      if (n > 0) return n;
+    }
+  return 1;
+}
+}  // namespace
+#endif
+
 int main(int argc, char** argv) {
+#ifdef GEOHAZ_SPH_MPI
+  geohaz::mpi::Session session(argc, argv);
+  const std::shared_ptr<const Communicator> comm = session.world();
+#endif
   ConfigApp app;
   app.name = "sph-slope";
   app.summary =
@@ -20,12 +52,50 @@ int main(int argc, char** argv) {
       "Example: sph-slope --config data/sph/slope_2d_granular.toml --set material[0].friction=20 --out slope-out";
   app.options_caption = "Options (all physical quantities in SI units: m, s, kg, Pa; angles in the config in degrees)";
   app.describe = [](ConfigReader& r) { (void)read_config(r, true); };
-  app.run = [](ConfigReader& reader, const CommonOptions& opts) {
+  app.run = [&](ConfigReader& reader, const CommonOptions& opts) {
     RunConfig cfg = read_config(reader, false);
     reader.finish();
     cfg.resolved_config = reader.resolved();
+#ifdef GEOHAZ_SPH_MPI
+    if (comm) check_distributable(cfg);  // what several ranks cannot do yet, before anything else
+#endif
     validate(cfg);  // everything checked before the output directory is created
+#ifdef GEOHAZ_SPH_MPI
+    if (comm) {
+      if (opts.threads == 0) omp_set_num_threads(std::max(1, omp_get_num_procs() / local_ranks()));
+      // Rank 0 alone writes the outputs; the others start when it has its output folder (the
+      // folder policy may refuse it: exit 2 on every rank, not a hang).
+      std::array<double, 1> refused{0.0};
+      if (comm->rank() != 0) {
+        comm->max_all(refused);
+        if (refused[0] > 0.0) return kExitInputError;
+        return run_case(cfg, {}, true, comm);
+      }
+      bool started = false;
+      try {
+        return run_in_output_dir(opts.out, "sph-slope", {cfg.restart}, [&] {
+          started = true;
+          comm->max_all(refused);
+          return run_case(cfg, opts.out, opts.quiet, comm);
+        });
+      } catch (const InputError&) {
+        if (!started) {
+          refused[0] = 1.0;
+          comm->max_all(refused);
+        }
+        throw;
+      }
+    }
+#endif
     return run_in_output_dir(opts.out, "sph-slope", {cfg.restart}, [&] { return run_case(cfg, opts.out, opts.quiet); });
   };
+#ifdef GEOHAZ_SPH_MPI
+  const int code = run_config_app(argc, argv, app);
+  // An error on one rank while the others wait for it would hang the job: end them all. (Input
+  // errors happen on every rank alike, before any message is exchanged.)
+  if (code != kExitOk && code != kExitInputError) session.abort(code);
+  return code;
+#else
   return run_config_app(argc, argv, app);
+#endif
 }

@@ -19,8 +19,12 @@ struct SphSimulation::Impl {
   std::unique_ptr<SimulationModel> model;
 };
 
-SphSimulation::SphSimulation(const RunConfig& cfg, bool quiet) : cfg_(cfg), impl_(std::make_unique<Impl>()) {
-  if (cfg.analysis == Analysis::LimitEquilibrium)
+SphSimulation::SphSimulation(const RunConfig& cfg, bool quiet, std::shared_ptr<const Communicator> comm)
+    : cfg_(cfg), impl_(std::make_unique<Impl>()) {
+  if (comm) {
+    check_distributable(cfg);
+    impl_->model = make_dynamic_run(cfg, quiet, std::move(comm));
+  } else if (cfg.analysis == Analysis::LimitEquilibrium)
     impl_->model = make_limit_equilibrium_run(cfg, quiet);
   else if (cfg.analysis == Analysis::StrengthReduction)
     impl_->model = make_strength_reduction_run(cfg, quiet);
@@ -84,7 +88,10 @@ class SphRunFiles final : public RunObserver {
     }
     if (next_) next_->progress(sim, p);
   }
+  // The snapshot points are the same on every rank of a distributed run (the gather is collective);
+  // only the rank with the output folder writes.
   void started(const SphSimulation& sim) override {
+    model_.gather_for_output();
     if (snaps_) model_.write_snapshot(*snaps_);
     next_snap_ = sim.time() + cfg_.snapshot_interval;
     if (cfg_.analysis == Analysis::Dynamic) main_.emplace("sph-slope", cfg_.end_time, quiet_);
@@ -96,14 +103,16 @@ class SphRunFiles final : public RunObserver {
   }
   void stepped(const SphSimulation& sim) override {
     if (main_) main_->update(sim.time(), sim.step_count(), sim.particle_count());
-    if (snaps_ && cfg_.snapshot_interval > 0.0 && sim.time() >= next_snap_ - 1e-12) {
-      model_.write_snapshot(*snaps_);
+    if (cfg_.snapshot_interval > 0.0 && sim.time() >= next_snap_ - 1e-12) {
+      model_.gather_for_output();
+      if (snaps_) model_.write_snapshot(*snaps_);
       next_snap_ += cfg_.snapshot_interval;
     }
     if (next_) next_->stepped(sim);
   }
   void finished(const SphSimulation& sim) override {
     if (main_) main_->finish(sim.time(), sim.step_count(), sim.particle_count());
+    model_.gather_for_output();
     if (snaps_) model_.write_snapshot(*snaps_);
     if (next_) next_->finished(sim);
   }
@@ -138,8 +147,9 @@ void run_with_outputs(SphSimulation& sim, const std::filesystem::path& out, bool
   if (!out.empty()) write_outputs(sim, out);
 }
 
-int run_case(const RunConfig& cfg, const std::filesystem::path& out, bool quiet) {
-  SphSimulation sim(cfg, quiet);
+int run_case(const RunConfig& cfg, const std::filesystem::path& out, bool quiet,
+             std::shared_ptr<const Communicator> comm) {
+  SphSimulation sim(cfg, quiet, std::move(comm));
   run_with_outputs(sim, out, quiet);
   return 0;
 }

@@ -90,18 +90,22 @@ struct ReleaseOutput {
 template <int Dim>
 class DynamicRun final : public SimulationModel {
  public:
-  DynamicRun(const RunConfig& c, bool quiet);
+  DynamicRun(const RunConfig& c, bool quiet, std::shared_ptr<const Communicator> comm);
   void run(const SphSimulation& self, RunObserver* obs) override;
   double time() const override { return solver_.time(); }
   std::int64_t step_count() const override { return solver_.step_count(); }
-  std::size_t particle_count() const override { return solver_.store().size(); }
+  std::size_t particle_count() const override { return soil_count_ + boundary_count_; }
   bool main_phase_started() const override { return main_started_; }
   nlohmann::json summary() const override { return summary_with(release()); }
   std::vector<NamedTable> tables() const override;
-  ParticleFields particles() const override { return fields_of(solver_.store()); }
+  ParticleFields particles() const override { return fields_of(state()); }
   void write_snapshot(SnapshotWriter& w) const override {
-    sph::write_snapshot<Dim>(w, solver_, step_offset_ + solver_.step_count());
+    if (solver_.domain())  // the gathered state, without the solver state (check_distributable)
+      write_fields<Dim>(w, view_, solver_.time(), step_offset_ + solver_.step_count());
+    else
+      sph::write_snapshot<Dim>(w, solver_, step_offset_ + solver_.step_count());
   }
+  void gather_for_output() override { refresh_view(); }
   void draw_due_pngs(const std::filesystem::path& out) override;
   void write_outputs(const std::filesystem::path& out) const override;
   void write_partial(const std::filesystem::path& out) const override;
@@ -121,6 +125,11 @@ class DynamicRun final : public SimulationModel {
   ReleaseOutput release() const;
   void write_release(const std::filesystem::path& out, const ReleaseOutput& r) const;
   nlohmann::json summary_with(const ReleaseOutput& r) const;
+  /// The whole state the outputs read: the solver's store on one process; over several ranks the
+  /// gathered copy of the last refresh_view() (every output point calls it on every rank).
+  const SphStore<Dim>& state() const { return solver_.domain() ? view_ : solver_.store(); }
+  void refresh_view(bool force = false);
+  void record_decomposition();
 
   const RunConfig& c_;
   bool quiet_;
@@ -144,10 +153,15 @@ class DynamicRun final : public SimulationModel {
   double next_out_ = 0.0, max_speed_run_ = 0.0, max_runout_ = 0.0, last_moving_ = 0.0, t_start_ = 0.0;
   SeriesRow last_;
   StaticBishop bishop_;
+  // Over several ranks: the gathered state (state()), the step it was gathered at, and the
+  // decomposition's figures for summary.json.
+  SphStore<Dim> view_;
+  std::int64_t view_step_ = -1;
+  nlohmann::json decomposition_;
 };
 
 template <int Dim>
-DynamicRun<Dim>::DynamicRun(const RunConfig& c, bool quiet)
+DynamicRun<Dim>::DynamicRun(const RunConfig& c, bool quiet, std::shared_ptr<const Communicator> comm)
     : c_(c),
       quiet_(quiet),
       wall0_(std::chrono::steady_clock::now()),
@@ -164,6 +178,7 @@ DynamicRun<Dim>::DynamicRun(const RunConfig& c, bool quiet)
     for (const auto& s : b_.sc.structures) bases.push_back(s.base);
     solver_.track_structures(std::move(bases));
   }
+  if (comm) solver_.distribute(std::move(comm));
   for (const auto& m : solver_.materials()) rho0_.push_back(m.density);
   if (c_.geostatic && c_.restart.empty() && c_.scenario != ScenarioType::Biaxial)
     geostatic_duration(c_, href_, solver_.max_wave_speed());  // checked now
@@ -206,6 +221,7 @@ void DynamicRun<Dim>::run(const SphSimulation& self, RunObserver* obs) {
     geostatic_phase(self, obs);
   if (c_.scenario == ScenarioType::Biaxial) move_platens();
   if (c_.restart.empty()) set_initial_velocity<Dim>(c_, solver_.store());
+  refresh_view(true);
   mark_free_end();
   start_main_phase();
   if (obs) obs->started(self);
@@ -263,7 +279,7 @@ void DynamicRun<Dim>::move_platens() {
 template <int Dim>
 void DynamicRun<Dim>::mark_free_end() {
   if (c_.clamp_boxes.empty()) return;
-  const auto& S = solver_.store();
+  const auto& S = state();
   const auto& x = S.template get<Position<Dim>>();
   const auto& u = S.template get<Displacement<Dim>>();
   const auto& id = S.template get<ParticleId>();
@@ -282,7 +298,7 @@ void DynamicRun<Dim>::mark_free_end() {
 
 template <int Dim>
 double DynamicRun<Dim>::tip_displacement() const {
-  const auto& S = solver_.store();
+  const auto& S = state();
   const auto& id = S.template get<ParticleId>();
   double sum = 0.0;
   int count = 0;
@@ -339,17 +355,52 @@ void DynamicRun<Dim>::main_phase(const SphSimulation& self, RunObserver* obs) {
   }
   last_ = record();
   finished_ = true;
+  record_decomposition();
   if (obs) obs->finished(self);
+}
+
+/// Over several ranks (collective): the whole state at this step, unless it is already the view.
+template <int Dim>
+void DynamicRun<Dim>::refresh_view(bool force) {
+  if (!solver_.domain() || (!force && view_step_ == solver_.step_count())) return;
+  view_ = solver_.gathered_store();
+  view_step_ = solver_.step_count();
+}
+
+/// Over several ranks (collective): summary.json's domain_decomposition block, per rank.
+template <int Dim>
+void DynamicRun<Dim>::record_decomposition() {
+  const auto* d = solver_.domain();
+  if (!d) return;
+  const auto& st = d->stats();
+  const std::vector<double> mine{static_cast<double>(d->owned()), static_cast<double>(st.ghosts),
+                                 static_cast<double>(st.migrated_out - st.first_migrated_out),
+                                 static_cast<double>(st.partitions), static_cast<double>(st.rebuilds)};
+  const std::vector<double> all = d->comm().all_gather(mine);
+  nlohmann::json owned = nlohmann::json::array(), ghosts = nlohmann::json::array();
+  double migrated = 0.0;
+  for (std::size_t r = 0; r < all.size() / mine.size(); ++r) {
+    owned.push_back(static_cast<std::int64_t>(all[r * mine.size()]));
+    ghosts.push_back(static_cast<std::int64_t>(all[r * mine.size() + 1]));
+    migrated += all[r * mine.size() + 2];
+  }
+  decomposition_ = {{"ranks", d->size()},
+                    {"owned_particles", owned},
+                    {"ghost_particles", ghosts},
+                    {"migrated_particles", static_cast<std::int64_t>(migrated)},
+                    {"partitions", static_cast<std::int64_t>(st.partitions)},
+                    {"rebuilds", static_cast<std::int64_t>(st.rebuilds)}};
 }
 
 /// A row of the series (and of the structure loads, and of the biaxial curve).
 template <int Dim>
 SeriesRow DynamicRun<Dim>::record() {
-  const auto r = series_row(solver_.store(), b_.frame);
+  refresh_view();
+  const auto r = series_row(state(), b_.frame);
   double runout = r.runout, nrun = r.normalised_runout;
   if (c_.scenario == ScenarioType::Section) {
     runout = 0.0;
-    for (const auto& u : solver_.store().template get<Displacement<Dim>>()) runout = std::max(runout, std::abs(u[0]));
+    for (const auto& u : state().template get<Displacement<Dim>>()) runout = std::max(runout, std::abs(u[0]));
     nrun = runout / b_.frame.base_length;
   }
   max_runout_ = std::max(max_runout_, runout);
@@ -374,7 +425,7 @@ SeriesRow DynamicRun<Dim>::record() {
 /// The mean axial and lateral stress of the specimen.
 template <int Dim>
 void DynamicRun<Dim>::record_biaxial() {
-  const auto& S = solver_.store();
+  const auto& S = state();
   double sa = 0, sl = 0;
   int n = 0;
   for (std::size_t i = 0; i < S.size(); ++i)
@@ -406,8 +457,8 @@ std::vector<NamedTable> DynamicRun<Dim>::tables() const {
   std::vector<NamedTable> t{{"series", series_}};
   if (!structures_.empty()) t.push_back({"structure_forces", structures_.table()});
   if (c_.scenario == ScenarioType::Biaxial) t.push_back({"stress_strain", biaxial_});
-  t.push_back({"surface_final", xz_table(free_surface(solver_.store(), c_.numerics.spacing))});
-  t.push_back({"slip_surface", xz_table(slip_surface(solver_.store(), c_.numerics.spacing, c_.failed_threshold))});
+  t.push_back({"surface_final", xz_table(free_surface(state(), c_.numerics.spacing))});
+  t.push_back({"slip_surface", xz_table(slip_surface(state(), c_.numerics.spacing, c_.failed_threshold))});
   return t;
 }
 
@@ -427,7 +478,7 @@ void DynamicRun<Dim>::write_outputs(const std::filesystem::path& out) const {
   const nlohmann::json summary = summary_with(rel);
   write_text_file(out / "summary.json", summary.dump(2) + "\n");
   if (!quiet_) {
-    const auto fm = failed_mass(solver_.store(), rho0_, c_.failed_threshold);
+    const auto fm = failed_mass(state(), rho0_, c_.failed_threshold);
     std::fprintf(stderr, "sph-slope: t = %.4g s, run-out %.4g m (normalised %.4g), failed %s %.4g, outputs in %s\n",
                  solver_.time(), summary["runout_m"].get<double>(), summary["normalised_runout"].get<double>(),
                  Dim == 2 ? "area (m^2/m)" : "volume (m^3)", fm.volume, out.string().c_str());
@@ -437,7 +488,7 @@ void DynamicRun<Dim>::write_outputs(const std::filesystem::path& out) const {
 /// Quick-looks of the final state coloured by displacement and by plastic strain.
 template <int Dim>
 void DynamicRun<Dim>::write_pictures(const std::filesystem::path& out) const {
-  const auto& S = solver_.store();
+  const auto& S = state();
   std::vector<double> u(S.size());
   double umax = 0.0;
   for (std::size_t i = 0; i < u.size(); ++i) {
@@ -460,7 +511,7 @@ ReleaseOutput DynamicRun<Dim>::release() const {
   ReleaseOutput r;
   if (c_.scenario != ScenarioType::Section || !c_.write_release) return r;
   const auto& P = c_.section.profile;
-  const auto& S = solver_.store();
+  const auto& S = state();
   std::vector<Vec2> pts;
   std::vector<double> vols;
   const double W = Dim == 2 ? c_.section.release_width : strip_width(c_);
@@ -521,7 +572,7 @@ void DynamicRun<Dim>::write_release(const std::filesystem::path& out, const Rele
 
 template <int Dim>
 nlohmann::json DynamicRun<Dim>::summary_with(const ReleaseOutput& rel) const {
-  const auto& S = solver_.store();
+  const auto& S = state();
   const auto& mats = solver_.materials();
   nlohmann::json s = summary_header<Dim>(c_, solver_, soil_count_);
   s["boundary_particles"] = boundary_count_;
@@ -562,6 +613,7 @@ nlohmann::json DynamicRun<Dim>::summary_with(const ReleaseOutput& rel) const {
   s["time_to_rest_s"] = last_.max_speed < c_.rest_speed ? nlohmann::json(last_moving_ - t_start_) : nlohmann::json();
   s["rest_speed_m_per_s"] = c_.rest_speed;
   s["bytes_per_particle"] = solver_.bytes_per_particle();
+  if (!decomposition_.is_null()) s["domain_decomposition"] = decomposition_;
   bishop_.add_to(s);
   if (section && c_.write_release) {
     s["release"] = {{"file", "release.h5"},
@@ -589,9 +641,10 @@ nlohmann::json DynamicRun<Dim>::summary_with(const ReleaseOutput& rel) const {
 
 }  // namespace
 
-std::unique_ptr<SimulationModel> make_dynamic_run(const RunConfig& c, bool quiet) {
-  if (c.dimension == 2) return std::make_unique<DynamicRun<2>>(c, quiet);
-  return std::make_unique<DynamicRun<3>>(c, quiet);
+std::unique_ptr<SimulationModel> make_dynamic_run(const RunConfig& c, bool quiet,
+                                                  std::shared_ptr<const Communicator> comm) {
+  if (c.dimension == 2) return std::make_unique<DynamicRun<2>>(c, quiet, std::move(comm));
+  return std::make_unique<DynamicRun<3>>(c, quiet, std::move(comm));
 }
 
 }  // namespace geohaz::sph

@@ -31,6 +31,9 @@ class SimulationModel {
   virtual ParticleFields particles() const = 0;
   /// The state a snapshot shows now (SphRunFiles: at the start, at snapshot times, at the end).
   virtual void write_snapshot(SnapshotWriter& w) const = 0;
+  /// Over several ranks: gather the whole state for write_snapshot (collective: every rank calls it
+  /// where rank 0 may write a snapshot). Nothing on one process.
+  virtual void gather_for_output() {}
   /// Quick-look PNGs whose time has come (before a main-phase step).
   virtual void draw_due_pngs(const std::filesystem::path& out) = 0;
   /// Every output of a finished run into `out`; a line on stderr unless quiet.
@@ -89,7 +92,8 @@ nlohmann::json newmark_report(const RunConfig& c);
 std::unique_ptr<SimulationModel> make_limit_equilibrium_run(const RunConfig& c, bool quiet);
 
 /// The analysis run.analysis = dynamic (run_dynamic.cpp) in the config's dimension.
-std::unique_ptr<SimulationModel> make_dynamic_run(const RunConfig& c, bool quiet);
+std::unique_ptr<SimulationModel> make_dynamic_run(const RunConfig& c, bool quiet,
+                                                  std::shared_ptr<const Communicator> comm = nullptr);
 
 /// The analysis run.analysis = strength_reduction (run_strength_reduction.cpp) in the config's dimension.
 std::unique_ptr<SimulationModel> make_strength_reduction_run(const RunConfig& c, bool quiet);

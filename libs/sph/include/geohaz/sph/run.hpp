@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "geohaz/core/communicator.hpp"
 #include "geohaz/core/raster.hpp"
 #include "geohaz/sph/constitutive.hpp"
 #include "geohaz/sph/limit_equilibrium.hpp"
@@ -246,8 +247,10 @@ class SphSimulation {
  public:
   /// Build the scenario and the solver of `cfg` (checked by validate() first); unless `quiet`,
   /// print the particle counts and the materials on stderr. Keeps a reference to `cfg`: it must
-  /// outlive the simulation.
-  explicit SphSimulation(const RunConfig& cfg, bool quiet = true);
+  /// outlive the simulation. With `comm` the run is spread over its ranks (domain decomposition,
+  /// docs/sph.md): every rank constructs and runs the same simulation, collectively; what cannot run
+  /// on several ranks yet is refused first (check_distributable).
+  explicit SphSimulation(const RunConfig& cfg, bool quiet = true, std::shared_ptr<const Communicator> comm = nullptr);
   ~SphSimulation();
   SphSimulation(const SphSimulation&) = delete;
   SphSimulation& operator=(const SphSimulation&) = delete;
@@ -291,7 +294,17 @@ void run_with_outputs(SphSimulation& sim, const std::filesystem::path& out, bool
                       RunObserver* observer = nullptr);
 
 /// The whole `sph-slope` run of a validated config: build, run with outputs into `out` (created).
-/// Returns the process exit code (0).
-int run_case(const RunConfig& cfg, const std::filesystem::path& out, bool quiet);
+/// Returns the process exit code (0). With `comm`, over its ranks (SphSimulation): every rank calls
+/// it, rank 0 with the output folder, the others with an empty `out` (they write nothing).
+int run_case(const RunConfig& cfg, const std::filesystem::path& out, bool quiet,
+             std::shared_ptr<const Communicator> comm = nullptr);
+
+/// What a run over several ranks cannot do yet (issue #36; docs/sph.md, "Domain decomposition"):
+/// InputError naming the key for the strength reduction and the limit-equilibrium analysis
+/// (run.analysis), a restart (run.restart), quick-look PNGs during the run (run.velocity_png_times)
+/// and the total-Lagrangian formulation (numerics.formulation). The dynamic analysis runs, with its
+/// series, summary, outputs and snapshots (written by rank 0 from the gathered state, without the
+/// solver state: a restart from them continues on one process with a fresh neighbour list).
+void check_distributable(const RunConfig& cfg);
 
 }  // namespace geohaz::sph

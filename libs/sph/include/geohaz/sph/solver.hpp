@@ -45,19 +45,28 @@
 /// then steps 5 and 6 (solver_total_lagrangian.cpp; docs/sph.md).
 /// The pair sums of steps 2 and 4 are grouped alike on any thread count, and SolverState + resume
 /// restart a run bit for bit (docs/sph.md, "Determinism: thread count and restart").
+/// Over several processes (`distribute`, decomposition.hpp; docs/sph.md "Domain decomposition") each
+/// rank steps its own particles with ghost copies of its neighbours': step 0 migrates particles and
+/// makes the ghost layer at each list rebuild, the passes loop over the owned particles (a soil pair
+/// with a ghost is evaluated from the owned side, its reaction dropped: the ghost's owner evaluates
+/// it from its own side), the ghosts' fields are refreshed after steps 2 (correction), 3 and 5, and
+/// the step's maxima and sums are reduced over the ranks in a fixed order before step 6.
 /// Units: SI throughout (m, s, kg, Pa).
 
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <tuple>
 #include <utility>
 #include <vector>
 
+#include "geohaz/core/communicator.hpp"
 #include "geohaz/core/neighbours.hpp"
 #include "geohaz/sph/constitutive.hpp"
+#include "geohaz/sph/decomposition.hpp"
 #include "geohaz/sph/fields.hpp"
 #include "geohaz/sph/loading.hpp"
 
@@ -257,6 +266,20 @@ class SphSolver {
   /// Memory actually held per particle (store + neighbour list), bytes.
   double bytes_per_particle() const;
 
+  /// Run over the ranks of `comm` (domain decomposition, decomposition.hpp): every rank constructs
+  /// the solver with the same full store and calls this before the first step; each keeps a share,
+  /// and the first step partitions them. Collective from then on: every rank calls step() (and the
+  /// other collective calls below) in the same order. Throws InputError for what is not distributed
+  /// yet (the total-Lagrangian formulation).
+  void distribute(std::shared_ptr<const Communicator> comm);
+  /// The decomposition (null on one process without distribute()).
+  const DomainDecomposition<Dim>* domain() const noexcept { return domain_.get(); }
+  /// Particles this rank owns: slots [0, owned_count()) of store() (the rest are ghosts).
+  std::size_t owned_count() const noexcept { return domain_ ? domain_->owned() : store_.size(); }
+  /// Every particle of every rank, sorted by ParticleId (collective); without distribute() a copy of
+  /// the store in that order.
+  SphStore<Dim> gathered_store() const;
+
  private:
   // One step (solver_passes.cpp; 0, 5 and 6 in solver.cpp), the numbered passes of the file comment:
   template <class Kernel, class Model>
@@ -268,21 +291,31 @@ class SphSolver {
   void prepare_boundary_pairs(const Vec<Dim>& gbar);  // 1
   template <class Kernel>
   void gradient_correction();  // 2 (kernel_correction only)
-  template <class Kernel, bool Corrected>
+  // Ghosts: the form over several ranks (a soil pair with a ghost has no reaction); without, the
+  // loop of one process exactly (the test of a ghost cost it 9 % of its instructions).
+  template <class Kernel, bool Corrected, bool Ghosts>
   void velocity_gradient();  // 2
   template <class Model>
   void update_stress(const Model& model);  // 3
+  void update_stress_ghosts();             // 3 (distributed: what step 4 reads of a ghost)
   template <class T, class Add, class Finish>
   void gather_reactions(const std::vector<T>& buffer, Add&& add, Finish&& finish);  // 2, 4
   template <class Kernel, bool Corrected>
   auto momentum_pair_term();  // step 4's pair term, shared by 4 and 4b (solver_passes.cpp)
-  template <class Kernel, bool Corrected>
+  template <class Kernel, bool Corrected, bool Ghosts>
   void momentum();  // 4
+  // Passes 2 and 4 over several ranks, in their own translation unit (solver_distributed.cpp).
+  template <class Kernel>
+  void distributed_velocity_gradient();
+  template <class Kernel>
+  void distributed_momentum();
   template <class Kernel, bool Corrected>
   void structure_forces();               // 4b (tracked structures only)
   void integrate(const Vec<Dim>& gbar);  // 5
   void check_state() const;              // 6
+  void reduce_over_ranks();              // 6 (distributed: maxima, sums and the state check)
   void update_dt();                      // 6
+  void rebuild_distributed();            // 0 (distributed: migration and ghosts)
   // The total-Lagrangian step (settings_.total_lagrangian; solver_total_lagrangian.cpp):
   template <class Kernel>
   void tl_step();
@@ -319,6 +352,8 @@ class SphSolver {
   double max_wave_speed_ = 0.0;
   double model_dt_limit_ = 0.0;
   double max_drift_ = 0.0;  // largest displacement since the last neighbour build (m)
+  // Domain decomposition (distribute()); null on one process.
+  std::unique_ptr<DomainDecomposition<Dim>> domain_;
   // Scratch, rewritten every step (not particle state): 1 where the artificial stress R_i ≠ 0, so
   // the momentum pass need not read a neighbour's R (as big as its stress) to find it is zero.
   std::vector<std::uint8_t> has_as_;
