@@ -902,4 +902,9 @@ std::vector<double> read_member_max_depth(const fs::path& out, int i) {
   return uncrop(p, p.depth);
 }
 
+std::array<std::vector<double>, 3> read_member_peak_maps(const fs::path& out, int i) {
+  const MemberPeaks p = read_member_peaks(member_dir(out, i) / "peaks.bin");
+  return {uncrop(p, p.depth), uncrop(p, p.speed), uncrop(p, p.pressure)};
+}
+
 }  // namespace geohaz::runout
