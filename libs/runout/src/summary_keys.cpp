@@ -236,6 +236,8 @@ constexpr SummaryKey kKeys[] = {
     {"local_members", "members of the local searches", "1"},
     {"local_search.algorithm", "local search algorithm", ""},
     {"local_search.starts", "local searches", "1"},
+    {"local_search.restarts", "local searches restarted when one ends", ""},
+    {"local_search.searches", "local searches run", "1"},
     {"local_search.stops", "why the local searches ended", ""},
     {"acceptable_members", "acceptable members", "1"},
     {"acceptable_range.*", "range over the acceptable members", kUnitOfParameter},
