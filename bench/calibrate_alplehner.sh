@@ -140,6 +140,26 @@ print(f"wall time, 1 rank x {threads} thread(s): {w1:.1f} s ({w1 / 60:.2f} min)"
 print(f"wall time, 2 ranks x {threads} thread(s): {w2:.1f} s ({w2 / 60:.2f} min)  [target: under 15 min]")
 print(f"members' CPU time (1-rank run, all threads): {cpu:.1f} s, {cpu / max(1, one['members']):.2f} s per member")
 print(f"rank efficiency 1 -> 2: T1 / (2 T2) = {w1 / (2 * w2) * 100:.1f} %  [target: >= 90 %]")
+# The batches' schedule on two ranks from the members' CPU times of the 1-rank run (members.csv's
+# batch column; rank 0 hands the next member of a batch to the first rank that is free): what the
+# lockstep alone costs, apart from MPI and from load. 1.0 would be two ranks busy all the time.
+import csv
+from collections import defaultdict
+cost = {int(p.parent.name): json.loads(p.read_text()).get("cpu_time_s", 0.0)
+        for p in (work / "one" / "members").glob("*/member.json")}
+batches = defaultdict(list)
+with open(work / "one" / "members.csv") as f:
+    for row in csv.DictReader(f):
+        batches[int(row["batch"])].append(cost.get(int(row["member"]), 0.0))
+span = 0.0
+for b in sorted(batches):
+    free = [0.0, 0.0]
+    for c in batches[b]:
+        k = free.index(min(free))
+        free[k] += c
+    span += max(free)
+print(f"schedule efficiency of the batches on 2 ranks (CPU times, no MPI): {cpu / (2 * span) * 100:.1f} % "
+      f"in {len(batches)} batches")
 print(f"identical members on 1 and 2 ranks: {identical}; same best set: {one['best'] == two['best']}")
 print(f"best: mu {b['model.mu']:.5f} (truth 0.155), xi {b['model.xi']:.1f} (truth 4000), "
       f"T {one['best']['misfit']['tversky']:.4f}, score {one['best']['misfit']['score']:.4g}")

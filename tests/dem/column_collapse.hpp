@@ -81,6 +81,8 @@ inline ColumnResult run_column(const ColumnSpec& c, DemSolver& s) {
   pk.locked_in_stress = 0;
   pk.friction_after = c.friction;
   pk.seed = c.seed;
+  pk.expansion_steps = 4000;  // the packing this test's stored figures were made with
+  pk.max_relax_steps = 20000;
   PackedSample col = pack_discs_in_box(pk, s.law);
   s.discs = col.discs;
   ColumnResult res;

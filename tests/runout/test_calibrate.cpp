@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -196,6 +197,64 @@ TEST(CalibrationIdentifiability, RecoversVoellmyMuWithXiFixed) {
               f.summary["best"]["misfit"]["score"].get<double>(), f.summary["members"].get<int>());
   EXPECT_NEAR(f.best[0], 0.15, 0.05 * 0.15);
   EXPECT_GE(t, 0.99);
+  fs::remove_all(c.dir);
+}
+
+TEST(CalibrationSearch, RestartsRefillEndedSearchesWithinTheBudget) {
+  // The lockstep local stage with and without restarts on the one-parameter Voellmy case, the
+  // batches recorded as the ranks would receive them. Sbplx stops both searches (step below
+  // local_xtol) after 15 of their 30 members; without restarts the rest of the budget is unused,
+  // with them each slot is refilled by a new search, the local members stay within
+  // local_starts x local_evaluations, the batches are full before the tail the budget can no
+  // longer fund, and the search finds the truth either way.
+  const auto c = calibration_case::make(work_dir("restarts"),
+                                        "friction = \"voellmy\"\nmu = 0.15\nxi = 500.0\nd0 = 5.0\nh0 = 0.5", {});
+  struct Run {
+    std::vector<std::size_t> widths;  // of the local batches, in order
+    int local_members = 0, searches = 0;
+    double best = 0.0;
+  };
+  const auto search = [&](bool restarts) {
+    const fs::path out = c.dir / (restarts ? "on" : "off");
+    fs::remove_all(out);
+    ConfigReader cfg = ConfigReader::from_string(
+        calibration_case::config(
+            c, "[[calibration.parameter]]\nkey = \"model.mu\"\nmin = 0.08\nmax = 0.3\n",
+            std::string("global_members = 8\nmorris_trajectories = 2\nlocal_starts = 2\n"
+                        "local_evaluations = 30\nlocal_xtol = 0.01\nlocal_algorithm = \"sbplx\"\nlocal_restarts = ") +
+                (restarts ? "true\n" : "false\n")),
+        (c.dir / "calibrate.toml").string());
+    CalibrationSetup s = read_calibration(cfg);
+    prepare_calibration_output(s, out);
+    const auto runner = make_calibration_runner(s);
+    Run r;
+    bool global = true;
+    const CalibrationResult res = run_calibration(
+        s, out,
+        [&](const std::vector<int>& batch) {
+          for (int i : batch) runner->run(i, out, 0, 1);
+          if (!global) r.widths.push_back(batch.size()), r.local_members += static_cast<int>(batch.size());
+          global = false;
+        },
+        true);
+    r.searches = static_cast<int>(res.local_stops.size());
+    r.best = res.evaluations.at(static_cast<std::size_t>(res.best)).values[0];
+    return r;
+  };
+  const Run off = search(false), on = search(true);
+  std::printf(
+      "CALIBRATION restarts: off %d searches, %d local members in %zu batches; on %d searches, %d local "
+      "members in %zu batches\n",
+      off.searches, off.local_members, off.widths.size(), on.searches, on.local_members, on.widths.size());
+  EXPECT_EQ(off.searches, 2);
+  EXPECT_LT(off.local_members, 2 * 30) << "the case must leave budget for a restart";
+  EXPECT_GT(on.searches, 2);
+  EXPECT_GT(on.local_members, off.local_members);
+  EXPECT_LE(on.local_members, 2 * 30);
+  // Full batches first, then the tail the budget can no longer fund.
+  EXPECT_TRUE(std::is_sorted(on.widths.rbegin(), on.widths.rend()));
+  EXPECT_NEAR(on.best, 0.15, 0.05 * 0.15);
+  EXPECT_NEAR(off.best, 0.15, 0.05 * 0.15);
   fs::remove_all(c.dir);
 }
 

@@ -128,7 +128,7 @@ TEST(CalibrateApp, FailedMemberIsRecordedWithItsParametersAndPenalised) {
   EXPECT_NE(j["failed"][0]["diagnosis"].get<std::string>().find("injected"), std::string::npos);
   EXPECT_NE(j["best"]["member"].get<int>(), 2);
   const std::string csv = slurp(out / "members.csv");
-  EXPECT_NE(csv.find("\n2,design,failed,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\n2,design,0,failed,"), std::string::npos) << csv;
   // The outputs, and the best set as a config that reads back with the best values.
   for (const char* f : {"best.toml", "members.csv", "acceptable.csv", "acceptable.svg", "sensitivity.csv",
                         "comparison.tif", "comparison.png", "comparison.qml", "thalweg_profile.csv"})

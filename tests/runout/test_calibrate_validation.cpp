@@ -4,10 +4,12 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <nlohmann/json.hpp>
 
 #include "calibration_case.hpp"
@@ -61,25 +63,48 @@ TEST(CalibrationValidation, AlplehnerTwoParameterCalibrationRecoversVoellmyMuAnd
   // Printed: the fit, the members and the wall time (docs/performance.md).
   const fs::path alr = fs::path(GEOHAZ_SOURCE_DIR) / "data" / "terrain" / "alr";
   const fs::path d = work_dir("alr");
-  std::ofstream(d / "base.toml") << "[terrain]\ndsm = \"" << (alr / "avaAlr.tif").string() << "\"\n[release]\nfile = \""
-                                 << (alr / "relAlr.shp").string()
-                                 << "\"\ndepth = 1.0\n[model]\nfriction = \"voellmy\"\nmu = 0.155\nxi = 4000.0\nd0 = "
-                                    "10.0\nh0 = 0.25\n[run]\nduration = 400.0\n";
-  {
+  const auto write_base = [&](double mu) {
+    std::ofstream(d / "base.toml") << std::setprecision(17) << "[terrain]\ndsm = \"" << (alr / "avaAlr.tif").string()
+                                   << "\"\n[release]\nfile = \"" << (alr / "relAlr.shp").string()
+                                   << "\"\ndepth = 1.0\n[model]\nfriction = \"voellmy\"\nmu = " << mu
+                                   << "\nxi = 4000.0\nd0 = 10.0\nh0 = 0.25\n[run]\nduration = 400.0\n";
+  };
+  // The footprint (peak depth > 0.1 m) and the deposit of a run with this mu.
+  const auto event = [&](double mu, Raster* deposit_out) {
+    write_base(mu);
     ConfigReader cfg = ConfigReader::from_file(d / "base.toml");
     const RunoutCase rc = read_case(cfg);
     const RunoutInputs in = load_inputs(rc);
     RunoutSimulation sim(in, rc.params, rc.output);
     sim.run();
-    Raster fp = in.dsm.like(0.0, -9999.0), dep = in.dsm.like(0.0, -9999.0);
-    const auto deposit = sim.deposit();
-    for (std::size_t k = 0; k < fp.data.size(); ++k) {
-      fp.data[k] = sim.maps().max_depth()[k] > 0.1 ? 1.0 : 0.0;
-      dep.data[k] = deposit[k];
+    Raster fp = in.dsm.like(0.0, -9999.0);
+    for (std::size_t k = 0; k < fp.data.size(); ++k) fp.data[k] = sim.maps().max_depth()[k] > 0.1 ? 1.0 : 0.0;
+    if (deposit_out) {
+      *deposit_out = in.dsm.like(0.0, -9999.0);
+      const auto deposit = sim.deposit();
+      for (std::size_t k = 0; k < fp.data.size(); ++k) deposit_out->data[k] = deposit[k];
     }
-    write_geotiff(d / "footprint.tif", fp);
-    write_geotiff(d / "deposit.tif", dep, true);
+    return fp;
+  };
+  // The footprint's noise floor: the particles' paths amplify any perturbation (docs/calibration.md,
+  // "How close to perfect"), so the truth's own runs with mu changed by 1e-9 and 2e-9 (relative)
+  // score T 0.96-0.98 against the truth's footprint, as do mu +-0.01-1 %. No search can beat the
+  // truth itself: the fit must come within 1 % of the lowest T of those two runs.
+  Raster dep;
+  const Raster obs = event(0.155, &dep);
+  double floor = 1.0;
+  for (const double eps : {1e-9, 2e-9}) {
+    const Raster f = event(0.155 * (1.0 + eps), nullptr);
+    double tp = 0.0, fp = 0.0, fn = 0.0;
+    for (std::size_t k = 0; k < f.data.size(); ++k) {
+      const bool o = obs.data[k] > 0.5, m = f.data[k] > 0.5;
+      tp += o && m, fp += m && !o, fn += o && !m;
+    }
+    floor = std::min(floor, tp / (tp + 0.5 * fp + 0.5 * fn));
   }
+  write_base(0.155);
+  write_geotiff(d / "footprint.tif", obs);
+  write_geotiff(d / "deposit.tif", dep, true);
   calibration_case::Case c{d, d / "base.toml", d / "footprint.tif", d / "deposit.tif", alr / "path_aimec.shp", 0.0};
   const auto t0 = std::chrono::steady_clock::now();
   const Fit f = calibrate(
@@ -91,11 +116,11 @@ TEST(CalibrationValidation, AlplehnerTwoParameterCalibrationRecoversVoellmyMuAnd
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double t = f.summary["best"]["misfit"]["tversky"].get<double>();
   std::printf(
-      "VALIDATION calibration alr d0 = 10 m: mu %.5f (truth 0.155), xi %.1f (truth 4000), T %.4f, %d members, "
-      "wall %.0f s on 1 rank\n",
-      f.best[0], f.best[1], t, f.summary["members"].get<int>(), wall);
+      "VALIDATION calibration alr d0 = 10 m: mu %.5f (truth 0.155), xi %.1f (truth 4000), T %.4f (the truth's own "
+      "floor %.4f), %d members, wall %.0f s on 1 rank\n",
+      f.best[0], f.best[1], t, floor, f.summary["members"].get<int>(), wall);
   EXPECT_NEAR(f.best[0], 0.155, 0.05 * 0.155);
   EXPECT_NEAR(f.best[1], 4000.0, 0.05 * 4000.0);
-  EXPECT_GE(t, 0.99);
+  EXPECT_GE(t, 0.99 * floor);
   fs::remove_all(d);
 }

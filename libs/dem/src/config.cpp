@@ -58,19 +58,19 @@ void read_sample(ConfigReader& r, RunConfig& c, std::int64_t seed, bool describe
   // [sample]: packing
   PackingSpec& p = c.packing;
   p.seed = static_cast<std::uint64_t>(seed);
-  p.width = r.get("sample.width", 0.03, Range::positive(), {"m", "sample width (lab tests)"});
-  p.height = r.get("sample.height", 0.06, Range::positive(), {"m", "sample height (lab tests)"});
-  p.r_min = r.get("sample.r_min", 0.8e-3, Range::positive(), {"m", "smallest disc radius"});
-  p.r_max = r.get("sample.r_max", 1.66 * 0.8e-3, Range::positive(),
+  p.width = r.get("sample.width", p.width, Range::positive(), {"m", "sample width (lab tests)"});
+  p.height = r.get("sample.height", p.height, Range::positive(), {"m", "sample height (lab tests)"});
+  p.r_min = r.get("sample.r_min", p.r_min, Range::positive(), {"m", "smallest disc radius"});
+  p.r_max = r.get("sample.r_max", p.r_max, Range::positive(),
                   {"m", "largest disc radius (R_max/R_min = 1.66 in Potyondy & Cundall 2004)"});
   p.porosity =
-      r.get("sample.porosity", 0.18, Range::closed(0.1, 0.4), {"1", "target porosity of the radius expansion"});
-  p.locked_in_stress = r.get("sample.locked_in_stress", 1e6, Range::non_negative(),
+      r.get("sample.porosity", p.porosity, Range::closed(0.1, 0.4), {"1", "target porosity of the radius expansion"});
+  p.locked_in_stress = r.get("sample.locked_in_stress", p.locked_in_stress, Range::non_negative(),
                              {"Pa", "isotropic stress installed by servo walls before bonding (0: none)"});
   p.expansion_steps = static_cast<int>(
-      r.get_int("sample.expansion_steps", 2000, Range::closed(10, 1e7), {"1", "radius-expansion steps"}));
-  p.max_relax_steps = static_cast<int>(
-      r.get_int("sample.relax_steps", 6000, Range::closed(100, 1e8), {"1", "cap on each packing equilibrium stage"}));
+      r.get_int("sample.expansion_steps", p.expansion_steps, Range::closed(10, 1e7), {"1", "radius-expansion steps"}));
+  p.max_relax_steps = static_cast<int>(r.get_int("sample.relax_steps", p.max_relax_steps, Range::closed(100, 1e8),
+                                                 {"1", "cap on each packing equilibrium stage"}));
   if (!describe && p.r_max < p.r_min)
     throw InputError("must be ≥ sample.r_min (" + std::to_string(p.r_min) + " m)", r.source(), "sample.r_max",
                      std::to_string(p.r_max));
@@ -84,14 +84,16 @@ void read_material(ConfigReader& r, RunConfig& c) {
   p.density = m.density =
       r.get("material.density", m.density, Range::positive(), {"kg/m^3", "disc density (discs are 1 m thick)"});
   // the choices and their sentences come from the one name table (contact_laws.hpp)
-  m.law = *contact_law_from_name(r.get_choice("material.contact_law", "linear", ContactLawNames::choices(),
-                                              {"", ContactLawNames::help("contact law")}));
-  const double Ec = r.get("material.contact_modulus", 20e9, Range::positive(),
+  m.law = *contact_law_from_name(r.get_choice("material.contact_law",
+                                              std::visit([](const auto& l) { return std::string(l.name); }, m.law),
+                                              ContactLawNames::choices(), {"", ContactLawNames::help("contact law")}));
+  const double Ec = r.get("material.contact_modulus", LinearSpringCoulomb{}.kn / 2, Range::positive(),
                           {"Pa", "linear law: contact modulus E_c, k_n = 2 E_c (PFC2D, unit thickness)"});
-  const double kratio = r.get("material.stiffness_ratio", 2.5, Range::positive(), {"1", "linear law: k_n/k_s"});
-  const double E =
-      r.get("material.youngs_modulus", 20e9, Range::positive(), {"Pa", "Hertz-Mindlin: particle Young's modulus"});
-  const double nu = r.get("material.poisson_ratio", 0.25, Range::closed_open(0.0, 0.5),
+  const double kratio = r.get("material.stiffness_ratio", LinearSpringCoulomb{}.kn / LinearSpringCoulomb{}.ks,
+                              Range::positive(), {"1", "linear law: k_n/k_s"});
+  const double E = r.get("material.youngs_modulus", HertzMindlin{}.youngs, Range::positive(),
+                         {"Pa", "Hertz-Mindlin: particle Young's modulus"});
+  const double nu = r.get("material.poisson_ratio", HertzMindlin{}.poisson, Range::closed_open(0.0, 0.5),
                           {"1", "Hertz-Mindlin: particle Poisson's ratio"});
   // One case per law and no generic one: a law added to ContactLaw without its case fails to compile.
   std::visit(Overloaded{[&](LinearSpringCoulomb& l) {
@@ -103,27 +105,29 @@ void read_material(ConfigReader& r, RunConfig& c) {
                           h.poisson = nu;
                         }},
              m.law);
-  m.contact.friction = r.get("material.friction", 0.5, Range::non_negative(), {"1", "contact friction coefficient mu"});
-  m.contact.restitution =
-      r.get("material.restitution", 0.5, Range::open_closed(0.0, 1.0), {"1", "normal restitution coefficient e"});
+  m.contact.friction =
+      r.get("material.friction", m.contact.friction, Range::non_negative(), {"1", "contact friction coefficient mu"});
+  m.contact.restitution = r.get("material.restitution", m.contact.restitution, Range::open_closed(0.0, 1.0),
+                                {"1", "normal restitution coefficient e"});
   // μ_r is the tangent of a rolling angle: 1 is a square resting on a face (tan 45°), STONE's
   // largest tan β is 0.80; above 2 the rolling stiffness 2.25 μ_r² k_n R² makes the time step collapse.
-  m.contact.rolling_friction = r.get("material.rolling_friction", 0.0, Range::closed(0.0, 2.0),
+  m.contact.rolling_friction = r.get("material.rolling_friction", m.contact.rolling_friction, Range::closed(0.0, 2.0),
                                      {"1", "rolling-resistance coefficient mu_r (Ai et al. 2011, model C), 0 to 2"});
-  m.contact.rolling_damping =
-      r.get("material.rolling_damping", 0.3, Range::closed(0.0, 1.0), {"1", "rolling viscous damping ratio eta_r"});
+  m.contact.rolling_damping = r.get("material.rolling_damping", m.contact.rolling_damping, Range::closed(0.0, 1.0),
+                                    {"1", "rolling viscous damping ratio eta_r"});
   m.contact.tangential_damping =
-      r.get("material.tangential_damping", 0.0, Range::closed(0.0, 1.0),
+      r.get("material.tangential_damping", m.contact.tangential_damping, Range::closed(0.0, 1.0),
             {"1",
              "tangential dashpot while sticking, as a fraction of the normal damping ratio (0: none, 1: the same "
              "ratio, Cundall & Strack 1979)"});
   m.contact.fragment_damping_mass =
-      r.get_choice("material.terrain_damping_mass", "disc", {"disc", "fragment"},
+      r.get_choice("material.terrain_damping_mass", m.contact.fragment_damping_mass ? "fragment" : "disc",
+                   {"disc", "fragment"},
                    {"",
                     "mass of the disc-terrain and disc-wall dashpots: disc = the disc's own; fragment = the "
                     "effective mass of its bonded fragment at the contact point, 1/(1/M + (r x n)^2/I)"}) == "fragment";
   m.contact.fragment_rolling =
-      r.get_choice("material.terrain_rolling", "disc", {"disc", "fragment"},
+      r.get_choice("material.terrain_rolling", m.contact.fragment_rolling ? "fragment" : "disc", {"disc", "fragment"},
                    {"",
                     "lever arm of the disc-terrain rolling resistance: disc = the disc radius, moment on "
                     "the disc; fragment = the height of its bonded fragment's centre above the contact, moment on the "
@@ -152,11 +156,12 @@ void read_material(ConfigReader& r, RunConfig& c) {
                            {"1", "friction coefficient of joint contacts"});
   for (auto& js : r.tables("joints.set", {"", "joint sets: dip, spacing, persistence, trace_length"})) {
     JointSet s;
-    s.dip = js.get("dip", 45.0, Range::closed(-180, 180), {"deg", "trace angle from +x, counter-clockwise"});
+    s.dip = js.get("dip", s.dip, Range::closed(-180, 180), {"deg", "trace angle from +x, counter-clockwise"});
     s.spacing = js.require("spacing", Range::positive(), {"m", "normal spacing of the traces"});
-    s.persistence =
-        js.get("persistence", 1.0, Range::open_closed(0.0, 1.0), {"1", "jointed fraction of each trace line"});
-    s.trace_length = js.get("trace_length", 1.0, Range::positive(), {"m", "length of one joint when persistence < 1"});
+    s.persistence = js.get("persistence", s.persistence, Range::open_closed(0.0, 1.0),
+                           {"1", "jointed fraction of each trace line"});
+    s.trace_length =
+        js.get("trace_length", s.trace_length, Range::positive(), {"m", "length of one joint when persistence < 1"});
     m.joint_sets.push_back(s);
   }
   for (auto& jt : r.tables("joints.trace", {"", "explicit joint traces: from = [x, z], to = [x, z] (m)"})) {
@@ -169,14 +174,15 @@ void read_material(ConfigReader& r, RunConfig& c) {
 /// [numerics] and [output].
 void read_numerics_and_output(ConfigReader& r, RunConfig& c) {
   // [numerics]
-  c.numerics.safety_factor = r.get("numerics.safety_factor", 0.25, Range::open_closed(0.0, 1.0),
+  c.numerics.safety_factor = r.get("numerics.safety_factor", c.numerics.safety_factor, Range::open_closed(0.0, 1.0),
                                    {"1", "time step = safety factor x critical time step sqrt(m/k)"});
-  c.numerics.max_speed =
-      r.get("numerics.max_speed", 500.0, Range::positive(), {"m/s", "a disc faster than this is a blow-up"});
+  c.numerics.max_speed = r.get("numerics.max_speed", c.numerics.max_speed, Range::positive(),
+                               {"m/s", "a disc faster than this is a blow-up"});
   // [output]
-  c.snapshot_every = static_cast<int>(r.get_int("output.snapshot_every", 20, Range::closed(0, 1e9),
+  c.snapshot_every = static_cast<int>(r.get_int("output.snapshot_every", c.snapshot_every, Range::closed(0, 1e9),
                                                 {"1", "records between HDF5 snapshots (0: first and last only)"}));
-  c.write_tessellation = r.get_bool("output.tessellation", true, {"", "write the power cells and triangulation (VTK)"});
+  c.write_tessellation =
+      r.get_bool("output.tessellation", c.write_tessellation, {"", "write the power cells and triangulation (VTK)"});
 }
 
 /// [biaxial]: the lab tests, with the specimen checks (size, shape, memory).
@@ -185,10 +191,10 @@ void read_lab(ConfigReader& r, RunConfig& c, bool describe) {
   const MaterialSpec& m = c.material;
   LabTestSpec& l = c.lab;
   l.test = c.kind == TestKind::Tension ? LabTest::BiaxialTension : LabTest::BiaxialCompression;
-  c.confining = r.get_array("biaxial.confining_stresses", {0.0, 5e6, 10e6}, Range::non_negative(),
+  c.confining = r.get_array("biaxial.confining_stresses", c.confining, Range::non_negative(),
                             {"Pa", "confining stresses sigma_3 of the compression tests (one test each)"});
   l.loading_velocity =
-      r.get("biaxial.loading_velocity", 0.25, Range::closed(1e-3, 100.0),
+      r.get("biaxial.loading_velocity", l.loading_velocity, Range::closed(1e-3, 100.0),
             {"m/s",
              "speed of each platen / grip (quasi-static tests: 0.01-1; the test lasts strain·height/speed "
              "at a step of ~1e-7 s, so slower is impractically long)"});
@@ -229,8 +235,8 @@ void read_avalanche_profile(ConfigReader& r, AvalancheSpec& a, bool describe) {
     const auto sx =
         r.get_array("avalanche.section_x", {}, Range{}, {"m", "section polyline x (map CRS), uphill first"});
     const auto sy = r.get_array("avalanche.section_y", {}, Range{}, {"m", "section polyline y (map CRS)"});
-    const double spacing =
-        r.get("avalanche.section_spacing", 5.0, Range::positive(), {"m", "profile sampling interval"});
+    const double spacing = a.section_spacing =
+        r.get("avalanche.section_spacing", a.section_spacing, Range::positive(), {"m", "profile sampling interval"});
     if (!describe) {
       if (sx.size() != sy.size() || sx.size() < 2)
         throw InputError("section_x and section_y need the same number (≥ 2) of values", r.source(),
@@ -306,7 +312,7 @@ void read_avalanche(ConfigReader& r, RunConfig& c, bool describe) {
   a.strength_factor = r.get("avalanche.strength_factor", a.strength_factor, Range::closed(0.0, 1.0),
                             {"1", "bond strengths are multiplied by this at release (weathering / weakening trigger)"});
   const auto trig =
-      r.get_array("avalanche.trigger_acceleration", {0.0, 0.0}, Range{},
+      r.get_array("avalanche.trigger_acceleration", {a.trigger_acceleration.x(), a.trigger_acceleration.y()}, Range{},
                   {"m/s^2", "extra acceleration [ax, az] applied during the trigger (earthquake-like push)"}, 2);
   a.trigger_acceleration = Vec2(trig[0], trig[1]);
   a.trigger_duration = r.get("avalanche.trigger_duration", a.trigger_duration, Range::non_negative(),
@@ -329,8 +335,9 @@ void read_avalanche(ConfigReader& r, RunConfig& c, bool describe) {
   a.volume_width = r.get("avalanche.volume_width", a.volume_width, Range::non_negative(),
                          {"m", "out-of-plane width turning the 2D source area into a volume (0: source length)"});
   a.packing = p;
-  a.packing.locked_in_stress = r.get("avalanche.locked_in_stress", 0.0, Range::non_negative(),
-                                     {"Pa", "isotropic stress of the packing box before the mass is cut out"});
+  a.packing.locked_in_stress =
+      r.get("avalanche.locked_in_stress", AvalancheSpec{}.packing.locked_in_stress, Range::non_negative(),
+            {"Pa", "isotropic stress of the packing box before the mass is cut out"});
   a.material = m;
   if (!describe) {
     double x0 = 1e300, x1 = -1e300, z0 = 1e300, z1 = -1e300;
@@ -361,7 +368,8 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   c.kind = test == "biaxial-compression" ? TestKind::Compression
            : test == "biaxial-tension"   ? TestKind::Tension
                                          : TestKind::Avalanche;
-  const auto seed = r.get_int("seed", 1, Range::non_negative(), {"1", "random seed of packing, strengths and joints"});
+  const auto seed = r.get_int("seed", static_cast<std::int64_t>(PackingSpec{}.seed), Range::non_negative(),
+                              {"1", "random seed of packing, strengths and joints"});
   read_sample(r, c, seed, describe);
   read_material(r, c);
   read_numerics_and_output(r, c);

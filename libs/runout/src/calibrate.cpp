@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <deque>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -13,6 +14,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <nlopt.hpp>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -187,6 +189,12 @@ struct Keys {
     q.local_evaluations =
         static_cast<int>(cfg.get_int("calibration.local_evaluations", q.local_evaluations, Range::closed(1, 100000),
                                      {"1", "members per local search at most"}));
+    q.local_restarts = cfg.get_bool(
+        "calibration.local_restarts", q.local_restarts,
+        {"",
+         "a local search that ends hands its slot to a new search from the best member at least an initial step "
+         "away from every start and every search's best, while local_starts x local_evaluations local members are "
+         "not spent (keeps local_starts ranks busy)"});
     q.local_xtol = cfg.get("calibration.local_xtol", q.local_xtol, Range::open_closed(0.0, 1.0),
                            {"1", "a local search stops when a step moves u (unit cube) by less than this"});
     q.local_step = cfg.get("calibration.local_step", q.local_step, Range::closed(0.0, 1.0),
@@ -611,6 +619,7 @@ class Evaluator {
   std::vector<double> evaluate(const std::vector<std::vector<double>>& us, const std::vector<std::string>& stages) {
     std::vector<int> idx;
     std::vector<int> fresh;
+    const int first_new = next_;
     for (std::size_t k = 0; k < us.size(); ++k) {
       const std::vector<double> v = values_of(us[k]);
       const auto it = known_.find(v);
@@ -625,6 +634,7 @@ class Evaluator {
       if (values.size() <= static_cast<std::size_t>(i)) values.resize(static_cast<std::size_t>(i) + 1);
       values[static_cast<std::size_t>(i)] = v;
       stage_[i] = stages[k];
+      batch_[i] = batches_;
       if (member_done(out_, i)) {
         // A member of an earlier (killed) run: it must be the same point, or the folder is another search's.
         const MemberRecord rec = parse_member_json(slurp(member_dir(out_, i) / "member.json"));
@@ -639,6 +649,7 @@ class Evaluator {
       }
     }
     if (!fresh.empty()) run_(fresh);
+    if (next_ > first_new) ++batches_;
     std::vector<double> f;
     for (int i : idx) {
       if (r_.evaluations.size() <= static_cast<std::size_t>(i)) r_.evaluations.resize(static_cast<std::size_t>(i) + 1);
@@ -646,6 +657,7 @@ class Evaluator {
       if (e.stage.empty()) {
         e = read_evaluation(s_, out_, i);
         e.stage = stage_[i];
+        e.batch = batch_[i];
         if (!quiet_) {
           std::ostringstream o;
           o << "geohaz-calibrate: member " << i << " (" << e.stage << ")";
@@ -662,6 +674,8 @@ class Evaluator {
     }
     return f;
   }
+  /// Whether the point (u in the unit cube) has a member already.
+  bool known(const std::vector<double>& u) const { return known_.count(values_of(u)) > 0; }
   int resumed() const noexcept { return resumed_; }
   int members() const noexcept { return next_; }
 
@@ -673,31 +687,38 @@ class Evaluator {
   bool quiet_;
   std::map<std::vector<double>, int> known_;
   std::map<int, std::string> stage_;
-  int next_ = 0, resumed_ = 0;
+  std::map<int, int> batch_;
+  int next_ = 0, resumed_ = 0, batches_ = 0;
 };
 
 /// Local searches in lockstep: each NLopt search runs in its own thread and blocks in its objective
-/// until the driver has evaluated one point of every live search as one batch.
+/// until the driver has evaluated one point of every live search as one batch. A search that ends
+/// frees its slot; while the local budget (`local_starts` x `local_evaluations` members) has room,
+/// the driver fills the slot with a new search from `next_start` (restarts), so the batches stay
+/// `local_starts` wide and that many ranks stay busy. Every decision is taken at the barrier between
+/// two batches from the scores alone, so the members do not depend on the number of ranks.
 class LockstepSearches {
  public:
   struct Search {
     std::vector<double> x0;
-    bool waiting = false, answered = false, done = false;
-    std::vector<double> request;
-    double answer = 0.0;
+    int max_evaluations = 0, used = 0;  ///< NLopt's budget for this search, points asked so far
+    bool waiting = false, answered = false, done = false, restarted = false;
+    std::vector<double> request, best_x;
+    double answer = 0.0, best_f = std::numeric_limits<double>::infinity();
     std::string stop;
   };
+  /// Gives the start of a new search (u in the unit cube), or nothing when no start is left.
+  using NextStart = std::function<std::optional<std::vector<double>>(const std::deque<Search>&)>;
 
-  LockstepSearches(const SearchSettings& q, int dims, std::vector<std::vector<double>> starts) : q_(q), dims_(dims) {
-    searches_.resize(starts.size());
-    for (std::size_t k = 0; k < starts.size(); ++k) searches_[k].x0 = std::move(starts[k]);
-  }
+  LockstepSearches(const SearchSettings& q, int dims) : q_(q), dims_(dims) {}
 
-  void run(const std::function<std::vector<double>(const std::vector<std::vector<double>>&,
-                                                   const std::vector<std::size_t>&)>& evaluate) {
+  void run(const std::vector<std::vector<double>>& starts,
+           const std::function<std::vector<double>(const std::vector<std::vector<double>>&,
+                                                   const std::vector<std::size_t>&)>& evaluate,
+           const std::function<bool(const std::vector<double>&)>& known, const NextStart& next_start) {
     nlopt::srand(q_.seed);
-    std::vector<std::thread> threads;
-    for (std::size_t k = 0; k < searches_.size(); ++k) threads.emplace_back([this, k] { search(k); });
+    budget_ = static_cast<long>(starts.size()) * q_.local_evaluations;
+    for (const auto& x0 : starts) launch(x0, q_.local_evaluations);
     try {
       for (;;) {
         std::vector<std::size_t> live;
@@ -707,16 +728,36 @@ class LockstepSearches {
           cv_.wait(lock, [&] {
             return std::all_of(searches_.begin(), searches_.end(), [](const Search& s) { return s.waiting || s.done; });
           });
+        }
+        refill(next_start);
+        {
+          std::unique_lock lock(m_);
+          cv_.wait(lock, [&] {
+            return std::all_of(searches_.begin(), searches_.end(), [](const Search& s) { return s.waiting || s.done; });
+          });
           for (std::size_t k = 0; k < searches_.size(); ++k)
             if (searches_[k].waiting) live.push_back(k), pts.push_back(searches_[k].request);
         }
         if (live.empty()) break;
+        // Points met before cost nothing: they are answered at once, and the searches that asked
+        // for them ask again, so that a batch holds only new members and stays as wide as the
+        // searches that need one (a repeated point would otherwise leave a rank idle).
+        std::vector<std::size_t> seen;
+        for (std::size_t j = 0; j < live.size(); ++j)
+          if (known(pts[j])) seen.push_back(j);
+        if (!seen.empty()) {
+          std::vector<std::size_t> l;
+          std::vector<std::vector<double>> p;
+          for (std::size_t j : seen) l.push_back(live[j]), p.push_back(pts[j]);
+          live = std::move(l), pts = std::move(p);
+        }
         const std::vector<double> f = evaluate(pts, live);
         {
           std::lock_guard lock(m_);
           for (std::size_t j = 0; j < live.size(); ++j) {
             Search& s = searches_[live[j]];
-            s.answer = f[j], s.waiting = false, s.answered = true;
+            s.answer = f[j], s.waiting = false, s.answered = true, ++s.used;
+            if (f[j] < s.best_f) s.best_f = f[j], s.best_x = s.request;
           }
         }
         cv_.notify_all();
@@ -727,24 +768,57 @@ class LockstepSearches {
         abort_ = true;
       }
       cv_.notify_all();
-      for (auto& t : threads) t.join();
+      for (auto& t : threads_) t.join();
       throw;
     }
-    for (auto& t : threads) t.join();
+    for (auto& t : threads_) t.join();
   }
-  const std::vector<Search>& searches() const noexcept { return searches_; }
+  const std::deque<Search>& searches() const noexcept { return searches_; }
 
  private:
   struct Context {
     LockstepSearches* self;
     std::size_t k;
   };
+
+  /// Starts a search (the lock is not held: the new thread takes it).
+  void launch(const std::vector<double>& x0, int max_evaluations) {
+    {
+      std::lock_guard lock(m_);
+      Search s;
+      s.x0 = x0, s.max_evaluations = max_evaluations;
+      searches_.push_back(std::move(s));  // a deque: the running threads' references stay valid
+    }
+    const std::size_t k = searches_.size() - 1;
+    threads_.emplace_back([this, k] { search(k); });
+  }
+
+  /// At the barrier: every search that ended since the last one, in slot order, hands its slot to a
+  /// new search while the budget has room for one of at least dims + 2 members (BOBYQA's 2 P + 1
+  /// interpolation points need less than the budget of the first searches).
+  void refill(const NextStart& next_start) {
+    if (!q_.local_restarts) return;
+    const std::size_t n = searches_.size();
+    for (std::size_t k = 0; k < n; ++k) {
+      Search& s = searches_[k];
+      if (!s.done || s.restarted) continue;
+      s.restarted = true;
+      long committed = 0;  // members asked, plus the rest of every live search's budget
+      for (const Search& o : searches_) committed += o.done ? o.used : o.max_evaluations;
+      const long room = std::min<long>(q_.local_evaluations, budget_ - committed);
+      if (room < dims_ + 2) continue;
+      const auto x0 = next_start(searches_);
+      if (!x0) return;
+      launch(*x0, static_cast<int>(room));
+    }
+  }
+
   static double objective(const std::vector<double>& x, std::vector<double>& grad, void* data) {
     (void)grad;  // derivative-free methods only
     auto* c = static_cast<Context*>(data);
     LockstepSearches& L = *c->self;
-    Search& s = L.searches_[c->k];
     std::unique_lock lock(L.m_);
+    Search& s = L.searches_[c->k];
     if (L.abort_) throw nlopt::forced_stop();
     s.request = x, s.waiting = true;
     L.cv_.notify_all();
@@ -755,7 +829,13 @@ class LockstepSearches {
   }
 
   void search(std::size_t k) {
-    Search& s = searches_[k];
+    std::vector<double> x;
+    int max_evaluations = 0;
+    {
+      std::lock_guard lock(m_);
+      x = searches_[k].x0;
+      max_evaluations = searches_[k].max_evaluations;
+    }
     std::string stop;
     try {
       const nlopt::algorithm alg = q_.local_algorithm == "bobyqa"       ? nlopt::LN_BOBYQA
@@ -766,17 +846,16 @@ class LockstepSearches {
       opt.set_upper_bounds(std::vector<double>(static_cast<std::size_t>(dims_), 1.0));
       Context ctx{this, k};
       opt.set_min_objective(&LockstepSearches::objective, &ctx);
-      opt.set_maxeval(q_.local_evaluations);
+      opt.set_maxeval(max_evaluations);
       opt.set_xtol_abs(q_.local_xtol);
       const double step = q_.local_step > 0.0 ? q_.local_step : 1.0 / std::max(1, q_.global_members);
       std::vector<double> steps(static_cast<std::size_t>(dims_));
       for (int d = 0; d < dims_; ++d) {
         // Step towards the interior when the start lies on a bound (BOBYQA needs x0 ± step inside).
-        const double x = s.x0[static_cast<std::size_t>(d)];
-        steps[static_cast<std::size_t>(d)] = std::min(step, std::max(std::max(x, 1.0 - x), 1e-3));
+        const double xd = x[static_cast<std::size_t>(d)];
+        steps[static_cast<std::size_t>(d)] = std::min(step, std::max(std::max(xd, 1.0 - xd), 1e-3));
       }
       opt.set_initial_step(steps);
-      std::vector<double> x = s.x0;
       double f = 0.0;
       const nlopt::result res = opt.optimize(x, f);
       stop = res == nlopt::MAXEVAL_REACHED   ? "maximum evaluations reached"
@@ -792,13 +871,16 @@ class LockstepSearches {
       stop = std::string("stopped: ") + e.what();
     }
     std::lock_guard lock(m_);
+    Search& s = searches_[k];
     s.stop = stop, s.done = true, s.waiting = false;
     cv_.notify_all();
   }
 
   const SearchSettings& q_;
   int dims_;
-  std::vector<Search> searches_;
+  long budget_ = 0;
+  std::deque<Search> searches_;
+  std::vector<std::thread> threads_;
   std::mutex m_;
   std::condition_variable cv_;
   bool abort_ = false;
@@ -832,28 +914,58 @@ CalibrationResult run_calibration(CalibrationSetup& s, const fs::path& out, cons
   r.design_members = s.search.global_members;
   r.morris_members = ev.members() - r.design_members;
 
-  // 2. Local searches from the best distinct successful members, in lockstep.
-  std::vector<const Evaluation*> ranked;
-  for (const auto& e : r.evaluations)
-    if (e.ok) ranked.push_back(&e);
-  std::stable_sort(ranked.begin(), ranked.end(),
-                   [](const Evaluation* a, const Evaluation* b) { return a->misfit.score < b->misfit.score; });
-  std::vector<std::vector<double>> starts;
-  for (const Evaluation* e : ranked) {
-    if (static_cast<int>(starts.size()) >= s.search.local_starts) break;
+  // 2. Local searches from the best distinct successful members, in lockstep; a slot whose search
+  //    ended is refilled from the best member far enough from every start and every search's best.
+  const auto unit_of = [&](const Evaluation& e) {
     std::vector<double> u(static_cast<std::size_t>(P));
     for (int d = 0; d < P; ++d)
       u[static_cast<std::size_t>(d)] =
-          std::clamp(s.parameters[static_cast<std::size_t>(d)].unit(e->values[static_cast<std::size_t>(d)]), 0.0, 1.0);
+          std::clamp(s.parameters[static_cast<std::size_t>(d)].unit(e.values[static_cast<std::size_t>(d)]), 0.0, 1.0);
+    return u;
+  };
+  const auto ranked = [&] {
+    std::vector<const Evaluation*> v;
+    for (const auto& e : r.evaluations)
+      if (e.ok) v.push_back(&e);
+    std::stable_sort(v.begin(), v.end(),
+                     [](const Evaluation* a, const Evaluation* b) { return a->misfit.score < b->misfit.score; });
+    return v;
+  };
+  std::vector<std::vector<double>> starts;
+  for (const Evaluation* e : ranked()) {
+    if (static_cast<int>(starts.size()) >= s.search.local_starts) break;
+    const std::vector<double> u = unit_of(*e);
     if (std::find(starts.begin(), starts.end(), u) == starts.end()) starts.push_back(u);
   }
   if (!starts.empty()) {
-    LockstepSearches L(s.search, P, starts);
-    L.run([&](const std::vector<std::vector<double>>& us, const std::vector<std::size_t>& which) {
-      std::vector<std::string> st;
-      for (std::size_t k : which) st.push_back("local" + std::to_string(k));
-      return ev.evaluate(us, st);
-    });
+    // A restart keeps an initial step's distance (Chebyshev, in u) from where every search began
+    // and from the best point each found, so it explores another part of the valley.
+    const double sep = s.search.local_step > 0.0 ? s.search.local_step : 1.0 / std::max(1, s.search.global_members);
+    const auto far_from = [&](const std::vector<double>& u, const std::vector<double>& v) {
+      if (v.empty()) return true;
+      double d = 0.0;
+      for (std::size_t i = 0; i < u.size(); ++i) d = std::max(d, std::abs(u[i] - v[i]));
+      return d >= sep;
+    };
+    LockstepSearches L(s.search, P);
+    L.run(
+        starts,
+        [&](const std::vector<std::vector<double>>& us, const std::vector<std::size_t>& which) {
+          std::vector<std::string> st;
+          for (std::size_t k : which) st.push_back("local" + std::to_string(k));
+          return ev.evaluate(us, st);
+        },
+        [&](const std::vector<double>& u) { return ev.known(u); },
+        [&](const std::deque<LockstepSearches::Search>& searches) -> std::optional<std::vector<double>> {
+          for (const Evaluation* e : ranked()) {
+            const std::vector<double> u = unit_of(*e);
+            if (std::all_of(searches.begin(), searches.end(), [&](const LockstepSearches::Search& q) {
+                  return far_from(u, q.x0) && far_from(u, q.best_x);
+                }))
+              return u;
+          }
+          return std::nullopt;
+        });
     for (const auto& q : L.searches()) r.local_stops.push_back(q.stop);
   }
   // 3. The best member (lowest score, then lowest index).

@@ -40,14 +40,14 @@ std::string csv_text(std::string s) {
 
 void member_table(const fs::path& path, const CalibrationSetup& s, const std::vector<const Evaluation*>& rows) {
   AtomicTextFile csv(path);
-  csv << "member,stage,status";
+  csv << "member,stage,batch,status";
   for (const auto& p : s.parameters) csv << ',' << p.key;
   csv << ",score,tversky,tp_m2,fp_m2,fn_m2,runout_s_m,runout_diff_m,depth_rmse_m,volume_m3,term_footprint,term_"
          "runout,term_depth,term_volume,diagnosis\n";
   csv.stream() << std::setprecision(17);
   for (const Evaluation* e : rows) {
     const Misfit& m = e->misfit;
-    csv << e->index << ',' << e->stage << ',' << (e->ok ? "ok" : "failed");
+    csv << e->index << ',' << e->stage << ',' << e->batch << ',' << (e->ok ? "ok" : "failed");
     for (double v : e->values) csv << ',' << v;
     csv << ',' << m.score << ',' << m.tversky << ',' << m.tp << ',' << m.fp << ',' << m.fn << ',' << m.runout_s << ','
         << m.runout_diff << ',' << m.depth_rmse << ',' << m.volume << ',' << m.term_footprint << ',' << m.term_runout
@@ -464,8 +464,11 @@ void write_calibration_outputs(const CalibrationSetup& s, const CalibrationResul
   j["design_members"] = r.design_members;
   j["morris_members"] = r.morris_members;
   j["local_members"] = static_cast<int>(r.evaluations.size()) - r.design_members - r.morris_members;
-  j["local_search"] = {
-      {"algorithm", s.search.local_algorithm}, {"starts", s.search.local_starts}, {"stops", r.local_stops}};
+  j["local_search"] = {{"algorithm", s.search.local_algorithm},
+                       {"starts", s.search.local_starts},
+                       {"restarts", s.search.local_restarts},
+                       {"searches", r.local_stops.size()},
+                       {"stops", r.local_stops}};
   j["failed"] = fj;
   j["acceptable_members"] = acceptable.size();
   nlohmann::json range = nlohmann::json::object();

@@ -29,7 +29,7 @@ struct RunConfig {
   SolverSettings numerics;
   // lab tests
   LabTestSpec lab;
-  std::vector<double> confining;  ///< σ_3 of the compression tests, one test each (Pa)
+  std::vector<double> confining{0.0, 5e6, 10e6};  ///< σ_3 of the compression tests, one test each (Pa)
   // avalanche
   AvalancheSpec avalanche;
   // outputs

@@ -80,8 +80,10 @@ inline double clamped_damping_ratio_from_restitution(double e) {
 struct LinearSpringCoulomb {
   static constexpr const char* name = "linear";
   static constexpr const char* summary = "linear spring-dashpot + Coulomb friction (Cundall & Strack 1979)";
-  double kn = 1e8;  ///< normal stiffness (N/m per m thickness)
-  double ks = 1e8;  ///< shear stiffness (N/m per m thickness)
+  // dem-avalanche's defaults: contact modulus E_c = 20 GPa (k_n = 2 E_c, PFC2D at unit thickness),
+  // k_n/k_s = 2.5 (Potyondy & Cundall 2004); config.cpp derives its defaults from these.
+  double kn = 2 * 20e9;        ///< normal stiffness (N/m per m thickness)
+  double ks = 2 * 20e9 / 2.5;  ///< shear stiffness (N/m per m thickness)
 
   /// \param zeta damping ratio from the restitution coefficient (damping_ratio_from_restitution).
   ContactResponse evaluate(double delta, double meff, double /*reff*/, double /*slice*/, double zeta) const noexcept {
@@ -111,7 +113,7 @@ struct HertzMindlin {
   static constexpr const char* name = "hertz";
   static constexpr const char* summary =
       "Hertz-Mindlin no-slip, spheres of the disc diameter per metre (Tsuji et al. 1992)";
-  double youngs = 1e9;               ///< particle Young's modulus E (Pa)
+  double youngs = 20e9;              ///< particle Young's modulus E (Pa)
   double poisson = 0.25;             ///< Poisson's ratio ν
   double reference_overlap = 0.005;  ///< δ/R used for the time step of a disc with no contact yet
 

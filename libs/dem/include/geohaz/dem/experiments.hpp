@@ -54,7 +54,7 @@ struct LabTestSpec {
   PackingSpec packing;
   MaterialSpec material;
   double confining_stress = 1e6;   ///< σ_3 on the lateral walls (Pa); 0: unconfined (walls removed)
-  double loading_velocity = 0.05;  ///< speed of each platen / grip (m/s)
+  double loading_velocity = 0.25;  ///< speed of each platen / grip (m/s)
   double max_axial_strain = 0.02;  ///< stop at this strain
   double post_peak_stop = 0.7;     ///< stop once the stress drops below this fraction of the peak
   double local_damping = 0.7;      ///< Cundall α for the quasi-static test
@@ -103,11 +103,18 @@ MohrCoulombFit fit_mohr_coulomb(const std::vector<double>& sigma3, const std::ve
 // Rock avalanche
 
 struct AvalancheSpec {
-  std::vector<Vec2> terrain;  ///< profile (distance along the section, elevation) (m), downhill in +x
+  std::vector<Vec2> terrain;     ///< profile (distance along the section, elevation) (m), downhill in +x
+  double section_spacing = 5.0;  ///< m, sampling interval of a profile cut from a DSM (avalanche.section_spacing)
   double terrain_friction = 0.6, terrain_restitution = 0.3;
   double terrain_rolling_friction = -1.0;  ///< μ_r of disc–terrain contacts (< 0: material.contact's)
   std::vector<Vec2> source;                ///< rock-mass polygon (m)
-  PackingSpec packing;                     ///< radii, porosity, seed (width/height are taken from the polygon)
+  /// Radii, porosity, seed (width/height are taken from the polygon); no locked-in stress by default
+  /// (the mass is cut out of the packing box).
+  PackingSpec packing = [] {
+    PackingSpec p;
+    p.locked_in_stress = 0.0;
+    return p;
+  }();
   MaterialSpec material;
   double settle_time = 1.0;  ///< s, gravity settling with damping and the support in place
   double settle_damping = 0.7;

@@ -22,17 +22,19 @@
 namespace geohaz::dem {
 
 struct PackingSpec {
-  double width = 0.05;            ///< container width W (m)
-  double height = 0.1;            ///< container height H (m)
-  double r_min = 0.5e-3;          ///< smallest radius (m)
-  double r_max = 0.83e-3;         ///< largest radius (m), R_max/R_min = 1.66 by default
-  double porosity = 0.16;         ///< target porosity n of the expansion stage
+  // The defaults are dem-avalanche's (config.cpp reads these members as its defaults): a lab
+  // sample of Potyondy & Cundall's 2004 proportions.
+  double width = 0.03;            ///< container width W (m)
+  double height = 0.06;           ///< container height H (m)
+  double r_min = 0.8e-3;          ///< smallest radius (m)
+  double r_max = 1.66 * 0.8e-3;   ///< largest radius (m), R_max/R_min = 1.66 (Potyondy & Cundall 2004)
+  double porosity = 0.18;         ///< target porosity n of the expansion stage
   double density = 2650;          ///< disc density (kg/m³)
-  double locked_in_stress = 1e5;  ///< isotropic stress σ_0 after packing (Pa), 0: skip
+  double locked_in_stress = 1e6;  ///< isotropic stress σ_0 after packing (Pa), 0: skip
   double friction_after = 0.5;    ///< μ restored after packing
   std::uint64_t seed = 1;
-  int expansion_steps = 4000;   ///< radius-expansion steps
-  int max_relax_steps = 20000;  ///< cap on each equilibrium stage
+  int expansion_steps = 2000;  ///< radius-expansion steps
+  int max_relax_steps = 6000;  ///< cap on each equilibrium stage
 };
 
 /// A packed sample: discs (ids 0..N−1, origin at the lower-left container corner) and the

@@ -37,7 +37,7 @@ struct SolverSettings {
   double fixed_time_step = 0.0;     ///< > 0: use this Δt (s) instead (must be below the critical one)
   double skin = 0.0;                ///< Verlet skin (m); 0: 0.3 R_min
   int reorder_every = 20;           ///< sort the store by cell at every this-many-th list rebuild (0: never)
-  double max_speed = 1e3;           ///< a disc faster than this (m/s) is a blow-up
+  double max_speed = 500.0;         ///< a disc faster than this (m/s) is a blow-up
   double joint_friction = 0.5;      ///< μ of contacts across a joint (smooth-joint-like)
 };
 

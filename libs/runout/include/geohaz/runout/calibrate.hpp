@@ -21,7 +21,9 @@
 ///     parameters (the ensemble's sampler) plus Morris trajectories (Morris 1991; μ* of Campolongo
 ///     et al. 2007) as one batch, then derivative-free local searches (NLopt: Sbplx, BOBYQA or
 ///     Nelder–Mead, bounded) from the best distinct members, run in lockstep: every iteration is a
-///     batch of one point per live search, so `local_starts` searches keep that many ranks busy.
+///     batch of one point per live search, so `local_starts` searches keep that many ranks busy; the
+///     slot of a search that ends is refilled by a restart from the best distinct member while the
+///     local budget (`local_starts` x `local_evaluations` members) lasts.
 ///     Every evaluation is a member (members/<i>/, ensemble.hpp) whose index is fixed by the
 ///     sequence alone: a rerun replays the searches and finds finished members on disk.
 ///  4. The outputs (`write_calibration_outputs`): best.toml (a ready-to-run debris-runout config),
@@ -111,6 +113,7 @@ struct SearchSettings {
   int morris_levels = 4;                  ///< grid levels p (step Δ = p / (2 (p − 1)))
   int local_starts = 2;                   ///< local searches from the best distinct members
   int local_evaluations = 30;             ///< members per local search at most
+  bool local_restarts = true;             ///< refill the slot of an ended search while the budget lasts
   double local_xtol = 1e-3;               ///< stop when a step changes u by less than this (unit cube)
   std::string local_algorithm = "sbplx";  ///< sbplx, bobyqa (P ≥ 2), neldermead
   double local_step = 0.0;                ///< initial step in u (0: 1 / global_members)
@@ -140,6 +143,7 @@ void describe_calibration(ConfigReader& cfg);
 struct Evaluation {
   int index = 0;
   std::string stage;  ///< "design", "morris", "local<k>"
+  int batch = 0;      ///< the batch it was run in (0: the global stage), fixed by the search alone
   std::vector<double> values;
   bool ok = false;
   std::string diagnosis;
