@@ -367,6 +367,15 @@ bool write_best_profile(const CalibrationSetup& s, const Evaluation& best, const
   return true;
 }
 
+/// A member's cropped map (MemberPeaks window) on the full grid, 0 outside the window.
+std::vector<double> uncrop(const MemberPeaks& p, const std::vector<double>& v) {
+  std::vector<double> out(static_cast<std::size_t>(p.nx) * p.ny, 0.0);
+  for (int r = 0; r < p.h; ++r)
+    for (int c = 0; c < p.w; ++c)
+      out[static_cast<std::size_t>(p.r0 + r) * p.nx + p.c0 + c] = v[static_cast<std::size_t>(r) * p.w + c];
+  return out;
+}
+
 }  // namespace
 
 void write_calibration_outputs(const CalibrationSetup& s, const CalibrationResult& r, const fs::path& out, int ranks,
@@ -498,6 +507,23 @@ void write_calibration_outputs(const CalibrationSetup& s, const CalibrationResul
       << fmt(best.misfit.runout_diff, 4) << " m); " << acceptable.size() << " acceptable; outputs in " << out.string();
     std::cerr << o.str() << "\n";
   }
+}
+
+// The members' maps on the full grid (calibrate.hpp).
+
+std::vector<double> read_member_deposit(const fs::path& out, int i) {
+  const MemberPeaks p = read_member_peaks(member_dir(out, i) / "deposit.bin");
+  return uncrop(p, p.depth);
+}
+
+std::vector<double> read_member_max_depth(const fs::path& out, int i) {
+  const MemberPeaks p = read_member_peaks(member_dir(out, i) / "peaks.bin");
+  return uncrop(p, p.depth);
+}
+
+std::array<std::vector<double>, 3> read_member_peak_maps(const fs::path& out, int i) {
+  const MemberPeaks p = read_member_peaks(member_dir(out, i) / "peaks.bin");
+  return {uncrop(p, p.depth), uncrop(p, p.speed), uncrop(p, p.pressure)};
 }
 
 }  // namespace geohaz::runout
