@@ -18,6 +18,9 @@
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
 #include "geohaz/core/raster.hpp"
+#include "geohaz/dem/summary_keys.hpp"
+#include "geohaz/runout/summary_keys.hpp"
+#include "geohaz/sph/summary_keys.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -168,7 +171,8 @@ std::string format_quantity(double value, const std::string& unit) {
 
 namespace {
 
-enum GroupId { kVolumes, kReach, kPeak, kStrength, kDamage, kTime, kOther, kGroups };
+constexpr int kGroups = static_cast<int>(SummaryGroup::Other) + 1;
+constexpr int kOther = static_cast<int>(SummaryGroup::Other);
 constexpr const char* kGroupTitles[kGroups] = {"Volumes and areas",
                                                "Reach and H/L",
                                                "Peak values",
@@ -176,121 +180,6 @@ constexpr const char* kGroupTitles[kGroups] = {"Volumes and areas",
                                                "Damage and fragmentation",
                                                "Time",
                                                "Run bookkeeping / other"};
-
-/// A summary.json key as a reader knows it. `unit` overrides the unit read from the key name.
-struct KeyLabel {
-  const char* key;
-  GroupId group;
-  const char* label;
-  bool headline = false;
-  const char* unit = nullptr;
-};
-
-// Keys written by sph-slope, debris-runout and dem-avalanche (their summary_json / main). A key
-// not listed here is shown under "Run bookkeeping / other", labelled from its name.
-const KeyLabel kKeys[] = {
-    // sph-slope
-    {"release.total_volume_m3", kVolumes, "failed volume handed to the run-out", true},
-    {"release.volume_on_raster_m3", kVolumes, "failed volume on the thickness raster"},
-    {"release.width_m", kVolumes, "width the section stands for"},
-    {"failed_area_m2_per_m", kVolumes, "failed area of the section (per metre width)", true},
-    {"max_runout_m", kReach, "largest run-out of the toe during the run", true},
-    {"runout_m", kReach, "run-out of the toe at the end"},
-    {"normalised_runout", kReach, "run-out / slope height"},
-    {"front_m", kReach, "front position at the end"},
-    {"tip_m", kReach, "tip position at the end"},
-    {"max_displacement_m", kPeak, "largest displacement", true},
-    {"max_plastic_strain", kPeak, "largest plastic strain"},
-    {"max_speed_m_per_s", kPeak, "peak speed", true},
-    {"final_max_speed_m_per_s", kPeak, "largest speed at the end"},
-    {"end_time_s", kTime, "simulated time"},
-    {"time_to_rest_s", kTime, "time to come to rest", true},
-    {"stopped_at_rest", kTime, "came to rest"},
-    // debris-runout
-    {"volumes_m3.release_read", kVolumes, "release volume read", true},
-    {"volumes_m3.seeded", kVolumes, "volume seeded as particles"},
-    {"volumes_m3.deposited", kVolumes, "volume stopped (deposited particles)"},
-    {"volumes_m3.mobile", kVolumes, "volume still moving at the end"},
-    {"volumes_m3.lost", kVolumes, "volume lost over the DTM edge"},
-    {"volumes_m3.deposit_raster", kVolumes, "deposit volume on the raster", true},
-    {"volumes_m3.mobile_raster", kVolumes, "moving volume on the raster"},
-    {"volumes_m3.entrained", kVolumes, "volume entrained from the bed"},
-    {"volumes_m3.injected", kVolumes, "volume injected by inflows"},
-    {"area_affected_m2", kVolumes, "area reached by the flow", true},
-    {"mobile_at_end.fraction", kVolumes, "fraction still moving at the end"},
-    {"mobile_at_end.volume_m3", kVolumes, "volume still moving at the end"},
-    {"fahrboeschung.ratio_H_over_L", kReach, "H/L (Fahrböschung: release top to toe)", true},
-    {"fahrboeschung.angle_deg", kReach, "Fahrböschung angle"},
-    {"fahrboeschung.drop_height_m", kReach, "drop height H", true},
-    {"fahrboeschung.reach_m", kReach, "horizontal reach L", true},
-    {"fahrboeschung.toe_x_m", kReach, "toe easting"},
-    {"fahrboeschung.toe_y_m", kReach, "toe northing"},
-    {"runout_length_along_path_m", kReach, "run-out length along the path"},
-    {"centre_of_mass.travel_m", kReach, "centre of mass: horizontal travel"},
-    {"centre_of_mass.drop_m", kReach, "centre of mass: drop"},
-    {"centre_of_mass.angle_deg", kReach, "centre of mass: travel angle"},
-    {"max_speed_m_s", kPeak, "peak speed", true},  // debris-runout folders from before the key rule (python.md)
-    {"max_pressure_pa", kPeak, "peak pressure ρv²", true},
-    {"mobile_at_end.max_speed_m_per_s", kPeak, "largest speed at the end"},
-    {"mobile_at_end.max_speed_m_s", kPeak, "largest speed at the end"},
-    {"kinetic_energy_j.peak", kPeak, "peak kinetic energy"},
-    {"kinetic_energy_j.at_end", kPeak, "kinetic energy at the end"},
-    {"processes.entrainment.max_eroded_depth_m", kPeak, "deepest erosion"},
-    {"simulated_time_s", kTime, "simulated time", true},
-    {"ended_by", kTime, "the run ended by"},
-    {"release_time_s", kTime, "release time"},
-    // dem-avalanche, biaxial
-    {"mohr_coulomb.cohesion_Pa", kStrength, "cohesion c (Mohr–Coulomb fit over the tests)", true},
-    {"mohr_coulomb.friction_angle_deg", kStrength, "friction angle φ (Mohr–Coulomb fit)", true},
-    {"mohr_coulomb.failure_plane_angle_deg", kStrength, "failure plane angle 45° + φ/2"},
-    {"mohr_coulomb.valid", kStrength, "fit valid (at least two confining stresses)"},
-    {"sample.porosity", kStrength, "sample porosity"},
-    // dem-avalanche, avalanche
-    {"volume_m3", kVolumes, "rock volume", true},
-    {"source_area_m2", kVolumes, "source area of the section"},
-    {"H_over_L", kReach, "H/L (fall height over run-out)", true},
-    {"fall_height_H_m", kReach, "fall height H"},
-    {"runout_L_m", kReach, "run-out L", true},
-    {"scheidegger_1973_H_over_L", kReach, "H/L for this volume by Scheidegger (1973)"},
-    {"bond_breaks.tensile", kDamage, "bonds broken in tension"},
-    {"bond_breaks.shear", kDamage, "bonds broken in shear"},
-    {"bond_breaks.before_release", kDamage, "bonds broken before release"},
-    {"bonds_initial", kDamage, "bonds at the start"},
-    {"bonds_intact_final", kDamage, "bonds intact at the end"},
-    {"fragments_final", kDamage, "fragments at the end"},
-    {"largest_fragment_discs", kDamage, "discs in the largest fragment"},
-    {"fragments_with_2_or_more_discs", kDamage, "fragments of two discs or more"},
-    {"discontinuities.traces", kDamage, "joint traces"},
-    {"discontinuities.total_length_m", kDamage, "total joint trace length"},
-    {"discontinuities.intensity_P21_per_m", kDamage, "joint intensity P21"},
-    {"discontinuities.bonds_cut", kDamage, "bonds cut by joints"},
-    // bookkeeping, in every app
-    {"wall_time_s", kOther, "wall-clock time"},
-    {"mass_balance_error_relative", kOther, "relative mass-balance error"},
-    {"bytes_per_particle", kOther, "memory per particle", false, "bytes"},
-};
-
-/// Column labels of the tables made from arrays of objects.
-const KeyLabel kTableKeys[] = {
-    {"tests.confining_stress_Pa", kStrength, "confining stress σ3"},
-    {"tests.peak_stress_Pa", kStrength, "peak axial stress σ1"},
-    {"tests.deviator_at_peak_Pa", kStrength, "deviator at peak σ1 − σ3"},
-    {"tests.youngs_modulus_Pa", kStrength, "Young's modulus E"},
-    {"tests.poisson_ratio", kStrength, "Poisson's ratio ν"},
-    {"tests.peak_axial_strain", kStrength, "axial strain at peak"},
-    {"tests.crack_band_inclination_deg", kStrength, "crack band inclination"},
-    {"tests.tensile_breaks", kStrength, "tensile cracks"},
-    {"tests.shear_breaks", kStrength, "shear cracks"},
-};
-constexpr const char* kTableTitles[][2] = {{"tests", "Results per confining stress"},
-                                           {"materials", "Materials (derived model constants)"},
-                                           {"discontinuities.sets", "Joint sets"}};
-
-const KeyLabel* find_key(const std::string& k) {
-  for (const auto& e : kKeys)
-    if (k == e.key) return &e;
-  return nullptr;
-}
 
 std::string value_text(const json& v, const std::string& unit) {
   if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
@@ -306,115 +195,137 @@ std::string value_text(const json& v, const std::string& unit) {
   return v.dump();
 }
 
-/// "a.b_c_m" → "a: b c" with its unit from the name.
-std::pair<std::string, std::string> label_from_key(const std::string& key) {
-  std::string prefix, last = key;
-  if (const auto dot = key.rfind('.'); dot != std::string::npos) {
-    prefix = key.substr(0, dot);
-    last = key.substr(dot + 1);
-    std::replace(prefix.begin(), prefix.end(), '_', ' ');
-    std::replace(prefix.begin(), prefix.end(), '.', ' ');
+/// A key as the writer declared it: label and display unit, group, headline flag and its place
+/// in the declarations (the display order). A key matched by a "*" pattern gets what the star
+/// stands for after its label ("run-out length along the path: p10"), and a value of a named
+/// parameter its parameter's label and unit. Undeclared: the key itself, no unit (nothing is
+/// guessed from the name), in the bookkeeping group.
+struct Declared {
+  std::string label, unit;
+  int group = kOther;
+  bool headline = false;
+  long rank = std::numeric_limits<long>::max();
+};
+
+Declared declared(std::span<const SummaryKey> keys, const std::string& key, const std::string& parameter = "") {
+  const SummaryKey* k = find_summary_key(keys, key);
+  if (!k) return {key, ""};
+  Declared d{std::string(k->label), display_unit(std::string(k->unit)), static_cast<int>(k->group), k->headline,
+             k - keys.data()};
+  if (const auto star = k->key.find('*'); star != std::string_view::npos) {
+    const std::string rest = key.substr(std::min(key.size(), star));
+    if (k->unit == kUnitOfParameter) {
+      const auto [plabel, punit] = parameter_label(rest);
+      d.label += ": " + plabel;
+      d.unit = punit;
+    } else {
+      d.label += ": " + rest;
+    }
+  } else if (k->unit == kUnitOfParameter) {
+    d.unit = parameter.empty() ? "" : parameter_label(parameter).second;
   }
-  const Quantity q = quantity_from_name(last);
-  return {prefix.empty() ? q.label : prefix + ": " + q.label, q.unit};
+  return d;
 }
 
-/// The unit of a dotted key: from its last segment, else from the nearest parent that names one
-/// ("volumes_m3.deposited" → m³, "kinetic_energy_j.peak" → J).
-std::string unit_of_key(const std::string& key) {
-  const auto seg = split(key, '.');
-  for (auto it = seg.rbegin(); it != seg.rend(); ++it)
-    if (const Quantity q = quantity_from_name(*it); !q.unit.empty()) return q.unit;
-  return "";
+/// A table of an array of objects: declared columns first, in the declarations' order, "name"
+/// before them; the title from the array's own declaration ("tests[]"); folded when that is
+/// bookkeeping.
+SubTable sub_table(std::span<const SummaryKey> keys, const std::string& key, const json& array) {
+  SubTable t;
+  const Declared title = declared(keys, key + "[]");
+  t.title = title.label == key + "[]" ? key : title.label;
+  if (!t.title.empty()) t.title[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(t.title[0])));
+  t.folded = title.group == kOther;
+  std::vector<std::string> cols;
+  for (const auto& e : array)
+    for (auto c = e.begin(); c != e.end(); ++c)
+      if (!c->is_structured() || (c->is_array() && !c->empty() && c->front().is_number()))
+        if (std::find(cols.begin(), cols.end(), c.key()) == cols.end()) cols.push_back(c.key());
+  std::stable_sort(cols.begin(), cols.end(), [&](const std::string& a, const std::string& b) {
+    const auto rank = [&](const std::string& c) { return c == "name" ? -1L : declared(keys, key + "[]." + c).rank; };
+    return rank(a) < rank(b);
+  });
+  for (const auto& c : cols) {
+    const Declared d = declared(keys, key + "[]." + c);
+    const std::string label = d.label == key + "[]." + c ? c : d.label;
+    t.headers.push_back(d.unit.empty() ? label : label + " (" + d.unit + ")");
+  }
+  for (const auto& e : array) {
+    std::vector<std::string> row;
+    const std::string parameter = e.value("key", json()).is_string() ? e.at("key").get<std::string>() : "";
+    for (const auto& c : cols)
+      row.push_back(e.contains(c) ? value_text(e[c], declared(keys, key + "[]." + c, parameter).unit) : "");
+    t.cells.push_back(std::move(row));
+  }
+  return t;
 }
 
-void flatten(const json& j, const std::string& prefix, Summary& out, std::vector<Row> (&groups)[kGroups]) {
+struct KeyedRow {
+  Row row;
+  long rank;
+  int group;
+};
+
+void flatten(std::span<const SummaryKey> keys, const json& j, const std::string& prefix, Summary& out,
+             std::vector<KeyedRow> (&groups)[kGroups], std::vector<KeyedRow>& headline) {
   for (auto it = j.begin(); it != j.end(); ++it) {
     const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
     if (it->is_object()) {
-      flatten(*it, key, out, groups);
+      flatten(keys, *it, key, out, groups, headline);
       continue;
     }
     if (it->is_array() && !it->empty() && it->front().is_object()) {
-      SubTable t;
-      t.title = key;
-      for (const auto& tt : kTableTitles)
-        if (key == tt[0]) t.title = tt[1];
-      t.folded = key == "materials";
-      std::vector<std::string> cols;
-      for (const auto& e : *it)
-        for (auto c = e.begin(); c != e.end(); ++c)
-          if (!c->is_structured() && std::find(cols.begin(), cols.end(), c.key()) == cols.end())
-            cols.push_back(c.key());
-      // Labelled columns first, in the label table's order.
-      std::vector<std::string> ordered;
-      for (const auto& e : kTableKeys) {
-        const std::string full = e.key;
-        if (full.rfind(key + ".", 0) == 0) {
-          const std::string c = full.substr(key.size() + 1);
-          if (std::find(cols.begin(), cols.end(), c) != cols.end()) ordered.push_back(c);
-        }
-      }
-      if (auto n = std::find(cols.begin(), cols.end(), "name"); n != cols.end())
-        ordered.insert(ordered.begin(), "name");
-      for (const auto& c : cols)
-        if (std::find(ordered.begin(), ordered.end(), c) == ordered.end()) ordered.push_back(c);
-      std::vector<std::string> units;
-      for (const auto& c : ordered) {
-        std::string label = quantity_from_name(c).label, unit = quantity_from_name(c).unit;
-        for (const auto& e : kTableKeys)
-          if (key + "." + c == e.key) label = e.label;
-        t.headers.push_back(unit.empty() ? label : label + " (" + unit + ")");
-        units.push_back(unit);
-      }
-      for (const auto& e : *it) {
-        std::vector<std::string> row;
-        for (std::size_t c = 0; c < ordered.size(); ++c)
-          row.push_back(e.contains(ordered[c]) ? value_text(e[ordered[c]], units[c]) : "");
-        t.cells.push_back(row);
-      }
-      out.tables.push_back(std::move(t));
+      out.tables.push_back(sub_table(keys, key, *it));
       continue;
     }
     if (it->is_array() && it->size() > 8) continue;  // long arrays are left to the files
-    const KeyLabel* kl = find_key(key);
-    auto [label, unit] = label_from_key(key);
-    unit = unit_of_key(key);
-    GroupId g = kOther;
-    if (kl) {
-      label = kl->label;
-      if (kl->unit) unit = kl->unit;
-      g = kl->group;
-    }
-    Row r{key, label, value_text(*it, unit)};
-    if (kl && kl->headline) out.headline.push_back(r);
-    groups[g].push_back(std::move(r));
+    // An empty array of objects (no barriers) reads under the array's own declaration ("barriers[]").
+    const bool empty_table = it->is_array() && it->empty() && !find_summary_key(keys, key);
+    Declared d = declared(keys, empty_table ? key + "[]" : key);
+    if (empty_table) d.group = kOther;  // "none": bookkeeping
+    KeyedRow r{{key, d.label == key + "[]" ? key : d.label, value_text(*it, d.unit)}, d.rank, d.group};
+    if (d.headline) headline.push_back(r);
+    groups[d.group].push_back(std::move(r));
   }
 }
 
 }  // namespace
 
-Quantity summary_label(const std::string& key) {
-  const KeyLabel* kl = find_key(key);
-  return {kl ? kl->label : label_from_key(key).first, kl && kl->unit ? kl->unit : unit_of_key(key)};
+std::span<const SummaryKey> declared_summary_keys(const json& summary) {
+  // The writer's own list: runout (debris-runout, geohaz-ensemble, geohaz-calibrate), dem
+  // (dem-avalanche), else sph (sph-slope names its constitutive model here, or nothing;
+  // slope-stability its app).
+  const std::string model = summary.is_object() ? summary.value("model", std::string()) : std::string();
+  if (model == "debris-runout" || model == "geohaz-ensemble" || model == "geohaz-calibrate")
+    return runout::summary_keys();
+  if (model == "dem-avalanche") return dem::summary_keys();
+  return sph::summary_keys();
+}
+
+Quantity summary_label(std::span<const SummaryKey> keys, const std::string& key) {
+  const Declared d = declared(keys, key);
+  return {d.label, d.unit};
 }
 
 Summary summarise(const json& summary) {
+  const std::span<const SummaryKey> keys = declared_summary_keys(summary);
   Summary s;
-  std::vector<Row> groups[kGroups];
-  flatten(summary, "", s, groups);
-  // Labelled keys in the label table's order (the headline in group order); the rest alphabetically.
-  const auto rank = [](const Row& r) {
-    const auto it = std::find_if(std::begin(kKeys), std::end(kKeys), [&](const KeyLabel& k) { return r.key == k.key; });
-    return std::pair<int, long>{it == std::end(kKeys) ? kGroups : static_cast<int>(it->group), it - std::begin(kKeys)};
-  };
-  const auto by_rank = [&](const Row& a, const Row& b) { return rank(a) < rank(b); };
+  std::vector<KeyedRow> groups[kGroups], headline;
+  flatten(keys, summary, "", s, groups, headline);
+  // Declared keys in the declarations' order (the headline too), the rest alphabetically.
+  const auto by_rank = [](const KeyedRow& a, const KeyedRow& b) { return a.rank < b.rank; };
   for (int g = 0; g < kGroups; ++g) {
     auto& rows = groups[g];
     std::stable_sort(rows.begin(), rows.end(), by_rank);
-    if (!rows.empty()) s.groups.push_back({kGroupTitles[g], rows});
+    if (rows.empty()) continue;
+    Group out{kGroupTitles[g], {}};
+    for (auto& r : rows) out.rows.push_back(std::move(r.row));
+    s.groups.push_back(std::move(out));
   }
-  std::stable_sort(s.headline.begin(), s.headline.end(), by_rank);
+  std::stable_sort(headline.begin(), headline.end(), [](const KeyedRow& a, const KeyedRow& b) {
+    return std::pair(a.group, a.rank) < std::pair(b.group, b.rank);
+  });
+  for (auto& r : headline) s.headline.push_back(std::move(r.row));
   return s;
 }
 
@@ -468,8 +379,10 @@ const Caption kCaptions[] = {
     {"cracks_*", "Bonds and cracks at the end of the test at this confining stress."},
     {"deposit_profile", "Deposit thickness along the profile."},
     {"profile",
-     "Thalweg long profile along the flow's centreline: terrain, peak depth above it (exaggerated), "
-     "the α line from the top of the release to the run-out point; peak speed below."},
+     "Thalweg long profile along the flow's centreline (or the given path): terrain, peak depth above it "
+     "(exaggerated); two reaches of the same run, each named: α along the profile (red, from the top of the "
+     "reached part to the run-out point along this path; summary: profile) and the H/L of the toe path "
+     "(orange, dashed; along the toe particle's own path; summary: fahrboeschung); peak speed below."},
     {"gauges", "Gauges (output.gauges): flow depth, speed and discharge across the sections against time."},
     {"probability", "Probability over the ensemble, in classes, on the cells any member reached."},
     {"mean_max_depth", "Mean of the members' peak flow depth."},

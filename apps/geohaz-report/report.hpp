@@ -6,9 +6,12 @@
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "geohaz/core/summary_keys.hpp"
 
 namespace geohaz::report {
 
@@ -73,9 +76,11 @@ struct SubTable {
   std::vector<std::vector<std::string>> cells;
   bool folded = false;  ///< bookkeeping (derived model constants): shown folded, after the pictures
 };
-/// The key numbers of a summary.json, grouped by meaning. Keys of the label table get its label and
-/// group; any other key still appears, labelled from its name, in "Run bookkeeping / other" (so keys
-/// added later show up). Arrays of objects become SubTables; long number arrays are left out.
+/// The key numbers of a summary.json, grouped by meaning. Label, unit, group and headline come
+/// from the declarations of the library that wrote the summary (declared_summary_keys); a key it
+/// does not declare still appears, under its own name and without a unit, in "Run bookkeeping /
+/// other". Arrays of objects become SubTables (title and columns declared as "name[]" and
+/// "name[].column"); long number arrays are left out.
 struct Summary {
   std::vector<Group> groups;  ///< in display order, empty groups left out
   std::vector<SubTable> tables;
@@ -143,9 +148,14 @@ struct Marker {
 std::string svg_distribution(std::vector<double> values, const Quantity& quantity, const std::vector<Marker>& markers,
                              const std::string& title);
 
-/// The label and unit a summary.json key gets in the key-number tables: the label table's label
-/// (else words from the name) and the unit from the key's name (report.cpp).
-Quantity summary_label(const std::string& key);
+/// The declared summary keys of the library that wrote `summary` (by its "model": runout for
+/// debris-runout, geohaz-ensemble and geohaz-calibrate, dem for dem-avalanche, else sph).
+std::span<const SummaryKey> declared_summary_keys(const nlohmann::json& summary);
+
+/// The label and display unit a summary.json key gets in the key-number tables, from `keys` (a
+/// key matched by a "*" pattern gets what the star stands for after its label); the key itself
+/// and no unit when it is not declared.
+Quantity summary_label(std::span<const SummaryKey> keys, const std::string& key);
 
 /// The red "map check" lines under a map drawn by write_quicklook_png that lacks its legend,
 /// ticks or scale bar ("" when it has them or is not such a map).

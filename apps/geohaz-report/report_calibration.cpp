@@ -287,12 +287,18 @@ CalibrationPart calibration_part(const fs::path& run_dir, const json& summary, c
     comparison_map(o, run_dir, dir);
     part.html = o.str();
     thalweg_profile(part, run_dir, svg_prefix);
+    if (fs::exists(run_dir / "profile.png"))
+      part.html += "<figure><img alt=\"profile\" src=\"" + escape_html(dir) +
+                   "profile.png\"><figcaption><b>profile.png</b> The best member's long profile along the "
+                   "observation's thalweg (profile.csv): terrain, peak depth above it, α along the profile and "
+                   "peak speed; the observed run-out (blue) beside the modelled one (purple), both measured along "
+                   "the thalweg as the score measures them.</figcaption></figure>\n";
     part.html += "</div>\n";
   } catch (const json::exception& e) {
     throw InputError(std::string("summary.json of a calibration lacks an entry: ") + e.what(),
                      (run_dir / "summary.json").string());
   }
-  part.shown = {"acceptable.svg", "comparison.png", "thalweg_profile.csv"};
+  part.shown = {"acceptable.svg", "comparison.png", "thalweg_profile.csv", "profile.png", "profile.csv"};
   return part;
 }
 

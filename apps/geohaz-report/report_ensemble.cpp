@@ -5,6 +5,7 @@
 /// depth, and the distributions of run-out and H/L over the members.
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "geohaz/core/errors.hpp"
+#include "geohaz/runout/summary_keys.hpp"
 #include "report.hpp"
 
 namespace fs = std::filesystem;
@@ -75,22 +77,23 @@ std::vector<double> ok_values(const MemberTable& t, const std::string& column) {
   return v;
 }
 
-/// The statistics the ensemble writes for each quantity: the summary key, the key a single run
-/// writes for the same quantity (its label), the column of members.csv.
+/// The statistics the ensemble writes for each quantity: the summary key and the column of
+/// members.csv.
 struct Statistic {
   const char* summary_key;
-  const char* label_key;
   const char* column;
 };
 constexpr Statistic kStatistics[] = {
-    {"runout_length_along_path_m", "runout_length_along_path_m", "runout_m"},
-    {"fahrboeschung_ratio_H_over_L", "fahrboeschung.ratio_H_over_L", "H_over_L"},
-    {"area_affected_m2", "area_affected_m2", "area_affected_m2"},
+    {"runout_length_along_path_m", "runout_m"},
+    {"fahrboeschung_ratio_H_over_L", "H_over_L"},
+    {"area_affected_m2", "area_affected_m2"},
 };
 
-/// Label from the summary table's labels, unit from the ensemble's key name (the key-name rule).
+/// Label and unit as geohaz-ensemble declares its statistics ("runout_length_along_path_m.*").
 Quantity statistic_quantity(const Statistic& s) {
-  return {summary_label(s.label_key).label, quantity_from_name(s.summary_key).unit};
+  const std::string key = std::string(s.summary_key) + ".*";
+  const SummaryKey* k = find_summary_key(runout::summary_keys(), key);
+  return k ? Quantity{std::string(k->label), display_unit(std::string(k->unit))} : Quantity{s.summary_key, ""};
 }
 
 std::string number_of(const json& j, const std::string& unit) {
@@ -195,30 +198,52 @@ std::string probability_event(const std::string& stem) {
   const struct {
     const char* prefix;
     const char* what;
-    const char* unit;
-  } kinds[] = {{"prob_max_depth_gt_", "the peak flow depth exceeds ", "m"},
-               {"prob_max_speed_gt_", "the peak speed exceeds ", "m_per_s"},
-               {"prob_max_pressure_gt_", "the peak dynamic pressure ρv² exceeds ", "Pa"},
-               {"prob_intensity_ge_", "the intensity class is at least ", ""}};
+    const char* unit;   ///< as the file name spells it (ensemble.cpp write_products)
+    const char* shown;  ///< as a reader writes it
+  } kinds[] = {{"prob_max_depth_gt_", "the peak flow depth exceeds ", "m", "m"},
+               {"prob_max_speed_gt_", "the peak speed exceeds ", "m_per_s", "m/s"},
+               {"prob_max_pressure_gt_", "the peak dynamic pressure ρv² exceeds ", "Pa", "Pa"},
+               {"prob_intensity_ge_", "the intensity class is at least ", "", ""}};
   for (const auto& k : kinds) {
     if (stem.rfind(k.prefix, 0) != 0) continue;
     std::string t = stem.substr(std::string(k.prefix).size());
     const std::string u = k.unit;
     if (!u.empty() && t.size() > u.size() && t.ends_with(u)) t.resize(t.size() - u.size());
     const double v = std::strtod(t.c_str(), nullptr);
-    return k.what + (u.empty() ? t : format_quantity(v, quantity_from_name("x_" + u).unit));
+    return k.what + (u.empty() ? t : format_quantity(v, k.shown));
   }
   return stem;
 }
 
+/// The fields of the mean and percentile maps (ensemble.cpp write_products), in reading order.
+struct MapField {
+  const char* field;  ///< the file names' suffix: mean_<field>.png, p<q>_<field>.png
+  const char* what;   ///< for the heading and captions
+  const char* classes;
+};
+constexpr MapField kMapFields[] = {
+    {"max_depth", "peak flow depth", "the base case's depth classes (output.map_depth_classes)"},
+    {"max_speed", "peak speed", "the base case's speed classes (output.map_speed_classes)"},
+    {"max_pressure", "peak dynamic pressure ρv² (kPa)",
+     "the base case's pressure classes (output.map_pressure_classes, drawn in kPa)"},
+};
+
 void maps(std::ostringstream& o, RunPart& part, const fs::path& run_dir, const json& s, const std::string& page_dir) {
-  std::vector<std::string> prob, depth;
+  std::vector<std::string> prob, field_maps[std::size(kMapFields)];
   for (const auto& e : fs::directory_iterator(run_dir)) {
     const std::string f = e.path().filename().string();
     if (e.path().extension() != ".png") continue;
-    if (f.rfind("prob_", 0) == 0) prob.push_back(f);
-    if (f == "mean_max_depth.png" || (f.front() == 'p' && f.ends_with("_max_depth.png") && f.rfind("prob_", 0) != 0))
-      depth.push_back(f);
+    if (f.rfind("prob_", 0) == 0) {
+      prob.push_back(f);
+      continue;
+    }
+    for (std::size_t k = 0; k < std::size(kMapFields); ++k) {
+      const std::string suffix = std::string("_") + kMapFields[k].field + ".png";
+      if (f == "mean" + suffix ||
+          (f.front() == 'p' && f.ends_with(suffix) && std::isdigit(static_cast<unsigned char>(f[1])) &&
+           f.find('_') + suffix.size() == f.size()))
+        field_maps[k].push_back(f);
+    }
   }
   // In the order of the summary's products (depth, speed, pressure thresholds, intensity), else by name.
   const json& products = s.value("products", json::array());
@@ -231,11 +256,6 @@ void maps(std::ostringstream& o, RunPart& part, const fs::path& run_dir, const j
   std::sort(prob.begin(), prob.end(), [&](const std::string& a, const std::string& b) {
     const auto ra = product_rank(a), rb = product_rank(b);
     return ra != rb ? ra < rb : a < b;
-  });
-  // The mean first, then the percentiles in rising order.
-  std::sort(depth.begin(), depth.end(), [](const std::string& a, const std::string& b) {
-    const auto rank = [](const std::string& f) { return f[0] == 'm' ? -1.0 : std::strtod(f.c_str() + 1, nullptr); };
-    return rank(a) < rank(b);
   });
   const int ok = s.value("succeeded", 0);
   const auto figure = [&](const std::string& f, const std::string& caption) {
@@ -250,17 +270,29 @@ void maps(std::ostringstream& o, RunPart& part, const fs::path& run_dir, const j
                   " members that ran, in classes of 0.1 to 0.9, on the cells the members reached (one extent for "
                   "every map of the ensemble). GeoTIFF and QGIS style beside it.");
   const json& acc = s.value("percentile_accuracy", json::object());
-  const std::string err = acc.contains("max_relative_error_depth")
-                              ? format_quantity(100 * acc.value("max_relative_error_depth", 0.0), "%")
-                              : std::string("one bin");
-  if (!depth.empty()) o << "<h3>Mean and percentile maps of the peak flow depth</h3>\n";
-  for (const auto& f : depth)
-    figure(f, f[0] == 'm' ? "Mean of the members' peak flow depth per cell (a member that did not reach the cell "
-                            "counts as 0), in the base case's depth classes."
-                          : "Percentile " + f.substr(1, f.find('_') - 1) +
-                                " of the members' peak flow depth per cell (nearest rank; 0 where fewer members "
-                                "reached the cell), from a log-binned histogram within " +
-                                err + " of the exact value; speed and pressure maps are in the GeoTIFFs.");
+  for (std::size_t k = 0; k < std::size(kMapFields); ++k) {
+    auto& list = field_maps[k];
+    if (list.empty()) continue;
+    // The mean first, then the percentiles in rising order.
+    std::sort(list.begin(), list.end(), [](const std::string& a, const std::string& b) {
+      const auto rank = [](const std::string& f) { return f[0] == 'm' ? -1.0 : std::strtod(f.c_str() + 1, nullptr); };
+      return rank(a) < rank(b);
+    });
+    const MapField& mf = kMapFields[k];
+    const std::string error_key = std::string("max_relative_error_") + (k == 0   ? "depth"
+                                                                        : k == 1 ? "speed"
+                                                                                 : "pressure");
+    const std::string err =
+        acc.contains(error_key) ? format_quantity(100 * acc.value(error_key, 0.0), "%") : std::string("one bin");
+    o << "<h3>Mean and percentile maps of the " << escape_html(mf.what) << "</h3>\n";
+    for (const auto& f : list)
+      figure(f, f[0] == 'm' ? std::string("Mean of the members' ") + mf.what +
+                                  " per cell (a member that did not reach the cell counts as 0), in " + mf.classes + "."
+                            : "Percentile " + f.substr(1, f.find('_') - 1) + " of the members' " + mf.what +
+                                  " per cell (nearest rank; 0 where fewer members reached the cell), from a "
+                                  "log-binned histogram within " +
+                                  err + " of the exact value, in " + mf.classes + ".");
+  }
 }
 
 void distributions(std::ostringstream& o, RunPart& part, const json& s, const MemberTable& members,

@@ -17,7 +17,9 @@
 #include "geohaz/core/raster.hpp"
 #include "geohaz/core/snapshot.hpp"
 #include "geohaz/dem/experiments.hpp"
+#include "geohaz/dem/summary_keys.hpp"
 #include "run_command.hpp"
+#include "summary_keys_check.hpp"
 
 using namespace geohaz;
 using namespace geohaz::dem;
@@ -238,7 +240,9 @@ fs::path fresh_dir(const std::string& name) {
 
 nlohmann::json read_json(const fs::path& p) {
   std::ifstream in(p);
-  return nlohmann::json::parse(in);
+  const auto j = nlohmann::json::parse(in);
+  if (p.filename() == "summary.json") EXPECT_SUMMARY_KEYS_DECLARED(j, geohaz::dem::summary_keys());  // issue #33
+  return j;
 }
 
 const std::string kTinyLab =

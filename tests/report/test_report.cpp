@@ -10,7 +10,12 @@
 
 #include "calibration_results.hpp"
 #include "geohaz/core/errors.hpp"
+#include "geohaz/core/summary_keys.hpp"
+#include "geohaz/dem/summary_keys.hpp"
+#include "geohaz/runout/summary_keys.hpp"
+#include "geohaz/sph/summary_keys.hpp"
 #include "report.hpp"
+#include "summary_keys_check.hpp"
 
 namespace fs = std::filesystem;
 using namespace geohaz::report;
@@ -97,43 +102,99 @@ TEST(ReportPlots, SvgPointsSitWhereTheAxesSay) {
   fs::remove_all(d);
 }
 
-TEST(ReportSummary, KeysAreGroupedLabelledAndUnknownKeysKept) {
+TEST(ReportSummary, KeysAreGroupedAndLabelledFromTheWritersDeclarationsAndUnknownKeysKept) {
   const auto j = nlohmann::json::parse(R"({
+    "model": "debris-runout",
     "fahrboeschung": {"ratio_H_over_L": 0.5131776, "reach_m": 2802.16},
     "max_pressure_pa": 2.208e6,
     "volumes_m3": {"deposited": 3911.4},
-    "bytes_per_particle": 610.2,
+    "wall_time_s": 61.2,
     "barrier_peak_force_N": 12500.0,
-    "tests": [{"name": "sigma3_5MPa", "confining_stress_Pa": 5e6, "peak_stress_Pa": 9.76e7}],
+    "runout_length_along_path_m": {"p10": 2500.0},
     "long": [1,2,3,4,5,6,7,8,9,10]
   })");
   const Summary s = summarise(j);
+  // Label and unit are debris-runout's declarations (runout::summary_keys), read here from them.
+  const auto keys = declared_summary_keys(j);
+  const auto declared = [&](const std::string& key) { return geohaz::find_summary_key(keys, key); };
   const Group* reach = find_group(s, "Reach and H/L");
   ASSERT_NE(reach, nullptr);
   const Row* hl = find_row(reach->rows, "fahrboeschung.ratio_H_over_L");
   ASSERT_NE(hl, nullptr);
-  EXPECT_EQ(hl->label, "H/L (Fahrböschung: release top to toe)");
-  EXPECT_EQ(hl->value, "0.5132");
+  ASSERT_NE(declared("fahrboeschung.ratio_H_over_L"), nullptr);
+  EXPECT_EQ(hl->label, declared("fahrboeschung.ratio_H_over_L")->label);
+  EXPECT_EQ(hl->value, "0.5132");  // declared "1": dimensionless
+  EXPECT_EQ(find_row(reach->rows, "fahrboeschung.reach_m")->value, "2802 m");
+  // A "*" declaration: its label with what the star stands for.
+  EXPECT_EQ(find_row(reach->rows, "runout_length_along_path_m.p10")->label,
+            std::string(declared("runout_length_along_path_m.*")->label) + ": p10");
   const Group* volumes = find_group(s, "Volumes and areas");
   ASSERT_NE(volumes, nullptr);
-  EXPECT_EQ(find_row(volumes->rows, "volumes_m3.deposited")->value, "3911 m³");  // the unit from the parent key
+  EXPECT_EQ(find_row(volumes->rows, "volumes_m3.deposited")->value, "3911 m³");  // declared "m^3"
   const Group* peak = find_group(s, "Peak values");
   ASSERT_NE(peak, nullptr);
   EXPECT_EQ(find_row(peak->rows, "max_pressure_pa")->value, "2.208 MPa");
   const Group* other = find_group(s, "Run bookkeeping / other");
   ASSERT_NE(other, nullptr);
-  const Row* added = find_row(other->rows, "barrier_peak_force_N");  // a key another branch adds
+  EXPECT_EQ(find_row(other->rows, "wall_time_s")->value, "61.2 s");
+  // A key the writer does not declare is still shown, under its own name and without a unit: the
+  // report guesses nothing from a name (the apps' tests make every key they write declared).
+  const Row* added = find_row(other->rows, "barrier_peak_force_N");
   ASSERT_NE(added, nullptr);
-  EXPECT_EQ(added->label, "barrier peak force");
-  EXPECT_EQ(added->value, "12.5 kN");
-  EXPECT_NE(find_row(other->rows, "bytes_per_particle"), nullptr);
+  EXPECT_EQ(added->label, "barrier_peak_force_N");
+  EXPECT_EQ(added->value, "12\u202F500");
   EXPECT_EQ(find_row(other->rows, "long"), nullptr);  // long arrays are left to the files
   EXPECT_NE(find_row(s.headline, "fahrboeschung.ratio_H_over_L"), nullptr);
-  ASSERT_EQ(s.tables.size(), 1u);
-  EXPECT_EQ(s.tables[0].title, "Results per confining stress");
-  EXPECT_EQ(s.tables[0].headers[0], "name");
-  EXPECT_EQ(s.tables[0].headers[1], "confining stress σ3 (Pa)");
-  EXPECT_EQ(s.tables[0].cells[0][1], "5 MPa");
+
+  // dem-avalanche's biaxial tests: a table titled and headed from its declarations.
+  const auto d = nlohmann::json::parse(R"({
+    "model": "dem-avalanche",
+    "tests": [{"name": "sigma3_5MPa", "confining_stress_Pa": 5e6, "peak_stress_Pa": 9.76e7}]
+  })");
+  const Summary t = summarise(d);
+  ASSERT_EQ(t.tables.size(), 1u);
+  EXPECT_EQ(t.tables[0].title, "Results per confining stress");
+  EXPECT_FALSE(t.tables[0].folded);
+  EXPECT_EQ(t.tables[0].headers[0], "test");
+  EXPECT_EQ(t.tables[0].headers[1], "confining stress σ3 (Pa)");
+  EXPECT_EQ(t.tables[0].cells[0][1], "5 MPa");
+  // sph-slope (its "model" is the constitutive model): the materials table is bookkeeping, folded.
+  const Summary m = summarise(nlohmann::json::parse(
+      R"({"model": "drucker_prager", "materials": [{"name": "soil", "K_Pa": 1e7}], "failed_area_m2_per_m": 52.5})"));
+  ASSERT_EQ(m.tables.size(), 1u);
+  EXPECT_TRUE(m.tables[0].folded);
+  EXPECT_EQ(m.tables[0].headers[1], "bulk modulus K (Pa)");
+  EXPECT_EQ(find_row(m.headline, "failed_area_m2_per_m")->value, "52.5 m²/m");
+}
+
+// The declarations the apps' tests hold every real summary.json to (EXPECT_SUMMARY_KEYS_DECLARED):
+// a number without a declared label and unit is named, nested or in an array of objects, so a key
+// added to a summary without its line fails; "*" patterns and array titles work as documented.
+TEST(SummaryKeys, ANumberWithoutADeclarationIsNamedAndPatternsMatch) {
+  const auto j = nlohmann::json::parse(R"({
+    "model": "debris-runout",
+    "volumes_m3": {"deposited": 1.0, "new_volume_m3": 2.0},
+    "barriers": [{"name": "dam", "peak_force_n": 3.0, "new_force_n": 4.0}],
+    "profile": {"runout_xy_m": [1.0, 2.0], "reached": true},
+    "runout_length_along_path_m": {"p10": 5.0},
+    "best": {"parameters": {"model.mu": 0.2}},
+    "ended_by": "duration",
+    "missing_time_s": null
+  })");
+  const auto missing = geohaz::testing::undeclared_summary_keys(j, geohaz::runout::summary_keys());
+  EXPECT_EQ(missing,
+            (std::vector<std::string>{"barriers[].new_force_n", "missing_time_s", "volumes_m3.new_volume_m3"}));
+  const auto keys = geohaz::runout::summary_keys();
+  ASSERT_NE(geohaz::find_summary_key(keys, "best.parameters.model.mu"), nullptr);  // a last "*": the rest
+  EXPECT_EQ(geohaz::find_summary_key(keys, "best.parameters.model.mu")->key, "best.parameters.*");
+  EXPECT_EQ(geohaz::find_summary_key(keys, "best.parameters"), nullptr);
+  EXPECT_EQ(geohaz::find_summary_key(keys, "runout_length_along_path_m.p10")->key, "runout_length_along_path_m.*");
+  // Every declaration of the three libraries has a label; every unit is one the report can show.
+  for (const auto list : {geohaz::runout::summary_keys(), geohaz::sph::summary_keys(), geohaz::dem::summary_keys()})
+    for (const geohaz::SummaryKey& k : list) {
+      EXPECT_FALSE(k.label.empty()) << k.key;
+      EXPECT_EQ(display_unit(std::string(k.unit)).find('_'), std::string::npos) << k.key;
+    }
 }
 
 TEST(ReportInputs, ParametersInTheUsersTermsForTheChosenLawOnly) {
@@ -176,8 +237,9 @@ TEST(ReportInputs, ParametersInTheUsersTermsForTheChosenLawOnly) {
   ASSERT_GE(m.size(), 5u);
   bool c = false, phi = false;
   for (const auto& row : m) {
-    c = c || (row.label == "colluvium: c cohesion" && row.value == "20 kPa");
-    phi = phi || (row.label == "colluvium: φ friction angle" && row.value == "35°");
+    // Labels and units from sph-slope's declarations (help "cohesion c (Drucker-Prager)", "Pa").
+    c = c || (row.label == "colluvium: cohesion c" && row.value == "20 kPa");
+    phi = phi || (row.label == "colluvium: friction angle φ" && row.value == "35°");
   }
   EXPECT_TRUE(c);
   EXPECT_TRUE(phi);
@@ -247,7 +309,7 @@ TEST(ReportCalibration, BestSetAcceptableSetMorrisMapAndProfileFromACalibrationF
   for (const char* label : {"observed max deposit", "modelled max deposit"})
     EXPECT_NE(p.plots[1].second.find(label), std::string::npos);
   EXPECT_NE(p.html.find("src=\"report_files/cal_thalweg_width.svg\""), std::string::npos);
-  EXPECT_EQ(p.shown.size(), 3u);
+  EXPECT_EQ(p.shown.size(), 5u);  // acceptable.svg, comparison.png, thalweg_profile.csv, profile.png/.csv
   // Not a calibration: no part. A calibration summary without its best set: InputError.
   EXPECT_FALSE(calibration_part(d / "cal", nlohmann::json{{"model", "debris-runout"}}, "cal", "cal_").present);
   nlohmann::json broken = sj;

@@ -149,8 +149,8 @@ TEST(ReportInBrowser, EveryImageDecodesWithoutErrorsAndTheScreenshotShowsThePage
   EXPECT_TRUE(fs::exists(results / "report_files" / "1-runout_barrier_forces.svg"));
   EXPECT_TRUE(fs::exists(results / "report_files" / "2-rock-biaxial_curve_sigma3_5MPa.svg"));
   EXPECT_NE(html.find("Coulomb friction coefficient μ"), std::string::npos);
-  EXPECT_NE(html.find("barrier peak force"), std::string::npos);    // an unknown key still shows
-  EXPECT_EQ(html.find("http://"), html.find("http://www.w3.org"));  // no network (SVG namespace only)
+  EXPECT_NE(html.find(">barrier_peak_force_N<"), std::string::npos);  // an undeclared key still shows, as named
+  EXPECT_EQ(html.find("http://"), html.find("http://www.w3.org"));    // no network (SVG namespace only)
   EXPECT_EQ(html.find("https://"), std::string::npos);
   std::size_t images = 0;
   for (auto p = html.find("<img"); p != std::string::npos; p = html.find("<img", p + 1)) ++images;
@@ -463,20 +463,45 @@ TEST(ReportInBrowser, EnsembleSectionDrawsMapsAndDistributionsOfTheMembers) {
   // In reading order: the overview, the parameters, the percentiles, the probability maps (every
   // one), the mean and percentile maps, the two distributions.
   std::size_t at = section;
-  for (const char* part :
-       {"<div class=ensemble>", "<table class=ensemble-overview>", "members that failed</td><td class=v>1",
-        "<table class=ensemble-parameters>", "<table class=ensemble-stats>", "src=\"ens/prob_max_depth_gt_1e-06m.png\"",
-        "src=\"ens/prob_max_pressure_gt_1000Pa.png\"", "src=\"ens/prob_intensity_ge_2.png\"",
-        "src=\"ens/mean_max_depth.png\"", "src=\"ens/p10_max_depth.png\"", "src=\"ens/p50_max_depth.png\"",
-        "src=\"ens/p90_max_depth.png\"", "src=\"report_files/ens_runout_m_distribution.svg\"",
-        "src=\"report_files/ens_H_over_L_distribution.svg\"", "</section>"}) {
+  for (const char* part : {"<div class=ensemble>",
+                           "<table class=ensemble-overview>",
+                           "members that failed</td><td class=v>1",
+                           "<table class=ensemble-parameters>",
+                           "<table class=ensemble-stats>",
+                           "src=\"ens/prob_max_depth_gt_1e-06m.png\"",
+                           "src=\"ens/prob_max_pressure_gt_1000Pa.png\"",
+                           "src=\"ens/prob_intensity_ge_2.png\"",
+                           "src=\"ens/mean_max_depth.png\"",
+                           "src=\"ens/p10_max_depth.png\"",
+                           "src=\"ens/p50_max_depth.png\"",
+                           "src=\"ens/p90_max_depth.png\"",
+                           "src=\"ens/mean_max_speed.png\"",
+                           "src=\"ens/p10_max_speed.png\"",
+                           "src=\"ens/p50_max_speed.png\"",
+                           "src=\"ens/p90_max_speed.png\"",
+                           "src=\"ens/mean_max_pressure.png\"",
+                           "src=\"ens/p10_max_pressure.png\"",
+                           "src=\"ens/p50_max_pressure.png\"",
+                           "src=\"ens/p90_max_pressure.png\"",
+                           "src=\"report_files/ens_runout_m_distribution.svg\"",
+                           "src=\"report_files/ens_H_over_L_distribution.svg\"",
+                           "</section>"}) {
     const auto next = html.find(part, at);
     EXPECT_NE(next, std::string::npos) << part;
     if (next != std::string::npos) at = next;
   }
   std::size_t images = 0;
   for (auto p = html.find("<img"); p != std::string::npos; p = html.find("<img", p + 1)) ++images;
-  EXPECT_EQ(images, 3u + 4u + 2u);  // no picture shown twice
+  EXPECT_EQ(images, 3u + 3u * 4u + 2u);  // no picture shown twice
+  // The speed and pressure mean and percentile maps (issue #33) decode, 1800 px wide, and carry a
+  // legend, coordinate ticks and a scale bar (check_map_png probes the layout they record).
+  for (const char* field : {"max_speed", "max_pressure"})
+    for (const char* stat : {"mean_", "p10_", "p50_", "p90_"}) {
+      const fs::path png = out / (std::string(stat) + field + ".png");
+      ASSERT_TRUE(fs::exists(png)) << png;
+      EXPECT_EQ(geohaz::read_image(png).width, 1800) << png;
+      EXPECT_TRUE(geohaz::check_map_png(png).empty()) << png;
+    }
 
   // P10/P50/P90 in the page = the nearest-rank percentiles of the members' CSV, recomputed here.
   const auto nearest_rank = [](std::vector<double> v, double q) {

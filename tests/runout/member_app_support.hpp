@@ -17,6 +17,9 @@
 #include <thread>
 #include <vector>
 
+#include "geohaz/runout/summary_keys.hpp"
+#include "summary_keys_check.hpp"
+
 namespace member_app {
 
 namespace fs = std::filesystem;
@@ -55,7 +58,9 @@ inline std::string slurp(const fs::path& p) {
 }
 
 inline nlohmann::json summary(const fs::path& out) {
-  return nlohmann::json::parse(slurp(out / "summary.json"));
+  const auto j = nlohmann::json::parse(slurp(out / "summary.json"));
+  EXPECT_SUMMARY_KEYS_DECLARED(j, geohaz::runout::summary_keys());  // every number labelled (issue #33)
+  return j;
 }
 
 /// Start `exe` with `args` (no shell, so that the signal hits the app itself; output discarded),

@@ -23,8 +23,10 @@
 #include "geohaz/core/raster.hpp"
 #include "geohaz/core/snapshot.hpp"
 #include "geohaz/runout/run.hpp"
+#include "geohaz/runout/summary_keys.hpp"
 #include "geohaz/runout/synthetic_terrain.hpp"
 #include "run_command.hpp"
+#include "summary_keys_check.hpp"
 
 namespace fs = std::filesystem;
 
@@ -98,6 +100,7 @@ TEST(DebrisRunoutApp, TinyValleyRunsAndBalancesVolume) {
     EXPECT_TRUE(fs::exists(out / f)) << f;
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
+  EXPECT_SUMMARY_KEYS_DECLARED(j, geohaz::runout::summary_keys());  // every number labelled (issue #33)
   const double read = j["volumes_m3"]["release_read"], seeded = j["volumes_m3"]["seeded"];
   // Release: 3 m (normal to the slope, the default) over the block 30–60 m down-valley, ±10 m
   // across: about 3 × 30 × 20 m³ (cells whose centres fall inside; up to 10 % more for the slope).
@@ -281,6 +284,7 @@ TEST(DebrisRunoutApp, ReleaseFromSphSlopeFileMatchesVolume) {
   ASSERT_EQ(r.code, 0) << r.output;
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
+  EXPECT_SUMMARY_KEYS_DECLARED(j, geohaz::runout::summary_keys());  // every number labelled (issue #33)
   EXPECT_NEAR(j["volumes_m3"]["release_read"].get<double>(), total, 1e-12 * total);
   EXPECT_NEAR(j["volumes_m3"]["seeded"].get<double>(), total, 1e-12 * total);
   EXPECT_NE(r.output.find("m^3 read"), std::string::npos) << r.output;
@@ -326,6 +330,7 @@ TEST(DebrisRunoutApp, ReleaseInAnotherCrsIsReprojected) {
   ASSERT_EQ(r.code, 0) << r.output;
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
+  EXPECT_SUMMARY_KEYS_DECLARED(j, geohaz::runout::summary_keys());  // every number labelled (issue #33)
   EXPECT_NEAR(j["volumes_m3"]["seeded"].get<double>(), 100.0, 1e-10);
 }
 
@@ -342,6 +347,7 @@ TEST(DebrisRunoutApp, LibraryRunInProcessGivesTheAppsNumbers) {
   ASSERT_EQ(r.code, 0) << r.output;
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
+  EXPECT_SUMMARY_KEYS_DECLARED(j, geohaz::runout::summary_keys());  // every number labelled (issue #33)
 
   auto cfg =
       geohaz::ConfigReader::from_string("[model]\nd0 = 2.5\nh0 = 0.75\n[run]\nduration = 20\n[terrain]\ndsm = \"" +
@@ -379,6 +385,7 @@ TEST(DebrisRunoutApp, RunEndingAtItsDurationWithMassMovingSaysSo) {
   EXPECT_NE(r.output.find("warning: the run ended at its duration"), std::string::npos) << r.output;
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
+  EXPECT_SUMMARY_KEYS_DECLARED(j, geohaz::runout::summary_keys());  // every number labelled (issue #33)
   EXPECT_EQ(j["ended_by"], "duration reached");
   ASSERT_EQ(j["warnings"].size(), 1u);
   EXPECT_GT(j["mobile_at_end"]["fraction"].get<double>(), 0.5);
@@ -399,6 +406,7 @@ TEST(DebrisRunoutApp, KineticEnergyCriterionEndsTheRun) {
   ASSERT_EQ(r.code, 0) << r.output;
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
+  EXPECT_SUMMARY_KEYS_DECLARED(j, geohaz::runout::summary_keys());  // every number labelled (issue #33)
   EXPECT_EQ(j["ended_by"], "kinetic energy below the stop fraction of its peak");
   EXPECT_LT(j["simulated_time_s"].get<double>(), 1000.0);
   const double ke = j["kinetic_energy_j"]["at_end"], peak = j["kinetic_energy_j"]["peak"];
@@ -489,6 +497,7 @@ TEST(DebrisRunoutApp, ProcessesRunEndToEndAndBalanceVolume) {
   for (const char* f : {"erosion_depth.tif", "erosion_depth.png"}) EXPECT_TRUE(fs::exists(out / f)) << f;
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
+  EXPECT_SUMMARY_KEYS_DECLARED(j, geohaz::runout::summary_keys());  // every number labelled (issue #33)
   const auto& v = j["volumes_m3"];
   const double read = v["release_read"], entrained = v["entrained"];
   EXPECT_GT(entrained, 0.05 * read);  // 220 m of erodible channel at E_s = 0.005/m: ≈ × 3 if all of it ran through
@@ -522,6 +531,7 @@ TEST(DebrisRunoutApp, HydrographInflowDeliversItsVolume) {
   ASSERT_EQ(r.code, 0) << r.output;
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
+  EXPECT_SUMMARY_KEYS_DECLARED(j, geohaz::runout::summary_keys());  // every number labelled (issue #33)
   const auto& v = j["volumes_m3"];
   EXPECT_NEAR(v["injected"].get<double>(), 100.0, 1e-9 * 100.0);
   EXPECT_NEAR(j["processes"]["inflow"]["volume_of_table_m3"].get<double>(), 100.0, 1e-12);
@@ -597,6 +607,7 @@ TEST(DebrisRunoutApp, ErodibleRasterOnAnotherGridIsResampled) {
   EXPECT_NE(r.output.find("another grid"), std::string::npos) << r.output;
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
+  EXPECT_SUMMARY_KEYS_DECLARED(j, geohaz::runout::summary_keys());  // every number labelled (issue #33)
   EXPECT_GT(j["volumes_m3"]["entrained"].get<double>(), 0.0);
   EXPECT_LE(j["processes"]["entrainment"]["max_eroded_depth_m"].get<double>(), 0.3 + 1e-12);
   const geohaz::Raster ero = geohaz::read_raster(out / "erosion_depth.tif");
@@ -643,6 +654,7 @@ TEST(DebrisRunoutApp, BarrierAcrossTheChannelWritesItsForceSeries) {
   EXPECT_EQ(header.rfind("time_s,force_N,force_per_m_N_m,", 0), 0u) << header;
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
+  EXPECT_SUMMARY_KEYS_DECLARED(j, geohaz::runout::summary_keys());  // every number labelled (issue #33)
   ASSERT_EQ(j["barriers"].size(), 1u);
   const auto& b = j["barriers"][0];
   EXPECT_EQ(b["name"], "barrier_0");
@@ -746,6 +758,7 @@ TEST(DebrisRunoutApp, GaugesAndProfilePathWriteTheirFiles) {
   EXPECT_GT(hmax, 0.0);
   std::ifstream in(out / "summary.json");
   const auto j = nlohmann::json::parse(in);
+  EXPECT_SUMMARY_KEYS_DECLARED(j, geohaz::runout::summary_keys());  // every number labelled (issue #33)
   ASSERT_EQ(j["gauges"].size(), 2u);
   EXPECT_EQ(j["gauges"][1]["kind"], "line");
   const double net = j["gauges"][1]["net_volume_m3"], read = j["volumes_m3"]["release_read"];
@@ -756,6 +769,33 @@ TEST(DebrisRunoutApp, GaugesAndProfilePathWriteTheirFiles) {
   std::getline(prof, line);
   std::getline(prof, line);
   EXPECT_EQ(line.rfind("0,480020,4309875,", 0), 0u) << line;
+  // summary.json's profile block is the reach along this path, recomputed here from profile.csv:
+  // the reached stations (peak depth > 1 cm, the default intensity.min_depth 0 raised to 1 cm),
+  // the highest of them the top, the farthest the run-out point, H/L = (z_top − z_runout) /
+  // (s_runout − s_top). The CSV holds 10 significant digits: 1e-8 relative.
+  double s_top = 0.0, z_top = -1e300, s_run = -1.0, z_run = 0.0;
+  do {
+    std::vector<double> v;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) v.push_back(std::stod(c));
+    ASSERT_EQ(v.size(), 8u) << line;
+    if (!(v[4] > 0.01)) continue;
+    if (v[3] > z_top) s_top = v[0], z_top = v[3];
+    if (v[0] > s_run) s_run = v[0], z_run = v[3];
+  } while (std::getline(prof, line));
+  ASSERT_GT(s_run, s_top);
+  const auto& pj = j["profile"];
+  EXPECT_EQ(pj["path"], "given");
+  EXPECT_EQ(pj["reached"], true);
+  EXPECT_NEAR(pj["top_station_m"].get<double>(), s_top, 1e-8 * s_run);
+  EXPECT_NEAR(pj["runout_station_m"].get<double>(), s_run, 1e-8 * s_run);
+  EXPECT_NEAR(pj["drop_height_m"].get<double>(), z_top - z_run, 1e-8 * z_top);
+  EXPECT_NEAR(pj["length_m"].get<double>(), s_run - s_top, 1e-8 * s_run);
+  const double hl = (z_top - z_run) / (s_run - s_top);
+  EXPECT_NEAR(pj["ratio_H_over_L"].get<double>(), hl, 1e-7 * hl);
+  EXPECT_NEAR(pj["alpha_deg"].get<double>(), std::atan(hl) * 180.0 / M_PI, 1e-6);
+  // The toe path's H/L is another number of the same run (another path), kept under its own name.
+  EXPECT_TRUE(j["fahrboeschung"]["ratio_H_over_L"].is_number());
 }
 
 // The profile path from a vector file (output.profile_path_file): its first line, here a GeoJSON

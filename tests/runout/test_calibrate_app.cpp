@@ -8,8 +8,11 @@
 //    exit 2 naming the key, nothing written.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -17,6 +20,7 @@
 #include "calibration_case.hpp"
 #include "geohaz/core/config.hpp"
 #include "geohaz/core/raster.hpp"
+#include "geohaz/core/raster_extra.hpp"
 #include "geohaz/runout/run.hpp"
 #include "member_app_support.hpp"
 #include "run_command.hpp"
@@ -103,6 +107,16 @@ TEST(CalibrateApp, KilledAndResumedRunGivesTheUninterruptedResultWithoutRerunnin
 TEST(CalibrateApp, FailedMemberIsRecordedWithItsParametersAndPenalised) {
   const auto c = make_case("failed", "inject_failure = [2]\n");
   const fs::path out = c.dir / "out";
+  // An observed run-out point: the thalweg's vertex 28 (the config ends in [observation]), so its
+  // station along the thalweg is the length of the polyline up to it.
+  const auto line = nlohmann::json::parse(slurp(c.thalweg))["features"][0]["geometry"]["coordinates"];
+  double s_point = 0.0;
+  for (int k = 1; k <= 28; ++k)
+    s_point += std::hypot(line[k][0].get<double>() - line[k - 1][0].get<double>(),
+                          line[k][1].get<double>() - line[k - 1][1].get<double>());
+  std::ofstream(c.dir / "cal.toml", std::ios::app)
+      << std::setprecision(12) << "runout_point = [" << line[28][0].get<double>() << ", " << line[28][1].get<double>()
+      << "]\n";
   const auto r =
       geohaz::testing::run_command(app((c.dir / "cal.toml").string() + " --threads 1 --out " + out.string()));
   ASSERT_EQ(r.code, 0) << r.output;
@@ -125,6 +139,26 @@ TEST(CalibrateApp, FailedMemberIsRecordedWithItsParametersAndPenalised) {
   geohaz::ConfigReader again = geohaz::ConfigReader::from_file(out / "best.toml");
   EXPECT_EQ(again.get("model.n", 0.0, geohaz::Range{}, {"", ""}), j["best"]["values"][0].get<double>());
   EXPECT_EQ(again.get("model.icr", 0.0, geohaz::Range{}, {"", ""}), j["best"]["values"][1].get<double>());
+  // The best member's long profile along the thalweg with the observed run-out marked beside the
+  // modelled one (issue #33): stations from 0 along the thalweg, the observed run-out at the
+  // point's station, the mark drawn in its colour (a vertical line of the upper panel's 700 px,
+  // 3 px wide, on whole pixels: 2100 pixels, at least half of them where the modelled run-out's
+  // dashed line falls on the same station).
+  EXPECT_EQ(j["observation"]["runout_from"], "runout_point");
+  EXPECT_NEAR(j["observation"]["runout_s_m"].get<double>(), s_point, 1e-6 * s_point);
+  const auto& outputs = j["outputs"];
+  for (const char* f : {"profile.csv", "profile.png"}) {
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+    EXPECT_NE(std::find(outputs.begin(), outputs.end(), f), outputs.end()) << f;
+  }
+  const std::string prof = slurp(out / "profile.csv");
+  EXPECT_EQ(prof.find("s_along_path_m,x_m,y_m,terrain_elevation_m,max_depth_m,"), 0u);
+  EXPECT_EQ(prof.find("\n0,", 0), prof.find('\n'));  // the first station at the thalweg's start
+  const geohaz::Image img = geohaz::read_image(out / "profile.png");
+  int observed_mark = 0;
+  for (std::size_t k = 0; k + 2 < img.rgb.size(); k += 3)
+    observed_mark += img.rgb[k] == 31 && img.rgb[k + 1] == 119 && img.rgb[k + 2] == 180;
+  EXPECT_GT(observed_mark, 1000);
   const geohaz::Raster cmp = geohaz::read_raster(out / "comparison.tif");
   int tp = 0;
   for (double v : cmp.data) tp += v == 1.0;
@@ -147,6 +181,8 @@ TEST(CalibrateApp, FailedMemberIsRecordedWithItsParametersAndPenalised) {
   EXPECT_EQ(html.find("class=map-problem"), std::string::npos);
   EXPECT_TRUE(fs::exists(out / "report_files" / "out_thalweg_width.svg"));
   EXPECT_TRUE(fs::exists(out / "report_files" / "out_thalweg_deposit.svg"));
+  EXPECT_NE(html.find("src=\"profile.png\""), std::string::npos);                  // the long profile, in the part
+  EXPECT_EQ(html.find("src=\"profile.png\""), html.rfind("src=\"profile.png\""));  // once
 #endif
   fs::remove_all(c.dir);
 }

@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "geohaz/runout/run.hpp"
+#include "geohaz/runout/summary_keys.hpp"
+#include "summary_keys_check.hpp"
 
 using namespace geohaz;
 using namespace geohaz::runout;
@@ -100,6 +102,7 @@ TEST(DetachedParticle, RidgeReleaseLeavesNoTrailAndIsReported) {
   EXPECT_GT(d.farthest_distance, 200.0);
 
   const auto j = nlohmann::json::parse(summary_json(r.c, sim, 1));
+  EXPECT_SUMMARY_KEYS_DECLARED(j, geohaz::runout::summary_keys());
   EXPECT_NEAR(j["detached"]["volume_m3"].get<double>(), 25.0, 1e-9);
   EXPECT_NEAR(j["left_raster"]["at_edge_m3"].get<double>(), 25.0, 1e-9);
   ASSERT_EQ(j["warnings"].size(), 1u);

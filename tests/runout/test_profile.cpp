@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -72,6 +74,11 @@ TEST(ThalwegProfile, UniformFlowOnAPlaneGivesTheAnalyticProfile) {
   EXPECT_DOUBLE_EQ(p.s_runout, 549.0);  // x = 599 m, the last sample inside the last cell
   EXPECT_NEAR(p.alpha_deg, 30.0, 1e-9);
   EXPECT_NEAR(p.z_top - p.z_runout, kTan * 499.0, 1e-9);
+  // H, L and H/L of the profile's own reach (summary.json's "profile" block): along the plane.
+  const ProfileReach reach = profile_reach(p);
+  EXPECT_NEAR(reach.drop_height, kTan * 499.0, 1e-9);
+  EXPECT_DOUBLE_EQ(reach.length, 499.0);
+  EXPECT_NEAR(reach.ratio, kTan, 1e-12);
 
   // The files: a CSV row per sample and a picture.
   const fs::path dir = fs::temp_directory_path() / ("geohaz_profile_" + std::to_string(::getpid()));
@@ -85,6 +92,24 @@ TEST(ThalwegProfile, UniformFlowOnAPlaneGivesTheAnalyticProfile) {
   int lines = 0;
   while (std::getline(in, line)) ++lines;
   EXPECT_EQ(lines, 652);
+  // Both reaches named on the figure: the toe path's H/L dashed in orange from the top, and a
+  // marked station (an observed run-out) as a vertical line in its colour (pixel counts: the
+  // dashed line, antialiased, and the vertical 3 x 700 px line on whole pixels, against none).
+  const auto count = [&](const Image& im, std::array<std::uint8_t, 3> c) {
+    int n = 0;
+    for (std::size_t k = 0; k + 2 < im.rgb.size(); k += 3)
+      n += im.rgb[k] == c[0] && im.rgb[k + 1] == c[1] && im.rgb[k + 2] == c[2];
+    return n;
+  };
+  const std::array<std::uint8_t, 3> orange{230, 140, 20}, blue{31, 119, 180};
+  EXPECT_EQ(count(img, orange), 0);
+  ProfileFigure f;
+  f.toe_path_angle_deg = 35.0;
+  f.marks = {{300.0, "observed run-out", blue}};
+  write_profile_png(dir / "profile_marked.png", p, f);
+  const Image marked = read_image(dir / "profile_marked.png");
+  EXPECT_GT(count(marked, orange), 100);
+  EXPECT_GT(count(marked, blue), 1500);
   fs::remove_all(dir);
 }
 

@@ -21,7 +21,9 @@
 
 #include "geohaz/core/snapshot.hpp"
 #include "geohaz/sph/constitutive.hpp"
+#include "geohaz/sph/summary_keys.hpp"
 #include "run_command.hpp"
+#include "summary_keys_check.hpp"
 
 namespace {
 
@@ -45,7 +47,9 @@ Result run(const std::string& args, const std::string& name, int threads = 1) {
 
 nlohmann::json summary(const fs::path& dir) {
   std::ifstream in(dir / "summary.json");
-  return nlohmann::json::parse(in);
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_SUMMARY_KEYS_DECLARED(j, geohaz::sph::summary_keys());  // every number labelled (issue #33)
+  return j;
 }
 
 std::size_t csv_rows(const fs::path& p) {

@@ -15,7 +15,9 @@
 
 #include "geohaz/core/raster.hpp"
 #include "geohaz/core/raster_extra.hpp"
+#include "geohaz/sph/summary_keys.hpp"
 #include "run_command.hpp"
+#include "summary_keys_check.hpp"
 
 namespace fs = std::filesystem;
 
@@ -190,6 +192,7 @@ TEST(SlopeStabilityApp, ReleasePolygonVolumeIsWhatDebrisRunoutSeeds) {
   ASSERT_EQ(r.code, 0) << r.output;
   std::ifstream sj(out / "summary.json");
   const auto s = nlohmann::json::parse(sj);
+  EXPECT_SUMMARY_KEYS_DECLARED(s, geohaz::sph::summary_keys());  // every number labelled (issue #33)
   const double volume = s["release"]["volume_m3"].get<double>();
   const double failed = s["cells"]["failed"].get<double>();
   EXPECT_NEAR(volume, failed * kZ * kDx * kDx, 1e-9 * volume);

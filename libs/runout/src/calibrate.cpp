@@ -507,14 +507,6 @@ MemberPeaks crop(const GridGeometry& g, const std::vector<double>& v) {
   return p;
 }
 
-std::vector<double> uncrop(const MemberPeaks& p, const std::vector<double>& v) {
-  std::vector<double> out(static_cast<std::size_t>(p.nx) * p.ny, 0.0);
-  for (int r = 0; r < p.h; ++r)
-    for (int c = 0; c < p.w; ++c)
-      out[static_cast<std::size_t>(p.r0 + r) * p.nx + p.c0 + c] = v[static_cast<std::size_t>(r) * p.w + c];
-  return out;
-}
-
 }  // namespace
 
 std::unique_ptr<MemberRunner> make_calibration_runner(const CalibrationSetup& s) {
@@ -1002,16 +994,6 @@ void run_calibration_serial(CalibrationSetup& s, const fs::path& out, int thread
   write_calibration_outputs(s, r, out, 1, threads, wall, quiet);
 }
 
-// Outputs are in calibrate_outputs.cpp.
-
-std::vector<double> read_member_deposit(const fs::path& out, int i) {
-  const MemberPeaks p = read_member_peaks(member_dir(out, i) / "deposit.bin");
-  return uncrop(p, p.depth);
-}
-
-std::vector<double> read_member_max_depth(const fs::path& out, int i) {
-  const MemberPeaks p = read_member_peaks(member_dir(out, i) / "peaks.bin");
-  return uncrop(p, p.depth);
-}
+// Outputs, and the members' maps read back, are in calibrate_outputs.cpp.
 
 }  // namespace geohaz::runout

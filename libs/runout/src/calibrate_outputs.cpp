@@ -4,6 +4,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -17,6 +18,7 @@
 #include "geohaz/core/output.hpp"
 #include "geohaz/core/raster.hpp"
 #include "geohaz/runout/calibrate.hpp"
+#include "geohaz/runout/profile.hpp"
 #include "geohaz/runout/run.hpp"
 
 namespace fs = std::filesystem;
@@ -262,43 +264,9 @@ std::string best_config(const CalibrationSetup& s, const Evaluation& best, const
   return o.str();
 }
 
-}  // namespace
-
-void write_calibration_outputs(const CalibrationSetup& s, const CalibrationResult& r, const fs::path& out, int ranks,
-                               int threads, double wall_time_s, bool quiet) {
-  if (r.best < 0) throw std::logic_error("calibration without members");
-  const Evaluation& best = r.evaluations[static_cast<std::size_t>(r.best)];
-  const double j_best = best.misfit.score, tol = s.score.acceptable_tolerance;
-
-  // 1. Tables: every member, the acceptable set.
-  std::vector<const Evaluation*> all, acceptable;
-  for (const auto& e : r.evaluations) {
-    all.push_back(&e);
-    if (e.ok && e.misfit.score <= j_best + tol) acceptable.push_back(&e);
-  }
-  member_table(out / "members.csv", s, all);
-  std::stable_sort(acceptable.begin(), acceptable.end(),
-                   [](const Evaluation* a, const Evaluation* b) { return a->misfit.score < b->misfit.score; });
-  member_table(out / "acceptable.csv", s, acceptable);
-  write_acceptable_svg(out / "acceptable.svg", s, r, j_best, tol);
-
-  // 2. Morris ranking.
-  const std::vector<MorrisEffect> morris = morris_effects(s, r);
-  {
-    AtomicTextFile csv(out / "sensitivity.csv");
-    csv << "rank,key,mu_star,mu,sigma,effects\n";
-    csv.stream() << std::setprecision(10);
-    for (std::size_t k = 0; k < morris.size(); ++k)
-      csv << k + 1 << ',' << morris[k].key << ',' << morris[k].mu_star << ',' << morris[k].mu << ',' << morris[k].sigma
-          << ',' << morris[k].effects << '\n';
-    csv.commit();
-  }
-
-  // 3. The best set, ready to run.
-  write_text_file(out / "best.toml", best_config(s, best, out));
-
-  // 4. Comparison map and thalweg profile of the best member.
-  const Raster dsm = read_raster(s.members.dsm);
+/// The comparison map (comparison.tif, .qml, .png: TP/FP/FN over the hillshade) and the binned
+/// thalweg profile (thalweg_profile.csv) of the best member.
+void write_comparison(const CalibrationSetup& s, const Evaluation& best, const Raster& dsm, const fs::path& out) {
   const Observation& ob = s.observation;
   const GridGeometry& g = ob.grid;
   std::vector<double> depth(g.cells(), 0.0), deposit(g.cells(), 0.0);
@@ -365,6 +333,89 @@ void write_calibration_outputs(const CalibrationSetup& s, const CalibrationResul
           << ',' << mh[b] << '\n';
     csv.commit();
   }
+}
+
+/// The best member's long profile along the observation's thalweg (profile.hpp; peaks across the
+/// path within the base case's output.profile_half_width, reached where the peak depth exceeds
+/// score.depth_threshold), with the observed run-out marked beside the modelled one, both as the
+/// score measures them along the thalweg (issue #33 item 2). False when the best member failed.
+bool write_best_profile(const CalibrationSetup& s, const Evaluation& best, const Raster& dsm, const fs::path& out) {
+  if (!best.ok) return false;
+  const Observation& ob = s.observation;
+  const auto peaks = read_member_peak_maps(out, best.index);
+  std::array<Raster, 3> maps;
+  for (int f = 0; f < 3; ++f) {
+    maps[f] = dsm.like(0.0, -9999.0);
+    for (std::size_t k = 0; k < maps[f].data.size() && k < peaks[f].size(); ++k) maps[f].data[k] = peaks[f][k];
+  }
+  const double cell = std::min(dsm.cell_size_x(), dsm.cell_size_y());
+  const ThalwegProfile p = thalweg_profile(dsm, maps[0], maps[1], maps[2], ob.thalweg, cell, s.score.depth_threshold,
+                                           s.members.aggregation.profile_half_width);
+  write_profile_csv(out / "profile.csv", p);
+  ProfileFigure f;
+  f.title = "best member " + std::to_string(best.index) + " along the observed thalweg";
+  const std::string from = ob.runout_from == "runout_point"  ? "the observed run-out point"
+                           : ob.runout_from == "runout_line" ? "the observed run-out line"
+                                                             : "the farthest observed footprint cell";
+  f.marks = {{ob.runout_s, "observed run-out (blue): s = " + fmt(ob.runout_s, 5) + " m, from " + from, {31, 119, 180}},
+             {best.misfit.runout_s,
+              "modelled run-out (purple, dashed; the score's, farthest affected cell): s = " +
+                  fmt(best.misfit.runout_s, 5) + " m",
+              {148, 103, 189},
+              true}};
+  write_profile_png(out / "profile.png", p, f);
+  return true;
+}
+
+/// A member's cropped map (MemberPeaks window) on the full grid, 0 outside the window.
+std::vector<double> uncrop(const MemberPeaks& p, const std::vector<double>& v) {
+  std::vector<double> out(static_cast<std::size_t>(p.nx) * p.ny, 0.0);
+  for (int r = 0; r < p.h; ++r)
+    for (int c = 0; c < p.w; ++c)
+      out[static_cast<std::size_t>(p.r0 + r) * p.nx + p.c0 + c] = v[static_cast<std::size_t>(r) * p.w + c];
+  return out;
+}
+
+}  // namespace
+
+void write_calibration_outputs(const CalibrationSetup& s, const CalibrationResult& r, const fs::path& out, int ranks,
+                               int threads, double wall_time_s, bool quiet) {
+  if (r.best < 0) throw std::logic_error("calibration without members");
+  const Evaluation& best = r.evaluations[static_cast<std::size_t>(r.best)];
+  const double j_best = best.misfit.score, tol = s.score.acceptable_tolerance;
+
+  // 1. Tables: every member, the acceptable set.
+  std::vector<const Evaluation*> all, acceptable;
+  for (const auto& e : r.evaluations) {
+    all.push_back(&e);
+    if (e.ok && e.misfit.score <= j_best + tol) acceptable.push_back(&e);
+  }
+  member_table(out / "members.csv", s, all);
+  std::stable_sort(acceptable.begin(), acceptable.end(),
+                   [](const Evaluation* a, const Evaluation* b) { return a->misfit.score < b->misfit.score; });
+  member_table(out / "acceptable.csv", s, acceptable);
+  write_acceptable_svg(out / "acceptable.svg", s, r, j_best, tol);
+
+  // 2. Morris ranking.
+  const std::vector<MorrisEffect> morris = morris_effects(s, r);
+  {
+    AtomicTextFile csv(out / "sensitivity.csv");
+    csv << "rank,key,mu_star,mu,sigma,effects\n";
+    csv.stream() << std::setprecision(10);
+    for (std::size_t k = 0; k < morris.size(); ++k)
+      csv << k + 1 << ',' << morris[k].key << ',' << morris[k].mu_star << ',' << morris[k].mu << ',' << morris[k].sigma
+          << ',' << morris[k].effects << '\n';
+    csv.commit();
+  }
+
+  // 3. The best set, ready to run.
+  write_text_file(out / "best.toml", best_config(s, best, out));
+
+  // 4. Comparison map, thalweg profile and long profile of the best member.
+  const Raster dsm = read_raster(s.members.dsm);
+  write_comparison(s, best, dsm, out);
+  const bool profile = write_best_profile(s, best, dsm, out);
+  const Observation& ob = s.observation;
 
   // 5. Summary.
   nlohmann::json j;
@@ -445,6 +496,7 @@ void write_calibration_outputs(const CalibrationSetup& s, const CalibrationResul
   j["wall_time_s"] = wall_time_s;
   j["outputs"] = {"best.toml",      "members.csv",    "acceptable.csv", "acceptable.svg",      "sensitivity.csv",
                   "comparison.tif", "comparison.png", "comparison.qml", "thalweg_profile.csv", "summary.json"};
+  if (profile) j["outputs"].insert(j["outputs"].end() - 1, {"profile.csv", "profile.png"});
   (void)failed;
   write_text_file(out / "summary.json", j.dump(2) + "\n");
   if (!quiet) {
@@ -455,6 +507,23 @@ void write_calibration_outputs(const CalibrationSetup& s, const CalibrationResul
       << fmt(best.misfit.runout_diff, 4) << " m); " << acceptable.size() << " acceptable; outputs in " << out.string();
     std::cerr << o.str() << "\n";
   }
+}
+
+// The members' maps on the full grid (calibrate.hpp).
+
+std::vector<double> read_member_deposit(const fs::path& out, int i) {
+  const MemberPeaks p = read_member_peaks(member_dir(out, i) / "deposit.bin");
+  return uncrop(p, p.depth);
+}
+
+std::vector<double> read_member_max_depth(const fs::path& out, int i) {
+  const MemberPeaks p = read_member_peaks(member_dir(out, i) / "peaks.bin");
+  return uncrop(p, p.depth);
+}
+
+std::array<std::vector<double>, 3> read_member_peak_maps(const fs::path& out, int i) {
+  const MemberPeaks p = read_member_peaks(member_dir(out, i) / "peaks.bin");
+  return {uncrop(p, p.depth), uncrop(p, p.speed), uncrop(p, p.pressure)};
 }
 
 }  // namespace geohaz::runout

@@ -309,6 +309,11 @@ void read_map_settings(ConfigReader& cfg, OutputSettings& o) {
           "output.map_pressure_classes", o.map_pressure_classes, Range::open_closed(0.0, 1e9),
           {"Pa", "class breaks of the peak pressure map, increasing (shown in kPa; empty: a continuous ramp)"}),
       "Pa");
+  o.map_speed_classes =
+      increasing("output.map_speed_classes",
+                 cfg.get_array("output.map_speed_classes", o.map_speed_classes, Range::open_closed(0.0, 1e3),
+                               {"m/s", "class breaks of the peak speed maps, increasing (empty: a continuous ramp)"}),
+                 "m/s");
   o.map_margin = cfg.get("output.map_margin", o.map_margin, Range::closed(0.0, 1e5),
                          {"m", "margin around the affected area (and the release) in every map of the run"});
   o.attribution = cfg.get_string("output.attribution", o.attribution,

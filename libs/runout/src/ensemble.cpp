@@ -552,6 +552,9 @@ EnsembleSetup read_ensemble(ConfigReader& cfg) {
     s.dsm = c.dsm;
     a.intensity = c.output.intensity;
     a.map_depth_classes = c.output.map_depth_classes;
+    a.map_speed_classes = c.output.map_speed_classes;
+    a.profile_half_width = c.output.profile_half_width;
+    a.map_pressure_classes = c.output.map_pressure_classes;
     a.map_margin = c.output.map_margin;
     a.attribution = c.output.attribution;
   }
@@ -698,12 +701,13 @@ std::vector<std::string> write_products(const AggregationSettings& a, const Ense
   struct Map {
     std::string name, title, unit;
     Raster raster;
+    std::vector<double> breaks;  ///< its classes (the probability classes for prob_*)
   };
   std::vector<Map> maps;  // drawn below, every one on the same extent
   const auto prob = [&](int field, double t, const std::string& name, std::string what) {
     Raster r = put(name, agg.exceedance(field, t), what + of_n, "1", ColourRamp::Viridis, probability_classes);
     for (std::size_t k; (k = what.find(" >= ")) != std::string::npos;) what.replace(k, 4, " \u2265 ");
-    maps.push_back({name, what, "", std::move(r)});
+    maps.push_back({name, what, "", std::move(r), probability_classes});
   };
   for (double t : a.depth_thresholds)
     prob(0, t, "prob_max_depth_gt_" + threshold_name(t) + "m", "probability peak depth > " + threshold_name(t) + " m");
@@ -717,6 +721,19 @@ std::vector<std::string> write_products(const AggregationSettings& a, const Ense
     prob(3, k, "prob_intensity_ge_" + std::to_string(k),
          "probability intensity class >= " + std::to_string(k) + " (" + to_string(a.intensity.scheme) + ")");
   Raster any_reached;  // the sum of the members' peak depths (N × the mean)
+  // The mean and percentile maps of each field in the base case's classes, as its own maps: depth
+  // (m), speed (m/s), pressure drawn in kPa (issue #33).
+  const char* const map_titles[3] = {"peak flow depth", "peak speed", "peak dynamic pressure"};
+  const char* const map_units[3] = {"m", "m/s", "kPa"};
+  std::vector<double> kpa_breaks;
+  for (double b : a.map_pressure_classes) kpa_breaks.push_back(b * 1e-3);
+  const std::vector<double>* map_breaks[3] = {&a.map_depth_classes, &a.map_speed_classes, &kpa_breaks};
+  const auto add_map = [&](int f, std::string name, std::string title, Raster r) {
+    if (f == 2)
+      for (double& v : r.data)
+        if (v != -9999.0) v *= 1e-3;
+    maps.push_back({std::move(name), std::move(title), map_units[f], std::move(r), *map_breaks[f]});
+  };
   for (int f = 0; f < 3; ++f) {
     const ColourRamp ramp = f == 0 ? ColourRamp::Viridis : ColourRamp::Magma;
     const std::vector<double> none, &breaks = f == 0 ? a.map_depth_classes : none;
@@ -725,8 +742,8 @@ std::vector<std::string> write_products(const AggregationSettings& a, const Ense
     if (f == 0) {
       any_reached = mean;
       for (double& v : any_reached.data) v = v == -9999.0 ? v : v * agg.members();
-      maps.push_back({"mean_max_depth", "mean peak flow depth" + of_n, "m", std::move(mean)});
     }
+    add_map(f, std::string("mean_") + kFieldNames[f], std::string("mean ") + map_titles[f] + of_n, std::move(mean));
     for (double q : a.percentiles) {
       std::string name = "p";  // built step by step: GCC 12 warns (-Wrestrict, a false positive) on "p" + string
       name += threshold_name(q);
@@ -736,7 +753,7 @@ std::vector<std::string> write_products(const AggregationSettings& a, const Ense
           put(name, agg.percentile(f, q),
               "percentile " + threshold_name(q) + " of the " + kFieldDescriptions[f] + of_n + " (log-binned histogram)",
               kFieldUnits[f], ramp, breaks);
-      if (f == 0) maps.push_back({name, "percentile " + threshold_name(q) + " of peak flow depth", "m", std::move(pr)});
+      add_map(f, name, "percentile " + threshold_name(q) + " of " + map_titles[f], std::move(pr));
     }
   }
   if (agg.members() == 0) return products;
@@ -760,7 +777,8 @@ std::vector<std::string> write_products(const AggregationSettings& a, const Ense
     d.overlay_min = probability ? 1e-9 : 0.01;
     d.vmin = 0.0;
     d.vmax = probability ? 1.0 : 0.0;
-    d.class_breaks = probability ? probability_classes : a.map_depth_classes;
+    d.class_breaks = m.breaks;
+    if (!probability && m.name.find("max_depth") == std::string::npos) d.ramp = ColourRamp::Magma;
     write_quicklook_png(out / (m.name + ".png"), dsm, &m.raster, d);
   }
   return products;

@@ -187,10 +187,35 @@ void write_profile_csv(const std::filesystem::path& path, const ThalwegProfile& 
 
 using detail::Panel;
 
-void write_profile_png(const std::filesystem::path& path, const ThalwegProfile& p) {
+ProfileReach profile_reach(const ThalwegProfile& p) noexcept {
+  ProfileReach r;
+  if (!p.reached) return r;
+  r.drop_height = p.z_top - p.z_runout;
+  r.length = p.s_runout - p.s_top;
+  r.ratio = r.length > 0.0 ? r.drop_height / r.length : 0.0;
+  return r;
+}
+
+namespace {
+
+/// A straight line from (s0, z0) to (s1, z1) drawn in dashes of about 24 px.
+void dashed(Image& img, const Panel& f, double s0, double z0, double s1, double z1, std::array<std::uint8_t, 3> c,
+            int width) {
+  const double px = std::hypot(f.px(s1) - f.px(s0), f.py(z1) - f.py(z0));
+  const int n = std::max(1, static_cast<int>(px / 24.0));
+  for (int k = 0; k < n; k += 2) {
+    const double a = double(k) / n, b = double(k + 1) / n;
+    detail::thick_polyline(img, f, {s0 + a * (s1 - s0), s0 + b * (s1 - s0)}, {z0 + a * (z1 - z0), z0 + b * (z1 - z0)},
+                           c, width);
+  }
+}
+
+}  // namespace
+
+void write_profile_png(const std::filesystem::path& path, const ThalwegProfile& p, const ProfileFigure& f) {
   const int W = 1800, H = 1250, s = 3;
   Image img(W, H);
-  std::vector<double> sv, z, top, speed, alpha;
+  std::vector<double> sv, z, top, speed;
   double zlo = 1e300, zhi = -1e300, vmax = 0.0, dmax = 0.0;
   for (const ProfileRow& r : p.rows) {
     zlo = std::min(zlo, r.z);
@@ -212,31 +237,63 @@ void write_profile_png(const std::filesystem::path& path, const ThalwegProfile& 
     z.push_back(r.z);
     top.push_back(r.z + ex * r.depth);
     speed.push_back(r.speed);
-    alpha.push_back(r.alpha_z);
   }
   const double pad = 0.05 * std::max(1.0, zhi - zlo);
   const Panel upper{sv.front(), sv.back(), zlo - pad, zhi + pad, 170, 90, W - 230, 700};
   const Panel lower{sv.front(), sv.back(), 0.0, vmax > 0.0 ? 1.1 * vmax : 1.0, 170, 960, W - 230, 200};
+  const std::array<std::uint8_t, 3> red{200, 40, 40}, orange{230, 140, 20};
+  if (!f.title.empty()) draw_text(img, upper.left, 12, f.title, s);
   // The flow (depth above the terrain) filled, then the terrain, the α line, the run-out point.
   for (std::size_t k = 0; k < sv.size(); ++k)
     if (top[k] > z[k]) img.line(upper.px(sv[k]), upper.py(z[k]), upper.px(sv[k]), upper.py(top[k]), {70, 130, 200});
   detail::axes(img, upper, "horizontal distance along the path (m)", "elevation (m)", s);
   detail::thick_polyline(img, upper, sv, top, {40, 90, 170}, 2);
   detail::thick_polyline(img, upper, sv, z, {30, 30, 30}, 3);
-  if (p.reached) {
-    const std::vector<double> as{p.s_top, p.s_runout}, az{p.z_top, p.z_runout};
-    detail::thick_polyline(img, upper, as, az, {200, 40, 40}, 2);
-    img.fill_circle(upper.px(p.s_runout), upper.py(p.z_runout), 9, {200, 40, 40});
-    img.fill_circle(upper.px(p.s_top), upper.py(p.z_top), 7, {200, 40, 40});
-  }
-  const std::string legend1 =
+  // Legend lines right-aligned at the top of the panel, where the terrain has fallen away.
+  int ly = upper.top + 20;
+  const auto legend = [&](const std::string& text, std::array<std::uint8_t, 3> c) {
+    draw_text(img, upper.left + upper.width - 20 - text_width(text, 2), ly, text, 2, c);
+    ly += 30;
+  };
+  legend(
       "terrain (black), peak depth x " + format_tick(ex) + " above it (blue)" +
-      (p.half_width > 0.0 ? "; peaks: the largest within " + format_tick(p.half_width) + " m across the path" : "");
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "alpha line (red): alpha = %.1f deg, run-out point at s = %.0f m", p.alpha_deg,
-                p.s_runout);
-  draw_text(img, upper.left + 20, upper.top + 20, legend1, 2);
-  draw_text(img, upper.left + 20, upper.top + 50, p.reached ? buf : "the flow did not reach the path", 2);
+          (p.half_width > 0.0 ? "; peaks: the largest within " + format_tick(p.half_width) + " m across the path" : ""),
+      {0, 0, 0});
+  char buf[240];
+  if (p.reached) {
+    const ProfileReach reach = profile_reach(p);
+    // The toe path's H/L (summary.json), dashed from the same top down to the panel's floor.
+    if (std::isfinite(f.toe_path_angle_deg) && f.toe_path_angle_deg > 0.0) {
+      const double t = std::tan(f.toe_path_angle_deg * M_PI / 180.0);
+      const double s_end = std::min(sv.back(), p.s_top + (p.z_top - upper.y0) / t);
+      dashed(img, upper, p.s_top, p.z_top, s_end, p.z_top - t * (s_end - p.s_top), orange, 3);
+    }
+    detail::thick_polyline(img, upper, {p.s_top, p.s_runout}, {p.z_top, p.z_runout}, red, 2);
+    img.fill_circle(upper.px(p.s_runout), upper.py(p.z_runout), 9, red);
+    img.fill_circle(upper.px(p.s_top), upper.py(p.z_top), 7, red);
+    std::snprintf(buf, sizeof buf,
+                  "α along the profile (red): %.1f°, H/L = %.3f (H = %.0f m, L = %.0f m); run-out point "
+                  "at s = %.0f m",
+                  p.alpha_deg, reach.ratio, reach.drop_height, reach.length, p.s_runout);
+    legend(buf, red);
+    if (std::isfinite(f.toe_path_angle_deg)) {
+      std::snprintf(buf, sizeof buf,
+                    "H/L of the toe path (orange, dashed; summary.json fahrboeschung): %.1f°, H/L = %.3f",
+                    f.toe_path_angle_deg, std::tan(f.toe_path_angle_deg * M_PI / 180.0));
+      legend(buf, orange);
+    }
+  } else {
+    legend("the flow did not reach the path", red);
+  }
+  for (const ProfileMark& m : f.marks) {
+    if (!std::isfinite(m.s)) continue;
+    const double x = std::round(upper.px(std::clamp(m.s, upper.x0, upper.x1)));
+    for (int y = upper.top; y < upper.top + upper.height; y += m.dashed ? 40 : upper.height) {
+      const int y1 = std::min(upper.top + upper.height, y + (m.dashed ? 20 : upper.height));
+      for (int o = -1; o <= 1; ++o) img.line(x + o, y, x + o, y1, m.colour);
+    }
+    legend(m.label, m.colour);
+  }
   detail::axes(img, lower, "horizontal distance along the path (m)", "peak speed (m/s)", s);
   detail::thick_polyline(img, lower, sv, speed, {150, 60, 150}, 2);
   write_png(path, img);

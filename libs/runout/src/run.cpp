@@ -704,7 +704,7 @@ void write_series_tables(const RunoutSimulation& sim, const fs::path& out) {
 
 }  // namespace
 
-std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int threads) {
+std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int threads, const ThalwegProfile* profile) {
   const IntensityTable& itab = c.output.intensity;
   const auto& solver = sim.solver();
   const RunoutResult res = sim.result();
@@ -769,6 +769,7 @@ std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int t
       {"drop_height_m", sum.drop_height},   {"reach_m", sum.reach},   {"ratio_H_over_L", sum.fahrboeschung},
       {"angle_deg", sum.fahrboeschung_deg}, {"toe_x_m", sum.toe.x()}, {"toe_y_m", sum.toe.y()}};
   j["centre_of_mass"] = {{"drop_m", sum.com_drop}, {"travel_m", sum.com_travel}, {"angle_deg", sum.com_angle_deg}};
+  if (profile) j["profile"] = detail::profile_summary(*profile, !sim.inputs().profile_path.empty());
   j["max_speed_m_per_s"] = res.max_speed;
   j["max_pressure_pa"] = res.max_pressure;
   j["area_affected_m2"] = res.affected_area;
@@ -927,7 +928,7 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
   if (c.output.pngs) {
     map_png("max_depth", r_depth, ColourRamp::Viridis, "peak flow depth", "m", 0.01, {}, c.output.map_depth_classes);
     map_png("deposit", r_dep, ColourRamp::Viridis, "deposit thickness", "m", 0.01, {}, c.output.map_depth_classes);
-    map_png("max_speed", r_speed, ColourRamp::Magma, "peak speed", "m/s", 0.01);
+    map_png("max_speed", r_speed, ColourRamp::Magma, "peak speed", "m/s", 0.01, {}, c.output.map_speed_classes);
     Raster r_kpa = r_pressure;  // kPa reads better than 2.2e+06 Pa
     for (double& v : r_kpa.data)
       if (v != -9999.0) v *= 1e-3;
@@ -938,12 +939,13 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
     map_png("intensity", r_int, ColourRamp::Intensity, "intensity class", "", 0.5, intensity_classes_legend);
   }
 
-  detail::write_profile_outputs(c, sim, r_depth, r_speed, r_pressure, r_arrival, out);
+  const std::optional<ThalwegProfile> profile =
+      detail::write_profile_outputs(c, sim, r_depth, r_speed, r_pressure, r_arrival, out);
   detail::write_gauge_outputs(c, sim, out);
 
   write_series_tables(sim, out);
 
-  write_text_file(out / "summary.json", summary_json(c, sim, threads) + "\n");
+  write_text_file(out / "summary.json", summary_json(c, sim, threads, profile ? &*profile : nullptr) + "\n");
 }
 
 RunoutResult run_case(const RunoutCase& c, const fs::path& out, bool quiet, int threads) {

@@ -28,8 +28,9 @@ void load_output_geometry(const RunoutCase& c, RunoutInputs& in) {
   check_gauges(o.gauges, in.dsm, source);
 }
 
-void write_profile_outputs(const RunoutCase& c, const RunoutSimulation& sim, const Raster& depth, const Raster& speed,
-                           const Raster& pressure, const Raster& arrival, const fs::path& out) {
+std::optional<ThalwegProfile> write_profile_outputs(const RunoutCase& c, const RunoutSimulation& sim,
+                                                    const Raster& depth, const Raster& speed, const Raster& pressure,
+                                                    const Raster& arrival, const fs::path& out) {
   const Raster& dsm = sim.inputs().dsm;
   const Terrain terrain(dsm);
   std::vector<Vec2> path = sim.inputs().profile_path;
@@ -48,16 +49,40 @@ void write_profile_outputs(const RunoutCase& c, const RunoutSimulation& sim, con
           start = q;
         }
       }
-    if (!std::isfinite(start.x())) return;  // no release on the grid (a hand-off outside it): no profile
+    if (!std::isfinite(start.x())) return std::nullopt;  // no release on the grid (a hand-off outside it)
     for (const Vec2& q : arrival_centreline(arrival, depth, start, c.output.series_interval, dsm.cell_size_x()))
       if (std::isfinite(terrain.elevation(q.x(), q.y()))) path.push_back(q);
-    if (path.size() < 2) return;
+    if (path.size() < 2) return std::nullopt;
   }
   const double min_depth = std::max(c.output.intensity.min_depth, 0.01);
   const ThalwegProfile p =
       thalweg_profile(dsm, depth, speed, pressure, path, dsm.cell_size_x(), min_depth, c.output.profile_half_width);
   write_profile_csv(out / "profile.csv", p);
-  if (c.output.pngs) write_profile_png(out / "profile.png", p);
+  ProfileFigure figure;  // both reaches of the run, each with its name (docs/runout.md)
+  const RunoutResult res = sim.result();
+  if (res.path.reach > 0.0) figure.toe_path_angle_deg = res.path.fahrboeschung_deg;
+  if (c.output.pngs) write_profile_png(out / "profile.png", p, figure);
+  return p;
+}
+
+nlohmann::json profile_summary(const ThalwegProfile& p, bool given_path) {
+  const ProfileReach r = profile_reach(p);
+  nlohmann::json j = {
+      {"path", given_path ? "given" : "flow centreline"}, {"reached", p.reached}, {"half_width_m", p.half_width}};
+  if (!p.reached) return j;
+  Vec2 xy(0.0, 0.0);
+  for (const ProfileRow& row : p.rows)
+    if (row.s == p.s_runout) xy = Vec2(row.x, row.y);
+  j.update({{"top_station_m", p.s_top},
+            {"top_elevation_m", p.z_top},
+            {"runout_station_m", p.s_runout},
+            {"runout_elevation_m", p.z_runout},
+            {"runout_xy_m", {xy.x(), xy.y()}},
+            {"drop_height_m", r.drop_height},
+            {"length_m", r.length},
+            {"ratio_H_over_L", r.ratio},
+            {"alpha_deg", p.alpha_deg}});
+  return j;
 }
 
 void write_gauge_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::path& out) {

@@ -5,7 +5,9 @@
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 
+#include "geohaz/runout/profile.hpp"
 #include "geohaz/runout/run.hpp"
 
 namespace geohaz::runout::detail {
@@ -18,9 +20,15 @@ void load_output_geometry(const RunoutCase& c, RunoutInputs& in);
 /// profile.csv and profile.png: along the user's path, or the flow's own centreline (from the
 /// highest cell of the release through the depth-weighted centroids of the arrival fronts, one per
 /// output.series_interval; points off the DSM's data skipped), peaks over
-/// ±output.profile_half_width.
-void write_profile_outputs(const RunoutCase& c, const RunoutSimulation& sim, const Raster& depth, const Raster& speed,
-                           const Raster& pressure, const Raster& arrival, const std::filesystem::path& out);
+/// ±output.profile_half_width. The figure names both reaches of the run: α along the profile and
+/// the H/L of the toe path (summary.json's fahrboeschung). Returns the profile (none without one).
+std::optional<ThalwegProfile> write_profile_outputs(const RunoutCase& c, const RunoutSimulation& sim,
+                                                    const Raster& depth, const Raster& speed, const Raster& pressure,
+                                                    const Raster& arrival, const std::filesystem::path& out);
+
+/// summary.json's "profile": the path, the top and the run-out point's stations and elevations,
+/// H, L and H/L = tan α measured along the profile path (profile_reach), α.
+nlohmann::json profile_summary(const ThalwegProfile& p, bool given_path);
 
 /// gauges.csv and gauges.png (none without gauges).
 void write_gauge_outputs(const RunoutCase& c, const RunoutSimulation& sim, const std::filesystem::path& out);

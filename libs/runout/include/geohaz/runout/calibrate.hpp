@@ -28,8 +28,11 @@
 ///     sequence alone: a rerun replays the searches and finds finished members on disk.
 ///  4. The outputs (`write_calibration_outputs`): best.toml (a ready-to-run debris-runout config),
 ///     members.csv, acceptable.csv and acceptable.svg, sensitivity.csv, comparison.tif/.png
-///     (TP/FP/FN over the hillshade), thalweg_profile.csv and summary.json.
+///     (TP/FP/FN over the hillshade), thalweg_profile.csv, the best member's long profile along
+///     the thalweg with the observed run-out marked beside the modelled one (profile.csv,
+///     profile.png) and summary.json.
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -164,6 +167,8 @@ Evaluation read_evaluation(const CalibrationSetup& s, const std::filesystem::pat
 /// Member i's deposit and peak flow depth on the full DSM grid (m), from its folder.
 std::vector<double> read_member_deposit(const std::filesystem::path& out, int i);
 std::vector<double> read_member_max_depth(const std::filesystem::path& out, int i);
+/// Member i's peak depth (m), speed (m/s) and pressure (Pa) on the full DSM grid.
+std::array<std::vector<double>, 3> read_member_peak_maps(const std::filesystem::path& out, int i);
 
 /// The result of a search.
 struct CalibrationResult {
@@ -179,7 +184,8 @@ CalibrationResult run_calibration(CalibrationSetup& s, const std::filesystem::pa
                                   bool quiet);
 
 /// Write best.toml (+ best_release.tif when the thickness factor is searched), members.csv,
-/// acceptable.csv/.svg, sensitivity.csv, comparison.tif/.qml/.png, thalweg_profile.csv, summary.json.
+/// acceptable.csv/.svg, sensitivity.csv, comparison.tif/.qml/.png, thalweg_profile.csv, profile.csv
+/// and profile.png (when the best member ran), summary.json.
 void write_calibration_outputs(const CalibrationSetup& s, const CalibrationResult& r, const std::filesystem::path& out,
                                int ranks, int threads, double wall_time_s, bool quiet);
 

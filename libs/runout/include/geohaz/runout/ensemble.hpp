@@ -101,11 +101,15 @@ struct AggregationSettings {
   std::vector<double> percentiles{10.0, 50.0, 90.0};
   int bins = 96;             ///< log-spaced histogram bins per field and cell
   IntensityTable intensity;  ///< class thresholds (those of the base case)
-  /// The maps as the base case draws its own (run.hpp OutputSettings): depth classes (m), margin
-  /// around the affected area (m), attribution ("" : the DSM's metadata).
+  /// The maps as the base case draws its own (run.hpp OutputSettings): depth, speed and pressure
+  /// classes (m, m/s, Pa), margin around the affected area (m), attribution ("" : the DSM's
+  /// metadata).
   std::vector<double> map_depth_classes{0.5, 1.0, 2.0};
+  std::vector<double> map_speed_classes{1.0, 3.0, 10.0};
+  std::vector<double> map_pressure_classes{3e3, 3e4, 1e5};
   double map_margin = 200.0;
   std::string attribution;
+  double profile_half_width = 50.0;  ///< m: the base case's output.profile_half_width
 };
 
 /// Log-binned histogram ranges of the three fields (values below the low end go into one bin,

@@ -20,7 +20,10 @@
 ///   z_α(s) = z_top − tan α · (s − s_top) (written for every row; it meets the terrain at the top
 ///   and at the run-out point).
 
+#include <array>
+#include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -81,9 +84,36 @@ std::vector<Vec2> arrival_centreline(const Raster& arrival_time, const Raster& m
 /// the rows: the α line meets the terrain there).
 void write_profile_csv(const std::filesystem::path& path, const ThalwegProfile& p);
 
+/// H, L and H/L of the profile's own reach: from its top to its run-out point along the path.
+struct ProfileReach {
+  double drop_height = 0.0;  ///< H = z_top − z_runout (m)
+  double length = 0.0;       ///< L = s_runout − s_top, horizontal along the path (m)
+  double ratio = 0.0;        ///< H/L = tan α (0 when L = 0)
+};
+ProfileReach profile_reach(const ThalwegProfile& p) noexcept;
+
+/// A station marked on profile.png: a vertical line at s with its label (an observed run-out
+/// beside the modelled one, geohaz-calibrate).
+struct ProfileMark {
+  double s = 0.0;  ///< m along the path
+  std::string label;
+  std::array<std::uint8_t, 3> colour{0, 0, 0};
+  bool dashed = false;  ///< dashed (the marks before it show through where they coincide)
+};
+
+/// What profile.png shows beside the profile itself.
+struct ProfileFigure {
+  /// The angle of summary.json's H/L, measured along the toe particle's own path (degrees; NaN:
+  /// none): drawn dashed from the top of the profile and labelled "H/L of the toe path", so the
+  /// two reaches of one run read apart from "α along the profile".
+  double toe_path_angle_deg = std::numeric_limits<double>::quiet_NaN();
+  std::vector<ProfileMark> marks;  ///< stations marked with vertical lines and labels
+  std::string title;               ///< above the figure ("" : none)
+};
+
 /// profile.png: the terrain along the path with the peak depth drawn above it (exaggerated, the
-/// factor in the legend), the α line and the run-out point, and below it the peak speed and
-/// pressure against s; axes in metres.
-void write_profile_png(const std::filesystem::path& path, const ThalwegProfile& p);
+/// factor in the legend), the α line along the profile and the run-out point, the toe path's H/L
+/// and the marks of `f`, and below it the peak speed against s; axes in metres.
+void write_profile_png(const std::filesystem::path& path, const ThalwegProfile& p, const ProfileFigure& f = {});
 
 }  // namespace geohaz::runout

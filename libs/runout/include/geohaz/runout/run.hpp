@@ -124,6 +124,7 @@ struct OutputSettings {
   IntensityTable intensity;                                 ///< classes of intensity.tif
   std::vector<double> map_depth_classes{0.5, 1.0, 2.0};     ///< class breaks of the depth maps (m)
   std::vector<double> map_pressure_classes{3e3, 3e4, 1e5};  ///< class breaks of the pressure map (Pa)
+  std::vector<double> map_speed_classes{1.0, 3.0, 10.0};    ///< class breaks of the speed maps (m/s)
   double map_margin = 200.0;                                ///< m around the affected area in the maps
   std::string attribution;                                  ///< printed under every map ("" : the DSM's)
   /// A particle alone within 2·d0 paints the peak maps only where the depth it stands for exceeds
@@ -292,9 +293,12 @@ class RunoutSimulation {
   double wall_time_ = 0.0;
 };
 
+struct ThalwegProfile;
 /// The key figures of `sim` as the JSON text of summary.json (the app, the Python module and the
-/// ensemble runner read the same numbers).
-std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int threads);
+/// ensemble runner read the same numbers); with the run's `profile` (write_outputs) its "profile"
+/// block too: H, L and H/L along the profile path beside the toe path's "fahrboeschung".
+std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int threads,
+                         const ThalwegProfile* profile = nullptr);
 
 /// Write the maps (GeoTIFF on the DSM grid and CRS), the quick-look PNGs, series.csv and
 /// summary.json of `sim` into the existing directory `out`.

@@ -1,0 +1,16 @@
+#pragma once
+/// \file summary_keys.hpp
+/// The keys dem-avalanche writes into summary.json (run.cpp: the biaxial tests and the rock
+/// avalanche), each with its label, unit and reading group (core summary_keys.hpp; the list is in
+/// src/summary_keys.cpp and a test checks it against the real files).
+
+#include <span>
+
+#include "geohaz/core/summary_keys.hpp"
+
+namespace geohaz::dem {
+
+/// Every key of the summary.json of a dem-avalanche run.
+std::span<const SummaryKey> summary_keys() noexcept;
+
+}  // namespace geohaz::dem

@@ -1,0 +1,17 @@
+#pragma once
+/// \file summary_keys.hpp
+/// The keys sph-slope (the dynamic run, the strength reduction, the limit equilibrium) and
+/// slope-stability write into summary.json, each with its label, unit and reading group (core
+/// summary_keys.hpp; the list is in src/summary_keys.cpp and a test checks it against the real
+/// files).
+
+#include <span>
+
+#include "geohaz/core/summary_keys.hpp"
+
+namespace geohaz::sph {
+
+/// Every key of the summary.json of an sph-slope or slope-stability run.
+std::span<const SummaryKey> summary_keys() noexcept;
+
+}  // namespace geohaz::sph
