@@ -17,6 +17,9 @@
 #include <string>
 #include <vector>
 
+#include "geohaz/sph/summary_keys.hpp"
+#include "summary_keys_check.hpp"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -136,6 +139,7 @@ void expect_same_summary(const std::string& name, const std::string& args, int n
   const auto a = summary(one), b = summary(many);
   ASSERT_TRUE(b.contains("domain_decomposition")) << b.dump(2);
   EXPECT_EQ(b["domain_decomposition"]["ranks"], np);
+  EXPECT_SUMMARY_KEYS_DECLARED(b, geohaz::sph::summary_keys());  // the report labels them (issue #33)
   EXPECT_EQ(a["boundary_particles"], b["boundary_particles"]);
   EXPECT_EQ(a["failed_particles"], b["failed_particles"]);
   EXPECT_EQ(a["steps"], b["steps"]);

@@ -131,6 +131,12 @@ constexpr SummaryKey kKeys[] = {
     {"series[].time_s", "time", "s"},
     {"series[].unstable_cells", "unstable cells", "1"},
     // bookkeeping
+    {"domain_decomposition.ranks", "MPI ranks", "1"},
+    {"domain_decomposition.owned_particles", "particles owned by each rank at the end", "1"},
+    {"domain_decomposition.ghost_particles", "ghost particles held by each rank at the end", "1"},
+    {"domain_decomposition.migrated_particles", "particles that changed rank", "1"},
+    {"domain_decomposition.partitions", "partitions of the domain", "1"},
+    {"domain_decomposition.rebuilds", "neighbour-list rebuilds", "1"},
     {"scenario", "scenario", ""},
     {"analysis", "analysis", ""},
     {"dimension", "dimension", "1"},
