@@ -106,6 +106,28 @@ TEST(SphPoreWater, SaturatedSlopeCarriesBuoyantEffectiveStressAndStaysAtRest) {
   }
 }
 
+// A pore-pressure ratio r_u = 0.3 (u = r_u times the overburden stress at every particle): under the
+// level ground in front of the toe the total vertical stress is still the weight, so the effective
+// stress carries the rest, σ′_zz = −(1 − r_u) γ d. The ratio to it agrees with the dry deposit's ratio
+// to −γ d within 2 % (as the saturated deposit above: both share the surface row's discretisation).
+TEST(SphPoreWater, DepositUnderPorePressureRatioCarriesTheReducedEffectiveStress) {
+  auto start = [](const std::vector<std::string>& more) {
+    RunConfig c = slope_config(more);
+    SphSimulation sim(c);
+    AtStart obs;
+    sim.run(&obs);
+    return obs.fields;
+  };
+  const double ru = 0.3;
+  const auto dry = start({"water.phreatic=[]", "run.end_time=0.05", "material[0].cohesion=50000"});
+  const auto wet = start({"water.phreatic=[]", "water.ru=0.3", "run.end_time=0.05", "material[0].cohesion=50000"});
+  const double r_dry = vertical_stress_ratio(dry, kRho * kG);
+  const double r_ru = vertical_stress_ratio(wet, (1.0 - ru) * kRho * kG);
+  std::printf("sigma'_zz / (-gamma' d): dry %.4f, r_u = 0.3 %.4f\n", r_dry, r_ru);
+  EXPECT_NEAR(r_dry, 1.0, 0.1);
+  EXPECT_NEAR(r_ru, r_dry, 0.02 * r_dry);
+}
+
 /// The level L (m, elevation) of a horizontal water table, drawn down the face and clipped to the
 /// ground as the SPH's, at which Bishop's critical factor is 1 (bisection to 1 cm).
 double bishop_failure_level() {

@@ -298,8 +298,8 @@ void read_geostatic_and_earthquake(ConfigReader& r, RunConfig& c) {
 }
 
 /// [output].
-/// [water] and [seismic]: the pore water and the pseudo-static coefficients of the limit-equilibrium
-/// analysis (docs/sph.md, "Pore pressure and seismic coefficients").
+/// [water] and [seismic]: the pore water and the pseudo-static coefficients (docs/sph.md, "Pore
+/// pressure and seismic coefficients").
 void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
   auto& w = c.water;
   const auto line = r.get_array("water.phreatic", {}, {},
@@ -311,7 +311,9 @@ void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
                      std::to_string(line.size()) + " numbers");
   for (std::size_t k = 0; k + 1 < line.size(); k += 2) w.phreatic.push_back({line[k], line[k + 1]});
   w.ru = r.get("water.ru", 0.0, Range::closed_open(0.0, 1.0),
-               {"1", "pore-pressure ratio r_u = u / (gamma h) on the slice bases (not with water.phreatic)"});
+               {"1",
+                "pore-pressure ratio r_u = u / (gamma h): u = r_u times the vertical overburden stress on Bishop's "
+                "slice bases and at every SPH particle (2D slope; not with water.phreatic)"});
   const double rho_w = r.get("water.density", 1000.0, Range::closed(900.0, 1300.0), {"kg/m^3", "density of water"});
   w.unit_weight = rho_w * c.numerics.gravity;
   w.head_loss_correction =

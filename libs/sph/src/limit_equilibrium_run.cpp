@@ -65,10 +65,25 @@ std::vector<std::array<double, 2>> clipped_phreatic_surface(const RunConfig& c) 
 
 PoreWaterSettings pore_water_settings(const RunConfig& c) {
   PoreWaterSettings pw;
-  if (c.water.phreatic.empty() || c.scenario != ScenarioType::Slope || c.dimension != 2) return pw;
+  if (!c.water.active() || c.scenario != ScenarioType::Slope || c.dimension != 2) return pw;
+  pw.density = c.numerics.gravity > 0.0 ? c.water.unit_weight / c.numerics.gravity : 1000.0;
+  if (c.water.ru > 0.0) {
+    // u = r_u σ_v: the soil column above the particle in the slope's initial profile and layers, as
+    // Bishop's slices take it (limit_equilibrium.cpp, column_of).
+    ProfileDomain d = c.slope.profile();
+    apply_layers(d, c);
+    pw.ru = c.water.ru;
+    pw.overburden.ground = d.surface;
+    pw.overburden.tops = d.layer_materials.empty() ? std::vector<double>{} : d.layer_tops;
+    if (d.layer_materials.empty())
+      pw.overburden.densities = {c.materials.front().density};
+    else
+      for (const int m : d.layer_materials)
+        pw.overburden.densities.push_back(c.materials[static_cast<std::size_t>(m)].density);
+    return pw;
+  }
   pw.phreatic = c.water.phreatic;
   pw.ground = c.slope.profile().surface;
-  pw.density = c.numerics.gravity > 0.0 ? c.water.unit_weight / c.numerics.gravity : 1000.0;
   pw.history_times = c.water_history_times;
   pw.history_offsets = c.water_history_offsets;
   return pw;
@@ -80,11 +95,6 @@ void validate_water_and_seismic(const RunConfig& c) {
   if (water && (c.scenario != ScenarioType::Slope || c.dimension != 2))
     throw InputError("pore water needs the 2D slope scenario", c.config_source,
                      c.water.phreatic.empty() ? "water.ru" : "water.phreatic");
-  if (!le && c.water.ru > 0.0)
-    throw InputError(
-        "the SPH solver takes a phreatic surface (water.phreatic); r_u is for run.analysis = "
-        "limit_equilibrium",
-        c.config_source, "water.ru", std::to_string(c.water.ru));
   const auto& ht = c.water_history_times;
   if (ht.size() != c.water_history_offsets.size())
     throw InputError("needs as many offsets as water.history_times (" + std::to_string(ht.size()) + ")",

@@ -45,8 +45,7 @@ class SimulationModel {
 SlopeSection limit_equilibrium_section(const RunConfig& c, bool with_water_and_seismic);
 
 /// The cross-field checks of [water] and [seismic] (InputError naming the key): water only on a 2D
-/// slope, r_u only in the limit-equilibrium analysis (the SPH solver takes a phreatic surface), the
-/// history's arrays, k_h and k_v not in a dynamic run (its earthquake is the record), the water's own
+/// slope, the history's arrays, k_h and k_v not in a dynamic run (its earthquake is the record), the water's own
 /// checks (SlopeSection::validate_water).
 void validate_water_and_seismic(const RunConfig& c);
 
@@ -54,7 +53,7 @@ void validate_water_and_seismic(const RunConfig& c);
 /// and the Bishop check beside it use (no ponded water, the ground a seepage face).
 std::vector<std::array<double, 2>> clipped_phreatic_surface(const RunConfig& c);
 
-/// The solver's pore water of a config (dry unless [water] has a phreatic surface).
+/// The solver's pore water of a config (dry unless [water] has a phreatic surface or r_u).
 PoreWaterSettings pore_water_settings(const RunConfig& c);
 
 /// Saturated density below the water table at the start: each soil particle of a material with a
@@ -63,7 +62,7 @@ PoreWaterSettings pore_water_settings(const RunConfig& c);
 template <int Dim>
 void saturate_below_water_table(const RunConfig& c, SphStore<Dim>& s) {
   const auto pw = pore_water_settings(c);
-  if (!pw.active()) return;
+  if (pw.phreatic.empty()) return;  // r_u: the materials' own densities, as in Bishop's method
   const auto& x = s.template get<Position<Dim>>();
   const auto& kind = s.template get<ParticleKind>();
   const auto& mat = s.template get<MaterialId>();

@@ -1,0 +1,72 @@
+#pragma once
+/// \file pore_pressure.hpp
+/// The prescribed pore pressure of the SPH solver (docs/sph.md, "Pore pressure and seismic
+/// coefficients"): what `PoreWaterSettings` holds and how each soil particle's u is evaluated from
+/// its position x = (x, [y,] z) in every step (solver.hpp, step 3). One source of water at a time:
+///   * a phreatic surface z_w(x) (a polyline along axis 0), clipped to the ground z_g(x) and raised
+///     by the history Δz(t):   u = γ_w max(min(z_w(x) + Δz, z_g(x)) − z, 0);
+///   * a pore-pressure ratio r_u (Bishop & Morgenstern 1960: u = r_u γ h, γ h the vertical
+///     overburden stress of the soil column above the point, as Bishop's method takes it on a slice
+///     base, limit_equilibrium.hpp):   u = r_u g_f ∫_z^{z_g(x)} ρ(z′) dz′,
+///     ρ the density of the layer at each elevation (the section's layers, by elevation).
+/// γ_w = ρ_w g_f, g_f the gravity of the step (ramped with it in the geostatic phase). u is positive
+/// in compression of the pore water; the stress field is the effective stress σ′ (tension positive)
+/// and the momentum equation takes the total stress σ = σ′ − u I.
+/// Units SI (m, s, kg/m³, Pa).
+
+#include <algorithm>
+#include <array>
+#include <vector>
+
+#include "geohaz/core/vec.hpp"
+
+namespace geohaz::sph {
+
+/// The soil column above a point of a 2D section: ∫_z^{z_g(x)} ρ dz (kg/m²) with ρ piecewise constant
+/// by elevation (layer k holds z < tops[k], as ProfileDomain; above the last top the last density).
+struct OverburdenProfile {
+  std::vector<std::array<double, 2>> ground;  ///< (x, z) of the ground surface, x non-decreasing (m)
+  std::vector<double> tops;                   ///< layer tops, ascending (m); empty: one density
+  std::vector<double> densities;              ///< kg/m³, tops.size() + 1 values
+  /// ∫_z^{z_g(x)} ρ dz (kg/m²); 0 at or above the ground.
+  double mass_above(double x, double z) const noexcept;
+};
+
+/// Prescribed pore water (see the file comment): a phreatic surface (along axis 0; uniform across a
+/// 3D width), or r_u with the overburden profile. Default: dry.
+struct PoreWaterSettings {
+  std::vector<std::array<double, 2>> phreatic;  ///< (x, z) at the start, x non-decreasing (m); empty: none
+  std::vector<std::array<double, 2>> ground;    ///< (x, z) ground surface the table is clipped to (m); empty: none
+  double density = 1000.0;                      ///< ρ_w, kg/m³
+  std::vector<double> history_times;            ///< s (main-phase time), increasing; empty: no rise
+  std::vector<double> history_offsets;          ///< m: Δz at those times
+  double ru = 0.0;                              ///< r_u in [0, 1); > 0: u = r_u σ_v (no phreatic surface)
+  OverburdenProfile overburden;                 ///< the soil column of r_u
+  bool active() const noexcept { return !phreatic.empty() || ru > 0.0; }
+  /// Δz(t) (m).
+  double offset(double t) const noexcept;
+  /// Elevation of the (clipped) water table at x with offset dz (m).
+  double level(double x, double dz) const noexcept;
+};
+
+/// The pore water of one step: the settings at main-phase time t (0 in the geostatic phase) and
+/// gravity g·factor, evaluated per particle by pressure().
+struct PoreWaterStep {
+  const PoreWaterSettings* pw = nullptr;
+  double dz = 0.0;       ///< Δz(t) of the phreatic surface (m)
+  double gamma_w = 0.0;  ///< ρ_w g_f (N/m³)
+  double g = 0.0;        ///< g_f (m/s²)
+
+  PoreWaterStep() = default;
+  PoreWaterStep(const PoreWaterSettings& s, double t, double gravity, double factor) noexcept
+      : pw(&s), dz(s.offset(t)), gamma_w(s.density * gravity * factor), g(gravity * factor) {}
+
+  /// u (Pa) at position x (axis 0 along the section, axis Dim − 1 up).
+  template <int Dim>
+  double pressure(const Vec<Dim>& x) const noexcept {
+    if (pw->ru > 0.0) return pw->ru * g * pw->overburden.mass_above(x[0], x[Dim - 1]);
+    return gamma_w * std::max(pw->level(x[0], dz) - x[Dim - 1], 0.0);
+  }
+};
+
+}  // namespace geohaz::sph
