@@ -171,6 +171,36 @@ TEST(SphSlopeWater, StrengthReductionWithPorePressureRatioAgreesWithBishop) {
   EXPECT_NEAR(F, Fb, 0.05 * Fb);
 }
 
+// The rain example (data/sph/slope_rain.toml) shrunk: the 12 h of rain in 2 s of a 3 s main phase.
+// The summary reports the rain, its clock and the largest pore pressure (the deepest particle under
+// the crest, 14.5 m below the ground with the table at 6 m: ψ ≥ 8.5 m, 83 kPa at the start), the
+// series the rain's time; Bishop's factor falls from the dry slope's (the initial table lies below
+// its circle) to below 1 at the rain's end, and the slope moves (more than 10 cm). About 4 s.
+TEST(SphSlopeWater, RainExampleReportsTheRainItsClockAndPorePressure) {
+  const fs::path out = kWork / "rain_example";
+  fs::remove_all(out);
+  const auto r = run("--config " + (kData / "slope_rain.toml").string() + " --out " + out.string() +
+                         " --set run.end_time=3 --set rain.clock_times=[0,0,2,43200] --set run.snapshot_interval=0"
+                         " --quiet",
+                     "rain_example");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto s = summary(out);
+  const auto& w = s["water"];
+  EXPECT_EQ(w["source"], "rain");
+  EXPECT_EQ(w["rain"]["rain_time_at_end_s"].get<double>(), 43200.0);
+  EXPECT_EQ(w["rain"]["water_table_depth_m"].get<double>(), 6.0);
+  EXPECT_NEAR(w["rain"]["depth_m"].get<double>(), 0.432, 1e-12);  // 36 mm/h for 12 h
+  EXPECT_GT(w["max_pore_pressure_Pa"].get<double>(), 1000.0 * 9.81 * 8.5);
+  EXPECT_GT(s["bishop"]["factor"].get<double>(), 1.3);
+  EXPECT_LT(w["rain"]["bishop_factor_at_end"].get<double>(), 1.0);
+  EXPECT_GT(s["max_displacement_m"].get<double>(), 0.1);
+  std::ifstream series(out / "series.csv");
+  std::string header;
+  std::getline(series, header);
+  EXPECT_NE(header.find("max_pore_pressure_Pa"), std::string::npos) << header;
+  EXPECT_NE(header.find("rain_time_s"), std::string::npos) << header;
+}
+
 // Bad water input: exit 2 naming the key, nothing written.
 TEST(SphSlopeWater, BadWaterInputExitsTwoNamingTheKey) {
   const fs::path out = kWork / "bad_water";
@@ -184,7 +214,19 @@ TEST(SphSlopeWater, BadWaterInputExitsTwoNamingTheKey) {
            {"water.ru=0.2 --set water.phreatic=[0,12,65,5]", "water.ru"},               // both
            {"run.dimension=3 --set water.phreatic=[] --set water.ru=0.2", "water.ru"},  // 2D slope only
            {"water.history_times=[0,5]", "water.history_offsets"},                      // lengths differ
-           {"run.analysis=dynamic --set water.phreatic=[] --set seismic.kh=0.1", "seismic.kh"}}) {
+           {"run.analysis=dynamic --set water.phreatic=[] --set seismic.kh=0.1", "seismic.kh"},
+           {"run.analysis=dynamic --set rain.enabled=true", "rain.enabled"},  // and a phreatic surface
+           {"run.analysis=strength_reduction --set water.phreatic=[] --set rain.enabled=true", "rain.enabled"},
+           {"run.analysis=dynamic --set water.phreatic=[] --set rain.enabled=true --set rain.clock_times=[0,0,5]",
+            "rain.clock_times"},  // not pairs
+           {"run.analysis=dynamic --set water.phreatic=[] --set rain.enabled=true --set "
+            "rain.clock_times=[0,0,5,10,4,20]",
+            "rain.clock_times"},  // the run's time decreasing
+           {"hydrology.conductivity=-1e-5", "hydrology.conductivity"},
+           {"hydrology.steady_infiltration=2e-5", "hydrology.steady_infiltration"},  // above K_s
+           {"run.analysis=dynamic --set water.phreatic=[] --set rain.enabled=true --set "
+            "hydrology.steady_infiltration=9e-6",
+            "hydrology.steady_infiltration"}}) {  // above K_s cos^2 of the face (0.8 K_s)
     fs::remove_all(out);
     const auto r = run("--config " + kWater + " --out " + out.string() + " --set " + sets, "bad_water");
     EXPECT_EQ(r.code, 2) << sets << ": " << r.err;

@@ -1,12 +1,16 @@
 // Unit tests of the SPH solver's prescribed pore pressure (pore_pressure.hpp; docs/sph.md, "Pore
-// pressure and seismic coefficients"): the r_u overburden against hand integrals, and the solver's
-// pore-pressure field against the formula at every particle.
+// pressure and seismic coefficients"): the r_u overburden against hand integrals, the solver's
+// pore-pressure field against the formula at every particle, and rain's head and clock.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <memory>
 #include <numbers>
+#include <utility>
 #include <vector>
 
+#include "geohaz/sph/infiltration.hpp"
 #include "geohaz/sph/pore_pressure.hpp"
 #include "geohaz/sph/scenario.hpp"
 #include "geohaz/sph/solver.hpp"
@@ -98,6 +102,50 @@ TEST(PoreWaterStep, SolverGivesEverySoilParticleItsOverburdenPressure) {
     ++n;
   }
   EXPECT_GT(n, 200);
+}
+
+// Rain on a section: the head at a point is Iverson's ψ(Z, t_r, δ, d) (InfiltrationHistory, tested
+// against the analytic solution in stability_map's tests) of its column, Z the depth below the
+// ground, δ the inclination of the ground segment above the point (0 beyond the ends), and the clock
+// maps the run's time to the rain's, linear between its pairs and held beyond them.
+TEST(RainPorePressure, HeadIsIversonsOfTheColumnAndTheClockMapsTheRunsTime) {
+  InfiltrationParameters p;
+  p.conductivity = 1e-5;
+  p.diffusivity = 1e-3;
+  p.steady_flux = 1e-6;
+  const auto rain_history = RainfallHistory::uniform_steps(3600.0, {2e-5, 5e-6});  // the first beyond K_s
+  const std::vector<std::array<double, 2>> ground = {{0.0, 15.0}, {25.0, 15.0}, {45.0, 5.0}, {65.0, 5.0}};
+  const RainPorePressure rain(p, rain_history, ground, 4.0, {{0.0, 0.0}, {10.0, 7200.0}});
+  const InfiltrationHistory h(p, rain_history);
+  const double face = std::atan(0.5);
+  EXPECT_EQ(rain.slope_at(10.0), 0.0);
+  EXPECT_DOUBLE_EQ(rain.slope_at(30.0), face);
+  EXPECT_EQ(rain.slope_at(50.0), 0.0);
+  EXPECT_EQ(rain.slope_at(-5.0), 0.0);
+  EXPECT_EQ(rain.slope_at(70.0), 0.0);
+  for (const double t : {0.0, 1800.0, 5400.0, 20000.0})
+    for (const auto& [x, z] : {std::pair{10.0, 12.0}, {10.0, 3.0}, {30.0, 9.0}, {40.0, 2.0}, {55.0, 1.0}}) {
+      const double Z = (x < 25.0 ? 15.0 : (x < 45.0 ? 15.0 - (x - 25.0) / 2.0 : 5.0)) - z;
+      const double delta = x > 25.0 && x < 45.0 ? face : 0.0;
+      EXPECT_NEAR(rain.head(x, z, t), h.pressure_head(Z, t, delta, 4.0), 1e-12) << x << " " << z << " " << t;
+    }
+  EXPECT_EQ(rain.head(30.0, 13.0, 100.0), -std::numeric_limits<double>::infinity());  // above the ground
+  EXPECT_DOUBLE_EQ(rain.initial_level(35.0), 6.0);
+  EXPECT_EQ(rain.rain_time(-1.0), 0.0);
+  EXPECT_DOUBLE_EQ(rain.rain_time(2.5), 1800.0);
+  EXPECT_EQ(rain.rain_time(12.0), 7200.0);  // held beyond the last pair
+  const RainPorePressure identity(p, rain_history, ground, 4.0, {});
+  EXPECT_EQ(identity.rain_time(123.0), 123.0);
+
+  // The solver's u: γ_w max(ψ, 0) at the rain's time of the step.
+  PoreWaterSettings pw;
+  pw.rain = std::make_shared<const RainPorePressure>(rain);
+  ASSERT_TRUE(pw.active());
+  const PoreWaterStep step(pw, 5.0, 9.81, 1.0);  // rain time 3600 s
+  EXPECT_DOUBLE_EQ(step.t_rain, 3600.0);
+  EXPECT_NEAR(step.pressure<2>(Vec2(30.0, 9.0)), 1000.0 * 9.81 * std::max(rain.head(30.0, 9.0, 3600.0), 0.0), 1e-9);
+  EXPECT_GT(step.pressure<2>(Vec2(10.0, 3.0)), 0.0);   // below the table
+  EXPECT_EQ(step.pressure<2>(Vec2(10.0, 14.0)), 0.0);  // suction is not counted
 }
 
 }  // namespace

@@ -298,8 +298,8 @@ void read_geostatic_and_earthquake(ConfigReader& r, RunConfig& c) {
 }
 
 /// [output].
-/// [water] and [seismic]: the pore water and the pseudo-static coefficients (docs/sph.md, "Pore
-/// pressure and seismic coefficients").
+/// [water], [rain], [hydrology] and [seismic]: the pore water, the rain and the pseudo-static
+/// coefficients (docs/sph.md, "Pore pressure and seismic coefficients").
 void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
   auto& w = c.water;
   const auto line = r.get_array("water.phreatic", {}, {},
@@ -328,6 +328,30 @@ void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
   c.water_history_offsets =
       r.get_array("water.history_offsets", {}, {},
                   {"m", "rise of the phreatic surface at those times (linear between, held after; + up)"});
+  // [rain] and [hydrology]: the keys and reader of slope-stability (infiltration.hpp), here a loading history.
+  c.rain.enabled = r.get_bool("rain.enabled", false,
+                              {"",
+                               "rain infiltration (Iverson 2000, as slope-stability: [rain], [hydrology]) as the "
+                               "pore pressure of the main phase (2D slope, run.analysis = dynamic; not with "
+                               "water.phreatic or water.ru)"});
+  c.rain.infiltration = read_infiltration_keys(r);
+  const auto clock = r.get_array("rain.clock_times", {}, Range::non_negative(),
+                                 {"s",
+                                  "the rain's clock: pairs t, t_rain of main-phase time t and the rain's time t_rain "
+                                  "there, linear between, held beyond (e.g. [0, 0, 10, 86400]: a day of rain in 10 s "
+                                  "of SPH); empty: t_rain = t"});
+  if (clock.size() % 2 || clock.size() == 2)
+    throw InputError("needs pairs t, t_rain of at least two points", r.source(), "rain.clock_times",
+                     std::to_string(clock.size()) + " numbers");
+  for (std::size_t k = 0; k + 1 < clock.size(); k += 2) {
+    if (k > 0 && !(clock[k] > clock[k - 2]))
+      throw InputError("the main-phase times t must increase", r.source(), "rain.clock_times",
+                       std::to_string(clock[k]));
+    if (k > 0 && clock[k + 1] < clock[k - 1])
+      throw InputError("the rain's times t_rain must not decrease", r.source(), "rain.clock_times",
+                       std::to_string(clock[k + 1]));
+    c.rain.clock.push_back({clock[k], clock[k + 1]});
+  }
   c.seismic.kh = r.get("seismic.kh", 0.0, Range::closed_open(0.0, 1.0),
                        {"1",
                         "horizontal pseudo-static coefficient: a force k_h W in the direction of sliding "

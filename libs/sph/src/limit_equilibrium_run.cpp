@@ -2,9 +2,11 @@
 // section of a 2D slope with its pore water and seismic coefficients, the checks of [water] and
 // [seismic], the Newmark report (docs/sph.md, "Pore pressure and seismic coefficients"), and the
 // static Bishop check beside the dynamic run and the strength reduction.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <string>
 #include <variant>
@@ -46,9 +48,30 @@ SlopeSection limit_equilibrium_section(const RunConfig& c, bool with_water_and_s
     // Beside an SPH run, the SPH's water table: clipped to the ground (no ponded water).
     if (c.analysis != Analysis::LimitEquilibrium && !c.water.phreatic.empty())
       s.water.phreatic = clipped_phreatic_surface(c);
+    // Rain: its pore pressure at the start of the main phase.
+    if (c.rain.enabled) {
+      const auto rain = rain_pore_pressure(c);
+      apply_rain(s.water, rain, rain->rain_time(0.0));
+    }
     s.seismic = c.seismic;
   }
   return s;
+}
+
+std::shared_ptr<const RainPorePressure> rain_pore_pressure(const RunConfig& c) {
+  const auto& k = c.rain.infiltration;
+  return std::make_shared<const RainPorePressure>(k.hydrology, k.rain, c.slope.profile().surface, k.water_table_depth,
+                                                  c.rain.clock);
+}
+
+void apply_rain(PoreWater& w, const std::shared_ptr<const RainPorePressure>& rain, double t_rain) {
+  // The initial table, parallel to the ground, sets where the soil weighs its saturated unit weight
+  // (as the SPH's particles, saturate_below_water_table); the rain's head gives u.
+  w.phreatic.clear();
+  for (const auto& p : rain->ground()) w.phreatic.push_back({p[0], p[1] - rain->water_table_depth()});
+  w.pressure_field = [rain, gw = w.unit_weight, t_rain](double x, double z) {
+    return gw * std::max(rain->head(x, z, t_rain), 0.0);
+  };
 }
 
 std::vector<std::array<double, 2>> clipped_phreatic_surface(const RunConfig& c) {
@@ -65,8 +88,12 @@ std::vector<std::array<double, 2>> clipped_phreatic_surface(const RunConfig& c) 
 
 PoreWaterSettings pore_water_settings(const RunConfig& c) {
   PoreWaterSettings pw;
-  if (!c.water.active() || c.scenario != ScenarioType::Slope || c.dimension != 2) return pw;
+  if (!(c.water.active() || c.rain.enabled) || c.scenario != ScenarioType::Slope || c.dimension != 2) return pw;
   pw.density = c.numerics.gravity > 0.0 ? c.water.unit_weight / c.numerics.gravity : 1000.0;
+  if (c.rain.enabled) {
+    pw.rain = rain_pore_pressure(c);
+    return pw;
+  }
   if (c.water.ru > 0.0) {
     // u = r_u σ_v: the soil column above the particle in the slope's initial profile and layers, as
     // Bishop's slices take it (limit_equilibrium.cpp, column_of).
@@ -89,12 +116,43 @@ PoreWaterSettings pore_water_settings(const RunConfig& c) {
   return pw;
 }
 
+namespace {
+
+/// The checks of [rain] in sph-slope: one source of water, the 2D slope, a dynamic run, β > 0 on
+/// every segment of the ground.
+void validate_rain(const RunConfig& c) {
+  const std::string& src = c.config_source;
+  if (!c.water.phreatic.empty() || c.water.ru > 0.0)
+    throw InputError("one source of pore water at a time: rain, water.phreatic or water.ru", src, "rain.enabled",
+                     "true");
+  if (c.scenario != ScenarioType::Slope || c.dimension != 2)
+    throw InputError("rain needs the 2D slope scenario", src, "rain.enabled", "true");
+  if (c.analysis != Analysis::Dynamic)
+    throw InputError(
+        "rain is a loading history of the main phase: it needs run.analysis = dynamic (the strength reduction "
+        "and the limit-equilibrium analysis take water.phreatic or water.ru)",
+        src, "rain.enabled", "true");
+  const auto& h = c.rain.infiltration.hydrology;
+  const auto ground = c.slope.profile().surface;
+  for (std::size_t k = 1; k < ground.size(); ++k) {
+    const double dx = ground[k][0] - ground[k - 1][0], dz = ground[k][1] - ground[k - 1][1];
+    const double cos2 = dx * dx / (dx * dx + dz * dz);
+    if (dx > 0.0 && !(h.steady_flux / h.conductivity < cos2))
+      throw InputError("the long-term infiltration I_ZLT/K_s must be below cos^2 of the slope's face (" +
+                           std::to_string(cos2) + "): no steady slope-parallel flow otherwise",
+                       src, "hydrology.steady_infiltration", std::to_string(h.steady_flux));
+  }
+}
+
+}  // namespace
+
 void validate_water_and_seismic(const RunConfig& c) {
   const bool water = c.water.active();
   const bool le = c.analysis == Analysis::LimitEquilibrium;
   if (water && (c.scenario != ScenarioType::Slope || c.dimension != 2))
     throw InputError("pore water needs the 2D slope scenario", c.config_source,
                      c.water.phreatic.empty() ? "water.ru" : "water.phreatic");
+  if (c.rain.enabled) validate_rain(c);
   const auto& ht = c.water_history_times;
   if (ht.size() != c.water_history_offsets.size())
     throw InputError("needs as many offsets as water.history_times (" + std::to_string(ht.size()) + ")",
@@ -246,11 +304,7 @@ class LimitEquilibriumRun final : public SimulationModel {
     s["factor_of_safety"] = critical_.admissible() ? nlohmann::json(critical_.factor) : nlohmann::json();
     if (!note_.empty()) s["bishop_note"] = note_;
     s["seismic"] = {{"kh", c_.seismic.kh}, {"kv", c_.seismic.kv}};
-    const auto& w = c_.water;
-    s["water"] = {{"phreatic_surface", w.phreatic.empty() ? nlohmann::json() : nlohmann::json(w.phreatic)},
-                  {"ru", w.ru},
-                  {"unit_weight_N_per_m3", w.unit_weight},
-                  {"pore_pressure", w.head_loss_correction ? "head_loss_corrected" : "vertical_head"}};
+    s["water"] = water_summary(c_, 0.0);
     if (!newmark_.is_null())
       s["newmark"] = newmark_;
     else
@@ -364,6 +418,53 @@ void StaticBishop::add_to(nlohmann::json& s) const {
                            {"x_m", cover.x},
                            {"angle_deg", cover.angle * 180.0 / std::numbers::pi},
                            {"window_m", cover.window}};
+}
+
+namespace {
+
+/// The rain block of summary.json: the rain and hydrology, the clock, and Bishop's factor with the
+/// rain's pore pressure at the rain's time of the run's end t_end (s).
+nlohmann::json rain_summary(const RunConfig& c, double t_end) {
+  const auto& k = c.rain.infiltration;
+  const auto rain = rain_pore_pressure(c);
+  nlohmann::json clock = nlohmann::json::array();
+  for (const auto& p : c.rain.clock) clock.push_back({p[0], p[1]});
+  nlohmann::json r = {{"intensity_m_per_s", k.rain.intensities},
+                      {"step_s", k.rain.times.size() > 1 ? k.rain.times[1] - k.rain.times[0] : 0.0},
+                      {"end_s", k.rain.end()},
+                      {"depth_m", k.rain.depth_until(k.rain.end())},
+                      {"conductivity_m_per_s", k.hydrology.conductivity},
+                      {"diffusivity_m2_per_s", k.hydrology.diffusivity},
+                      {"steady_infiltration_m_per_s", k.hydrology.steady_flux},
+                      {"water_table_depth_m", k.water_table_depth},
+                      {"clock_times_s", clock},
+                      {"rain_time_at_start_s", rain->rain_time(0.0)},
+                      {"rain_time_at_end_s", rain->rain_time(t_end)}};
+  r["bishop_factor_at_end"] = nullptr;
+  if (has_shear_strength(c.model)) try {
+      auto s = section_of(c);
+      apply_rain(s.water, rain, rain->rain_time(t_end));
+      r["bishop_factor_at_end"] = bishop_critical_circle(s).factor;
+    } catch (const InputError&) {  // no admissible circle: null
+    }
+  return r;
+}
+
+}  // namespace
+
+nlohmann::json water_summary(const RunConfig& c, double t_end) {
+  const auto& w = c.water;
+  nlohmann::json j = {{"phreatic_surface", w.phreatic.empty() ? nlohmann::json() : nlohmann::json(w.phreatic)},
+                      {"ru", w.ru},
+                      {"unit_weight_N_per_m3", w.unit_weight},
+                      {"pore_pressure", w.head_loss_correction ? "head_loss_corrected" : "vertical_head"}};
+  j["source"] = c.rain.enabled ? "rain" : (!w.phreatic.empty() ? "phreatic_surface" : (w.ru > 0.0 ? "ru" : "none"));
+  if (!c.water_history_times.empty()) {
+    j["history_times_s"] = c.water_history_times;
+    j["history_offsets_m"] = c.water_history_offsets;
+  }
+  if (c.rain.enabled) j["rain"] = rain_summary(c, t_end);
+  return j;
 }
 
 std::unique_ptr<SimulationModel> make_limit_equilibrium_run(const RunConfig& c, bool quiet) {

@@ -144,6 +144,14 @@ struct RunConfig {
   std::vector<double> water_history_times, water_history_offsets;
   /// Saturated density per material (kg/m³; 0: the material's density), below the phreatic surface.
   std::vector<double> saturated_densities;
+  /// Rain infiltration as the pore-pressure history of the main phase ([rain] with rain.enabled and
+  /// [hydrology]: the keys of slope-stability, infiltration.hpp; docs/sph.md): the pressure head of
+  /// Iverson (2000) column by column, the rain's time t_r = clock(t) of the main-phase time t.
+  struct Rain {
+    bool enabled = false;
+    InfiltrationKeys infiltration;
+    std::vector<std::array<double, 2>> clock;  ///< (t, t_r) pairs (s); empty: t_r = t
+  } rain;
   /// Pseudo-static coefficients ([seismic]): in Bishop's method and in the strength-reduction trials.
   SeismicCoefficients seismic;
   // Main phase.
