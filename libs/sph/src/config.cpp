@@ -7,6 +7,7 @@
 #include <memory>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -328,6 +329,15 @@ void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
   c.water_history_offsets =
       r.get_array("water.history_offsets", {}, {},
                   {"m", "rise of the phreatic surface at those times (linear between, held after; + up)"});
+  {
+    const auto table = r.get_string("water.table_raster", "",
+                                    {"",
+                                     "raster of the water table's elevation (m) in the DSM's CRS: a DSM section's "
+                                     "phreatic surface, cut along the section (2D) or sampled over the strip (3D); "
+                                     "clipped to the ground; not with water.phreatic, water.ru or rain"});
+    if (!table.empty())
+      c.water_table_raster = std::filesystem::path(table).is_absolute() ? table : (r.base_dir() / table).string();
+  }
   // [rain] and [hydrology]: the keys and reader of slope-stability (infiltration.hpp), here a loading history.
   c.rain.enabled = r.get_bool("rain.enabled", false,
                               {"",
@@ -495,6 +505,24 @@ void read_walls_clamp_and_initial_velocity(ConfigReader& r, RunConfig& c, bool d
   }
 }
 
+/// The water-table raster of a DSM section (water.table_raster): readable, in the DSM's CRS.
+std::shared_ptr<const Terrain> read_water_table(const ConfigReader& r, const std::string& path, const Raster& dsm) {
+  Raster t;
+  try {
+    t = read_raster(path);
+  } catch (const InputError& e) {  // name the key the raster comes from
+    throw InputError(e.reason() + " (" + path + ")", r.source(), "water.table_raster", path);
+  }
+  if (!crs_equal(t.crs_wkt, dsm.crs_wkt))
+    throw InputError("must be in the DSM's CRS (" + crs_label(dsm.crs_wkt) + "; it is in " + crs_label(t.crs_wkt) + ")",
+                     r.source(), "water.table_raster", path);
+  try {
+    return std::make_shared<const Terrain>(std::move(t));
+  } catch (const InputError& e) {
+    throw InputError(e.reason() + " (" + path + ")", r.source(), "water.table_raster", path);
+  }
+}
+
 /// [section]: the DSM is read and the profile extracted here (not in describe mode).
 void read_section(ConfigReader& r, RunConfig& c, bool describe) {
   const auto& n = c.numerics;
@@ -543,6 +571,7 @@ void read_section(ConfigReader& r, RunConfig& c, bool describe) {
       c.section.crs_wkt = raster->crs_wkt;
       c.section.dsm = raster;
       c.section.terrain = std::make_shared<const Terrain>(*raster);
+      if (!c.water_table_raster.empty()) c.section.water_table = read_water_table(r, c.water_table_raster, *raster);
     }
   }
 }

@@ -86,8 +86,64 @@ std::vector<std::array<double, 2>> clipped_phreatic_surface(const RunConfig& c) 
   return out;
 }
 
+std::vector<std::array<double, 2>> section_water_table(const RunConfig& c) {
+  std::vector<std::array<double, 2>> cut;
+  for (const auto& p : c.section.profile) {
+    const double z = c.section.water_table->elevation(p.x, p.y);
+    if (!std::isfinite(z))
+      throw InputError("the water table raster has no value at the section's point (" + csv_number(p.x) + ", " +
+                           csv_number(p.y) + ") (s = " + csv_number(p.s) +
+                           " m): it must cover the section, without nodata",
+                       c.config_source, "water.table_raster", c.water_table_raster);
+    cut.push_back({p.s, z});
+  }
+  return cut;
+}
+
+std::shared_ptr<const WaterTableGrid> section_water_table_grid(const RunConfig& c) {
+  const auto& P = c.section.profile;
+  const double dx = c.numerics.spacing, width = strip_width(c), half = 0.5 * width;
+  auto g = std::make_shared<WaterTableGrid>();
+  const double length = P.back().s - P.front().s;
+  g->x0 = P.front().s;
+  g->nx = std::max(2, static_cast<int>(std::ceil(length / dx)) + 1);
+  g->dx = length / (g->nx - 1);
+  g->y0 = 0.0;
+  g->ny = std::max(2, static_cast<int>(std::ceil(width / dx)) + 1);
+  g->dy = width / (g->ny - 1);
+  for (int j = 0; j < g->ny; ++j)
+    for (int i = 0; i < g->nx; ++i) {
+      const Vec2 q = section_map_point(P, g->x0 + i * g->dx, g->y0 + j * g->dy - half);
+      const double zw = c.section.water_table->elevation(q.x(), q.y()), zg = c.section.terrain->elevation(q.x(), q.y());
+      if (!std::isfinite(zw))
+        throw InputError("the water table raster has no value at (" + csv_number(q.x()) + ", " + csv_number(q.y()) +
+                             ") on the 3D strip: it must cover the strip, without nodata",
+                         c.config_source, "water.table_raster", c.water_table_raster);
+      if (!std::isfinite(zg))
+        throw InputError("the 3D section strip leaves the DSM's data at (" + csv_number(q.x()) + ", " +
+                             csv_number(q.y()) + "): narrow geometry.width or move the polyline",
+                         c.config_source, "geometry.width", csv_number(c.width));
+      g->table.push_back(zw);
+      g->ground.push_back(zg);
+    }
+  return g;
+}
+
 PoreWaterSettings pore_water_settings(const RunConfig& c) {
   PoreWaterSettings pw;
+  if (c.scenario == ScenarioType::Section && c.section.water_table) {
+    // A DSM section: the raster cut along the section (2D, clipped to the profile) or over the strip (3D).
+    pw.density = c.numerics.gravity > 0.0 ? c.water.unit_weight / c.numerics.gravity : 1000.0;
+    pw.history_times = c.water_history_times;
+    pw.history_offsets = c.water_history_offsets;
+    if (c.dimension == 2) {
+      pw.phreatic = section_water_table(c);
+      pw.ground = section_profile(c).surface;
+    } else {
+      pw.table = section_water_table_grid(c);
+    }
+    return pw;
+  }
   if (!(c.water.active() || c.rain.enabled) || c.scenario != ScenarioType::Slope || c.dimension != 2) return pw;
   pw.density = c.numerics.gravity > 0.0 ? c.water.unit_weight / c.numerics.gravity : 1000.0;
   if (c.rain.enabled) {
@@ -118,6 +174,31 @@ PoreWaterSettings pore_water_settings(const RunConfig& c) {
 
 namespace {
 
+/// The checks of water.table_raster: a DSM section, one source of water, the raster covering the
+/// section (or strip) and lying below the ground somewhere.
+void validate_water_table(const RunConfig& c) {
+  if (c.water_table_raster.empty()) return;
+  const std::string& src = c.config_source;
+  const char* key = "water.table_raster";
+  if (c.scenario != ScenarioType::Section)
+    throw InputError("a water table raster needs a DSM section (run.scenario = section); a slope takes water.phreatic",
+                     src, key, c.water_table_raster);
+  if (!c.water.phreatic.empty() || c.water.ru > 0.0 || c.rain.enabled)
+    throw InputError("one source of pore water at a time: water.table_raster, water.phreatic, water.ru or rain", src,
+                     key, c.water_table_raster);
+  if (!c.section.water_table) return;
+  bool below = false;
+  if (c.dimension == 2) {
+    const auto cut = section_water_table(c);
+    for (std::size_t k = 0; k < cut.size(); ++k) below = below || cut[k][1] < c.section.profile[k].z;
+  } else {
+    const auto g = section_water_table_grid(c);
+    for (std::size_t k = 0; k < g->table.size(); ++k) below = below || g->table[k] < g->ground[k];
+  }
+  if (!below)
+    throw InputError("the water table lies above the ground over the whole section", src, key, c.water_table_raster);
+}
+
 /// The checks of [rain] in sph-slope: one source of water, the 2D slope, a dynamic run, β > 0 on
 /// every segment of the ground.
 void validate_rain(const RunConfig& c) {
@@ -147,6 +228,7 @@ void validate_rain(const RunConfig& c) {
 }  // namespace
 
 void validate_water_and_seismic(const RunConfig& c) {
+  validate_water_table(c);
   const bool water = c.water.active();
   const bool le = c.analysis == Analysis::LimitEquilibrium;
   if (water && (c.scenario != ScenarioType::Slope || c.dimension != 2))
@@ -160,8 +242,9 @@ void validate_water_and_seismic(const RunConfig& c) {
   for (std::size_t k = 1; k < ht.size(); ++k)
     if (!(ht[k] > ht[k - 1]))
       throw InputError("must increase", c.config_source, "water.history_times", std::to_string(ht[k]));
-  if (!ht.empty() && c.water.phreatic.empty())
-    throw InputError("a water-table history needs water.phreatic", c.config_source, "water.history_times");
+  if (!ht.empty() && c.water.phreatic.empty() && c.water_table_raster.empty())
+    throw InputError("a water-table history needs water.phreatic or water.table_raster", c.config_source,
+                     "water.history_times");
   if (c.analysis == Analysis::Dynamic && (c.seismic.kh != 0.0 || c.seismic.kv != 0.0))
     throw InputError(
         "the pseudo-static coefficients are for the limit-equilibrium analysis and the strength reduction; a "
@@ -371,6 +454,13 @@ SlopeSection section_of(const RunConfig& c, bool residual = false) {
     soils.push_back({m.density * c.numerics.gravity, coh, phi, sat * c.numerics.gravity});
   }
   auto s = SlopeSection::from_profile(d, soils);
+  if (c.scenario == ScenarioType::Section && c.section.water_table) {
+    // The raster's table cut along the section, clipped to the ground as the SPH's.
+    s.water = c.water;
+    const auto cut = section_water_table(c);
+    for (std::size_t k = 0; k < cut.size(); ++k)
+      s.water.phreatic.push_back({cut[k][0], std::min(cut[k][1], c.section.profile[k].z)});
+  }
   if (c.scenario == ScenarioType::Slope) {
     // The pore water (clipped to the ground as the SPH's) and the pseudo-static coefficients of the
     // strength reduction (a dynamic run has none: its earthquake is the record).
@@ -458,7 +548,11 @@ nlohmann::json water_summary(const RunConfig& c, double t_end) {
                       {"ru", w.ru},
                       {"unit_weight_N_per_m3", w.unit_weight},
                       {"pore_pressure", w.head_loss_correction ? "head_loss_corrected" : "vertical_head"}};
-  j["source"] = c.rain.enabled ? "rain" : (!w.phreatic.empty() ? "phreatic_surface" : (w.ru > 0.0 ? "ru" : "none"));
+  j["source"] =
+      !c.water_table_raster.empty()
+          ? "table_raster"
+          : (c.rain.enabled ? "rain" : (!w.phreatic.empty() ? "phreatic_surface" : (w.ru > 0.0 ? "ru" : "none")));
+  if (!c.water_table_raster.empty()) j["table_raster"] = c.water_table_raster;
   if (!c.water_history_times.empty()) {
     j["history_times_s"] = c.water_history_times;
     j["history_offsets_m"] = c.water_history_offsets;

@@ -1,5 +1,5 @@
-// The prescribed pore pressure of the SPH solver (pore_pressure.hpp): the soil column of r_u and the
-// pressure head of rain infiltration on a section.
+// The prescribed pore pressure of the SPH solver (pore_pressure.hpp): the soil column of r_u, the
+// pressure head of rain infiltration on a section, the water table over a 3D strip.
 #include "geohaz/sph/pore_pressure.hpp"
 
 #include <algorithm>
@@ -23,6 +23,24 @@ double OverburdenProfile::mass_above(double x, double z) const noexcept {
     lo = hi;
   }
   return m;
+}
+
+double WaterTableGrid::level(double x, double y, double dz) const noexcept {
+  auto locate = [](double v, double v0, double d, int n, int& k, double& w) {
+    const double f = std::clamp((v - v0) / d, 0.0, static_cast<double>(n - 1));
+    k = std::min(static_cast<int>(f), n - 2);
+    w = f - k;
+  };
+  int i = 0, j = 0;
+  double wx = 0.0, wy = 0.0;
+  locate(x, x0, dx, nx, i, wx);
+  locate(y, y0, dy, ny, j, wy);
+  auto at = [&](const std::vector<double>& f) {
+    const std::size_t a = static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i);
+    const std::size_t b = a + static_cast<std::size_t>(nx);
+    return (1.0 - wy) * ((1.0 - wx) * f[a] + wx * f[a + 1]) + wy * ((1.0 - wx) * f[b] + wx * f[b + 1]);
+  };
+  return std::min(at(table) + dz, at(ground));
 }
 
 RainPorePressure::RainPorePressure(const InfiltrationParameters& p, const RainfallHistory& rain,

@@ -60,7 +60,17 @@ std::shared_ptr<const RainPorePressure> rain_pore_pressure(const RunConfig& c);
 /// the initial table (parallel to the ground) for the saturated weights.
 void apply_rain(PoreWater& w, const std::shared_ptr<const RainPorePressure>& rain, double t_rain);
 
-/// The solver's pore water of a config (dry unless [water] has a phreatic surface or r_u).
+/// The water table raster of a 2D DSM section cut along it: (s, z_w) at the profile's points.
+/// InputError naming water.table_raster where the raster has no value.
+std::vector<std::array<double, 2>> section_water_table(const RunConfig& c);
+
+/// The water table raster over a 3D DSM strip: z_w and the DSM's z_g on a grid of the strip's local
+/// coordinates at the particle spacing. InputError naming water.table_raster where the raster has no
+/// value (geometry.width where the strip leaves the DSM).
+std::shared_ptr<const WaterTableGrid> section_water_table_grid(const RunConfig& c);
+
+/// The solver's pore water of a config (dry unless [water] has a phreatic surface, r_u or a table
+/// raster on a section, or [rain] is enabled).
 PoreWaterSettings pore_water_settings(const RunConfig& c);
 
 /// Saturated density below the water table at the start (rain: the initial table): each soil particle of a material
@@ -69,7 +79,7 @@ PoreWaterSettings pore_water_settings(const RunConfig& c);
 template <int Dim>
 void saturate_below_water_table(const RunConfig& c, SphStore<Dim>& s) {
   const auto pw = pore_water_settings(c);
-  if (pw.phreatic.empty() && !pw.rain) return;  // r_u: the materials' own densities, as in Bishop's method
+  if (pw.phreatic.empty() && !pw.rain && !pw.table) return;  // r_u: the materials' own densities, as Bishop's
   const auto& x = s.template get<Position<Dim>>();
   const auto& kind = s.template get<ParticleKind>();
   const auto& mat = s.template get<MaterialId>();
@@ -79,7 +89,13 @@ void saturate_below_water_table(const RunConfig& c, SphStore<Dim>& s) {
     if (kind[i] != static_cast<std::uint8_t>(Kind::Soil)) continue;
     const auto k = static_cast<std::size_t>(mat[i]);
     const double sat = k < c.saturated_densities.size() ? c.saturated_densities[k] : 0.0;
-    const double level = pw.rain ? pw.rain->initial_level(x[i][0]) : pw.level(x[i][0], 0.0);
+    double level = 0.0;
+    if (pw.rain)
+      level = pw.rain->initial_level(x[i][0]);
+    else if (pw.table)
+      level = pw.table->level(x[i][0], x[i][Dim == 3 ? 1 : 0], 0.0);
+    else
+      level = pw.level(x[i][0], 0.0);
     if (!(sat > 0.0) || x[i][Dim - 1] >= level) continue;
     const double f = sat / c.materials[k].density;
     m[i] *= f;

@@ -5,6 +5,10 @@
 /// its position x = (x, [y,] z) in every step (solver.hpp, step 3). One source of water at a time:
 ///   * a phreatic surface z_w(x) (a polyline along axis 0), clipped to the ground z_g(x) and raised
 ///     by the history Δz(t):   u = γ_w max(min(z_w(x) + Δz, z_g(x)) − z, 0);
+///   * on a 3D DSM strip, a water-table surface z_w(x, y) over the strip (cut from the raster
+///     `water.table_raster`, sampled on a grid of the strip's local coordinates, bilinear between its
+///     nodes) clipped to the ground z_g(x, y) of the same grid: u = γ_w max(min(z_w + Δz, z_g) − z, 0)
+///     (a 2D DSM section takes the raster cut along the section as its phreatic polyline);
 ///   * a pore-pressure ratio r_u (Bishop & Morgenstern 1960: u = r_u γ h, γ h the vertical
 ///     overburden stress of the soil column above the point, as Bishop's method takes it on a slice
 ///     base, limit_equilibrium.hpp):   u = r_u g_f ∫_z^{z_g(x)} ρ(z′) dz′,
@@ -76,6 +80,18 @@ class RainPorePressure {
   std::size_t segment_of(double x) const noexcept;
 };
 
+/// A water table over a 3D strip: z_w and the ground z_g on a regular grid of the strip's local
+/// coordinates (x along the section, y across), bilinear between the nodes, clamped at the edges.
+struct WaterTableGrid {
+  double x0 = 0.0, y0 = 0.0;   ///< the first node (m)
+  double dx = 1.0, dy = 1.0;   ///< node spacing (m)
+  int nx = 0, ny = 0;          ///< nodes along x and y (≥ 2 each)
+  std::vector<double> table;   ///< z_w at node (i, j), index j·nx + i (m)
+  std::vector<double> ground;  ///< z_g at the nodes (m)
+  /// min(z_w(x, y) + dz, z_g(x, y)) (m).
+  double level(double x, double y, double dz) const noexcept;
+};
+
 /// Prescribed pore water (see the file comment): a phreatic surface (along axis 0; uniform across a
 /// 3D width), or r_u with the overburden profile. Default: dry.
 struct PoreWaterSettings {
@@ -87,7 +103,8 @@ struct PoreWaterSettings {
   double ru = 0.0;                               ///< r_u in [0, 1); > 0: u = r_u σ_v (no phreatic surface)
   OverburdenProfile overburden;                  ///< the soil column of r_u
   std::shared_ptr<const RainPorePressure> rain;  ///< rain infiltration (no phreatic surface, no r_u); null: none
-  bool active() const noexcept { return !phreatic.empty() || ru > 0.0 || rain; }
+  std::shared_ptr<const WaterTableGrid> table;   ///< 3D DSM strip: the table over the strip; null: none
+  bool active() const noexcept { return !phreatic.empty() || ru > 0.0 || rain || table; }
   /// Δz(t) (m).
   double offset(double t) const noexcept;
   /// Elevation of the (clipped) water table at x with offset dz (m).
@@ -116,6 +133,8 @@ struct PoreWaterStep {
   double pressure(const Vec<Dim>& x) const noexcept {
     if (pw->ru > 0.0) return pw->ru * g * pw->overburden.mass_above(x[0], x[Dim - 1]);
     if (pw->rain) return gamma_w * std::max(pw->rain->head(x[0], x[Dim - 1], t_rain), 0.0);
+    if constexpr (Dim == 3)
+      if (pw->table) return gamma_w * std::max(pw->table->level(x[0], x[1], dz) - x[2], 0.0);
     return gamma_w * std::max(pw->level(x[0], dz) - x[Dim - 1], 0.0);
   }
 };
