@@ -29,8 +29,8 @@ def run(config, *, set=None, out=None, progress=None, progress_every=1, quiet=Tr
     stem: {column: float64 array}}: series, structure_forces, stress_strain, surface_final,
     slip_surface; srm_trials, srm_curve, bishop_circle for a strength reduction), "particles"
     (final state, or the failure mechanism of a strength reduction: position, velocity and
-    displacement (n, dim), stress (n, 3, 3) in Pa, plastic_strain, density, mass (n,), material_id,
-    kind (0 soil), id), "resolved_config" (TOML text), "out", "threads".
+    displacement (n, dim), stress (n, 3, 3) in Pa, plastic_strain, pore_pressure (Pa, the prescribed
+    u, 0 when dry), density, mass (n,), material_id, kind (0 soil), id), "resolved_config" (TOML text), "out", "threads".
 
     Raises geohaz.InputError (the app's message, attributes file, key, value, reason; nothing
     written), SimulationError, IoError.

@@ -46,6 +46,7 @@ py::dict particle_arrays(const ParticleFields& f) {
   d["displacement"] = array_of(f.displacement, {n, dim});
   d["stress"] = array_of(f.stress, {n, 3, 3});
   d["plastic_strain"] = array_of(f.plastic_strain, {n});
+  d["pore_pressure"] = array_of(f.pore_pressure, {n});
   d["density"] = array_of(f.density, {n});
   d["mass"] = array_of(f.mass, {n});
   d["material_id"] = array_of(f.material_id, {n});

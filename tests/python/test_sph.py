@@ -69,6 +69,20 @@ def test_the_particle_fields_are_the_final_state_of_the_summary(tmp_path, data):
     assert r["out"] is None and r["tables"]["series"]["time_s"][-1] == pytest.approx(s["end_time_s"], abs=0)
 
 
+def test_the_pore_pressure_is_a_particle_field(data):
+    # r_u = 0.25 on the example slope: every soil particle's u, the largest of which the summary reports
+    # (at the series' rows: the last row is this state, the slope at rest, so within 1e-6 of it).
+    r = geohaz.sph.run(data / "sph/slope_water_newmark.toml", threads=1,
+                       set={"run.analysis": "dynamic", "earthquake.type": "none", "water.phreatic": [],
+                            "water.ru": 0.25, "numerics.spacing": 2.0, "run.end_time": 0.02})
+    s, f = r["summary"], r["particles"]
+    soil = f["kind"] == 0
+    assert f["pore_pressure"].shape == f["density"].shape
+    assert s["water"]["source"] == "ru" and s["water"]["ru"] == 0.25
+    assert f["pore_pressure"][soil].max() == pytest.approx(s["water"]["max_pore_pressure_Pa"], rel=1e-6)
+    assert np.all(f["pore_pressure"][~soil] == 0)
+
+
 @pytest.mark.parametrize("bad", [
     {"no.such_key": 1},                                   # unknown key
     {"run.end_time": -1.0},                               # out of range

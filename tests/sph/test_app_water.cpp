@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -15,7 +16,9 @@
 
 #include "geohaz/sph/loading.hpp"
 #include "geohaz/sph/newmark.hpp"
+#include "geohaz/sph/summary_keys.hpp"
 #include "run_command.hpp"
+#include "summary_keys_check.hpp"
 
 namespace {
 
@@ -36,9 +39,12 @@ Result run(const std::string& args, const std::string& name) {
   return {r.code, r.output};
 }
 
+/// The run's summary.json, every number of which must have a declared label and unit (issue #33).
 nlohmann::json summary(const fs::path& dir) {
   std::ifstream in(dir / "summary.json");
-  return nlohmann::json::parse(in);
+  nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_SUMMARY_KEYS_DECLARED(j, geohaz::sph::summary_keys());
+  return j;
 }
 
 const std::string kAcads = (kData / "acads_1a_srm.toml").string();
@@ -150,20 +156,85 @@ TEST(SphSlopeWater, StrengthReductionWithWaterTableAgreesWithBishop) {
   EXPECT_NEAR(F, Fb, 0.05 * Fb);
 }
 
+// Strength reduction with a pore-pressure ratio r_u = 0.25 (u = r_u times the overburden stress at every
+// particle, the same key as Bishop's) on the example's slope with c′ = 5 kPa at Δx = 1 m: Bishop with the
+// same r_u gives 1.033, and the bracket [0.98, 1.08] is its ±5 % (−5.1 %, +4.5 %): the outcome
+// "bracketed" (f_min stable, f_max failed) puts F within it (1.030), three trials (ΔF = 0.05). About
+// 5 s on one thread.
+TEST(SphSlopeWater, StrengthReductionWithPorePressureRatioAgreesWithBishop) {
+  const fs::path out = kWork / "srm_ru";
+  fs::remove_all(out);
+  const auto r = run("--config " + kWater + " --out " + out.string() +
+                         " --set run.analysis=strength_reduction --set earthquake.type=none"
+                         " --set numerics.spacing=1.0 --set material[0].cohesion=5000"
+                         " --set water.phreatic=[] --set water.ru=0.25 --set strength_reduction.f_min=0.98"
+                         " --set strength_reduction.f_max=1.08 --set strength_reduction.tolerance=0.05 --quiet",
+                     "srm_ru");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto s = summary(out);
+  EXPECT_EQ(s["outcome"], "bracketed");
+  const double F = s["factor_of_safety"].get<double>(), Fb = s["bishop"]["factor"].get<double>();
+  std::printf("r_u = 0.25: strength reduction %.4f, Bishop %.4f\n", F, Fb);
+  EXPECT_NEAR(Fb, 1.033, 0.002);
+  EXPECT_NEAR(F, Fb, 0.05 * Fb);
+}
+
+// The rain example (data/sph/slope_rain.toml) shrunk: the 12 h of rain in 2 s of a 3 s main phase.
+// The summary reports the rain, its clock and the largest pore pressure (the deepest particle under
+// the crest, 14.5 m below the ground with the table at 6 m: ψ ≥ 8.5 m, 83 kPa at the start), the
+// series the rain's time; Bishop's factor falls from the dry slope's (the initial table lies below
+// its circle) to below 1 at the rain's end, and the slope moves (more than 10 cm). About 4 s.
+TEST(SphSlopeWater, RainExampleReportsTheRainItsClockAndPorePressure) {
+  const fs::path out = kWork / "rain_example";
+  fs::remove_all(out);
+  const auto r = run("--config " + (kData / "slope_rain.toml").string() + " --out " + out.string() +
+                         " --set run.end_time=3 --set rain.clock_times=[0,0,2,43200] --set run.snapshot_interval=0"
+                         " --quiet",
+                     "rain_example");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto s = summary(out);
+  const auto& w = s["water"];
+  EXPECT_EQ(w["source"], "rain");
+  EXPECT_EQ(w["rain"]["rain_time_at_end_s"].get<double>(), 43200.0);
+  EXPECT_EQ(w["rain"]["water_table_depth_m"].get<double>(), 6.0);
+  EXPECT_NEAR(w["rain"]["depth_m"].get<double>(), 0.432, 1e-12);  // 36 mm/h for 12 h
+  EXPECT_GT(w["max_pore_pressure_Pa"].get<double>(), 1000.0 * 9.81 * 8.5);
+  EXPECT_GT(s["bishop"]["factor"].get<double>(), 1.3);
+  EXPECT_LT(w["rain"]["bishop_factor_at_end"].get<double>(), 1.0);
+  EXPECT_GT(s["max_displacement_m"].get<double>(), 0.1);
+  std::ifstream series(out / "series.csv");
+  std::string header;
+  std::getline(series, header);
+  EXPECT_NE(header.find("max_pore_pressure_Pa"), std::string::npos) << header;
+  EXPECT_NE(header.find("rain_time_s"), std::string::npos) << header;
+}
+
 // Bad water input: exit 2 naming the key, nothing written.
 TEST(SphSlopeWater, BadWaterInputExitsTwoNamingTheKey) {
   const fs::path out = kWork / "bad_water";
   for (const auto& [sets, key] : std::vector<std::pair<std::string, std::string>>{
            {"water.ru=1.0", "water.ru"},
            {"water.ru=-0.1", "water.ru"},
-           {"water.phreatic=[0,20,65,20]", "water.phreatic"},                     // above the ground everywhere
-           {"water.phreatic=[0,12,25]", "water.phreatic"},                        // not pairs
-           {"water.phreatic=[30,12,25,11]", "water.phreatic"},                    // x decreasing
-           {"material[0].saturated_density=1900", "material.saturated_density"},  // below the density
-           {"water.ru=0.2 --set water.phreatic=[0,12,65,5]", "water.ru"},         // both
-           {"run.analysis=dynamic --set water.phreatic=[] --set water.ru=0.2", "water.ru"},  // SPH: a table
-           {"water.history_times=[0,5]", "water.history_offsets"},                           // lengths differ
-           {"run.analysis=dynamic --set water.phreatic=[] --set seismic.kh=0.1", "seismic.kh"}}) {
+           {"water.phreatic=[0,20,65,20]", "water.phreatic"},                           // above the ground everywhere
+           {"water.phreatic=[0,12,25]", "water.phreatic"},                              // not pairs
+           {"water.phreatic=[30,12,25,11]", "water.phreatic"},                          // x decreasing
+           {"material[0].saturated_density=1900", "material.saturated_density"},        // below the density
+           {"water.ru=0.2 --set water.phreatic=[0,12,65,5]", "water.ru"},               // both
+           {"run.dimension=3 --set water.phreatic=[] --set water.ru=0.2", "water.ru"},  // 2D slope only
+           {"water.history_times=[0,5]", "water.history_offsets"},                      // lengths differ
+           {"run.analysis=dynamic --set water.phreatic=[] --set seismic.kh=0.1", "seismic.kh"},
+           {"run.analysis=dynamic --set rain.enabled=true", "rain.enabled"},  // and a phreatic surface
+           {"run.analysis=strength_reduction --set water.phreatic=[] --set rain.enabled=true", "rain.enabled"},
+           {"run.analysis=dynamic --set water.phreatic=[] --set rain.enabled=true --set rain.clock_times=[0,0,5]",
+            "rain.clock_times"},  // not pairs
+           {"run.analysis=dynamic --set water.phreatic=[] --set rain.enabled=true --set "
+            "rain.clock_times=[0,0,5,10,4,20]",
+            "rain.clock_times"},  // the run's time decreasing
+           {"hydrology.conductivity=-1e-5", "hydrology.conductivity"},
+           {"hydrology.steady_infiltration=2e-5", "hydrology.steady_infiltration"},  // above K_s
+           {"run.analysis=dynamic --set water.phreatic=[] --set rain.enabled=true --set "
+            "hydrology.steady_infiltration=9e-6",
+            "hydrology.steady_infiltration"}}) {  // above K_s cos^2 of the face (0.8 K_s)
     fs::remove_all(out);
     const auto r = run("--config " + kWater + " --out " + out.string() + " --set " + sets, "bad_water");
     EXPECT_EQ(r.code, 2) << sets << ": " << r.err;

@@ -17,6 +17,7 @@
 #include "geohaz/core/config.hpp"
 #include "geohaz/sph/config.hpp"
 #include "geohaz/sph/limit_equilibrium.hpp"
+#include "geohaz/sph/pore_pressure.hpp"
 #include "geohaz/sph/run.hpp"
 
 namespace {
@@ -106,6 +107,28 @@ TEST(SphPoreWater, SaturatedSlopeCarriesBuoyantEffectiveStressAndStaysAtRest) {
   }
 }
 
+// A pore-pressure ratio r_u = 0.3 (u = r_u times the overburden stress at every particle): under the
+// level ground in front of the toe the total vertical stress is still the weight, so the effective
+// stress carries the rest, σ′_zz = −(1 − r_u) γ d. The ratio to it agrees with the dry deposit's ratio
+// to −γ d within 2 % (as the saturated deposit above: both share the surface row's discretisation).
+TEST(SphPoreWater, DepositUnderPorePressureRatioCarriesTheReducedEffectiveStress) {
+  auto start = [](const std::vector<std::string>& more) {
+    RunConfig c = slope_config(more);
+    SphSimulation sim(c);
+    AtStart obs;
+    sim.run(&obs);
+    return obs.fields;
+  };
+  const double ru = 0.3;
+  const auto dry = start({"water.phreatic=[]", "run.end_time=0.05", "material[0].cohesion=50000"});
+  const auto wet = start({"water.phreatic=[]", "water.ru=0.3", "run.end_time=0.05", "material[0].cohesion=50000"});
+  const double r_dry = vertical_stress_ratio(dry, kRho * kG);
+  const double r_ru = vertical_stress_ratio(wet, (1.0 - ru) * kRho * kG);
+  std::printf("sigma'_zz / (-gamma' d): dry %.4f, r_u = 0.3 %.4f\n", r_dry, r_ru);
+  EXPECT_NEAR(r_dry, 1.0, 0.1);
+  EXPECT_NEAR(r_ru, r_dry, 0.02 * r_dry);
+}
+
 /// The level L (m, elevation) of a horizontal water table, drawn down the face and clipped to the
 /// ground as the SPH's, at which Bishop's critical factor is 1 (bisection to 1 cm).
 double bishop_failure_level() {
@@ -159,6 +182,78 @@ TEST(SphPoreWater, RisingWaterTableFailsTheSlopeAtBishopsLevel) {
   const auto [s75, s100] = trial(0.95 * Ls);
   EXPECT_LT(s100 - s75, 0.05 * s100);  // converged: stable
   const auto [f75, f100] = trial(1.05 * Ls);
+  EXPECT_TRUE(f100 - f75 > 0.05 * f100 || f100 > 5.0 * s100) << f75 << " " << f100;
+}
+
+/// The rain of the rain tests: 36 mm/h (= K_s: all of it infiltrates) for 12 h on a soil of
+/// D_0 = 1e-3 m²/s with the initial water table 6 m below the ground (keys of slope-stability).
+const std::vector<std::string> kRain = {"rain.enabled=true",
+                                        "water.phreatic=[]",
+                                        "hydrology.conductivity=1e-5",
+                                        "hydrology.diffusivity=1e-3",
+                                        "hydrology.water_table_depth=6",
+                                        "rain.step=43200",
+                                        "rain.intensity=[1e-5]",
+                                        "material[0].saturated_density=0"};
+
+/// The rain time t_B (s) at which Bishop's critical factor with the rain's pore pressure reaches 1
+/// (bisection to 10 s between 0 and 12 h; F(0) > 1 > F(12 h)).
+double bishop_failure_rain_time() {
+  SlopeGeometry g;
+  g.height = 10.0;
+  g.gradient = 2.0;
+  g.crest_length = 25.0;
+  g.front_length = 20.0;
+  g.base_thickness = 5.0;
+  auto s = SlopeSection::from_profile(g.profile(), {{kRho * kG, 5000.0, 25.0 * std::numbers::pi / 180.0}});
+  InfiltrationParameters p;
+  p.conductivity = 1e-5;
+  p.diffusivity = 1e-3;
+  const RainPorePressure rain(p, RainfallHistory::uniform_steps(43200.0, {1e-5}), g.profile().surface, 6.0, {});
+  auto factor = [&](double t) {
+    s.water.pressure_field = [&](double x, double z) { return kRhoW * kG * std::max(rain.head(x, z, t), 0.0); };
+    return bishop_critical_circle(s).factor;
+  };
+  double lo = 0.0, hi = 43200.0;
+  EXPECT_GT(factor(lo), 1.0);
+  EXPECT_LT(factor(hi), 1.0);
+  while (hi - lo > 10.0) {
+    const double mid = 0.5 * (lo + hi);
+    (factor(mid) > 1.0 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+// Rain as a loading history: the marginal slope (dry F = 1.35) stands under the initial water table
+// and fails when the rain-driven pressure head passes the level at which Bishop's factor with the
+// same pore pressure is 1. The rain's clock runs the rain to a rain time t over the first 5 s of the
+// main phase and holds it for 5 s (rain.clock_times = [0, 0, 5, t]): at t = 0.95 t_B the slope comes
+// to rest again (its displacement grew by less than 5 % over the last quarter), at 1.05 t_B it fails
+// (grew by more, or ended beyond 5x the stable run's). 5 % of the time (about 0.035 in Bishop's F
+// here, where F falls by 0.1 per hour of rain), as the issue asks.
+TEST(SphPoreWater, RainFailsTheSlopeAtBishopsTime) {
+  const double tb = bishop_failure_rain_time();
+  std::printf("Bishop: F = 1 after %.0f s (%.2f h) of rain\n", tb, tb / 3600.0);
+  ASSERT_GT(tb, 3600.0);
+  ASSERT_LT(tb, 36000.0);
+  auto trial = [](double t) {
+    auto sets = kRain;
+    sets.push_back("run.end_time=10");
+    sets.push_back("rain.clock_times=[0,0,5," + std::to_string(t) + "]");
+    RunConfig c = slope_config(sets);
+    SphSimulation sim(c);
+    sim.run();
+    const auto time = series(sim, "time_s"), u = series(sim, "max_displacement_m");
+    double u75 = 0.0;
+    for (std::size_t k = 0; k < time.size(); ++k)
+      if (time[k] <= 7.5 + 1e-9) u75 = u[k];
+    std::printf("rain time %.0f s: displacement %.4g m at 7.5 s, %.4g m at 10 s (rain time %.0f s)\n", t, u75, u.back(),
+                series(sim, "rain_time_s").back());
+    return std::pair{u75, u.back()};
+  };
+  const auto [s75, s100] = trial(0.95 * tb);
+  EXPECT_LT(s100 - s75, 0.05 * s100);  // converged: stable
+  const auto [f75, f100] = trial(1.05 * tb);
   EXPECT_TRUE(f100 - f75 > 0.05 * f100 || f100 > 5.0 * s100) << f75 << " " << f100;
 }
 

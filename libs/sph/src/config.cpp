@@ -7,6 +7,7 @@
 #include <memory>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -298,8 +299,8 @@ void read_geostatic_and_earthquake(ConfigReader& r, RunConfig& c) {
 }
 
 /// [output].
-/// [water] and [seismic]: the pore water and the pseudo-static coefficients of the limit-equilibrium
-/// analysis (docs/sph.md, "Pore pressure and seismic coefficients").
+/// [water], [rain], [hydrology] and [seismic]: the pore water, the rain and the pseudo-static
+/// coefficients (docs/sph.md, "Pore pressure and seismic coefficients").
 void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
   auto& w = c.water;
   const auto line = r.get_array("water.phreatic", {}, {},
@@ -311,7 +312,9 @@ void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
                      std::to_string(line.size()) + " numbers");
   for (std::size_t k = 0; k + 1 < line.size(); k += 2) w.phreatic.push_back({line[k], line[k + 1]});
   w.ru = r.get("water.ru", 0.0, Range::closed_open(0.0, 1.0),
-               {"1", "pore-pressure ratio r_u = u / (gamma h) on the slice bases (not with water.phreatic)"});
+               {"1",
+                "pore-pressure ratio r_u = u / (gamma h): u = r_u times the vertical overburden stress on Bishop's "
+                "slice bases and at every SPH particle (2D slope; not with water.phreatic)"});
   const double rho_w = r.get("water.density", 1000.0, Range::closed(900.0, 1300.0), {"kg/m^3", "density of water"});
   w.unit_weight = rho_w * c.numerics.gravity;
   w.head_loss_correction =
@@ -326,6 +329,39 @@ void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
   c.water_history_offsets =
       r.get_array("water.history_offsets", {}, {},
                   {"m", "rise of the phreatic surface at those times (linear between, held after; + up)"});
+  {
+    const auto table = r.get_string("water.table_raster", "",
+                                    {"",
+                                     "raster of the water table's elevation (m) in the DSM's CRS: a DSM section's "
+                                     "phreatic surface, cut along the section (2D) or sampled over the strip (3D); "
+                                     "clipped to the ground; not with water.phreatic, water.ru or rain"});
+    if (!table.empty())
+      c.water_table_raster = std::filesystem::path(table).is_absolute() ? table : (r.base_dir() / table).string();
+  }
+  // [rain] and [hydrology]: the keys and reader of slope-stability (infiltration.hpp), here a loading history.
+  c.rain.enabled = r.get_bool("rain.enabled", false,
+                              {"",
+                               "rain infiltration (Iverson 2000, as slope-stability: [rain], [hydrology]) as the "
+                               "pore pressure of the main phase (2D slope, run.analysis = dynamic; not with "
+                               "water.phreatic or water.ru)"});
+  c.rain.infiltration = read_infiltration_keys(r);
+  const auto clock = r.get_array("rain.clock_times", {}, Range::non_negative(),
+                                 {"s",
+                                  "the rain's clock: pairs t, t_rain of main-phase time t and the rain's time t_rain "
+                                  "there, linear between, held beyond (e.g. [0, 0, 10, 86400]: a day of rain in 10 s "
+                                  "of SPH); empty: t_rain = t"});
+  if (clock.size() % 2 || clock.size() == 2)
+    throw InputError("needs pairs t, t_rain of at least two points", r.source(), "rain.clock_times",
+                     std::to_string(clock.size()) + " numbers");
+  for (std::size_t k = 0; k + 1 < clock.size(); k += 2) {
+    if (k > 0 && !(clock[k] > clock[k - 2]))
+      throw InputError("the main-phase times t must increase", r.source(), "rain.clock_times",
+                       std::to_string(clock[k]));
+    if (k > 0 && clock[k + 1] < clock[k - 1])
+      throw InputError("the rain's times t_rain must not decrease", r.source(), "rain.clock_times",
+                       std::to_string(clock[k + 1]));
+    c.rain.clock.push_back({clock[k], clock[k + 1]});
+  }
   c.seismic.kh = r.get("seismic.kh", 0.0, Range::closed_open(0.0, 1.0),
                        {"1",
                         "horizontal pseudo-static coefficient: a force k_h W in the direction of sliding "
@@ -469,6 +505,24 @@ void read_walls_clamp_and_initial_velocity(ConfigReader& r, RunConfig& c, bool d
   }
 }
 
+/// The water-table raster of a DSM section (water.table_raster): readable, in the DSM's CRS.
+std::shared_ptr<const Terrain> read_water_table(const ConfigReader& r, const std::string& path, const Raster& dsm) {
+  Raster t;
+  try {
+    t = read_raster(path);
+  } catch (const InputError& e) {  // name the key the raster comes from
+    throw InputError(e.reason() + " (" + path + ")", r.source(), "water.table_raster", path);
+  }
+  if (!crs_equal(t.crs_wkt, dsm.crs_wkt))
+    throw InputError("must be in the DSM's CRS (" + crs_label(dsm.crs_wkt) + "; it is in " + crs_label(t.crs_wkt) + ")",
+                     r.source(), "water.table_raster", path);
+  try {
+    return std::make_shared<const Terrain>(std::move(t));
+  } catch (const InputError& e) {
+    throw InputError(e.reason() + " (" + path + ")", r.source(), "water.table_raster", path);
+  }
+}
+
 /// [section]: the DSM is read and the profile extracted here (not in describe mode).
 void read_section(ConfigReader& r, RunConfig& c, bool describe) {
   const auto& n = c.numerics;
@@ -517,6 +571,7 @@ void read_section(ConfigReader& r, RunConfig& c, bool describe) {
       c.section.crs_wkt = raster->crs_wkt;
       c.section.dsm = raster;
       c.section.terrain = std::make_shared<const Terrain>(*raster);
+      if (!c.water_table_raster.empty()) c.section.water_table = read_water_table(r, c.water_table_raster, *raster);
     }
   }
 }

@@ -2,12 +2,25 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <numbers>
+#include <sstream>
 #include <string>
 
+#include "geohaz/core/config.hpp"
 #include "geohaz/core/errors.hpp"
 
 namespace geohaz::sph {
+
+namespace {
+
+std::string number(double v) {
+  std::ostringstream o;
+  o << std::setprecision(6) << v;
+  return o.str();
+}
+
+}  // namespace
 
 RainfallHistory RainfallHistory::uniform_steps(double step, const std::vector<double>& intensities) {
   RainfallHistory r;
@@ -95,6 +108,30 @@ double InfiltrationHistory::response_sum(double t, double inv_zstar) const noexc
 
 double InfiltrationHistory::pressure_head(double Z, double t, double slope, double d) const noexcept {
   return std::min(pressure_head_uncapped(Z, t, slope, d), beta(slope) * Z);
+}
+
+InfiltrationKeys read_infiltration_keys(ConfigReader& cfg) {
+  InfiltrationKeys k;
+  auto& h = k.hydrology;
+  h.conductivity = cfg.get("hydrology.conductivity", h.conductivity, Range::positive(),
+                           {"m/s", "saturated hydraulic conductivity K_s (rain beyond it runs off)"});
+  h.diffusivity = cfg.get("hydrology.diffusivity", h.diffusivity, Range::positive(),
+                          {"m^2/s", "maximum hydraulic diffusivity D_0 (= K_s / specific storage)"});
+  h.steady_flux = cfg.get("hydrology.steady_infiltration", h.steady_flux, Range::non_negative(),
+                          {"m/s", "long-term infiltration rate I_ZLT before the rain (< K_s cos^2 delta)"});
+  k.water_table_depth =
+      cfg.get("hydrology.water_table_depth", k.water_table_depth, Range::non_negative(),
+              {"m", "initial water table depth d below the ground, vertical (>= 0: not above the ground)"});
+  const double step = cfg.get("rain.step", 3600.0, Range::open_closed(0.0, 1e7), {"s", "length of each rain step"});
+  const std::vector<double> intensity =
+      cfg.get_array("rain.intensity", {2.78e-6}, Range::closed(0.0, 1e-2),
+                    {"m/s", "intensity of each step in turn (1 mm/h = 2.778e-7 m/s); then no rain"});
+  k.rain = RainfallHistory::uniform_steps(step, intensity);
+  if (h.steady_flux >= h.conductivity)
+    throw InputError("the long-term infiltration must be below K_s (" + number(h.conductivity) + " m/s)", cfg.source(),
+                     "hydrology.steady_infiltration", number(h.steady_flux));
+  k.rain.validate(cfg.source().c_str(), "rain.intensity");
+  return k;
 }
 
 }  // namespace geohaz::sph

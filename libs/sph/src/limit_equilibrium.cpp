@@ -187,7 +187,9 @@ BishopResult bishop_mass(const SlopeSection& s, const SlipCircle& c, double x0, 
     const double arc = c.radius * std::abs(std::asin(std::clamp((x + 0.5 * b - c.xc) / c.radius, -1.0, 1.0)) -
                                            std::asin(std::clamp((x - 0.5 * b - c.xc) / c.radius, -1.0, 1.0)));
     double u = 0.0;
-    if (phreatic)
+    if (s.water.pressure_field)
+      u = s.water.pressure_field(x, zb);
+    else if (phreatic)
       u = s.water.pressure_at(x, zb);
     else if (s.water.ru > 0.0)
       u = s.water.ru * col.w;  // r_u = u / (γ h), γ h the soil column's weight per area

@@ -2,9 +2,11 @@
 // section of a 2D slope with its pore water and seismic coefficients, the checks of [water] and
 // [seismic], the Newmark report (docs/sph.md, "Pore pressure and seismic coefficients"), and the
 // static Bishop check beside the dynamic run and the strength reduction.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <string>
 #include <variant>
@@ -46,9 +48,30 @@ SlopeSection limit_equilibrium_section(const RunConfig& c, bool with_water_and_s
     // Beside an SPH run, the SPH's water table: clipped to the ground (no ponded water).
     if (c.analysis != Analysis::LimitEquilibrium && !c.water.phreatic.empty())
       s.water.phreatic = clipped_phreatic_surface(c);
+    // Rain: its pore pressure at the start of the main phase.
+    if (c.rain.enabled) {
+      const auto rain = rain_pore_pressure(c);
+      apply_rain(s.water, rain, rain->rain_time(0.0));
+    }
     s.seismic = c.seismic;
   }
   return s;
+}
+
+std::shared_ptr<const RainPorePressure> rain_pore_pressure(const RunConfig& c) {
+  const auto& k = c.rain.infiltration;
+  return std::make_shared<const RainPorePressure>(k.hydrology, k.rain, c.slope.profile().surface, k.water_table_depth,
+                                                  c.rain.clock);
+}
+
+void apply_rain(PoreWater& w, const std::shared_ptr<const RainPorePressure>& rain, double t_rain) {
+  // The initial table, parallel to the ground, sets where the soil weighs its saturated unit weight
+  // (as the SPH's particles, saturate_below_water_table); the rain's head gives u.
+  w.phreatic.clear();
+  for (const auto& p : rain->ground()) w.phreatic.push_back({p[0], p[1] - rain->water_table_depth()});
+  w.pressure_field = [rain, gw = w.unit_weight, t_rain](double x, double z) {
+    return gw * std::max(rain->head(x, z, t_rain), 0.0);
+  };
 }
 
 std::vector<std::array<double, 2>> clipped_phreatic_surface(const RunConfig& c) {
@@ -63,28 +86,155 @@ std::vector<std::array<double, 2>> clipped_phreatic_surface(const RunConfig& c) 
   return out;
 }
 
+std::vector<std::array<double, 2>> section_water_table(const RunConfig& c) {
+  std::vector<std::array<double, 2>> cut;
+  for (const auto& p : c.section.profile) {
+    const double z = c.section.water_table->elevation(p.x, p.y);
+    if (!std::isfinite(z))
+      throw InputError("the water table raster has no value at the section's point (" + csv_number(p.x) + ", " +
+                           csv_number(p.y) + ") (s = " + csv_number(p.s) +
+                           " m): it must cover the section, without nodata",
+                       c.config_source, "water.table_raster", c.water_table_raster);
+    cut.push_back({p.s, z});
+  }
+  return cut;
+}
+
+std::shared_ptr<const WaterTableGrid> section_water_table_grid(const RunConfig& c) {
+  const auto& P = c.section.profile;
+  const double dx = c.numerics.spacing, width = strip_width(c), half = 0.5 * width;
+  auto g = std::make_shared<WaterTableGrid>();
+  const double length = P.back().s - P.front().s;
+  g->x0 = P.front().s;
+  g->nx = std::max(2, static_cast<int>(std::ceil(length / dx)) + 1);
+  g->dx = length / (g->nx - 1);
+  g->y0 = 0.0;
+  g->ny = std::max(2, static_cast<int>(std::ceil(width / dx)) + 1);
+  g->dy = width / (g->ny - 1);
+  for (int j = 0; j < g->ny; ++j)
+    for (int i = 0; i < g->nx; ++i) {
+      const Vec2 q = section_map_point(P, g->x0 + i * g->dx, g->y0 + j * g->dy - half);
+      const double zw = c.section.water_table->elevation(q.x(), q.y()), zg = c.section.terrain->elevation(q.x(), q.y());
+      if (!std::isfinite(zw))
+        throw InputError("the water table raster has no value at (" + csv_number(q.x()) + ", " + csv_number(q.y()) +
+                             ") on the 3D strip: it must cover the strip, without nodata",
+                         c.config_source, "water.table_raster", c.water_table_raster);
+      if (!std::isfinite(zg))
+        throw InputError("the 3D section strip leaves the DSM's data at (" + csv_number(q.x()) + ", " +
+                             csv_number(q.y()) + "): narrow geometry.width or move the polyline",
+                         c.config_source, "geometry.width", csv_number(c.width));
+      g->table.push_back(zw);
+      g->ground.push_back(zg);
+    }
+  return g;
+}
+
 PoreWaterSettings pore_water_settings(const RunConfig& c) {
   PoreWaterSettings pw;
-  if (c.water.phreatic.empty() || c.scenario != ScenarioType::Slope || c.dimension != 2) return pw;
+  if (c.scenario == ScenarioType::Section && c.section.water_table) {
+    // A DSM section: the raster cut along the section (2D, clipped to the profile) or over the strip (3D).
+    pw.density = c.numerics.gravity > 0.0 ? c.water.unit_weight / c.numerics.gravity : 1000.0;
+    pw.history_times = c.water_history_times;
+    pw.history_offsets = c.water_history_offsets;
+    if (c.dimension == 2) {
+      pw.phreatic = section_water_table(c);
+      pw.ground = section_profile(c).surface;
+    } else {
+      pw.table = section_water_table_grid(c);
+    }
+    return pw;
+  }
+  if (!(c.water.active() || c.rain.enabled) || c.scenario != ScenarioType::Slope || c.dimension != 2) return pw;
+  pw.density = c.numerics.gravity > 0.0 ? c.water.unit_weight / c.numerics.gravity : 1000.0;
+  if (c.rain.enabled) {
+    pw.rain = rain_pore_pressure(c);
+    return pw;
+  }
+  if (c.water.ru > 0.0) {
+    // u = r_u σ_v: the soil column above the particle in the slope's initial profile and layers, as
+    // Bishop's slices take it (limit_equilibrium.cpp, column_of).
+    ProfileDomain d = c.slope.profile();
+    apply_layers(d, c);
+    pw.ru = c.water.ru;
+    pw.overburden.ground = d.surface;
+    pw.overburden.tops = d.layer_materials.empty() ? std::vector<double>{} : d.layer_tops;
+    if (d.layer_materials.empty())
+      pw.overburden.densities = {c.materials.front().density};
+    else
+      for (const int m : d.layer_materials)
+        pw.overburden.densities.push_back(c.materials[static_cast<std::size_t>(m)].density);
+    return pw;
+  }
   pw.phreatic = c.water.phreatic;
   pw.ground = c.slope.profile().surface;
-  pw.density = c.numerics.gravity > 0.0 ? c.water.unit_weight / c.numerics.gravity : 1000.0;
   pw.history_times = c.water_history_times;
   pw.history_offsets = c.water_history_offsets;
   return pw;
 }
 
+namespace {
+
+/// The checks of water.table_raster: a DSM section, one source of water, the raster covering the
+/// section (or strip) and lying below the ground somewhere.
+void validate_water_table(const RunConfig& c) {
+  if (c.water_table_raster.empty()) return;
+  const std::string& src = c.config_source;
+  const char* key = "water.table_raster";
+  if (c.scenario != ScenarioType::Section)
+    throw InputError("a water table raster needs a DSM section (run.scenario = section); a slope takes water.phreatic",
+                     src, key, c.water_table_raster);
+  if (!c.water.phreatic.empty() || c.water.ru > 0.0 || c.rain.enabled)
+    throw InputError("one source of pore water at a time: water.table_raster, water.phreatic, water.ru or rain", src,
+                     key, c.water_table_raster);
+  if (!c.section.water_table) return;
+  bool below = false;
+  if (c.dimension == 2) {
+    const auto cut = section_water_table(c);
+    for (std::size_t k = 0; k < cut.size(); ++k) below = below || cut[k][1] < c.section.profile[k].z;
+  } else {
+    const auto g = section_water_table_grid(c);
+    for (std::size_t k = 0; k < g->table.size(); ++k) below = below || g->table[k] < g->ground[k];
+  }
+  if (!below)
+    throw InputError("the water table lies above the ground over the whole section", src, key, c.water_table_raster);
+}
+
+/// The checks of [rain] in sph-slope: one source of water, the 2D slope, a dynamic run, β > 0 on
+/// every segment of the ground.
+void validate_rain(const RunConfig& c) {
+  const std::string& src = c.config_source;
+  if (!c.water.phreatic.empty() || c.water.ru > 0.0)
+    throw InputError("one source of pore water at a time: rain, water.phreatic or water.ru", src, "rain.enabled",
+                     "true");
+  if (c.scenario != ScenarioType::Slope || c.dimension != 2)
+    throw InputError("rain needs the 2D slope scenario", src, "rain.enabled", "true");
+  if (c.analysis != Analysis::Dynamic)
+    throw InputError(
+        "rain is a loading history of the main phase: it needs run.analysis = dynamic (the strength reduction "
+        "and the limit-equilibrium analysis take water.phreatic or water.ru)",
+        src, "rain.enabled", "true");
+  const auto& h = c.rain.infiltration.hydrology;
+  const auto ground = c.slope.profile().surface;
+  for (std::size_t k = 1; k < ground.size(); ++k) {
+    const double dx = ground[k][0] - ground[k - 1][0], dz = ground[k][1] - ground[k - 1][1];
+    const double cos2 = dx * dx / (dx * dx + dz * dz);
+    if (dx > 0.0 && !(h.steady_flux / h.conductivity < cos2))
+      throw InputError("the long-term infiltration I_ZLT/K_s must be below cos^2 of the slope's face (" +
+                           std::to_string(cos2) + "): no steady slope-parallel flow otherwise",
+                       src, "hydrology.steady_infiltration", std::to_string(h.steady_flux));
+  }
+}
+
+}  // namespace
+
 void validate_water_and_seismic(const RunConfig& c) {
+  validate_water_table(c);
   const bool water = c.water.active();
   const bool le = c.analysis == Analysis::LimitEquilibrium;
   if (water && (c.scenario != ScenarioType::Slope || c.dimension != 2))
     throw InputError("pore water needs the 2D slope scenario", c.config_source,
                      c.water.phreatic.empty() ? "water.ru" : "water.phreatic");
-  if (!le && c.water.ru > 0.0)
-    throw InputError(
-        "the SPH solver takes a phreatic surface (water.phreatic); r_u is for run.analysis = "
-        "limit_equilibrium",
-        c.config_source, "water.ru", std::to_string(c.water.ru));
+  if (c.rain.enabled) validate_rain(c);
   const auto& ht = c.water_history_times;
   if (ht.size() != c.water_history_offsets.size())
     throw InputError("needs as many offsets as water.history_times (" + std::to_string(ht.size()) + ")",
@@ -92,8 +242,9 @@ void validate_water_and_seismic(const RunConfig& c) {
   for (std::size_t k = 1; k < ht.size(); ++k)
     if (!(ht[k] > ht[k - 1]))
       throw InputError("must increase", c.config_source, "water.history_times", std::to_string(ht[k]));
-  if (!ht.empty() && c.water.phreatic.empty())
-    throw InputError("a water-table history needs water.phreatic", c.config_source, "water.history_times");
+  if (!ht.empty() && c.water.phreatic.empty() && c.water_table_raster.empty())
+    throw InputError("a water-table history needs water.phreatic or water.table_raster", c.config_source,
+                     "water.history_times");
   if (c.analysis == Analysis::Dynamic && (c.seismic.kh != 0.0 || c.seismic.kv != 0.0))
     throw InputError(
         "the pseudo-static coefficients are for the limit-equilibrium analysis and the strength reduction; a "
@@ -236,11 +387,7 @@ class LimitEquilibriumRun final : public SimulationModel {
     s["factor_of_safety"] = critical_.admissible() ? nlohmann::json(critical_.factor) : nlohmann::json();
     if (!note_.empty()) s["bishop_note"] = note_;
     s["seismic"] = {{"kh", c_.seismic.kh}, {"kv", c_.seismic.kv}};
-    const auto& w = c_.water;
-    s["water"] = {{"phreatic_surface", w.phreatic.empty() ? nlohmann::json() : nlohmann::json(w.phreatic)},
-                  {"ru", w.ru},
-                  {"unit_weight_N_per_m3", w.unit_weight},
-                  {"pore_pressure", w.head_loss_correction ? "head_loss_corrected" : "vertical_head"}};
+    s["water"] = water_summary(c_, 0.0);
     if (!newmark_.is_null())
       s["newmark"] = newmark_;
     else
@@ -307,6 +454,13 @@ SlopeSection section_of(const RunConfig& c, bool residual = false) {
     soils.push_back({m.density * c.numerics.gravity, coh, phi, sat * c.numerics.gravity});
   }
   auto s = SlopeSection::from_profile(d, soils);
+  if (c.scenario == ScenarioType::Section && c.section.water_table) {
+    // The raster's table cut along the section, clipped to the ground as the SPH's.
+    s.water = c.water;
+    const auto cut = section_water_table(c);
+    for (std::size_t k = 0; k < cut.size(); ++k)
+      s.water.phreatic.push_back({cut[k][0], std::min(cut[k][1], c.section.profile[k].z)});
+  }
   if (c.scenario == ScenarioType::Slope) {
     // The pore water (clipped to the ground as the SPH's) and the pseudo-static coefficients of the
     // strength reduction (a dynamic run has none: its earthquake is the record).
@@ -354,6 +508,57 @@ void StaticBishop::add_to(nlohmann::json& s) const {
                            {"x_m", cover.x},
                            {"angle_deg", cover.angle * 180.0 / std::numbers::pi},
                            {"window_m", cover.window}};
+}
+
+namespace {
+
+/// The rain block of summary.json: the rain and hydrology, the clock, and Bishop's factor with the
+/// rain's pore pressure at the rain's time of the run's end t_end (s).
+nlohmann::json rain_summary(const RunConfig& c, double t_end) {
+  const auto& k = c.rain.infiltration;
+  const auto rain = rain_pore_pressure(c);
+  nlohmann::json clock = nlohmann::json::array();
+  for (const auto& p : c.rain.clock) clock.push_back({p[0], p[1]});
+  nlohmann::json r = {{"intensity_m_per_s", k.rain.intensities},
+                      {"step_s", k.rain.times.size() > 1 ? k.rain.times[1] - k.rain.times[0] : 0.0},
+                      {"end_s", k.rain.end()},
+                      {"depth_m", k.rain.depth_until(k.rain.end())},
+                      {"conductivity_m_per_s", k.hydrology.conductivity},
+                      {"diffusivity_m2_per_s", k.hydrology.diffusivity},
+                      {"steady_infiltration_m_per_s", k.hydrology.steady_flux},
+                      {"water_table_depth_m", k.water_table_depth},
+                      {"clock_times_s", clock},
+                      {"rain_time_at_start_s", rain->rain_time(0.0)},
+                      {"rain_time_at_end_s", rain->rain_time(t_end)}};
+  r["bishop_factor_at_end"] = nullptr;
+  if (has_shear_strength(c.model)) try {
+      auto s = section_of(c);
+      apply_rain(s.water, rain, rain->rain_time(t_end));
+      r["bishop_factor_at_end"] = bishop_critical_circle(s).factor;
+    } catch (const InputError&) {  // no admissible circle: null
+    }
+  return r;
+}
+
+}  // namespace
+
+nlohmann::json water_summary(const RunConfig& c, double t_end) {
+  const auto& w = c.water;
+  nlohmann::json j = {{"phreatic_surface", w.phreatic.empty() ? nlohmann::json() : nlohmann::json(w.phreatic)},
+                      {"ru", w.ru},
+                      {"unit_weight_N_per_m3", w.unit_weight},
+                      {"pore_pressure", w.head_loss_correction ? "head_loss_corrected" : "vertical_head"}};
+  j["source"] =
+      !c.water_table_raster.empty()
+          ? "table_raster"
+          : (c.rain.enabled ? "rain" : (!w.phreatic.empty() ? "phreatic_surface" : (w.ru > 0.0 ? "ru" : "none")));
+  if (!c.water_table_raster.empty()) j["table_raster"] = c.water_table_raster;
+  if (!c.water_history_times.empty()) {
+    j["history_times_s"] = c.water_history_times;
+    j["history_offsets_m"] = c.water_history_offsets;
+  }
+  if (c.rain.enabled) j["rain"] = rain_summary(c, t_end);
+  return j;
 }
 
 std::unique_ptr<SimulationModel> make_limit_equilibrium_run(const RunConfig& c, bool quiet) {

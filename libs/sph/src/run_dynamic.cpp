@@ -147,6 +147,8 @@ class DynamicRun final : public SimulationModel {
   // With clamped regions: the free end's particles by id (tip_displacement_m).
   std::vector<std::uint8_t> free_end_;
   bool main_started_ = false, finished_ = false, stopped_at_rest_ = false;
+  // With pore water: the largest pore pressure of the soil at the series' rows and its time.
+  double max_pore_pressure_ = 0.0, max_pore_pressure_time_ = 0.0;
   Table series_, biaxial_;
   std::vector<double> png_times_;
   std::size_t next_png_ = 0;
@@ -324,6 +326,8 @@ void DynamicRun<Dim>::start_main_phase() {
                      "max_displacement_m",
                      "earthquake_acceleration_m_per_s2"};
   if (!free_end_.empty()) series_.columns.emplace_back("tip_displacement_m");
+  if (settings_.pore_water.active()) series_.columns.emplace_back("max_pore_pressure_Pa");
+  if (settings_.pore_water.rain) series_.columns.emplace_back("rain_time_s");
   biaxial_.columns = {"time_s", "axial_strain", "sigma_axial_Pa", "sigma_lateral_Pa", "deviator_Pa"};
   png_times_ = c_.velocity_png_times;
   std::sort(png_times_.begin(), png_times_.end());
@@ -417,6 +421,18 @@ SeriesRow DynamicRun<Dim>::record() {
                           r.max_displacement,
                           settings_.earthquake.horizontal(solver_.time())};
   if (!free_end_.empty()) row.push_back(tip_displacement());
+  if (settings_.pore_water.active()) {
+    const auto& S = solver_.store();
+    double umax = 0.0;
+    for (std::size_t i = 0; i < S.size(); ++i)
+      if (S.template get<ParticleKind>()[i] == kSoil) umax = std::max(umax, S.template get<PorePressure>()[i]);
+    if (umax > max_pore_pressure_) {
+      max_pore_pressure_ = umax;
+      max_pore_pressure_time_ = solver_.time();
+    }
+    row.push_back(umax);
+  }
+  if (settings_.pore_water.rain) row.push_back(settings_.pore_water.rain->rain_time(solver_.time()));
   series_.rows.push_back(std::move(row));
   if (c_.scenario == ScenarioType::Biaxial) record_biaxial();
   return r;
@@ -615,6 +631,11 @@ nlohmann::json DynamicRun<Dim>::summary_with(const ReleaseOutput& rel) const {
   s["bytes_per_particle"] = solver_.bytes_per_particle();
   if (!decomposition_.is_null()) s["domain_decomposition"] = decomposition_;
   bishop_.add_to(s);
+  if (settings_.pore_water.active()) {
+    s["water"] = water_summary(c_, solver_.time());
+    s["water"]["max_pore_pressure_Pa"] = max_pore_pressure_;
+    s["water"]["max_pore_pressure_time_s"] = max_pore_pressure_time_;
+  }
   if (section && c_.write_release) {
     s["release"] = {{"file", "release.h5"},
                     {"points", rel.handoff.points.size()},

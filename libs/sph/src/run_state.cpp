@@ -139,6 +139,7 @@ ParticleFields fields_of(const SphStore<Dim>& s) {
       for (int b = 0; b < 3; ++b) f.stress.push_back(s.template get<Stress>()[i](a, b));
   }
   f.plastic_strain = s.template get<PlasticStrain>();
+  f.pore_pressure = s.template get<PorePressure>();
   f.density = s.template get<Density>();
   f.mass = s.template get<Mass>();
   f.material_id = s.template get<MaterialId>();

@@ -340,6 +340,15 @@ nlohmann::json StrengthReductionRun<Dim>::summary() const {
     if (std::isfinite(bishop_.yield_coefficient)) s["bishop"]["yield_coefficient"] = bishop_.yield_coefficient;
   }
   s["seismic"] = {{"kh", c_.seismic.kh}, {"kv", c_.seismic.kv}};
+  if (settings_.pore_water.active()) {  // the trials' pore pressure: that of the geostatic state
+    s["water"] = water_summary(c_, 0.0);
+    double umax = 0.0;
+    if (initial_)
+      for (std::size_t i = 0; i < initial_->size(); ++i)
+        if (initial_->template get<ParticleKind>()[i] == kSoil)
+          umax = std::max(umax, initial_->template get<PorePressure>()[i]);
+    s["water"]["max_pore_pressure_Pa"] = umax;
+  }
 
   s["outcome"] = outcome_;
   s["factor_of_safety"] = outcome_ == "bracketed" ? nlohmann::json(lo_) : nlohmann::json();

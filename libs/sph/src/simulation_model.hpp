@@ -48,8 +48,7 @@ class SimulationModel {
 SlopeSection limit_equilibrium_section(const RunConfig& c, bool with_water_and_seismic);
 
 /// The cross-field checks of [water] and [seismic] (InputError naming the key): water only on a 2D
-/// slope, r_u only in the limit-equilibrium analysis (the SPH solver takes a phreatic surface), the
-/// history's arrays, k_h and k_v not in a dynamic run (its earthquake is the record), the water's own
+/// slope, the history's arrays, k_h and k_v not in a dynamic run (its earthquake is the record), the water's own
 /// checks (SlopeSection::validate_water).
 void validate_water_and_seismic(const RunConfig& c);
 
@@ -57,16 +56,33 @@ void validate_water_and_seismic(const RunConfig& c);
 /// and the Bishop check beside it use (no ponded water, the ground a seepage face).
 std::vector<std::array<double, 2>> clipped_phreatic_surface(const RunConfig& c);
 
-/// The solver's pore water of a config (dry unless [water] has a phreatic surface).
+/// The rain's pore pressure on the 2D slope of a config with rain.enabled (pore_pressure.hpp).
+std::shared_ptr<const RainPorePressure> rain_pore_pressure(const RunConfig& c);
+
+/// Bishop's pore water of rain at the rain's time t_r (s): u from the rain's head on the slice bases,
+/// the initial table (parallel to the ground) for the saturated weights.
+void apply_rain(PoreWater& w, const std::shared_ptr<const RainPorePressure>& rain, double t_rain);
+
+/// The water table raster of a 2D DSM section cut along it: (s, z_w) at the profile's points.
+/// InputError naming water.table_raster where the raster has no value.
+std::vector<std::array<double, 2>> section_water_table(const RunConfig& c);
+
+/// The water table raster over a 3D DSM strip: z_w and the DSM's z_g on a grid of the strip's local
+/// coordinates at the particle spacing. InputError naming water.table_raster where the raster has no
+/// value (geometry.width where the strip leaves the DSM).
+std::shared_ptr<const WaterTableGrid> section_water_table_grid(const RunConfig& c);
+
+/// The solver's pore water of a config (dry unless [water] has a phreatic surface, r_u or a table
+/// raster on a section, or [rain] is enabled).
 PoreWaterSettings pore_water_settings(const RunConfig& c);
 
-/// Saturated density below the water table at the start: each soil particle of a material with a
-/// saturated density whose position lies below the clipped table takes ρ_sat (mass and density
-/// scaled by ρ_sat/ρ).
+/// Saturated density below the water table at the start (rain: the initial table): each soil particle of a material
+/// with a saturated density whose position lies below the clipped table takes ρ_sat (mass and density scaled by
+/// ρ_sat/ρ).
 template <int Dim>
 void saturate_below_water_table(const RunConfig& c, SphStore<Dim>& s) {
   const auto pw = pore_water_settings(c);
-  if (!pw.active()) return;
+  if (pw.phreatic.empty() && !pw.rain && !pw.table) return;  // r_u: the materials' own densities, as Bishop's
   const auto& x = s.template get<Position<Dim>>();
   const auto& kind = s.template get<ParticleKind>();
   const auto& mat = s.template get<MaterialId>();
@@ -76,12 +92,24 @@ void saturate_below_water_table(const RunConfig& c, SphStore<Dim>& s) {
     if (kind[i] != static_cast<std::uint8_t>(Kind::Soil)) continue;
     const auto k = static_cast<std::size_t>(mat[i]);
     const double sat = k < c.saturated_densities.size() ? c.saturated_densities[k] : 0.0;
-    if (!(sat > 0.0) || x[i][Dim - 1] >= pw.level(x[i][0], 0.0)) continue;
+    double level = 0.0;
+    if (pw.rain)
+      level = pw.rain->initial_level(x[i][0]);
+    else if (pw.table)
+      level = pw.table->level(x[i][0], x[i][Dim == 3 ? 1 : 0], 0.0);
+    else
+      level = pw.level(x[i][0], 0.0);
+    if (!(sat > 0.0) || x[i][Dim - 1] >= level) continue;
     const double f = sat / c.materials[k].density;
     m[i] *= f;
     rho[i] *= f;
   }
 }
+
+/// The pore water of a run for summary.json (`water`): its source ("phreatic_surface", "ru", "rain" or
+/// "none"), the keys' values, the history and, with rain, the rain, the hydrology, the clock and
+/// Bishop's factor at the rain's time of the main-phase time t_end (s).
+nlohmann::json water_summary(const RunConfig& c, double t_end);
 
 /// The Newmark report of a 2D slope under the config's earthquake: the circle of the smallest yield
 /// coefficient (static: no k_h), k_y, and the rigid-block displacement for the record applied in the

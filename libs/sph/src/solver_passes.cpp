@@ -222,12 +222,12 @@ void SphSolver<Dim>::update_stress(const Model& /*model*/) {
   Mat<Dim>* R = field<ArtificialStress<Dim>>();
   Mat<Dim>* ps = field<PairStress<Dim>>();
   const MaterialParams* mats = materials_.data();
-  // Prescribed pore water (PoreWaterSettings): u from the water table of this step; the pair stress
+  // Prescribed pore water (pore_pressure.hpp): u of this step at the particle's position; the pair stress
   // of step 4 is the total stress σ′ − u I.
   const PoreWaterSettings& pw = settings_.pore_water;
   const bool water = pw.active();
-  const double pw_dz = water && earthquake_on_ ? pw.offset(time_) : (water ? pw.offset(0.0) : 0.0);
-  const double pw_gamma = pw.density * settings_.gravity * gravity_factor_;
+  const PoreWaterStep pws =
+      water ? PoreWaterStep(pw, earthquake_on_ ? time_ : 0.0, settings_.gravity, gravity_factor_) : PoreWaterStep();
   const Vec<Dim>* xpos = field<Position<Dim>>();
   double* upore = field<PorePressure>();
   // The model's internal variables (fields of the store), passed per particle to its update.
@@ -269,7 +269,7 @@ void SphSolver<Dim>::update_stress(const Model& /*model*/) {
       }
       ps[i] = sig[i].template topLeftCorner<Dim, Dim>();
       if (water) {
-        const double u = pw_gamma * std::max(pw.level(xpos[i][0], pw_dz) - xpos[i][Dim - 1], 0.0);
+        const double u = pws.pressure<Dim>(xpos[i]);
         upore[i] = u;
         ps[i].diagonal().array() -= u;
       }

@@ -87,26 +87,16 @@ StabilityMapCase read_stability_map_case(ConfigReader& cfg) {
                                 {"N/m^3", "unit weight of water gamma_w"});
   s.suction = cfg.get_bool("soil.suction", s.suction,
                            {"", "negative pressure heads (above the water table) add strength; false: counted as 0"});
-  // Hydrology.
-  auto& h = c.hydrology;
-  h.conductivity = cfg.get("hydrology.conductivity", h.conductivity, Range::positive(),
-                           {"m/s", "saturated hydraulic conductivity K_s (rain beyond it runs off)"});
-  h.diffusivity = cfg.get("hydrology.diffusivity", h.diffusivity, Range::positive(),
-                          {"m^2/s", "maximum hydraulic diffusivity D_0 (= K_s / specific storage)"});
-  h.steady_flux = cfg.get("hydrology.steady_infiltration", h.steady_flux, Range::non_negative(),
-                          {"m/s", "long-term infiltration rate I_ZLT before the rain (< K_s cos^2 delta)"});
-  c.water_table_depth =
-      cfg.get("hydrology.water_table_depth", c.water_table_depth, Range::non_negative(),
-              {"m", "initial water table depth d below the ground, vertical (>= 0: not above the ground)"});
+  // Hydrology and rain: the keys sph-slope reads too (infiltration.hpp).
+  {
+    const InfiltrationKeys k = read_infiltration_keys(cfg);
+    c.hydrology = k.hydrology;
+    c.water_table_depth = k.water_table_depth;
+    c.rain = k.rain;
+  }
   c.water_table_raster =
       resolve(cfg, cfg.get_string("hydrology.water_table_raster", "",
                                   {"", "raster of d (m) on the DSM's grid; overrides hydrology.water_table_depth"}));
-  // Rain.
-  const double step = cfg.get("rain.step", 3600.0, Range::open_closed(0.0, 1e7), {"s", "length of each rain step"});
-  const std::vector<double> intensity =
-      cfg.get_array("rain.intensity", {2.78e-6}, Range::closed(0.0, 1e-2),
-                    {"m/s", "intensity of each step in turn (1 mm/h = 2.778e-7 m/s); then no rain"});
-  c.rain = RainfallHistory::uniform_steps(step, intensity);
   // Run and outputs.
   c.duration =
       cfg.get("run.duration", c.duration, Range::closed(0.0, 1e8), {"s", "simulated time; 0: the end of the rain"});
@@ -128,10 +118,6 @@ StabilityMapCase read_stability_map_case(ConfigReader& cfg) {
   if (!(c.min_slope < c.max_slope))
     throw InputError("soil.min_slope must be below soil.max_slope (" + fmt(c.max_slope / kDeg) + " deg)", cfg.source(),
                      "soil.min_slope", fmt(c.min_slope / kDeg));
-  if (h.steady_flux >= h.conductivity)
-    throw InputError("the long-term infiltration must be below K_s (" + fmt(h.conductivity) + " m/s)", cfg.source(),
-                     "hydrology.steady_infiltration", fmt(h.steady_flux));
-  c.rain.validate(cfg.source().c_str(), "rain.intensity");
   if (c.duration == 0.0) c.duration = c.rain.end();
   return c;
 }

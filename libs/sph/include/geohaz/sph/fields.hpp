@@ -161,9 +161,9 @@ struct Clamped {
 template <class... Tags>
 struct FieldList {};
 
-/// Pore pressure u of a soil particle (prescribed from the phreatic surface, solver.hpp
-/// PoreWaterSettings; 0 when dry), Pa, positive in compression of the pore water: the stress field is
-/// the effective stress σ′ and the momentum equation takes the total stress σ′ − u I.
+/// Pore pressure u of a soil particle (prescribed: a phreatic surface, r_u, rain or a water-table
+/// raster, pore_pressure.hpp PoreWaterSettings; 0 when dry), Pa, positive in compression of the pore water: the stress
+/// field is the effective stress σ′ and the momentum equation takes the total stress σ′ − u I.
 struct PorePressure {
   using type = double;
   static constexpr const char* label = "pore_pressure";

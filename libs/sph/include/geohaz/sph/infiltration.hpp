@@ -35,6 +35,10 @@
 #include <cstddef>
 #include <vector>
 
+namespace geohaz {
+class ConfigReader;
+}
+
 namespace geohaz::sph {
 
 /// A rainfall history of piecewise-constant intensity: I_n over [T_n, T_{n+1}), n = 0..N−1, then
@@ -91,5 +95,18 @@ class InfiltrationHistory {
   InfiltrationParameters p_;
   std::vector<double> t_, dr_;
 };
+
+/// The infiltration keys shared by `slope-stability` and `sph-slope` ([hydrology] and [rain]; one
+/// declaration of their names, units, defaults, ranges and help).
+struct InfiltrationKeys {
+  InfiltrationParameters hydrology;
+  double water_table_depth = 1.5;  ///< d, initial water table depth below the ground, vertical (m)
+  RainfallHistory rain;            ///< rain.step, rain.intensity
+};
+
+/// Read (or, in describe mode, declare) hydrology.conductivity, hydrology.diffusivity,
+/// hydrology.steady_infiltration, hydrology.water_table_depth, rain.step and rain.intensity, and check
+/// what their ranges cannot (I_ZLT < K_s, the rain's steps): InputError naming the key.
+InfiltrationKeys read_infiltration_keys(ConfigReader& cfg);
 
 }  // namespace geohaz::sph

@@ -44,6 +44,7 @@
 /// Units SI (m, Pa, N/m³, radians).
 
 #include <array>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -74,7 +75,11 @@ struct PoreWater {
   bool head_loss_correction = false;
   double ru = 0.0;              ///< r_u = u / (γ h) on the slice base, [0, 1); 0 with a phreatic surface
   double unit_weight = 9.81e3;  ///< γ_w, N/m³
-  bool active() const noexcept { return !phreatic.empty() || ru > 0.0; }
+  /// A prescribed pore pressure u(x, z) (Pa) on the slice bases (rain infiltration at one time,
+  /// pore_pressure.hpp); replaces the phreatic surface's u (which then only sets where the soil
+  /// weighs its saturated unit weight) and r_u. Empty: none.
+  std::function<double(double, double)> pressure_field;
+  bool active() const noexcept { return !phreatic.empty() || ru > 0.0 || pressure_field; }
   /// Elevation of the phreatic surface at x (m); requires a phreatic surface.
   double level_at(double x) const noexcept;
   /// Pore pressure (Pa) at (x, z) from the phreatic surface (0 above it); requires one.

@@ -75,6 +75,9 @@ struct SectionInput {
   double base_thickness = 2.0;  ///< m: base material below the lowest point of the soil layer
   int soil_material = 1, base_material = 0;
   double release_width = 10.0;  ///< W (m): plane-strain particles are spread over this width
+  /// The water table raster (`water.table_raster`, the DSM's CRS): elevation of the table (m);
+  /// null: none.
+  std::shared_ptr<const Terrain> water_table;
 };
 
 /// What a run computes.
@@ -141,10 +144,21 @@ struct RunConfig {
   /// Bishop's method and, as a prescribed pore pressure (solver.hpp PoreWaterSettings, the table
   /// clipped to the ground), in the SPH solver of a 2D slope.
   PoreWater water;
+  /// `water.table_raster` as given (resolved against the config's folder; "" none): the water table of
+  /// a DSM section, loaded into section.water_table.
+  std::string water_table_raster;
   /// Loading history of the water table in the main phase: times (s) and offsets Δz (m).
   std::vector<double> water_history_times, water_history_offsets;
   /// Saturated density per material (kg/m³; 0: the material's density), below the phreatic surface.
   std::vector<double> saturated_densities;
+  /// Rain infiltration as the pore-pressure history of the main phase ([rain] with rain.enabled and
+  /// [hydrology]: the keys of slope-stability, infiltration.hpp; docs/sph.md): the pressure head of
+  /// Iverson (2000) column by column, the rain's time t_r = clock(t) of the main-phase time t.
+  struct Rain {
+    bool enabled = false;
+    InfiltrationKeys infiltration;
+    std::vector<std::array<double, 2>> clock;  ///< (t, t_r) pairs (s); empty: t_r = t
+  } rain;
   /// Pseudo-static coefficients ([seismic]): in Bishop's method and in the strength-reduction trials.
   SeismicCoefficients seismic;
   // Main phase.
@@ -202,6 +216,7 @@ struct ParticleFields {
   std::vector<double> displacement;       ///< m, count × dimension
   std::vector<double> stress;             ///< Pa, count × 3 × 3 (tension positive)
   std::vector<double> plastic_strain;     ///< 1, accumulated plastic strain
+  std::vector<double> pore_pressure;      ///< Pa, the prescribed u (compression positive; 0 when dry)
   std::vector<double> density;            ///< kg/m³
   std::vector<double> mass;               ///< kg (per metre out of the plane in 2D)
   std::vector<std::int32_t> material_id;  ///< index into the [[material]] list

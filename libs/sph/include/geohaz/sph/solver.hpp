@@ -69,6 +69,7 @@
 #include "geohaz/sph/decomposition.hpp"
 #include "geohaz/sph/fields.hpp"
 #include "geohaz/sph/loading.hpp"
+#include "geohaz/sph/pore_pressure.hpp"
 
 namespace geohaz::sph {
 
@@ -78,26 +79,6 @@ enum class KernelChoice { CubicSpline, WendlandC2 };
 /// The name table of the kernels (`numerics.kernel`).
 inline constexpr std::array<std::pair<std::string_view, KernelChoice>, 2> kernel_names{
     {{"cubic_spline", KernelChoice::CubicSpline}, {"wendland_c2", KernelChoice::WendlandC2}}};
-
-/// Prescribed pore water (docs/sph.md, "Pore pressure and seismic coefficients"): a phreatic surface
-/// z_w(x) (along axis 0; uniform across a 3D width), clipped to the ground (where it would lie above
-/// the ground the ground is a seepage face: no ponded water, whose load the particles cannot carry),
-/// raised by Δz(t) in the main phase (the loading history; linear between samples, held beyond).
-/// Each step every soil particle takes u = ρ_w g_f max(min(z_w(x) + Δz, z_g(x)) − z, 0), g_f the
-/// gravity of the step (ramped in the geostatic phase), and the momentum equation the total stress
-/// σ′ − u I (tension positive); the constitutive model sees the effective stress σ′ only.
-struct PoreWaterSettings {
-  std::vector<std::array<double, 2>> phreatic;  ///< (x, z) at the start, x non-decreasing (m); empty: dry
-  std::vector<std::array<double, 2>> ground;    ///< (x, z) ground surface the table is clipped to (m); empty: none
-  double density = 1000.0;                      ///< ρ_w, kg/m³
-  std::vector<double> history_times;            ///< s (main-phase time), increasing; empty: no rise
-  std::vector<double> history_offsets;          ///< m: Δz at those times
-  bool active() const noexcept { return !phreatic.empty(); }
-  /// Δz(t) (m).
-  double offset(double t) const noexcept;
-  /// Elevation of the (clipped) water table at x with offset dz (m).
-  double level(double x, double dz) const noexcept;
-};
 
 /// Numerical settings of a run that do not depend on the dimension (all SI). The defaults here are
 /// the only ones: sph-slope reads every `numerics.*` key into this struct with these defaults.
