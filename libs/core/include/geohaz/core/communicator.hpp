@@ -2,7 +2,7 @@
 /// \file communicator.hpp
 /// The few collective operations a model distributed over processes needs (issue #36: the SPH
 /// domain decomposition), behind an interface of ours so that the libraries stay free of MPI: the
-/// Open MPI implementation is `geohaz::mpi` (libs/mpi, built with the CMake option GEOHAZ_MPI),
+/// Open MPI implementation is `geohaz::mpi` (apps/mpi-communicator, built with the CMake option GEOHAZ_MPI),
 /// linked only by the apps that run under mpirun. Called a few times per step, never per particle
 /// or pair, so the virtual call costs nothing measurable.
 ///

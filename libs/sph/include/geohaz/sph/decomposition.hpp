@@ -2,7 +2,7 @@
 /// \file decomposition.hpp
 /// Domain decomposition of the SPH particles over the ranks of a Communicator (issue #36; docs/sph.md,
 /// "Domain decomposition"). MPI-free: the ranks talk through core's Communicator interface, whose Open
-/// MPI implementation (libs/mpi) only the apps link.
+/// MPI implementation (apps/mpi-communicator) only the apps link.
 ///
 /// Each rank's store holds its owned particles at [0, owned()) and, after them, ghost copies of the
 /// other ranks' particles within the halo of its subdomain (the kernel support plus the Verlet skin).
