@@ -5,6 +5,7 @@
 // map position, Bishop's factor beside the 2D section falls with the table, and bad rasters exit 2
 // naming the key with nothing written.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -28,7 +29,9 @@ using namespace geohaz;
 using namespace geohaz::sph;
 
 const fs::path kApp = fs::path(GEOHAZ_BINARY_DIR) / "apps/sph-slope/sph-slope";
-const fs::path kWork = fs::path(GEOHAZ_BINARY_DIR) / "tests/sph/water_table_runs";
+// One folder per process: ctest runs the cases of this file in parallel, and each writes dsm.tif
+// and table.tif (two cases writing the same file failed the rename of one of them).
+const fs::path kWork = fs::path(GEOHAZ_BINARY_DIR) / "tests/sph" / ("water_table_runs_" + std::to_string(::getpid()));
 constexpr double kX0 = 500000.0, kY0 = 4000000.0;  // the DSM's north-west corner (UTM 54N)
 constexpr double kGammaW = 1000.0 * 9.81;
 
