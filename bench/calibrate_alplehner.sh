@@ -152,9 +152,9 @@ with open(work / "one" / "members.csv") as f:
     for row in csv.DictReader(f):
         batches[int(row["batch"])].append(cost.get(int(row["member"]), 0.0))
 span = 0.0
-for b in sorted(batches):
+for batch in sorted(batches):
     free = [0.0, 0.0]
-    for c in batches[b]:
+    for c in batches[batch]:
         k = free.index(min(free))
         free[k] += c
     span += max(free)
