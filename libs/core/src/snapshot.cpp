@@ -26,6 +26,17 @@
 ///    write(store) -> read -> load_field is an exact round trip; for the symmetric tensors (stress,
 ///    strain rate) both orders coincide. Datasets with rows, cols > 1 carry an attribute
 ///    storage_order = "column-major" to say so.
+///  - Several processes (a Communicator of more than one rank; issue #36): each rank writes its own
+///    particles into its part file, <stem>.rank<q>.h5 beside the file (the layout above, without
+///    the XDMF helpers), with the serial HDF5 library; rank 0 writes the file itself, whose datasets
+///    are HDF5 virtual datasets (VDS, HDF5 >= 1.10) joining the parts in rank order: every reader
+///    (ours, h5py, h5dump, ParaView through the one XDMF file) sees one dataset per field with every
+///    particle. Rank 0 writes a snapshot's group only after every rank has flushed its part (the
+///    gather of the counts orders them), so a kill leaves no index entry pointing at a missing part.
+///    A missing part file would read as zeros through the VDS: the root attribute "part_files" lists
+///    them, and the reader refuses the file when one is missing. A parallel HDF5 library would write
+///    one file, but it cannot be linked beside the serial one the libraries and the Python module
+///    use (the same symbols), so the normal build stays serial.
 
 #include "geohaz/core/snapshot.hpp"
 
@@ -102,6 +113,33 @@ std::string vertex_index_name(std::size_t n) {
   return "vertices_" + std::to_string(n);
 }
 
+/// The part file of rank q beside the index `h5_path`: snapshots.h5 -> snapshots.rank0003.h5.
+std::string part_file_name(const std::filesystem::path& h5_path, int q) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, ".rank%04d", q);
+  return h5_path.stem().string() + buf + h5_path.extension().string();
+}
+
+/// Run `body` on every rank; when it throws IoError on any rank, every rank throws (the failing one
+/// its own error, the others one naming the first failing rank), so no rank waits for another in a
+/// later collective call.
+template <class Body>
+void all_ranks_or_throw(const Communicator& comm, const std::filesystem::path& path, const std::string& what,
+                        Body&& body) {
+  std::optional<IoError> error;
+  try {
+    body();
+  } catch (const IoError& e) {
+    error = e;
+  }
+  const std::vector<double> failed = comm.all_gather(std::vector<double>{error ? 1.0 : 0.0});
+  if (error) throw *error;
+  for (std::size_t q = 0; q < failed.size(); ++q)
+    if (failed[q] > 0.0)
+      throw IoError("rank " + std::to_string(q) + " could not " + what + " (its message names the reason)",
+                    path.string());
+}
+
 }  // namespace
 
 // ============================================================================================
@@ -111,6 +149,7 @@ std::string vertex_index_name(std::size_t n) {
 struct SnapshotWriter::Impl {
   struct FieldMeta {
     std::string label;
+    std::string unit;
     ScalarType type;
     int rows, cols;
   };
@@ -126,26 +165,68 @@ struct SnapshotWriter::Impl {
   std::filesystem::path h5_path, xmf_path;
   std::string model;
   int dimension = 0;
+  bool xdmf = true;  ///< write the XDMF companion (not for the part files of several processes)
   Hdf5Context ctx;
   Hid file, snapshots, xdmf_helpers;
   std::vector<Entry> entries;
   std::set<std::size_t> vertex_indices;  ///< particle counts whose /xdmf/vertices_<n> exists
+  // Several processes (see "Several processes" in the file comment): every rank's part file, the
+  // ranks, and (rank 0) the part files' names for the index.
+  std::unique_ptr<Impl> part;
+  std::shared_ptr<const Communicator> comm;
+  std::vector<std::string> part_names;
 
+  bool writes_index() const { return !comm || comm->rank() == 0; }
   void flush() { ctx.call(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "cannot flush"); }
   /// IoError unless the file system and the file size limit leave room for `bytes` more.
   void check_room(double bytes, const std::string& what) const;
   ~Impl() {
     if (ctx.failed) file.release();  // see the file comment: closing it would crash HDF5 at exit
   }
+  /// Create the file with its root attributes and groups.
+  void create(const std::string& resolved_config);
   void ensure_vertex_index(std::size_t n);
   void write_fields(hid_t group, const std::string& gpath, std::span<const FieldView> fields,
                     std::span<const std::uint32_t> lines);
+  /// Snapshot `name` of this file, fields written in full (one process, or a rank's part file).
+  void write_group(const std::string& name, double time, std::int64_t step, std::span<const FieldView> fields,
+                   std::span<const std::uint32_t> lines);
+  /// Snapshot `name` of the index file: every field a virtual dataset joining the parts, `counts[q]`
+  /// particles of rank q's part file.
+  void write_virtual_group(const std::string& name, double time, std::int64_t step, const Entry& e,
+                           const std::vector<std::size_t>& counts);
+  static Entry entry_of(double time, std::int64_t step, std::size_t n, std::span<const FieldView> fields,
+                        std::size_t line_count);
   std::string xdmf_text() const;
-  void write_xdmf() const { write_text_file(xmf_path, xdmf_text()); }
+  void write_xdmf() const {
+    if (xdmf) write_text_file(xmf_path, xdmf_text());
+  }
 };
 
+void SnapshotWriter::Impl::create(const std::string& resolved_config) {
+  ctx.file = h5_path.string();
+  ctx.input = false;
+  // Room for the root attributes and HDF5's superblock, heaps and B-trees.
+  check_room(static_cast<double>(resolved_config.size()) + 32.0 * 1024.0, "a new snapshot file");
+  Hid fapl = file_access_plist(ctx);
+  file = ctx.own(H5Fcreate(h5_path.string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose,
+                 "cannot create the snapshot file");
+  const hid_t root = file.get();
+  write_string_attribute(ctx, root, "model", model);
+  write_string_attribute(ctx, root, "version", GEOHAZ_VERSION);
+  const std::int32_t dim = dimension;
+  write_numeric_attribute(ctx, root, "dimension", H5T_NATIVE_INT32, &dim);
+  write_string_attribute(ctx, root, "resolved_config", resolved_config);
+  snapshots = ctx.own(H5Gcreate2(root, kSnapshotsGroup, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
+                      std::string("cannot create group ") + kSnapshotsGroup);
+  xdmf_helpers = ctx.own(H5Gcreate2(root, kXdmfGroup, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
+                         std::string("cannot create group ") + kXdmfGroup);
+  flush();
+  write_xdmf();
+}
+
 SnapshotWriter::SnapshotWriter(const std::filesystem::path& h5_path, std::string model, int dimension,
-                               std::string resolved_config)
+                               std::string resolved_config, std::shared_ptr<const Communicator> comm)
     : impl_(std::make_unique<Impl>()) {
   if (dimension != 2 && dimension != 3)
     throw std::invalid_argument("SnapshotWriter: dimension must be 2 or 3, got " + std::to_string(dimension));
@@ -157,26 +238,38 @@ SnapshotWriter::SnapshotWriter(const std::filesystem::path& h5_path, std::string
   m.model = std::move(model);
   m.dimension = dimension;
   m.ctx.file = h5_path.string();
-  m.ctx.input = false;
   silence_hdf5_errors();
-
-  // Room for the root attributes and HDF5's superblock, heaps and B-trees.
-  m.check_room(static_cast<double>(resolved_config.size()) + 32.0 * 1024.0, "a new snapshot file");
-  Hid fapl = file_access_plist(m.ctx);
-  m.file = m.ctx.own(H5Fcreate(h5_path.string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose,
-                     "cannot create the snapshot file");
-  const hid_t root = m.file.get();
-  write_string_attribute(m.ctx, root, "model", m.model);
-  write_string_attribute(m.ctx, root, "version", GEOHAZ_VERSION);
-  const std::int32_t dim = dimension;
-  write_numeric_attribute(m.ctx, root, "dimension", H5T_NATIVE_INT32, &dim);
-  write_string_attribute(m.ctx, root, "resolved_config", resolved_config);
-  m.snapshots = m.ctx.own(H5Gcreate2(root, kSnapshotsGroup, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
-                          std::string("cannot create group ") + kSnapshotsGroup);
-  m.xdmf_helpers = m.ctx.own(H5Gcreate2(root, kXdmfGroup, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
-                             std::string("cannot create group ") + kXdmfGroup);
-  m.flush();
-  m.write_xdmf();
+  if (!comm || comm->size() == 1) {
+    m.create(resolved_config);
+    return;
+  }
+  m.comm = std::move(comm);
+  const int ranks = m.comm->size(), rank = m.comm->rank();
+  for (int q = 0; q < ranks; ++q) m.part_names.push_back(part_file_name(h5_path, q));
+  // Rank 0 creates the index first (the others' part files go beside it), then every rank its part;
+  // a failure on any rank fails every rank (IoError), none waits for another.
+  all_ranks_or_throw(*m.comm, m.h5_path, "create the snapshot file", [&] {
+    if (rank != 0) return;
+    m.create(resolved_config);
+    const double count = ranks;
+    write_numeric_attribute(m.ctx, m.file.get(), "ranks", H5T_NATIVE_DOUBLE, &count);
+    std::string names;
+    for (const auto& p : m.part_names) names += p + "\n";
+    write_string_attribute(m.ctx, m.file.get(), "part_files", names);
+    m.flush();
+  });
+  all_ranks_or_throw(*m.comm, m.h5_path, "create its part file", [&] {
+    m.part = std::make_unique<Impl>();
+    m.part->h5_path = m.h5_path.parent_path() / m.part_names[static_cast<std::size_t>(rank)];
+    m.part->model = m.model;
+    m.part->dimension = dimension;
+    m.part->xdmf = false;
+    m.part->create("part " + std::to_string(rank) + " of " + std::to_string(ranks) + " of " +
+                   m.h5_path.filename().string() + " (the run's config is in that file)");
+    const double r = rank;
+    write_numeric_attribute(m.part->ctx, m.part->file.get(), "rank", H5T_NATIVE_DOUBLE, &r);
+    m.part->flush();
+  });
 }
 
 SnapshotWriter::~SnapshotWriter() = default;
@@ -206,11 +299,13 @@ void SnapshotWriter::Impl::check_room(double bytes, const std::string& what) con
 }
 
 void SnapshotWriter::set_attribute(const std::string& name, const std::string& value) {
+  if (!impl_->writes_index()) return;
   write_string_attribute(impl_->ctx, impl_->file.get(), name, value);
   impl_->flush();
 }
 
 void SnapshotWriter::set_attribute(const std::string& name, double value) {
+  if (!impl_->writes_index()) return;
   write_numeric_attribute(impl_->ctx, impl_->file.get(), name, H5T_NATIVE_DOUBLE, &value);
   impl_->flush();
 }
@@ -274,6 +369,57 @@ void SnapshotWriter::Impl::write_fields(hid_t group, const std::string& gpath, s
   }
 }
 
+void SnapshotWriter::Impl::write_group(const std::string& name, double time, std::int64_t step,
+                                       std::span<const FieldView> fields, std::span<const std::uint32_t> lines) {
+  const std::string gpath = std::string(kSnapshotsGroup) + "/" + name;
+  const std::size_t n = fields.empty() ? 0 : fields.front().count;
+  {
+    // Checked before the file is touched, so a full disk leaves the snapshots so far readable.
+    double bytes = 16.0 * 1024.0;  // group, attributes, B-tree and heap growth
+    for (const FieldView& f : fields) {
+      const std::size_t elem = f.type == ScalarType::Float64 || f.type == ScalarType::Int64 ? 8
+                               : f.type == ScalarType::Int32                                ? 4
+                                                                                            : 1;
+      bytes += static_cast<double>(f.count) * f.rows * f.cols * static_cast<double>(elem) + 1024.0;
+    }
+    bytes += 4.0 * static_cast<double>(lines.size() + (vertex_indices.count(n) || !xdmf ? 0 : n));
+    check_room(1.1 * bytes, "snapshot " + name);
+  }
+  try {
+    // Track creation order so the reader lists fields in the order the store declares them.
+    Hid gcpl = ctx.own(H5Pcreate(H5P_GROUP_CREATE), H5Pclose, "cannot create group " + gpath);
+    ctx.call(H5Pset_link_creation_order(gcpl.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED),
+             "cannot create group " + gpath);
+    Hid group = ctx.own(H5Gcreate2(snapshots.get(), name.c_str(), H5P_DEFAULT, gcpl.get(), H5P_DEFAULT), H5Gclose,
+                        "cannot create group " + gpath);
+    write_fields(group.get(), gpath, fields, lines);
+    if (xdmf) ensure_vertex_index(n);
+    write_numeric_attribute(ctx, group.get(), "time", H5T_NATIVE_DOUBLE, &time);
+    write_numeric_attribute(ctx, group.get(), "step", H5T_NATIVE_INT64, &step);
+    const std::int64_t count = static_cast<std::int64_t>(n);
+    // Written last: marks the snapshot complete (see the file comment).
+    write_numeric_attribute(ctx, group.get(), "particle_count", H5T_NATIVE_INT64, &count);
+  } catch (...) {
+    // Remove the partial group so the next write can reuse the name; the reader ignores it anyway.
+    H5Ldelete(snapshots.get(), name.c_str(), H5P_DEFAULT);
+    H5Eclear2(H5E_DEFAULT);
+    throw;
+  }
+  flush();
+  entries.push_back(entry_of(time, step, n, fields, lines.size() / 2));
+  write_xdmf();
+}
+
+SnapshotWriter::Impl::Entry SnapshotWriter::Impl::entry_of(double time, std::int64_t step, std::size_t n,
+                                                           std::span<const FieldView> fields, std::size_t line_count) {
+  Entry e{time, step, n, line_count, {}};
+  for (const FieldView& f : fields)
+    if (f.label == "position") e.fields.push_back({"position", std::string(f.unit), f.type, f.rows, f.cols});
+  for (const FieldView& f : fields)
+    if (f.label != "position") e.fields.push_back({std::string(f.label), std::string(f.unit), f.type, f.rows, f.cols});
+  return e;
+}
+
 void SnapshotWriter::write(double time, std::int64_t step, std::span<const FieldView> fields,
                            std::span<const std::uint32_t> lines) {
   Impl& m = *impl_;
@@ -304,59 +450,95 @@ void SnapshotWriter::write(double time, std::int64_t step, std::span<const Field
       throw std::invalid_argument("SnapshotWriter::write: field '" + std::string(f.label) + "' has " +
                                   std::to_string(f.count) + " entries, position has " + std::to_string(n));
   if (lines.size() % 2 != 0) throw std::invalid_argument("SnapshotWriter::write: lines must be index pairs");
+  if (m.comm && !lines.empty())
+    throw std::invalid_argument("SnapshotWriter::write: lines are not written by several processes");
   for (std::uint32_t i : lines)
     if (i >= n)
       throw std::invalid_argument("SnapshotWriter::write: line index " + std::to_string(i) + " >= particle count " +
                                   std::to_string(n));
 
-  if (m.ctx.failed)
+  if (m.ctx.failed || (m.part && m.part->ctx.failed))
     throw IoError("an earlier write to this file failed; no further snapshot is written", m.h5_path.string());
   // The same step and time as the previous snapshot is the same state: writing it again would
   // list every particle twice at that time in ParaView (a run ending on a snapshot time).
   if (!m.entries.empty() && m.entries.back().step == step && m.entries.back().time == time) return;
 
   const std::string name = snapshot_name(m.entries.size());
-  const std::string gpath = std::string(kSnapshotsGroup) + "/" + name;
-  {
-    // Checked before the file is touched, so a full disk leaves the snapshots so far readable.
-    double bytes = 16.0 * 1024.0;  // group, attributes, B-tree and heap growth
-    for (const FieldView& f : fields) {
-      const std::size_t elem = f.type == ScalarType::Float64 || f.type == ScalarType::Int64 ? 8
-                               : f.type == ScalarType::Int32                                ? 4
-                                                                                            : 1;
-      bytes += static_cast<double>(f.count) * f.rows * f.cols * static_cast<double>(elem) + 1024.0;
-    }
-    bytes += 4.0 * static_cast<double>(lines.size() + (m.vertex_indices.count(n) ? 0 : n));
-    m.check_room(1.1 * bytes, "snapshot " + name);
+  if (!m.comm) {
+    m.write_group(name, time, step, fields, lines);
+    return;
   }
+  // Several processes: every rank its part, then (when all have written theirs) rank 0 the index.
+  all_ranks_or_throw(*m.comm, m.h5_path, "write its part of snapshot " + name,
+                     [&] { m.part->write_group(name, time, step, fields, lines); });
+  const std::vector<double> counts = m.comm->all_gather(std::vector<double>{static_cast<double>(n)});
+  std::vector<std::size_t> per_rank;
+  std::size_t total = 0;
+  for (double c : counts) {
+    per_rank.push_back(static_cast<std::size_t>(c));
+    total += per_rank.back();
+  }
+  Impl::Entry e = Impl::entry_of(time, step, total, fields, 0);
+  if (m.writes_index()) m.write_virtual_group(name, time, step, e, per_rank);
+  m.entries.push_back(std::move(e));
+  if (m.writes_index()) m.write_xdmf();
+}
+
+void SnapshotWriter::Impl::write_virtual_group(const std::string& name, double time, std::int64_t step, const Entry& e,
+                                               const std::vector<std::size_t>& counts) {
+  const std::string gpath = std::string(kSnapshotsGroup) + "/" + name;
+  check_room(16.0 * 1024.0 + 2048.0 * static_cast<double>(e.fields.size() * counts.size()) +
+                 (vertex_indices.count(e.count) ? 0.0 : 4.0 * static_cast<double>(e.count)),
+             "snapshot " + name);
   try {
-    // Track creation order so the reader lists fields in the order the store declares them.
-    Hid gcpl = m.ctx.own(H5Pcreate(H5P_GROUP_CREATE), H5Pclose, "cannot create group " + gpath);
-    m.ctx.call(H5Pset_link_creation_order(gcpl.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED),
-               "cannot create group " + gpath);
-    Hid group = m.ctx.own(H5Gcreate2(m.snapshots.get(), name.c_str(), H5P_DEFAULT, gcpl.get(), H5P_DEFAULT), H5Gclose,
-                          "cannot create group " + gpath);
-    m.write_fields(group.get(), gpath, fields, lines);
-    m.ensure_vertex_index(n);
-    write_numeric_attribute(m.ctx, group.get(), "time", H5T_NATIVE_DOUBLE, &time);
-    write_numeric_attribute(m.ctx, group.get(), "step", H5T_NATIVE_INT64, &step);
-    const std::int64_t count = static_cast<std::int64_t>(n);
-    // Written last: marks the snapshot complete (see the file comment).
-    write_numeric_attribute(m.ctx, group.get(), "particle_count", H5T_NATIVE_INT64, &count);
+    Hid gcpl = ctx.own(H5Pcreate(H5P_GROUP_CREATE), H5Pclose, "cannot create group " + gpath);
+    ctx.call(H5Pset_link_creation_order(gcpl.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED),
+             "cannot create group " + gpath);
+    Hid group = ctx.own(H5Gcreate2(snapshots.get(), name.c_str(), H5P_DEFAULT, gcpl.get(), H5P_DEFAULT), H5Gclose,
+                        "cannot create group " + gpath);
+    for (const FieldMeta& f : e.fields) {
+      const std::string what = "cannot write the virtual dataset " + gpath + "/" + f.label;
+      const int comps = f.rows * f.cols, rank = comps == 1 ? 1 : 2;
+      const hsize_t dims[2] = {e.count, static_cast<hsize_t>(comps)};
+      Hid space = ctx.own(H5Screate_simple(rank, dims, nullptr), H5Sclose, what);
+      Hid dcpl = ctx.own(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, what);
+      hsize_t offset = 0;
+      for (std::size_t q = 0; q < counts.size(); ++q) {
+        if (counts[q] == 0) continue;
+        const hsize_t part_dims[2] = {counts[q], static_cast<hsize_t>(comps)};
+        const hsize_t start[2] = {offset, 0};
+        Hid source = ctx.own(H5Screate_simple(rank, part_dims, nullptr), H5Sclose, what);
+        ctx.call(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, part_dims, nullptr), what);
+        // The part's name relative to this file: HDF5 looks for it beside the index.
+        ctx.call(H5Pset_virtual(dcpl.get(), space.get(), part_names[q].c_str(), (gpath + "/" + f.label).c_str(),
+                                source.get()),
+                 what);
+        offset += counts[q];
+      }
+      ctx.call(H5Sselect_all(space.get()), what);
+      const hid_t type = native_type(f.type);
+      Hid dset =
+          ctx.own(H5Dcreate2(group.get(), f.label.c_str(), type, space.get(), H5P_DEFAULT, dcpl.get(), H5P_DEFAULT),
+                  H5Dclose, what);
+      write_string_attribute(ctx, dset.get(), "unit", f.unit);
+      if (comps > 1) {
+        const std::int32_t rows = f.rows, cols = f.cols;
+        write_numeric_attribute(ctx, dset.get(), "rows", H5T_NATIVE_INT32, &rows);
+        write_numeric_attribute(ctx, dset.get(), "cols", H5T_NATIVE_INT32, &cols);
+        if (f.rows > 1 && f.cols > 1) write_string_attribute(ctx, dset.get(), "storage_order", "column-major");
+      }
+    }
+    ensure_vertex_index(e.count);
+    write_numeric_attribute(ctx, group.get(), "time", H5T_NATIVE_DOUBLE, &time);
+    write_numeric_attribute(ctx, group.get(), "step", H5T_NATIVE_INT64, &step);
+    const std::int64_t count = static_cast<std::int64_t>(e.count);
+    write_numeric_attribute(ctx, group.get(), "particle_count", H5T_NATIVE_INT64, &count);  // last: complete
   } catch (...) {
-    // Remove the partial group so the next write can reuse the name; the reader ignores it anyway.
-    H5Ldelete(m.snapshots.get(), name.c_str(), H5P_DEFAULT);
+    H5Ldelete(snapshots.get(), name.c_str(), H5P_DEFAULT);
     H5Eclear2(H5E_DEFAULT);
     throw;
   }
-  m.flush();
-
-  Impl::Entry e{time, step, n, lines.size() / 2, {}};
-  e.fields.push_back({"position", position->type, position->rows, position->cols});
-  for (const FieldView& f : fields)
-    if (&f != position) e.fields.push_back({std::string(f.label), f.type, f.rows, f.cols});
-  m.entries.push_back(std::move(e));
-  m.write_xdmf();
+  flush();
 }
 
 // XDMF companion.

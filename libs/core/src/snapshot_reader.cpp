@@ -1,6 +1,7 @@
 /// \file snapshot_reader.cpp
 /// The reader of HDF5 particle snapshots (snapshot.hpp; the layout and the choices in snapshot.cpp).
 #include <algorithm>
+#include <sstream>
 
 #include "geohaz/core/snapshot.hpp"
 #include "hdf5_common.hpp"
@@ -63,6 +64,15 @@ SnapshotReader::SnapshotReader(const std::filesystem::path& h5_path) : impl_(std
     throw InputError("not a geohaz snapshot file: it has no /snapshots group", m.ctx.file);
   m.snapshots = m.ctx.own(H5Gopen2(m.file.get(), kSnapshotsGroup, H5P_DEFAULT), H5Gclose,
                           std::string("cannot open group ") + kSnapshotsGroup);
+  // Written by several processes: the datasets read through the part files beside this one, and a
+  // missing part would read as zeros (snapshot.cpp, "Several processes"), so each must be there.
+  if (const auto parts = read_attribute_text(m.ctx, m.file.get(), "/", "part_files")) {
+    std::istringstream names(*parts);
+    for (std::string name; std::getline(names, name);)
+      if (!name.empty() && !std::filesystem::exists(h5_path.parent_path() / name, ec))
+        throw InputError("the part file " + name + " of this snapshot file (written by several processes) is missing",
+                         m.ctx.file);
+  }
 
   std::vector<std::string> names = link_names(m.ctx, m.snapshots.get(), kSnapshotsGroup);
   // Zero-padded names sort numerically by (length, text), also past 999999 snapshots.
