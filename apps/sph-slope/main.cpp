@@ -63,13 +63,14 @@ int main(int argc, char** argv) {
 #ifdef GEOHAZ_SPH_MPI
     if (comm) {
       if (opts.threads == 0) omp_set_num_threads(std::max(1, omp_get_num_procs() / local_ranks()));
-      // Rank 0 alone writes the outputs; the others start when it has its output folder (the
-      // folder policy may refuse it: exit 2 on every rank, not a hang).
+      // Rank 0 writes the outputs, every rank its part of the snapshots into the same folder; the
+      // others start when rank 0 has checked (and cleaned) the folder (the folder policy may refuse
+      // it: exit 2 on every rank, not a hang).
       std::array<double, 1> refused{0.0};
       if (comm->rank() != 0) {
         comm->max_all(refused);
         if (refused[0] > 0.0) return kExitInputError;
-        return run_case(cfg, {}, true, comm);
+        return run_case(cfg, opts.out, true, comm);
       }
       bool started = false;
       try {

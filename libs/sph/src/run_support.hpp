@@ -68,11 +68,15 @@ std::vector<std::size_t> reported_structures(const RunConfig& c, const std::vect
 
 /// The fields written to snapshots: the state a restart needs plus what the issue asks to see.
 /// position_at_build (the positions of the last neighbour-list build) is restart state: the list,
-/// hence the Verlet-skin decisions and the order of the pair sums, is rebuilt from it.
+/// hence the Verlet-skin decisions and the order of the pair sums, is rebuilt from it. Only the
+/// first `count` particles (a rank's owned ones; a rank writing none of a state every rank holds: 0).
 template <int Dim>
-void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int64_t step);
+void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int64_t step,
+                  std::size_t count = static_cast<std::size_t>(-1));
 
-/// A snapshot of the solver's store and, as a root attribute, its solver state (SolverState).
+/// A snapshot of the solver's store (its owned particles over several ranks, which write it together
+/// through a SnapshotWriter of several processes) and, as a root attribute, its solver state
+/// (SolverState, the same on every rank).
 template <int Dim>
 void write_snapshot(SnapshotWriter& w, const SphSolver<Dim>& solver, std::int64_t step);
 
