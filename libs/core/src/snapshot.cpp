@@ -172,33 +172,6 @@ std::string format_double(double v) {
   return std::string(buf, r.ptr);
 }
 
-std::string xml_escape(std::string_view s) {
-  std::string out;
-  out.reserve(s.size());
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&apos;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
 std::string snapshot_name(std::size_t k) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%06zu", k);

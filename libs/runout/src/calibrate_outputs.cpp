@@ -56,12 +56,6 @@ void member_table(const fs::path& path, const CalibrationSetup& s, const std::ve
   csv.commit();
 }
 
-std::string xml_escape(const std::string& s) {
-  std::string o;
-  for (char c : s) o += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : std::string(1, c);
-  return o;
-}
-
 /// Score against each parameter (top row) and every pair of parameters (below): all members in grey,
 /// the acceptable ones coloured by score (dark = best), the best as a red ring.
 void write_acceptable_svg(const fs::path& path, const CalibrationSetup& s, const CalibrationResult& r, double j_best,
