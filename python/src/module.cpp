@@ -41,6 +41,8 @@ using namespace geohaz::runout;
 namespace geohaz::python {
 /// The sph-slope functions (python/src/sph.cpp).
 void add_sph(py::module_& m);
+/// The report page (python/src/report.cpp).
+void add_report(py::module_& m);
 }  // namespace geohaz::python
 
 namespace {
@@ -395,4 +397,5 @@ PYBIND11_MODULE(_geohaz, m) {
   m.def("read_raster", &read_raster_dict, py::arg("path"));
   geohaz::python::add_sph(m);
   register_dem(m);
+  geohaz::python::add_report(m);
 }
