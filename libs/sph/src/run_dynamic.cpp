@@ -101,7 +101,8 @@ class DynamicRun final : public SimulationModel {
   ParticleFields particles() const override { return fields_of(state()); }
   void write_snapshot(SnapshotWriter& w) const override {
     if (solver_.domain())  // the gathered state, without the solver state (check_distributable)
-      write_fields<Dim>(w, view_, solver_.time(), step_offset_ + solver_.step_count());
+      write_fields<Dim>(w, view_, solver_.time(), step_offset_ + solver_.step_count(),
+                        solver_.settings().pore_water.active());
     else
       sph::write_snapshot<Dim>(w, solver_, step_offset_ + solver_.step_count());
   }

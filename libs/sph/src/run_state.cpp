@@ -45,7 +45,7 @@ constexpr const char* kSolverStateAttribute = "sph_solver_state";
 }  // namespace
 
 template <int Dim>
-void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int64_t step) {
+void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int64_t step, bool pore_pressure) {
   std::vector<FieldView> v;
   add_view<Position<Dim>>(v, s);
   add_view<Velocity<Dim>>(v, s);
@@ -64,12 +64,13 @@ void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int6
   add_view<Clamped>(v, s);
   add_internal_variables(v, s, std::type_identity<ConstitutiveModel>{});
   add_view<PositionAtBuild<Dim>>(v, s);
+  if (pore_pressure) add_view<PorePressure>(v, s);
   w.write(t, step, v);
 }
 
 template <int Dim>
 void write_snapshot(SnapshotWriter& w, const SphSolver<Dim>& solver, std::int64_t step) {
-  write_fields<Dim>(w, solver.store(), solver.time(), step);
+  write_fields<Dim>(w, solver.store(), solver.time(), step, solver.settings().pore_water.active());
   const SolverState st = solver.state();
   char buf[160];
   std::snprintf(buf, sizeof buf, "snapshot %zu step %lld dt %a builds %lld", w.snapshot_count() - 1,
@@ -180,8 +181,8 @@ GeostaticReport geostatic_with_progress(SphSolver<Dim>& solver, double dur, cons
   return rep;
 }
 
-template void write_fields<2>(SnapshotWriter&, const SphStore<2>&, double, std::int64_t);
-template void write_fields<3>(SnapshotWriter&, const SphStore<3>&, double, std::int64_t);
+template void write_fields<2>(SnapshotWriter&, const SphStore<2>&, double, std::int64_t, bool);
+template void write_fields<3>(SnapshotWriter&, const SphStore<3>&, double, std::int64_t, bool);
 template void write_snapshot<2>(SnapshotWriter&, const SphSolver<2>&, std::int64_t);
 template void write_snapshot<3>(SnapshotWriter&, const SphSolver<3>&, std::int64_t);
 template Restart load_restart<2>(const std::filesystem::path&, SphStore<2>&);

@@ -71,9 +71,9 @@ class StrengthReductionRun final : public SimulationModel {
   /// critical factor (snapshot 1).
   void write_snapshot(SnapshotWriter& w) const override {
     if (!finished_)
-      write_fields<Dim>(w, *initial_, 0.0, 0);
+      write_fields<Dim>(w, *initial_, 0.0, 0, settings_.pore_water.active());
     else if (mechanism_)
-      write_fields<Dim>(w, *mechanism_, trial_duration_, 1);
+      write_fields<Dim>(w, *mechanism_, trial_duration_, 1, settings_.pore_water.active());
   }
   void draw_due_pngs(const std::filesystem::path&) override {}
   void write_outputs(const std::filesystem::path& out) const override;
