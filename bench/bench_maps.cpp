@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
   ConfigReader cfg = ConfigReader::from_file(src / "data/runout/alr_processes.toml");
   cfg.apply_override("model.h0=0.5");
   if (duration > 0.0) cfg.apply_override("run.duration=" + std::to_string(duration));
-  runout::RunoutCase c = runout::read_case(cfg);
+  runout::RunConfig c = runout::read_config(cfg);
   cfg.finish();
   c.resolved_config = cfg.resolved();
   c.output.snapshots = false;
@@ -91,7 +91,7 @@ int main(int argc, char** argv) {
   const fs::path run_dir = tmp / "runs" / "3-runout-processes";
   fs::create_directories(run_dir);
   const auto outputs = [&](bool pngs) {
-    runout::RunoutCase d = c;
+    runout::RunConfig d = c;
     d.output.pngs = pngs;
     for (const auto& e : fs::directory_iterator(run_dir)) fs::remove_all(e.path());
     fs::create_directories(run_dir);

@@ -1,12 +1,14 @@
 # Man pages and bash completion for the apps, and the Debian package (CPack), issue 20.
 include(GNUInstallDirs)
 
-set(_geohaz_apps sph-slope debris-runout dem-avalanche geohaz-report geohaz-ensemble geohaz-calibrate slope-stability)
+set(_geohaz_apps sph-slope debris-runout dem-avalanche geohaz-report geohaz-ensemble geohaz-calibrate slope-stability
+    sph-slope-mpi)
 
 # Which Debian package (CPack DEB component) each app goes into: the MPI app on its own, so that
 # the other apps do not pull in Open MPI.
 set(_geohaz_app_component_geohaz-ensemble mpi)
 set(_geohaz_app_component_geohaz-calibrate mpi)
+set(_geohaz_app_component_sph-slope-mpi mpi)
 foreach(app IN LISTS _geohaz_apps)
   if(NOT DEFINED _geohaz_app_component_${app})
     set(_geohaz_app_component_${app} apps)
@@ -75,7 +77,8 @@ endforeach()
 # prefix /usr, split as Debian would:
 #   geohaz             the apps sph-slope, debris-runout, dem-avalanche, geohaz-report, their man
 #                      pages and completions, README, docs and example data (share/geohaz)
-#   geohaz-ensemble    geohaz-ensemble, the MPI app (Open MPI only for those who install it)
+#   geohaz-ensemble    the MPI apps geohaz-ensemble, geohaz-calibrate and sph-slope-mpi (Open MPI only
+#                      for those who install it)
 #   python3-geohaz     the Python package, for the python3 it was built for
 #   libgeohaz-dev      headers, the static libraries and the CMake package (find_package(geohaz))
 #   libgeohaz<so>      the shared libraries, only with GEOHAZ_SHARED_LIBS=ON
@@ -164,10 +167,12 @@ infiltration and the infinite-slope factor of safety over a DSM) and
 geohaz-report, with man
 pages, bash completion, the documentation and example data
 (/usr/share/geohaz).")
-set(CPACK_DEBIAN_MPI_DESCRIPTION "landslide models: debris-runout ensembles and calibration over MPI
+set(CPACK_DEBIAN_MPI_DESCRIPTION "landslide models: ensembles, calibration and SPH over MPI
 geohaz-ensemble runs ensembles of debris-runout with sampled parameters over
 MPI ranks and writes probability, mean and percentile maps; geohaz-calibrate
-fits debris-runout's parameters to an observed event over the same ranks.")
+fits debris-runout's parameters to an observed event over the same ranks;
+sph-slope-mpi runs sph-slope's SPH model with its particles decomposed over
+MPI ranks, for slopes too large for one machine.")
 set(CPACK_DEBIAN_PYTHON_DESCRIPTION "landslide models: Python module geohaz
 The Python package geohaz runs the geohaz models in-process and returns maps,
 particles and series as NumPy arrays; geohaz.read_run reads any output folder

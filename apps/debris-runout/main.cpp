@@ -1,5 +1,5 @@
 // debris-runout: the depth-averaged particle debris-flow model run over a DSM, writing hazard maps.
-// This file is the command line only: options and config → RunoutCase → runout::run_case
+// This file is the command line only: options and config → RunConfig → runout::run_case
 // (libs/runout/run.hpp), which validates every input before it writes anything.
 #include <boost/program_options.hpp>
 #include <cmath>
@@ -113,7 +113,7 @@ int run(int argc, char** argv) {
     return kExitOk;
   if (common.help_config) {
     ConfigReader d = ConfigReader::describe();
-    read_case(d);
+    read_config(d);
     std::cout << ConfigReader::format_reference(d.reference());
     return kExitOk;
   }
@@ -143,13 +143,13 @@ int run(int argc, char** argv) {
   if (!dsm_arg.empty()) cfg.apply_override("terrain.dsm=\"" + dsm_arg + "\"");
   if (!release_arg.empty()) cfg.apply_override("release.file=\"" + release_arg + "\"");
   if (!release_from_arg.empty()) cfg.apply_override("release.from=\"" + release_from_arg + "\"");
-  RunoutCase c = read_case(cfg);
+  RunConfig c = read_config(cfg);
   cfg.finish();
   c.resolved_config = cfg.resolved();
   // The inputs read while the run goes on must not lie in the folder it cleans first.
   std::vector<fs::path> inputs{c.dsm, c.release.file, c.release.handoff, c.processes.hydrograph, c.processes.erodible};
   return run_in_output_dir(common.out, kApp, inputs, [&] {
-    run_case(c, common.out, common.quiet, threads);
+    run_case(c, {common.out, common.quiet, threads});
     return kExitOk;
   });
 }

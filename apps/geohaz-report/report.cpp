@@ -73,29 +73,6 @@ constexpr UnitName kUnits[] = {
 
 }  // namespace
 
-std::string escape_html(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '<':
-        o += "&lt;";
-        break;
-      case '>':
-        o += "&gt;";
-        break;
-      case '&':
-        o += "&amp;";
-        break;
-      case '"':
-        o += "&quot;";
-        break;
-      default:
-        o += c;
-    }
-  }
-  return o;
-}
-
 Quantity quantity_from_name(const std::string& name) {
   const auto tok = split(name, '_');
   // The longest unit suffix wins ("m_per_s" over "s"); at least one word must remain.
@@ -468,8 +445,8 @@ const char* kCheckScript = R"(<script>
 void rows_table(std::ostringstream& o, const std::vector<Row>& rows) {
   o << "<table>\n";
   for (const auto& r : rows)
-    o << "<tr><td title=\"" << escape_html(r.key) << "\">" << escape_html(r.label) << "</td><td class=v>"
-      << escape_html(r.value) << "</td></tr>\n";
+    o << "<tr><td title=\"" << xml_escape(r.key) << "\">" << xml_escape(r.label) << "</td><td class=v>"
+      << xml_escape(r.value) << "</td></tr>\n";
   o << "</table>\n";
 }
 
@@ -583,7 +560,7 @@ std::string map_check_html(const fs::path& png) {
   std::string o;
   const auto problems = check_map_png(png);
   if (problems.empty() || problems.front().rfind("records no map layout", 0) != 0)
-    for (const auto& m : problems) o += "<br><span class=map-problem>map check: " + escape_html(m) + "</span>";
+    for (const auto& m : problems) o += "<br><span class=map-problem>map check: " + xml_escape(m) + "</span>";
   return o;
 }
 
@@ -651,13 +628,13 @@ fs::path write_report(const fs::path& root, const std::string& title, const fs::
   head << "<h2>Overview</h2>\n<table><tr><th>run</th><th>quantity</th><th>value</th></tr>\n";
   for (const auto& r : all) {
     for (const auto& row : r.summary.headline)
-      head << "<tr><td><a href=\"#" << escape_html(r.name) << "\">" << escape_html(r.name) << "</a></td><td>"
-           << escape_html(row.label) << "</td><td class=v>" << escape_html(row.value) << "</td></tr>\n";
-    body << "<section id=\"" << escape_html(r.name) << "\"><h2>" << escape_html(r.name) << "</h2>\n"
+      head << "<tr><td><a href=\"#" << xml_escape(r.name) << "\">" << xml_escape(r.name) << "</a></td><td>"
+           << xml_escape(row.label) << "</td><td class=v>" << xml_escape(row.value) << "</td></tr>\n";
+    body << "<section id=\"" << xml_escape(r.name) << "\"><h2>" << xml_escape(r.name) << "</h2>\n"
          << r.ensemble.html << "<div class=row>\n";
     for (const auto& g : r.summary.groups) {
       if (g.title == std::string(kGroupTitles[kOther])) continue;
-      body << "<div><h3>" << escape_html(g.title) << "</h3>\n";
+      body << "<div><h3>" << xml_escape(g.title) << "</h3>\n";
       rows_table(body, g.rows);
       body << "</div>\n";
     }
@@ -668,12 +645,12 @@ fs::path write_report(const fs::path& root, const std::string& title, const fs::
     }
     body << "</div>\n" << r.calibration.html;
     const auto sub_table = [&](const SubTable& t) {
-      body << "<h3>" << escape_html(t.title) << "</h3>\n<table><tr>";
-      for (const auto& h : t.headers) body << "<th>" << escape_html(h) << "</th>";
+      body << "<h3>" << xml_escape(t.title) << "</h3>\n<table><tr>";
+      for (const auto& h : t.headers) body << "<th>" << xml_escape(h) << "</th>";
       body << "</tr>\n";
       for (const auto& row : t.cells) {
         body << "<tr>";
-        for (const auto& c : row) body << "<td class=v>" << escape_html(c) << "</td>";
+        for (const auto& c : row) body << "<td class=v>" << xml_escape(c) << "</td>";
         body << "</tr>\n";
       }
       body << "</table>\n";
@@ -684,18 +661,18 @@ fs::path write_report(const fs::path& root, const std::string& title, const fs::
       const std::string stem = p.stem().string();
       const int rank = caption_rank(stem);
       std::string caption = rank < static_cast<int>(std::size(kCaptions)) ? kCaptions[rank].text : "";
-      body << "<figure><img alt=\"" << escape_html(stem) << "\" src=\""
-           << escape_html(fs::relative(p, root).generic_string()) << "\"><figcaption><b>"
-           << escape_html(p.filename().string()) << "</b> " << escape_html(caption);
+      body << "<figure><img alt=\"" << xml_escape(stem) << "\" src=\""
+           << xml_escape(fs::relative(p, root).generic_string()) << "\"><figcaption><b>"
+           << xml_escape(p.filename().string()) << "</b> " << xml_escape(caption);
       if (stem.rfind("cracks_", 0) == 0) body << "<br>" << kCrackLegend;
       body << map_check_html(p) << "</figcaption></figure>\n";
     }
     for (const auto& [name, svg] : r.plots)
-      body << "<figure><img alt=\"" << escape_html(name) << "\" src=\"report_files/" << escape_html(name)
+      body << "<figure><img alt=\"" << xml_escape(name) << "\" src=\"report_files/" << xml_escape(name)
            << "\"></figure>\n";
     for (const auto& g : r.summary.groups)
       if (g.title == std::string(kGroupTitles[kOther])) {
-        body << "<details><summary>" << escape_html(g.title) << "</summary>\n";
+        body << "<details><summary>" << xml_escape(g.title) << "</summary>\n";
         rows_table(body, g.rows);
         for (const auto& t : r.summary.tables)
           if (t.folded) sub_table(t);
@@ -703,8 +680,8 @@ fs::path write_report(const fs::path& root, const std::string& title, const fs::
       }
     body << "<details><summary>Files</summary><ul class=files>\n";
     for (const auto& f : r.files)
-      body << "<li><a href=\"" << escape_html(fs::relative(f, root).generic_string()) << "\">"
-           << escape_html(f.filename().string()) << "</a></li>\n";
+      body << "<li><a href=\"" << xml_escape(fs::relative(f, root).generic_string()) << "\">"
+           << xml_escape(f.filename().string()) << "</a></li>\n";
     body << "</ul></details>\n</section>\n";
   }
   head << "</table>\n";
@@ -715,9 +692,9 @@ fs::path write_report(const fs::path& root, const std::string& title, const fs::
       for (const auto& [name, svg] : part->plots) write_text_file(files_dir / name, svg);
   }
   std::ostringstream html;
-  html << "<!DOCTYPE html>\n<html lang=en><head><meta charset=utf-8><title>" << escape_html(title)
-       << "</title>\n<style>" << kStyle << "</style>\n"
-       << kCheckScript << "</head><body>\n<div id=page-check></div>\n<h1>" << escape_html(title)
+  html << "<!DOCTYPE html>\n<html lang=en><head><meta charset=utf-8><title>" << xml_escape(title) << "</title>\n<style>"
+       << kStyle << "</style>\n"
+       << kCheckScript << "</head><body>\n<div id=page-check></div>\n<h1>" << xml_escape(title)
        << "</h1>\n<p>Generated by geohaz " << GEOHAZ_VERSION
        << ". The maps are quick-looks of the GeoTIFFs beside them (open those in QGIS, with the .qml styles); "
           "ParaView opens the <code>.xmf</code> files. Hover a label to see its summary.json key.</p>\n"

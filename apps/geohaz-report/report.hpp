@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "geohaz/core/output.hpp"
 #include "geohaz/core/summary_keys.hpp"
 
 namespace geohaz::report {
@@ -92,9 +93,6 @@ Summary summarise(const nlohmann::json& summary);
 /// strengths …) from its config.resolved.toml: rows "symbol — meaning", value with unit. Only the
 /// keys of the parameter table are shown (the whole file is linked). Empty when there is no file.
 std::vector<Row> input_parameters(const std::filesystem::path& resolved_config);
-
-/// The text with <, >, & and " escaped for HTML.
-std::string escape_html(const std::string& s);
 
 /// A debris-runout, ensemble or calibration parameter key in the user's terms with its unit for
 /// display: from the declarations of the runout config reader (runout::parameter_key: "model.xi" →

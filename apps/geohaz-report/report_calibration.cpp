@@ -72,11 +72,11 @@ std::string value_of(const json& j, const std::string& unit) {
 void table(std::ostringstream& o, const std::vector<std::string>& headers,
            const std::vector<std::vector<std::string>>& rows, const char* cls = nullptr) {
   o << "<table" << (cls ? std::string(" class=") + cls : std::string()) << "><tr>";
-  for (const auto& h : headers) o << "<th>" << escape_html(h) << "</th>";
+  for (const auto& h : headers) o << "<th>" << xml_escape(h) << "</th>";
   o << "</tr>\n";
   for (const auto& r : rows) {
     o << "<tr>";
-    for (std::size_t k = 0; k < r.size(); ++k) o << (k == 0 ? "<td>" : "<td class=v>") << escape_html(r[k]) << "</td>";
+    for (std::size_t k = 0; k < r.size(); ++k) o << (k == 0 ? "<td>" : "<td class=v>") << xml_escape(r[k]) << "</td>";
     o << "</tr>\n";
   }
   o << "</table>\n";
@@ -98,10 +98,10 @@ void best_set(std::ostringstream& o, const json& s, const std::string& page_dir)
                         : "n/a"});
   }
   o << "<h3>Best parameter set</h3>\n<p>Member " << best.at("member").get<int>() << " ("
-    << escape_html(best.at("stage").get<std::string>()) << ") of " << s.at("members").get<int>() << " ("
+    << xml_escape(best.at("stage").get<std::string>()) << ") of " << s.at("members").get<int>() << " ("
     << s.at("design_members").get<int>() << " design, " << s.at("morris_members").get<int>() << " Morris, "
     << s.at("local_members").get<int>() << " local; " << s.at("failed").size() << " failed). Ready to run: <a href=\""
-    << escape_html(page_dir) << "best.toml\">best.toml</a> "
+    << xml_escape(page_dir) << "best.toml\">best.toml</a> "
     << "(<code>debris-runout --config best.toml --out best-run</code>).</p>\n";
   table(o, {"parameter", "key", "best", "searched (scale)", "acceptable range"}, rows, "calibration-best");
   const json& m = best.at("misfit");
@@ -165,7 +165,7 @@ void acceptable_set(std::ostringstream& o, const fs::path& run_dir, const json& 
     o << "; the best " << kAcceptableRows << " shown, all in ";
   else
     o << "; also in ";
-  o << "<a href=\"" << escape_html(page_dir) << "acceptable.csv\">acceptable.csv</a>.</p>\n";
+  o << "<a href=\"" << xml_escape(page_dir) << "acceptable.csv\">acceptable.csv</a>.</p>\n";
   table(o, headers, rows, "calibration-acceptable");
 }
 
@@ -187,7 +187,7 @@ void morris(std::ostringstream& o, const json& s) {
   for (const auto& e : sens) {
     const double mu_star = e.at("mu_star").get<double>();
     const int px = top > 0.0 ? static_cast<int>(std::lround(120.0 * mu_star / top)) : 0;
-    o << "<tr><td>" << ++rank << "</td><td>" << escape_html(parameter_heading(e.at("key").get<std::string>()))
+    o << "<tr><td>" << ++rank << "</td><td>" << xml_escape(parameter_heading(e.at("key").get<std::string>()))
       << "</td><td class=v>" << format_quantity(mu_star, "") << "</td><td><span class=bar style=\"width:" << px
       << "px\"></span></td><td class=v>" << format_quantity(e.at("mu").get<double>(), "") << "</td><td class=v>"
       << format_quantity(e.at("sigma").get<double>(), "") << "</td><td class=v>" << e.at("effects").get<int>()
@@ -200,7 +200,7 @@ void morris(std::ostringstream& o, const json& s) {
 void comparison_map(std::ostringstream& o, const fs::path& run_dir, const std::string& page_dir) {
   const fs::path png = run_dir / "comparison.png";
   if (!fs::exists(png)) return;
-  o << "<figure><img alt=\"comparison\" src=\"" << escape_html(page_dir) << "comparison.png\"><figcaption>"
+  o << "<figure><img alt=\"comparison\" src=\"" << xml_escape(page_dir) << "comparison.png\"><figcaption>"
     << "<b>comparison.png</b> The best member against the observation over the hillshade, with the "
        "thalweg (comparison.tif with comparison.qml for QGIS).<br>"
        "<span class=key><i style=\"background:#2ca02c\"></i>true positive (both)</span>"
@@ -208,7 +208,7 @@ void comparison_map(std::ostringstream& o, const fs::path& run_dir, const std::s
        "<span class=key><i style=\"background:#1f77b4\"></i>false negative (observed only)</span>";
   const auto problems = check_map_png(png);
   if (problems.empty() || problems.front().rfind("records no map layout", 0) != 0)
-    for (const auto& m : problems) o << "<br><span class=map-problem>map check: " << escape_html(m) << "</span>";
+    for (const auto& m : problems) o << "<br><span class=map-problem>map check: " << xml_escape(m) << "</span>";
   o << "</figcaption></figure>\n";
 }
 
@@ -243,8 +243,8 @@ void thalweg_profile(CalibrationPart& part, const fs::path& run_dir, const std::
   for (const auto& p : plots) {
     if (!is_plottable(p.csv)) continue;
     part.plots.emplace_back(svg_prefix + p.file + ".svg", svg_plot(p.csv, p.title));
-    part.html += "<figure><img alt=\"" + escape_html(p.file) + "\" src=\"report_files/" +
-                 escape_html(part.plots.back().first) +
+    part.html += "<figure><img alt=\"" + xml_escape(p.file) + "\" src=\"report_files/" +
+                 xml_escape(part.plots.back().first) +
                  "\"><figcaption>Along the thalweg, in bins of score.profile_bin: the observed and modelled "
                  "affected area per metre of path";
     part.html += std::string(p.file) == "thalweg_width" ? " (width)." : ", and the largest deposit depth in the bin.";
@@ -279,7 +279,7 @@ CalibrationPart calibration_part(const fs::path& run_dir, const json& summary, c
     morris(o, summary);
     o << "</div></div>\n";
     if (fs::exists(run_dir / "acceptable.svg"))
-      o << "<figure><img alt=\"acceptable\" src=\"" << escape_html(dir)
+      o << "<figure><img alt=\"acceptable\" src=\"" << xml_escape(dir)
         << "acceptable.svg\"><figcaption><b>acceptable.svg</b> Score against each parameter (top row) and "
            "every pair of parameters: all members grey, the acceptable set coloured by score, the best ringed "
            "in red, failed members as red crosses. A long thin cloud in a pair panel is equifinality: the two "
@@ -288,7 +288,7 @@ CalibrationPart calibration_part(const fs::path& run_dir, const json& summary, c
     part.html = o.str();
     thalweg_profile(part, run_dir, svg_prefix);
     if (fs::exists(run_dir / "profile.png"))
-      part.html += "<figure><img alt=\"profile\" src=\"" + escape_html(dir) +
+      part.html += "<figure><img alt=\"profile\" src=\"" + xml_escape(dir) +
                    "profile.png\"><figcaption><b>profile.png</b> The best member's long profile along the "
                    "observation's thalweg (profile.csv): terrain, peak depth above it, α along the profile and "
                    "peak speed; the observed run-out (blue) beside the modelled one (purple), both measured along "

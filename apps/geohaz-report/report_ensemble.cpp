@@ -131,8 +131,8 @@ void overview(std::ostringstream& o, const json& s, const MemberTable& members, 
   const json& failed = s.value("failed", json::array());
   o << "<div class=row><div><h3>Overview</h3>\n<table class=ensemble-overview>\n";
   const auto row = [&](const std::string& key, const std::string& label, const std::string& value) {
-    o << "<tr><td title=\"" << escape_html(key) << "\">" << escape_html(label) << "</td><td class=v>"
-      << escape_html(value) << "</td></tr>\n";
+    o << "<tr><td title=\"" << xml_escape(key) << "\">" << xml_escape(label) << "</td><td class=v>" << xml_escape(value)
+      << "</td></tr>\n";
   };
   row("members", "members run", std::to_string(n));
   row("succeeded", "members that ran to the end (used in every map and number)", std::to_string(ok));
@@ -148,8 +148,8 @@ void overview(std::ostringstream& o, const json& s, const MemberTable& members, 
   else if (const auto a = ok_values(members, "area_affected_m2"); !a.empty())
     largest = format_quantity(*std::max_element(a.begin(), a.end()), area.unit);
   row("area_affected_m2.max", "largest " + area.label + " (one member)", largest);
-  o << "</table>\n<p>Base case: <a href=\"" << escape_html(page_dir) << "base.resolved.toml\">base.resolved.toml</a>; "
-    << "every member: <a href=\"" << escape_html(page_dir) << "members.csv\">members.csv</a>.</p></div>\n";
+  o << "</table>\n<p>Base case: <a href=\"" << xml_escape(page_dir) << "base.resolved.toml\">base.resolved.toml</a>; "
+    << "every member: <a href=\"" << xml_escape(page_dir) << "members.csv\">members.csv</a>.</p></div>\n";
 
   o << "<div><h3>Parameters varied</h3>\n<table class=ensemble-parameters>\n"
        "<tr><th>parameter</th><th>unit</th><th>distribution</th><th>values drawn (min – max)</th></tr>\n";
@@ -161,9 +161,9 @@ void overview(std::ostringstream& o, const json& s, const MemberTable& members, 
                                   ? ""
                                   : format_quantity(*std::min_element(drawn.begin(), drawn.end()), "") + " – " +
                                         format_quantity(*std::max_element(drawn.begin(), drawn.end()), "");
-    o << "<tr><td title=\"" << escape_html(key) << "\">" << escape_html(label) << "</td><td class=unit>"
-      << escape_html(unit) << "</td><td>" << escape_html(distribution_text(p)) << "</td><td class=v>"
-      << escape_html(range) << "</td></tr>\n";
+    o << "<tr><td title=\"" << xml_escape(key) << "\">" << xml_escape(label) << "</td><td class=unit>"
+      << xml_escape(unit) << "</td><td>" << xml_escape(distribution_text(p)) << "</td><td class=v>" << xml_escape(range)
+      << "</td></tr>\n";
   }
   o << "</table></div>\n";
 
@@ -173,12 +173,12 @@ void overview(std::ostringstream& o, const json& s, const MemberTable& members, 
     if (!s.contains(st.summary_key) || !s.at(st.summary_key).is_object()) continue;
     const json& j = s.at(st.summary_key);
     const Quantity q = statistic_quantity(st);
-    o << "<tr><td title=\"" << st.summary_key << "\">" << escape_html(q.label) << "</td>";
+    o << "<tr><td title=\"" << st.summary_key << "\">" << xml_escape(q.label) << "</td>";
     for (const char* k : {"p10", "p50", "p90", "mean", "min", "max"}) {
       const json& v = j.value(k, json());
       o << "<td class=v data-key=\"" << st.summary_key << '.' << k << "\"";
       if (v.is_number()) o << " data-value=\"" << v.dump() << "\"";
-      o << ">" << escape_html(number_of(v, q.unit)) << "</td>";
+      o << ">" << xml_escape(number_of(v, q.unit)) << "</td>";
     }
     o << "</tr>\n";
   }
@@ -188,7 +188,7 @@ void overview(std::ostringstream& o, const json& s, const MemberTable& members, 
     o << "<h3>Failed members</h3>\n<table class=ensemble-failed><tr><th>member</th><th>diagnosis</th></tr>\n";
     for (const json& f : failed)
       o << "<tr><td class=v>" << number_of(f.value("member", json()), "") << "</td><td>"
-        << escape_html(f.value("diagnosis", "")) << "</td></tr>\n";
+        << xml_escape(f.value("diagnosis", "")) << "</td></tr>\n";
     o << "</table>\n";
   }
 }
@@ -259,8 +259,8 @@ void maps(std::ostringstream& o, RunPart& part, const fs::path& run_dir, const j
   });
   const int ok = s.value("succeeded", 0);
   const auto figure = [&](const std::string& f, const std::string& caption) {
-    o << "<figure><img alt=\"" << escape_html(f) << "\" src=\"" << escape_html(page_dir + f) << "\"><figcaption><b>"
-      << escape_html(f) << "</b> " << escape_html(caption) << map_check_html(run_dir / f) << "</figcaption></figure>\n";
+    o << "<figure><img alt=\"" << xml_escape(f) << "\" src=\"" << xml_escape(page_dir + f) << "\"><figcaption><b>"
+      << xml_escape(f) << "</b> " << xml_escape(caption) << map_check_html(run_dir / f) << "</figcaption></figure>\n";
     part.shown.push_back(f);
   };
   if (!prob.empty()) o << "<h3>Probability maps</h3>\n";
@@ -284,7 +284,7 @@ void maps(std::ostringstream& o, RunPart& part, const fs::path& run_dir, const j
                                                                                  : "pressure");
     const std::string err =
         acc.contains(error_key) ? format_quantity(100 * acc.value(error_key, 0.0), "%") : std::string("one bin");
-    o << "<h3>Mean and percentile maps of the " << escape_html(mf.what) << "</h3>\n";
+    o << "<h3>Mean and percentile maps of the " << xml_escape(mf.what) << "</h3>\n";
     for (const auto& f : list)
       figure(f, f[0] == 'm' ? std::string("Mean of the members' ") + mf.what +
                                   " per cell (a member that did not reach the cell counts as 0), in " + mf.classes + "."
@@ -308,7 +308,7 @@ void distributions(std::ostringstream& o, RunPart& part, const json& s, const Me
     const Quantity q = statistic_quantity(st);
     const std::string name = svg_prefix + st.column + "_distribution.svg";
     part.plots.emplace_back(name, svg_distribution(v, q, marks, q.label + " of the members (members.csv)"));
-    o << "<figure><img alt=\"" << escape_html(name) << "\" src=\"report_files/" << escape_html(name)
+    o << "<figure><img alt=\"" << xml_escape(name) << "\" src=\"report_files/" << xml_escape(name)
       << "\"><figcaption>Histogram (bars, left axis) and empirical CDF (line, right axis) of the " << v.size()
       << " members that ran; dashed: P10, P50 and P90 of summary.json.</figcaption></figure>\n";
   }
@@ -324,8 +324,8 @@ void base_case(std::ostringstream& o, const fs::path& run_dir, const json& s) {
   if (rows.empty()) return;
   o << "<div><h3>Base case (the same in every member)</h3>\n<table class=ensemble-base>\n";
   for (const auto& r : rows)
-    o << "<tr><td title=\"" << escape_html(r.key) << "\">" << escape_html(r.label) << "</td><td class=v>"
-      << escape_html(r.value) << "</td></tr>\n";
+    o << "<tr><td title=\"" << xml_escape(r.key) << "\">" << xml_escape(r.label) << "</td><td class=v>"
+      << xml_escape(r.value) << "</td></tr>\n";
   o << "</table></div>\n";
 }
 
@@ -402,7 +402,7 @@ std::string svg_distribution(std::vector<double> v, const Quantity& q, const std
   s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H << "\" viewBox=\"0 0 " << W
     << ' ' << H << "\" font-family=\"sans-serif\" font-size=\"12\" data-members=\"" << n << "\">\n"
     << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"" << W / 2
-    << "\" y=\"20\" text-anchor=\"middle\" font-size=\"15\">" << escape_html(title) << " (N = " << n << ")</text>\n";
+    << "\" y=\"20\" text-anchor=\"middle\" font-size=\"15\">" << xml_escape(title) << " (N = " << n << ")</text>\n";
   for (double t : nice_ticks(lo, hi, 8))
     s << "<line x1=\"" << px(t) << "\" y1=\"" << top << "\" x2=\"" << px(t) << "\" y2=\"" << top + ph
       << "\" stroke=\"#e4e4e4\"/><text x=\"" << px(t) << "\" y=\"" << top + ph + 15 << "\" text-anchor=\"middle\">"
@@ -435,11 +435,11 @@ std::string svg_distribution(std::vector<double> v, const Quantity& q, const std
       << "\" stroke=\"#333\" stroke-dasharray=\"5,3\"/><text x=\"" << (right ? x - 3 : x + 3) << "\" y=\""
       << top + 14 + 14 * (m % 3) << "\" text-anchor=\"" << (right ? "end" : "start")
       << "\" font-size=\"11\" stroke=\"white\" stroke-width=\"3\" paint-order=\"stroke\">"
-      << escape_html(markers[m].name) << " " << escape_html(format_quantity(markers[m].value, q.unit)) << "</text>\n";
+      << xml_escape(markers[m].name) << " " << xml_escape(format_quantity(markers[m].value, q.unit)) << "</text>\n";
   }
   s << "<rect x=\"" << ml << "\" y=\"" << top << "\" width=\"" << pw << "\" height=\"" << ph
     << "\" fill=\"none\" stroke=\"black\"/>\n<text x=\"" << ml + pw / 2 << "\" y=\"" << top + ph + 34
-    << "\" text-anchor=\"middle\">" << escape_html(q.label) << (q.unit.empty() ? "" : " (" + q.unit + ")")
+    << "\" text-anchor=\"middle\">" << xml_escape(q.label) << (q.unit.empty() ? "" : " (" + q.unit + ")")
     << "</text>\n<text transform=\"translate(18," << top + ph / 2
     << ") rotate(-90)\" text-anchor=\"middle\">members per bin</text>\n<text transform=\"translate(" << W - 12 << ','
     << top + ph / 2 << ") rotate(90)\" text-anchor=\"middle\">fraction of members ≤ value</text>\n"

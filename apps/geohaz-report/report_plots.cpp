@@ -154,7 +154,7 @@ std::string svg_plot(const Csv& csv, const std::string& title) {
   s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H << "\" viewBox=\"0 0 " << W
     << ' ' << H << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
     << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-    << "<text x=\"" << W / 2 << "\" y=\"20\" text-anchor=\"middle\" font-size=\"15\">" << escape_html(title)
+    << "<text x=\"" << W / 2 << "\" y=\"20\" text-anchor=\"middle\" font-size=\"15\">" << xml_escape(title)
     << "</text>\n";
   const int pw = W - ml - mr;
   for (std::size_t p = 0; p < panels.size(); ++p) {
@@ -196,9 +196,9 @@ std::string svg_plot(const Csv& csv, const std::string& title) {
       ytitle += ')';
     }
     s << "<text transform=\"translate(" << 18 << ',' << y0 + ph / 2 << ") rotate(-90)\" text-anchor=\"middle\">"
-      << escape_html(ytitle) << "</text>\n";
+      << xml_escape(ytitle) << "</text>\n";
     s << "<text x=\"" << ml + pw / 2 << "\" y=\"" << y0 + ph + 32 << "\" text-anchor=\"middle\">"
-      << escape_html(xq.label) << (xq.unit.empty() ? "" : " (" + xq.unit + ")") << "</text>\n";
+      << xml_escape(xq.label) << (xq.unit.empty() ? "" : " (" + xq.unit + ")") << "</text>\n";
     for (std::size_t c = 0; c < panels[p].cols.size(); ++c) {
       const auto& y = csv.columns[panels[p].cols[c]];
       const char* colour = kLineColours[c % std::size(kLineColours)];
@@ -209,7 +209,7 @@ std::string svg_plot(const Csv& csv, const std::string& title) {
       const int ly = y0 + 12 + static_cast<int>(c) * 16;
       s << "<line x1=\"" << ml + pw + 10 << "\" y1=\"" << ly - 4 << "\" x2=\"" << ml + pw + 30 << "\" y2=\"" << ly - 4
         << "\" stroke=\"" << colour << "\" stroke-width=\"2\"/><text x=\"" << ml + pw + 34 << "\" y=\"" << ly << "\">"
-        << escape_html(quantity_from_name(csv.names[panels[p].cols[c]]).label) << "</text>\n";
+        << xml_escape(quantity_from_name(csv.names[panels[p].cols[c]]).label) << "</text>\n";
     }
     s << "</g>\n";
   }

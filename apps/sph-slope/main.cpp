@@ -26,7 +26,12 @@ int main(int argc, char** argv) {
   const std::shared_ptr<const Communicator> comm = geohaz::mpi::world_communicator(session);
 #endif
   ConfigApp app;
+  // The MPI build names itself (--version, messages, the default output folder), as its package does.
+#ifdef GEOHAZ_SPH_MPI
+  app.name = "sph-slope-mpi";
+#else
   app.name = "sph-slope";
+#endif
   app.summary =
       "SPH simulation of slope failure and post-failure flow of elasto-plastic soil "
       "(2D plane strain / 3D) under gravity and earthquake shaking.\n"

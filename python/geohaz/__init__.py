@@ -12,8 +12,8 @@ geohaz.SimulationError (a RuntimeError), a failed write geohaz.IoError (an OSErr
 See docs/python.md.
 """
 from ._geohaz import __version__, InputError, IoError, SimulationError
-from . import runout, sph, dem, ensemble, calibrate
+from . import runout, sph, dem, ensemble, calibrate, report
 from .results import read_run, read_raster
 
 __all__ = ["__version__", "InputError", "IoError", "SimulationError", "runout", "sph", "dem", "ensemble", "calibrate",
-           "read_run", "read_raster"]
+           "report", "read_run", "read_raster"]

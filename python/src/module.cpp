@@ -1,7 +1,7 @@
 // The compiled part of the Python package `geohaz` (python/geohaz/): the exceptions and an
 // in-process debris-runout run (the in-process sph-slope run is in sph.cpp). The Python side (python/geohaz/runout.py)
 // turns keyword arguments into the same config overrides as the app's flags; this file reads the config with the
-// model's own key declarations (runout::read_case), runs through libs/runout/run.hpp, and hands the maps, particles,
+// model's own key declarations (runout::read_config), runs through libs/runout/run.hpp, and hands the maps, particles,
 // series and summary back as NumPy arrays and dicts.
 //
 // The GIL is released for the whole run; it is taken back only to call a progress callback (when
@@ -41,6 +41,8 @@ using namespace geohaz::runout;
 namespace geohaz::python {
 /// The sph-slope functions (python/src/sph.cpp).
 void add_sph(py::module_& m);
+/// The report page (python/src/report.cpp).
+void add_report(py::module_& m);
 }  // namespace geohaz::python
 
 namespace {
@@ -120,7 +122,7 @@ py::dict series_arrays(const std::vector<SeriesRow>& rows) {
 }
 
 /// The key figures: summary.json's text, parsed by Python's json (the same numbers as the app's).
-py::object summary_dict(const RunoutSimulation& sim, const RunoutCase& c, int threads) {
+py::object summary_dict(const RunoutSimulation& sim, const RunConfig& c, int threads) {
   return py::module_::import("json").attr("loads")(summary_json(c, sim, threads));
 }
 
@@ -132,34 +134,19 @@ void check_progress(const py::object& progress, int progress_every) {
 }
 
 /// The observer of a run from Python: the progress callback (every `every` steps, and at start
-/// and end), snapshots and the progress line when writing into a directory, and Ctrl-C.
+/// and end) and Ctrl-C. The snapshots and the progress line are run_case's (run.hpp).
 class PythonObserver : public RunObserver {
  public:
   PythonObserver(py::object callback, int every, double duration) : cb_(std::move(callback)), every_(every) {
     duration_ = duration;
   }
-  std::unique_ptr<SnapshotWriter> snapshots;
-  double snapshot_interval = 0.0;
-  std::unique_ptr<ProgressReporter> progress;
   /// The member this run is of an ensemble or calibration (-1: a lone run), members finished so
   /// far and planned: passed to the callback as "member", "members_done", "members_planned".
   int member = -1, members_done = 0, members_planned = 0;
 
-  void started(const RunoutSimulation& sim) override {
-    if (snapshots) {
-      write_snapshot(sim);
-      next_snapshot_ = snapshot_interval;
-    }
-    call("started", sim);
-  }
+  void started(const RunoutSimulation& sim) override { call("started", sim); }
   void stepped(const RunoutSimulation& sim) override {
-    const auto& s = sim.solver();
-    if (snapshots && (s.time() >= next_snapshot_ - 1e-9 || s.finished())) {
-      write_snapshot(sim);
-      while (next_snapshot_ <= s.time() + 1e-9) next_snapshot_ += snapshot_interval;
-    }
-    if (progress) progress->update(s.time(), s.step_count(), s.particles().size());
-    const std::int64_t k = s.step_count();
+    const std::int64_t k = sim.solver().step_count();
     if (!cb_.is_none() && k % every_ == 0) {
       call("running", sim);
     } else if (k % 256 == 0) {  // let Ctrl-C through without a callback
@@ -167,17 +154,9 @@ class PythonObserver : public RunObserver {
       if (PyErr_CheckSignals() != 0) throw py::error_already_set();
     }
   }
-  void finished(const RunoutSimulation& sim) override {
-    const auto& s = sim.solver();
-    if (progress) progress->finish(s.time(), s.step_count(), s.particles().size());
-    call("finished", sim);
-  }
+  void finished(const RunoutSimulation& sim) override { call("finished", sim); }
 
  private:
-  void write_snapshot(const RunoutSimulation& sim) {
-    const auto& s = sim.solver();
-    snapshots->write(s.particles(), s.time(), s.step_count());
-  }
   void call(const char* phase, const RunoutSimulation& sim) {
     py::gil_scoped_acquire gil;
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();
@@ -199,7 +178,7 @@ class PythonObserver : public RunObserver {
   }
   py::object cb_;
   int every_;
-  double duration_ = 0.0, next_snapshot_ = 0.0;
+  double duration_ = 0.0;
 };
 
 /// geohaz._geohaz.runout_run: see python/geohaz/runout.py for the documented signature.
@@ -211,44 +190,28 @@ py::dict runout_run(const std::string& config, const std::vector<std::string>& o
   ConfigReader cfg =
       config.empty() ? ConfigReader::from_string("", "<no config file>") : ConfigReader::from_file(config);
   for (const auto& o : overrides) cfg.apply_override(o);
-  RunoutCase c = read_case(cfg);
+  RunConfig c = read_config(cfg);
   cfg.finish();
   c.resolved_config = cfg.resolved();
 
-  auto in = std::make_unique<RunoutInputs>();
-  std::unique_ptr<RunoutSimulation> sim;
   PythonObserver obs(progress, progress_every, c.params.duration);
+  CaseRun run;
   {
     py::gil_scoped_release nogil;
-    // 1-2. Inputs and particles, all checked before anything is written (as run_case).
-    *in = load_inputs(c);
-    sim = std::make_unique<RunoutSimulation>(*in, c.params, c.output);
-    // 3. Outputs only now, when asked for, in a folder under the apps' --out policy (app.hpp).
-    const auto run_and_write = [&]() -> int {
-      if (!out.empty()) {
-        make_output_dir(out);
-        write_text_file(fs::path(out) / "config.resolved.toml", c.resolved_config);
-        if (c.output.snapshots) {
-          obs.snapshots =
-              std::make_unique<SnapshotWriter>(fs::path(out) / "snapshots.h5", "debris-runout", 2, c.resolved_config);
-          obs.snapshots->set_attribute("crs_wkt", in->dsm.crs_wkt);
-          obs.snapshots->set_attribute("release_volume", in->volume);
-          obs.snapshot_interval = c.output.snapshot_interval;
-        }
-      }
-      if (!quiet) obs.progress = std::make_unique<ProgressReporter>("debris-runout", c.params.duration, quiet);
-      sim->run(&obs);
-      obs.snapshots.reset();  // closes the HDF5 file
-      if (!out.empty()) write_outputs(c, *sim, out, nthreads);
-      return 0;
-    };
+    // The app's run (run.hpp): every input checked before anything is written; outputs, when asked
+    // for, in a folder under the apps' --out policy (app.hpp).
+    const RunOptions options{out, quiet, nthreads};
     if (out.empty())
-      run_and_write();
+      run = run_case(c, options, &obs);
     else
       run_in_output_dir(out, "debris-runout",
-                        {c.dsm, c.release.file, c.release.handoff, c.processes.hydrograph, c.processes.erodible},
-                        run_and_write);
+                        {c.dsm, c.release.file, c.release.handoff, c.processes.hydrograph, c.processes.erodible}, [&] {
+                          run = run_case(c, options, &obs);
+                          return 0;
+                        });
   }
+  const RunoutInputs* in = run.inputs.get();
+  const RunoutSimulation* sim = run.simulation.get();
 
   const Raster& dsm = in->dsm;
   const HazardMaps& m = sim->maps();
@@ -285,7 +248,7 @@ py::dict runout_run(const std::string& config, const std::vector<std::string>& o
 /// The config keys of debris-runout with unit, default, range and help (as --help-config).
 std::string runout_help_config() {
   ConfigReader d = ConfigReader::describe();
-  read_case(d);
+  read_config(d);
   return ConfigReader::format_reference(d.reference());
 }
 
@@ -434,4 +397,5 @@ PYBIND11_MODULE(_geohaz, m) {
   m.def("read_raster", &read_raster_dict, py::arg("path"));
   geohaz::python::add_sph(m);
   register_dem(m);
+  geohaz::python::add_report(m);
 }

@@ -43,6 +43,15 @@ TEST(AtomicTextFile, AppearsOnlyOnCommit) {
   fs::remove_all(d);
 }
 
+// One escape for every XML and HTML writer (XDMF, QGIS styles, SVG, the report): each of the five
+// special characters becomes its entity, everything else (UTF-8 included) passes unchanged.
+TEST(XmlEscape, ReplacesTheFiveSpecialCharactersAndNothingElse) {
+  EXPECT_EQ(xml_escape("a<b>&\"c'd"), "a&lt;b&gt;&amp;&quot;c&apos;d");
+  EXPECT_EQ(xml_escape("τ_y (Pa) 5 m³/s"), "τ_y (Pa) 5 m³/s");
+  EXPECT_EQ(xml_escape(""), "");
+  EXPECT_EQ(xml_escape("&amp;"), "&amp;amp;");  // escaping is not idempotent: escape once, at the writer
+}
+
 TEST(OutputDir, CreatesAndRejectsFiles) {
   const auto d = temp_dir("outdir");
   EXPECT_NO_THROW(make_output_dir(d / "x" / "y"));

@@ -74,7 +74,15 @@ zcat "$root/usr/share/man/man1/debris-runout.1.gz" | grep -q '/usr/share/geohaz/
 ! zcat "$root"/usr/share/man/man1/*.gz | grep -q '@GEOHAZ_DATADIR@' || fail "man page: placeholder left"
 
 cd "$tmp"  # outside the source tree
-for app in sph-slope debris-runout dem-avalanche geohaz-report geohaz-ensemble; do
+apps=(sph-slope debris-runout dem-avalanche geohaz-report geohaz-ensemble)
+# The SPH app on MPI ranks goes into geohaz-ensemble when the build has it (GEOHAZ_MPI, Open MPI found).
+if [ -x "$build/apps/sph-slope/sph-slope-mpi" ]; then
+  apps+=(sph-slope-mpi)
+  [ -e "$root/usr/share/man/man1/sph-slope-mpi.1.gz" ] || fail "not in the packages: sph-slope-mpi's man page"
+  listing=$(dpkg-deb -c "$tmp/cpack/geohaz-ensemble_${version}_${arch}.deb")
+  [[ $listing == *usr/bin/sph-slope-mpi* ]] || fail "sph-slope-mpi is not in geohaz-ensemble"
+fi
+for app in "${apps[@]}"; do
   out=$("$root/usr/bin/$app" --version)
   [ "$out" = "$app $version" ] || fail "$app --version printed '$out'"
 done

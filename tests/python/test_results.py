@@ -71,3 +71,30 @@ def test_summary_keys_follow_one_rule_and_old_names_still_answer(small_run, tmp_
 def test_read_run_of_a_missing_folder_raises(tmp_path):
     with pytest.raises(FileNotFoundError):
         geohaz.read_run(tmp_path / "nothing")
+
+
+def test_report_write_gives_the_page_of_the_app(small_run, tmp_path):
+    """geohaz.report.write is geohaz-report's library: the same page from the same folder, with the
+    run's run-out as the summary gives it; a folder without a run raises InputError, nothing written."""
+    import shutil
+    import subprocess
+    from conftest import BIN
+    r, out = small_run
+    a, b = tmp_path / "a", tmp_path / "b"
+    shutil.copytree(out, a / "run")
+    shutil.copytree(out, b / "run")
+    got = geohaz.report.write(a, title="t")
+    assert got == {"html": str(a / "report.html"), "pdf": None}
+    proc = subprocess.run([str(BIN / "geohaz-report" / "geohaz-report"), str(b), "--title", "t"],
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    page_a = (a / "report.html").read_text()
+    page_b = (b / "report.html").read_text()
+    assert page_a.replace(str(a), "") == page_b.replace(str(b), "")
+    runout = json.loads((out / "summary.json").read_text())["runout_length_along_path_m"]
+    assert f"{runout:.4g}".rstrip("0").rstrip(".")[:3] in page_a
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    with pytest.raises(geohaz.InputError):
+        geohaz.report.write(empty)
+    assert list(empty.iterdir()) == []

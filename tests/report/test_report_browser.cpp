@@ -537,7 +537,7 @@ TEST(ReportInBrowser, EnsembleSectionDrawsMapsAndDistributionsOfTheMembers) {
   }
   // The parameters' labels and units are the config reader's declarations (read here from it).
   geohaz::ConfigReader d = geohaz::ConfigReader::describe();
-  (void)geohaz::runout::read_case(d);
+  (void)geohaz::runout::read_config(d);
   for (const auto& r : d.reference())
     if (r.key == "model.density" || r.key == "model.mu") {
       const auto row = html.find("<td title=\"" + r.key + "\">");

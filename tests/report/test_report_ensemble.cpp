@@ -20,10 +20,10 @@ using namespace geohaz::report;
 
 namespace {
 
-/// The declaration of a debris-runout key as read_case records it (the reader, not the report).
+/// The declaration of a debris-runout key as read_config records it (the reader, not the report).
 geohaz::KeyReference declaration(const std::string& key) {
   geohaz::ConfigReader d = geohaz::ConfigReader::describe();
-  (void)geohaz::runout::read_case(d);
+  (void)geohaz::runout::read_config(d);
   for (const auto& r : d.reference())
     if (r.key == key) return r;
   ADD_FAILURE() << "no declaration of " << key;

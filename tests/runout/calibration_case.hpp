@@ -75,7 +75,7 @@ inline Case make(const fs::path& d, const std::string& model, const std::vector<
   // The truth.
   ConfigReader cfg = ConfigReader::from_file(d / "base.toml");
   for (const auto& o : truth) cfg.apply_override(o);
-  RunoutCase c = read_case(cfg);
+  RunConfig c = read_config(cfg);
   const RunoutInputs in = load_inputs(c);
   RunoutSimulation sim(in, c.params, c.output);
   sim.run();

@@ -352,7 +352,7 @@ TEST(DebrisRunoutApp, LibraryRunInProcessGivesTheAppsNumbers) {
   auto cfg =
       geohaz::ConfigReader::from_string("[model]\nd0 = 2.5\nh0 = 0.75\n[run]\nduration = 20\n[terrain]\ndsm = \"" +
                                         dsm.string() + "\"\n[release]\nfile = \"" + rel.string() + "\"\n");
-  const geohaz::runout::RunoutCase c = geohaz::runout::read_case(cfg);
+  const geohaz::runout::RunConfig c = geohaz::runout::read_config(cfg);
   cfg.finish();
   const geohaz::runout::RunoutInputs inputs = geohaz::runout::load_inputs(c);
   geohaz::runout::RunoutSimulation sim(inputs, c.params, c.output);

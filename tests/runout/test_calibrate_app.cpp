@@ -134,7 +134,7 @@ TEST(CalibrateApp, FailedMemberIsRecordedWithItsParametersAndPenalised) {
                         "comparison.tif", "comparison.png", "comparison.qml", "thalweg_profile.csv"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   geohaz::ConfigReader best = geohaz::ConfigReader::from_file(out / "best.toml");
-  (void)geohaz::runout::read_case(best);
+  (void)geohaz::runout::read_config(best);
   best.finish();
   geohaz::ConfigReader again = geohaz::ConfigReader::from_file(out / "best.toml");
   EXPECT_EQ(again.get("model.n", 0.0, geohaz::Range{}, {"", ""}), j["best"]["values"][0].get<double>());

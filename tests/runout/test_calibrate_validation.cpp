@@ -73,7 +73,7 @@ TEST(CalibrationValidation, AlplehnerTwoParameterCalibrationRecoversVoellmyMuAnd
   const auto event = [&](double mu, Raster* deposit_out) {
     write_base(mu);
     ConfigReader cfg = ConfigReader::from_file(d / "base.toml");
-    const RunoutCase rc = read_case(cfg);
+    const RunConfig rc = read_config(cfg);
     const RunoutInputs in = load_inputs(rc);
     RunoutSimulation sim(in, rc.params, rc.output);
     sim.run();

@@ -35,7 +35,7 @@ double ridge(double x, double) {
 
 struct RidgeRun {
   RunoutInputs in;
-  RunoutCase c;
+  RunConfig c;
 };
 
 RidgeRun ridge_case(double sparse_min_depth) {

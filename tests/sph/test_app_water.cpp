@@ -215,16 +215,15 @@ TEST(SphSlopeWater, BadWaterInputExitsTwoNamingTheKey) {
   for (const auto& [sets, key] : std::vector<std::pair<std::string, std::string>>{
            {"water.ru=1.0", "water.ru"},
            {"water.ru=-0.1", "water.ru"},
-           {"water.phreatic=[0,20,65,20]", "water.phreatic"},                           // above the ground everywhere
-           {"water.phreatic=[0,12,25]", "water.phreatic"},                              // not pairs
-           {"water.phreatic=[30,12,25,11]", "water.phreatic"},                          // x decreasing
-           {"material[0].saturated_density=1900", "material.saturated_density"},        // below the density
-           {"water.ru=0.2 --set water.phreatic=[0,12,65,5]", "water.ru"},               // both
-           {"run.dimension=3 --set water.phreatic=[] --set water.ru=0.2", "water.ru"},  // 2D slope only
-           {"water.history_times=[0,5]", "water.history_offsets"},                      // lengths differ
+           {"water.phreatic=[0,20,65,20]", "water.phreatic"},                     // above the ground everywhere
+           {"water.phreatic=[0,12,25]", "water.phreatic"},                        // not pairs
+           {"water.phreatic=[30,12,25,11]", "water.phreatic"},                    // x decreasing
+           {"material[0].saturated_density=1900", "material.saturated_density"},  // below the density
+           {"water.ru=0.2 --set water.phreatic=[0,12,65,5]", "water.ru"},         // both
+           {"run.dimension=3 --set water.phreatic=[] --set water.ru=0.2", "run.scenario"},  // Bishop: 2D slope
+           {"water.history_times=[0,5]", "water.history_offsets"},                          // lengths differ
            {"run.analysis=dynamic --set water.phreatic=[] --set seismic.kh=0.1", "seismic.kh"},
            {"run.analysis=dynamic --set rain.enabled=true", "rain.enabled"},  // and a phreatic surface
-           {"run.analysis=strength_reduction --set water.phreatic=[] --set rain.enabled=true", "rain.enabled"},
            {"run.analysis=dynamic --set water.phreatic=[] --set rain.enabled=true --set rain.clock_times=[0,0,5]",
             "rain.clock_times"},  // not pairs
            {"run.analysis=dynamic --set water.phreatic=[] --set rain.enabled=true --set "

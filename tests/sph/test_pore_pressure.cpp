@@ -148,5 +148,60 @@ TEST(RainPorePressure, HeadIsIversonsOfTheColumnAndTheClockMapsTheRunsTime) {
   EXPECT_EQ(step.pressure<2>(Vec2(10.0, 14.0)), 0.0);  // suction is not counted
 }
 
+// A DSM section's cover (3 m of 1900 kg/m³ by depth) over its base (2200 kg/m³): ∫ρ dz by hand above a
+// point in the cover, at its base and in the base, under a 2D profile and under a 3D strip's grid.
+TEST(Overburden, CoverByDepthOverTheBaseUnderAProfileAndAGrid) {
+  OverburdenProfile p;
+  p.ground = {{0.0, 20.0}, {10.0, 15.0}};
+  p.densities = {2200.0};
+  p.surface_layer_depth = 3.0;
+  p.surface_density = 1900.0;
+  EXPECT_DOUBLE_EQ(p.mass_above(4.0, 16.0), 1900.0 * 2.0);  // ground 18 m
+  EXPECT_DOUBLE_EQ(p.mass_above(4.0, 15.0), 1900.0 * 3.0);
+  EXPECT_DOUBLE_EQ(p.mass_above(4.0, 13.5), 1900.0 * 3.0 + 2200.0 * 1.5);
+  EXPECT_EQ(p.mass_above(4.0, 18.5), 0.0);
+  auto g = std::make_shared<StripGrid>();
+  g->nx = 3;
+  g->ny = 2;
+  g->dx = 5.0;
+  g->dy = 4.0;
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 3; ++i) g->ground.push_back(20.0 - 0.5 * (5.0 * i) + 0.25 * (4.0 * j));
+  p.grid = g;
+  // z_g(4, 2) = 20 − 2 + 0.5 = 18.5 m.
+  EXPECT_DOUBLE_EQ(p.mass_above(4.0, 2.0, 14.0), 1900.0 * 3.0 + 2200.0 * 1.5);
+}
+
+// Rain under a 3D strip's grid of a plane whose gradient (0.3, 0.4) is oblique to the strip: the cell's
+// δ is the plane's true slope atan 0.5, so every point's head equals Iverson's at its vertical depth
+// below the plane with that δ (to round-off), and the initial level lies d below the plane.
+TEST(RainPorePressure, UnderAStripGridTheHeadTakesTheTrueSlopeOfTheCell) {
+  auto g = std::make_shared<StripGrid>();
+  g->nx = 5;
+  g->ny = 4;
+  g->x0 = 1.0;
+  g->dx = 2.0;
+  g->dy = 1.5;
+  auto plane = [](double x, double y) { return 30.0 - 0.3 * x + 0.4 * y; };
+  for (int j = 0; j < g->ny; ++j)
+    for (int i = 0; i < g->nx; ++i) g->ground.push_back(plane(g->x0 + g->dx * i, g->y0 + g->dy * j));
+  InfiltrationParameters h;
+  h.conductivity = 1e-5;
+  h.diffusivity = 2e-4;
+  const auto rain = RainfallHistory::uniform_steps(1800.0, {8e-6, 2e-5});
+  const RainPorePressure r(h, rain, g, 1.2, {});
+  const InfiltrationHistory ref(h, rain);
+  const double delta = std::atan(0.5);
+  EXPECT_NEAR(r.smallest_beta(), std::cos(delta) * std::cos(delta), 1e-15);
+  for (const double x : {1.3, 4.0, 8.9})
+    for (const double y : {0.2, 2.5, 4.4})
+      for (const double Z : {0.3, 1.0, 2.5}) {
+        const double z = plane(x, y) - Z;
+        EXPECT_NEAR(r.head(x, y, z, 2700.0), ref.pressure_head(Z, 2700.0, delta, 1.2), 1e-12) << x << " " << y;
+      }
+  EXPECT_NEAR(r.initial_level(4.0, 2.5), plane(4.0, 2.5) - 1.2, 1e-12);
+  EXPECT_EQ(r.head(4.0, 2.5, plane(4.0, 2.5) + 0.1, 2700.0), -std::numeric_limits<double>::infinity());
+}
+
 }  // namespace
 }  // namespace geohaz::sph

@@ -17,27 +17,6 @@ std::string hex(const std::array<std::uint8_t, 3>& c) {
   return b;
 }
 
-std::string xml_escape(const std::string& s) {
-  std::string o;
-  for (char ch : s) switch (ch) {
-      case '&':
-        o += "&amp;";
-        break;
-      case '<':
-        o += "&lt;";
-        break;
-      case '>':
-        o += "&gt;";
-        break;
-      case '"':
-        o += "&quot;";
-        break;
-      default:
-        o += ch;
-    }
-  return o;
-}
-
 std::string number(double v) {
   std::ostringstream o;
   o << std::setprecision(6) << v;

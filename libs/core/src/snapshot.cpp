@@ -80,33 +80,6 @@ std::pair<const char*, int> xdmf_number_type(ScalarType t) {
   throw std::invalid_argument("unknown ScalarType");
 }
 
-std::string xml_escape(std::string_view s) {
-  std::string out;
-  out.reserve(s.size());
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&apos;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
 /// Name of the Polyvertex connectivity dataset (0..n-1) for n particles, shared by all snapshots of
 /// that size.
 std::string vertex_index_name(std::size_t n) {

@@ -377,7 +377,7 @@ CalibrationSetup read_calibration(ConfigReader& cfg) {
     throw InputError("base case config not found", src, "calibration.base", e.base_config.string());
   {
     ConfigReader base = ConfigReader::from_file(e.base_config);
-    const RunoutCase c = read_case(base);
+    const RunConfig c = read_config(base);
     base.finish();
     e.base_resolved = base.resolved();
     e.dsm = c.dsm;
@@ -394,7 +394,7 @@ CalibrationSetup read_calibration(ConfigReader& cfg) {
       o << p.key << '=' << std::setprecision(17) << v;
       m.apply_override(o.str(),
                        src + " (" + kParamKeys + "[" + std::to_string(k) + "]." + (v == p.lower ? "min" : "max") + ")");
-      (void)read_case(m);
+      (void)read_config(m);
     }
   }
   e.plan.members = 0;

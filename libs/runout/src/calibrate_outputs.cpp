@@ -56,12 +56,6 @@ void member_table(const fs::path& path, const CalibrationSetup& s, const std::ve
   csv.commit();
 }
 
-std::string xml_escape(const std::string& s) {
-  std::string o;
-  for (char c : s) o += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : std::string(1, c);
-  return o;
-}
-
 /// Score against each parameter (top row) and every pair of parameters (below): all members in grey,
 /// the acceptable ones coloured by score (dark = best), the best as a red ring.
 void write_acceptable_svg(const fs::path& path, const CalibrationSetup& s, const CalibrationResult& r, double j_best,
@@ -199,14 +193,14 @@ void set_dotted(toml::table& t, const std::string& key, V value) {
 
 /// The best set as a debris-runout config that runs from anywhere: the base case's own file (the
 /// keys it sets, nothing more) with the best values and every input path made absolute; a
-/// searched thickness factor becomes best_release.tif. Read back through read_case before it is
+/// searched thickness factor becomes best_release.tif. Read back through read_config before it is
 /// written.
 std::string best_config(const CalibrationSetup& s, const Evaluation& best, const fs::path& out) {
   toml::table t = toml::parse_file(s.members.base_config.string());
-  RunoutCase base;
+  RunConfig base;
   {
     ConfigReader probe = ConfigReader::from_file(s.members.base_config);
-    base = read_case(probe);
+    base = read_config(probe);
   }
   const auto set_path = [&](const std::string& key, const std::string& p) {
     if (!p.empty()) set_dotted(t, key, fs::absolute(p).lexically_normal().generic_string());
@@ -253,7 +247,7 @@ std::string best_config(const CalibrationSetup& s, const Evaluation& best, const
   body << t << "\n";
   {
     ConfigReader check = ConfigReader::from_string(body.str(), (out / "best.toml").string());
-    (void)read_case(check);
+    (void)read_config(check);
     check.finish();
   }
   std::ostringstream o;

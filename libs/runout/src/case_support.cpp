@@ -27,7 +27,7 @@ std::string origin(const ConfigReader& cfg) {
 
 std::set<std::string> numeric_case_keys() {
   ConfigReader d = ConfigReader::describe();
-  read_case(d);
+  read_config(d);
   std::set<std::string> keys;
   for (const KeyReference& r : d.reference())
     if (r.type == "number" || r.type == "integer") keys.insert(r.key);

@@ -1,5 +1,5 @@
 // The debris-runout configuration keys: declared once here (unit, default, range, help), read into
-// RunoutCase. Defaults come from the structs of run.hpp / solver.hpp / basal_friction.hpp.
+// RunConfig. Defaults come from the structs of run.hpp / solver.hpp / basal_friction.hpp.
 #include "geohaz/core/config.hpp"
 
 #include <algorithm>
@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "geohaz/core/errors.hpp"
-#include "geohaz/runout/run.hpp"
+#include "geohaz/runout/config.hpp"
 
 namespace geohaz::runout {
 
@@ -189,7 +189,7 @@ std::string resolve(const ConfigReader& cfg, const std::string& key, std::string
 }
 
 /// Entrainment, friction zones, forest and the inflow hydrograph (docs/runout.md, "Processes").
-void read_processes(ConfigReader& cfg, RunoutCase& c) {
+void read_processes(ConfigReader& cfg, RunConfig& c) {
   auto& e = c.params.entrainment;
   auto& s = c.processes;
   const std::string law = cfg.get_choice("entrainment.law", to_string(e.law), {"none", "growth", "shear"},
@@ -388,8 +388,8 @@ void read_gauges_and_profile(ConfigReader& cfg, OutputSettings& o) {
 
 }  // namespace
 
-RunoutCase read_case(ConfigReader& cfg) {
-  RunoutCase c;
+RunConfig read_config(ConfigReader& cfg) {
+  RunConfig c;
   c.config_source = cfg.source();
   c.dsm = resolve(cfg, "terrain.dsm",
                   cfg.get_string("terrain.dsm", "",
@@ -491,7 +491,7 @@ RunoutCase read_case(ConfigReader& cfg) {
 
 std::vector<FrictionKey> friction_keys(std::string_view law) {
   ConfigReader d = ConfigReader::describe();
-  (void)read_case(d);
+  (void)read_config(d);
   const std::vector<KeyReference> refs = d.reference();
   const std::vector<std::string> names = BasalFrictionNames::choices();
   std::vector<FrictionKey> out;

@@ -546,7 +546,7 @@ EnsembleSetup read_ensemble(ConfigReader& cfg) {
   // input error naming the member, before anything is written).
   {
     ConfigReader base = ConfigReader::from_file(s.base_config);
-    const RunoutCase c = read_case(base);
+    const RunConfig c = read_config(base);
     base.finish();
     s.base_resolved = base.resolved();
     s.dsm = c.dsm;
@@ -578,7 +578,7 @@ EnsembleSetup read_ensemble(ConfigReader& cfg) {
       m.apply_override(o.str(),
                        src + " (ensemble.parameter[" + std::to_string(d) + "], member " + std::to_string(i) + ")");
     }
-    (void)read_case(m);
+    (void)read_config(m);
   }
   return s;
 }

@@ -1,5 +1,5 @@
 // Labels and units of debris-runout and ensemble parameter keys from their declarations (run.hpp
-// case_key, ensemble.hpp parameter_key): read_case in describe mode records every key with its
+// case_key, ensemble.hpp parameter_key): read_config in describe mode records every key with its
 // unit and help text, so a tool showing a run's parameters needs no table of its own.
 #include <algorithm>
 #include <optional>
@@ -9,18 +9,18 @@
 
 #include "geohaz/core/config.hpp"
 #include "geohaz/runout/basal_friction.hpp"
+#include "geohaz/runout/config.hpp"
 #include "geohaz/runout/ensemble.hpp"
-#include "geohaz/runout/run.hpp"
 
 namespace geohaz::runout {
 
 namespace {
 
-/// Every key read_case declares (read once; the declarations do not change while running).
+/// Every key read_config declares (read once; the declarations do not change while running).
 const std::vector<KeyReference>& case_reference() {
   static const std::vector<KeyReference> refs = [] {
     ConfigReader d = ConfigReader::describe();
-    (void)read_case(d);
+    (void)read_config(d);
     return d.reference();
   }();
   return refs;

@@ -60,7 +60,7 @@ class FailingObserver : public RunObserver {
   RunObserver* next_;
 };
 
-std::string inputs_key(const RunoutCase& c) {
+std::string inputs_key(const RunConfig& c) {
   std::ostringstream o;
   o << std::setprecision(17) << c.dsm << '|' << c.release.file << '|' << c.release.handoff << '|' << c.release.attribute
     << '|' << c.release.depth << '|' << to_string(c.release.direction) << '|' << c.params.d0 << '|'
@@ -97,7 +97,7 @@ MemberRecord MemberRunner::run(int i, const fs::path& out, int rank, int threads
       m.apply_override(o.str());
     }
   }
-  RunoutCase c = read_case(m);
+  RunConfig c = read_config(m);
   c.output.snapshots = false;
   c.output.pngs = false;
   const std::string key = inputs_key(c);

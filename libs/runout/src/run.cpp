@@ -252,7 +252,8 @@ std::string end_text(const RunoutResult& r, const RunoutParameters& p, double me
   m << (r.ended == RunEnd::Duration ? "; in mobile_at_end.tif, not in deposit.tif)"
                                     : "; counted in deposit.tif where it stood when the run stopped)");
   if (r.volumes.lost > 0.0) m << ", " << volume_text(r.volumes.lost) << " left the raster";
-  m << ".\n" << kModel << ": outputs in " << out.string() << "\n";
+  m << ".\n";
+  if (!out.empty()) m << kModel << ": outputs in " << out.string() << "\n";
   return m.str();
 }
 
@@ -271,7 +272,7 @@ std::string detached_line(const DetachedReport& d) {
 /// Writes particle snapshots every output.snapshot_interval (and at the end) while a run goes.
 class SnapshotObserver : public RunObserver {
  public:
-  SnapshotObserver(const fs::path& path, const RunoutCase& c, const RunoutInputs& in)
+  SnapshotObserver(const fs::path& path, const RunConfig& c, const RunoutInputs& in)
       : w_(path, kModel, 2, c.resolved_config), interval_(c.output.snapshot_interval) {
     w_.set_attribute("crs_wkt", in.dsm.crs_wkt);
     w_.set_attribute("release_volume", in.volume);
@@ -399,7 +400,7 @@ Vec2 flow_source(const RunoutInputs& in) {
   return c;
 }
 
-void load_barriers_into(const RunoutCase& c, RunoutInputs& in) {
+void load_barriers_into(const RunConfig& c, RunoutInputs& in) {
   if (c.barriers.file.empty()) return;
   in.barriers = load_barriers(c.barriers, in.dsm, in.surface, flow_source(in));
   in.wall_law = c.barriers.law;
@@ -408,7 +409,7 @@ void load_barriers_into(const RunoutCase& c, RunoutInputs& in) {
 
 }  // namespace
 
-RunoutInputs load_inputs(const RunoutCase& c) {
+RunoutInputs load_inputs(const RunConfig& c) {
   if (c.dsm.empty()) throw InputError("no DSM given (positional argument or terrain.dsm)", "command line");
   if (!c.release.file.empty() && !c.release.handoff.empty())
     throw InputError("give either --release or --release-from, not both", "command line");
@@ -601,7 +602,7 @@ namespace {
 
 /// summary.json's "processes": the entrainment law and its figures, the friction zones, the
 /// forest and the inflow in force (docs/runout.md, "Processes").
-nlohmann::json processes_json(const RunoutCase& c, const RunoutSimulation& sim, const VolumeBudget& b) {
+nlohmann::json processes_json(const RunConfig& c, const RunoutSimulation& sim, const VolumeBudget& b) {
   const auto& solver = sim.solver();
   const EntrainmentParameters& ent = sim.parameters().entrainment;
   const SpatialProcesses& proc = solver.processes();
@@ -704,7 +705,7 @@ void write_series_tables(const RunoutSimulation& sim, const fs::path& out) {
 
 }  // namespace
 
-std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int threads, const ThalwegProfile* profile) {
+std::string summary_json(const RunConfig& c, const RunoutSimulation& sim, int threads, const ThalwegProfile* profile) {
   const IntensityTable& itab = c.output.intensity;
   const auto& solver = sim.solver();
   const RunoutResult res = sim.result();
@@ -810,7 +811,7 @@ std::string summary_json(const RunoutCase& c, const RunoutSimulation& sim, int t
   return j.dump(2);
 }
 
-void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::path& out, int threads) {
+void write_outputs(const RunConfig& c, const RunoutSimulation& sim, const fs::path& out, int threads) {
   const Raster& dsm = sim.inputs().dsm;
   // Maps on the DSM's grid and CRS; nodata where the DSM has none.
   auto map_raster = [&](const std::vector<double>& v, double fill_unreached) {
@@ -948,37 +949,47 @@ void write_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::p
   write_text_file(out / "summary.json", summary_json(c, sim, threads, profile ? &*profile : nullptr) + "\n");
 }
 
-RunoutResult run_case(const RunoutCase& c, const fs::path& out, bool quiet, int threads) {
+CaseRun run_case(const RunConfig& c, const RunOptions& options, RunObserver* observer) {
   // 1-2. Inputs and particles, all checked before anything is written.
-  const RunoutInputs in = load_inputs(c);
-  RunoutSimulation sim(in, c.params, c.output);
+  CaseRun run;
+  run.inputs = std::make_unique<RunoutInputs>(load_inputs(c));
+  const RunoutInputs& in = *run.inputs;
+  run.simulation = std::make_unique<RunoutSimulation>(in, c.params, c.output);
+  RunoutSimulation& sim = *run.simulation;
+  const fs::path& out = options.out;
+  const bool quiet = options.quiet;
 
   // 3. Outputs: only now is anything created.
-  make_output_dir(out);
-  write_text_file(out / "config.resolved.toml", c.resolved_config);
+  std::unique_ptr<SnapshotObserver> snap;
+  if (!out.empty()) {
+    make_output_dir(out);
+    write_text_file(out / "config.resolved.toml", c.resolved_config);
+    if (c.output.snapshots) snap = std::make_unique<SnapshotObserver>(out / "snapshots.h5", c, in);
+  }
   const auto& p = sim.parameters();
   if (!quiet)
     std::cerr << kModel << ": " << in.description << ": volume " << fmt(in.volume, 12) << " m^3 read, "
               << fmt(sim.seeded().volume_seeded, 12) << " m^3 seeded in " << sim.seeded().particles
               << " particles (V0 = " << p.nominal_volume() << " m^3, d0 = " << p.d0 << " m), "
-              << friction_name(p.friction) << " friction, " << threads << " thread(s)\n";
-  std::unique_ptr<SnapshotObserver> snap;
-  if (c.output.snapshots) snap = std::make_unique<SnapshotObserver>(out / "snapshots.h5", c, in);
+              << friction_name(p.friction) << " friction, " << options.threads << " thread(s)\n";
   ProgressObserver progress(p.duration, quiet);
   Observers obs;
   obs.add(snap.get());
   obs.add(&progress);
+  obs.add(observer);
   sim.run(&obs);
+  snap.reset();  // closes snapshots.h5 before the outputs are written
 
   // 4-5. Maps, series and summary.
-  write_outputs(c, sim, out, threads);
-  const RunoutResult r = sim.result();
+  if (!out.empty()) write_outputs(c, sim, out, options.threads);
+  run.result = sim.result();
+  const RunoutResult& r = run.result;
   if (!quiet) std::cerr << end_text(r, p, sim.series().empty() ? 0.0 : sim.series().back().mean_speed, out);
   if (r.unfinished()) std::cout << kModel << ": warning: " << unfinished_warning(r) << "\n";
   const DetachedReport det = sim.maps().detached_report(sim.solver().particles());
   if (const std::string d = detached_line(det); !d.empty()) std::cout << kModel << ": " << d << "\n";
   if (const std::string w = edge_warning(det); !w.empty()) std::cout << kModel << ": warning: " << w << "\n";
-  return r;
+  return run;
 }
 
 }  // namespace geohaz::runout

@@ -14,7 +14,7 @@ namespace fs = std::filesystem;
 
 namespace geohaz::runout::detail {
 
-void load_output_geometry(const RunoutCase& c, RunoutInputs& in) {
+void load_output_geometry(const RunConfig& c, RunoutInputs& in) {
   const std::string source = c.config_source.empty() ? "command line" : c.config_source;
   const OutputSettings& o = c.output;
   if (!o.profile_path_file.empty()) {
@@ -28,7 +28,7 @@ void load_output_geometry(const RunoutCase& c, RunoutInputs& in) {
   check_gauges(o.gauges, in.dsm, source);
 }
 
-std::optional<ThalwegProfile> write_profile_outputs(const RunoutCase& c, const RunoutSimulation& sim,
+std::optional<ThalwegProfile> write_profile_outputs(const RunConfig& c, const RunoutSimulation& sim,
                                                     const Raster& depth, const Raster& speed, const Raster& pressure,
                                                     const Raster& arrival, const fs::path& out) {
   const Raster& dsm = sim.inputs().dsm;
@@ -85,7 +85,7 @@ nlohmann::json profile_summary(const ThalwegProfile& p, bool given_path) {
   return j;
 }
 
-void write_gauge_outputs(const RunoutCase& c, const RunoutSimulation& sim, const fs::path& out) {
+void write_gauge_outputs(const RunConfig& c, const RunoutSimulation& sim, const fs::path& out) {
   const GaugeRecorder& g = sim.gauges();
   if (g.empty()) return;
   write_gauges_csv(out / "gauges.csv", g);

@@ -314,7 +314,8 @@ void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
   w.ru = r.get("water.ru", 0.0, Range::closed_open(0.0, 1.0),
                {"1",
                 "pore-pressure ratio r_u = u / (gamma h): u = r_u times the vertical overburden stress on Bishop's "
-                "slice bases and at every SPH particle (2D slope; not with water.phreatic)"});
+                "slice bases and at every SPH particle (slope, DSM section: the column of its cover and base; 2D "
+                "and 3D; not with water.phreatic)"});
   const double rho_w = r.get("water.density", 1000.0, Range::closed(900.0, 1300.0), {"kg/m^3", "density of water"});
   w.unit_weight = rho_w * c.numerics.gravity;
   w.head_loss_correction =
@@ -337,14 +338,30 @@ void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
                                      "clipped to the ground; not with water.phreatic, water.ru or rain"});
     if (!table.empty())
       c.water_table_raster = std::filesystem::path(table).is_absolute() ? table : (r.base_dir() / table).string();
+    const auto pore = r.get_string(
+        "water.pore_pressure_raster", c.pore_pressure_raster,
+        {"",
+         "raster of the pore pressure u_b (Pa) at the base of a DSM section's soil cover (section.soil_thickness "
+         "below the ground; e.g. gamma_w times a pressure head of slope-stability) in the DSM's CRS: the "
+         "piezometric level z_g - D + u_b / (rho_w g) above and below (hydrostatic in the vertical), clipped to "
+         "the ground; not with another source of pore water"});
+    if (!pore.empty())
+      c.pore_pressure_raster = std::filesystem::path(pore).is_absolute() ? pore : (r.base_dir() / pore).string();
   }
   // [rain] and [hydrology]: the keys and reader of slope-stability (infiltration.hpp), here a loading history.
   c.rain.enabled = r.get_bool("rain.enabled", false,
                               {"",
                                "rain infiltration (Iverson 2000, as slope-stability: [rain], [hydrology]) as the "
-                               "pore pressure of the main phase (2D slope, run.analysis = dynamic; not with "
+                               "pore pressure: over time in a dynamic run, at rain.evaluate_at in the strength "
+                               "reduction and limit equilibrium (slope, DSM section; 2D and 3D; not with "
                                "water.phreatic or water.ru)"});
   c.rain.infiltration = read_infiltration_keys(r);
+  c.rain.evaluate_at = c.rain.infiltration.rain.end();
+  c.rain.evaluate_at = r.get("rain.evaluate_at", c.rain.evaluate_at, Range::non_negative(),
+                             {"s",
+                              "the rain's time t_rain whose pore pressure the strength reduction and the "
+                              "limit-equilibrium analysis take (a dynamic run follows rain.clock_times); default: "
+                              "the end of the rain"});
   const auto clock = r.get_array("rain.clock_times", {}, Range::non_negative(),
                                  {"s",
                                   "the rain's clock: pairs t, t_rain of main-phase time t and the rain's time t_rain "
@@ -505,21 +522,23 @@ void read_walls_clamp_and_initial_velocity(ConfigReader& r, RunConfig& c, bool d
   }
 }
 
-/// The water-table raster of a DSM section (water.table_raster): readable, in the DSM's CRS.
-std::shared_ptr<const Terrain> read_water_table(const ConfigReader& r, const std::string& path, const Raster& dsm) {
+/// A raster of a DSM section's pore water (water.table_raster, water.pore_pressure_raster under
+/// `key`): readable, in the DSM's CRS.
+std::shared_ptr<const Terrain> read_water_raster(const ConfigReader& r, const std::string& path, const Raster& dsm,
+                                                 const char* key) {
   Raster t;
   try {
     t = read_raster(path);
   } catch (const InputError& e) {  // name the key the raster comes from
-    throw InputError(e.reason() + " (" + path + ")", r.source(), "water.table_raster", path);
+    throw InputError(e.reason() + " (" + path + ")", r.source(), key, path);
   }
   if (!crs_equal(t.crs_wkt, dsm.crs_wkt))
     throw InputError("must be in the DSM's CRS (" + crs_label(dsm.crs_wkt) + "; it is in " + crs_label(t.crs_wkt) + ")",
-                     r.source(), "water.table_raster", path);
+                     r.source(), key, path);
   try {
     return std::make_shared<const Terrain>(std::move(t));
   } catch (const InputError& e) {
-    throw InputError(e.reason() + " (" + path + ")", r.source(), "water.table_raster", path);
+    throw InputError(e.reason() + " (" + path + ")", r.source(), key, path);
   }
 }
 
@@ -571,7 +590,10 @@ void read_section(ConfigReader& r, RunConfig& c, bool describe) {
       c.section.crs_wkt = raster->crs_wkt;
       c.section.dsm = raster;
       c.section.terrain = std::make_shared<const Terrain>(*raster);
-      if (!c.water_table_raster.empty()) c.section.water_table = read_water_table(r, c.water_table_raster, *raster);
+      if (!c.water_table_raster.empty())
+        c.section.water_table = read_water_raster(r, c.water_table_raster, *raster, "water.table_raster");
+      if (!c.pore_pressure_raster.empty())
+        c.section.pore_pressure = read_water_raster(r, c.pore_pressure_raster, *raster, "water.pore_pressure_raster");
     }
   }
 }

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "geohaz/core/errors.hpp"
+#include "geohaz/sph/infinite_slope.hpp"
 
 namespace geohaz::sph {
 
@@ -422,6 +423,31 @@ BishopResult bishop_critical_circle(const SlopeSection& s, const BishopSearchSet
                         yield);
 }
 
+namespace {
+
+/// The infinite-slope factor of the cover at x with the section's pore water (infinite_slope.hpp, the
+/// formula of slope-stability) on the plane at the cover's depth t: the pressure head there from a
+/// phreatic surface h_w = m t above the plane (m ≤ 1, the table clipped to the ground), slope-parallel
+/// seepage: ψ = m t cos²β; from r_u: ψ = r_u γ t / γ_w (and no saturated weight); from a prescribed
+/// field (rain): ψ = u / γ_w.
+double wet_infinite_slope(const SlopeSection& s, const LimitEquilibriumSoil& soil, double x, double beta) {
+  const double t = s.surface_layer_depth, gw = s.water.unit_weight;
+  const double zs = surface_at(s.surface, x), cos2 = std::cos(beta) * std::cos(beta);
+  InfiniteSlopeSoil q{soil.cohesion, soil.friction, soil.unit_weight, soil.unit_weight_below_water(), gw, false};
+  double psi = 0.0;
+  if (s.water.pressure_field) {
+    psi = s.water.pressure_field(x, zs - t) / gw;
+  } else if (!s.water.phreatic.empty()) {
+    psi = cos2 * std::clamp(std::min(s.water.level_at(x), zs) - (zs - t), 0.0, t);
+  } else {
+    psi = s.water.ru * soil.unit_weight * t / gw;
+    q.unit_weight_saturated = soil.unit_weight;
+  }
+  return infinite_slope_fs(beta, t, psi, cos2, q);
+}
+
+}  // namespace
+
 InfiniteSlopeResult infinite_slope_minimum(const SlopeSection& s, double window) {
   InfiniteSlopeResult r;
   const double t = s.surface_layer_depth;
@@ -435,8 +461,9 @@ InfiniteSlopeResult infinite_slope_minimum(const SlopeSection& s, double window)
     const double h = std::min(0.5 * w, 0.5 * length);
     const double beta = std::atan(std::abs(surface_at(s.surface, x + h) - surface_at(s.surface, x - h)) / (2.0 * h));
     if (!(beta > 0.0)) continue;
-    const double f = soil.cohesion / (soil.unit_weight * t * std::sin(beta) * std::cos(beta)) +
-                     std::tan(soil.friction) / std::tan(beta);
+    const double f = s.water.active() ? wet_infinite_slope(s, soil, x, beta)
+                                      : soil.cohesion / (soil.unit_weight * t * std::sin(beta) * std::cos(beta)) +
+                                            std::tan(soil.friction) / std::tan(beta);
     if (f < r.factor) {
       r.factor = f;
       r.x = x;

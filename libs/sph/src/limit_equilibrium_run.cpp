@@ -30,7 +30,8 @@ std::pair<double, double> shear_strength_of(const RunConfig& c, const MaterialPa
 }  // namespace
 
 SlopeSection limit_equilibrium_section(const RunConfig& c, bool with_water_and_seismic) {
-  if (c.scenario != ScenarioType::Slope || c.dimension != 2)
+  // Beside an SPH run a 3D slope has the section of its profile (the checks of its water).
+  if (c.scenario != ScenarioType::Slope || (c.dimension != 2 && c.analysis == Analysis::LimitEquilibrium))
     throw InputError("the limit-equilibrium analysis needs the 2D slope scenario", c.config_source, "run.scenario");
   ProfileDomain d = c.slope.profile();
   apply_layers(d, c);
@@ -48,9 +49,9 @@ SlopeSection limit_equilibrium_section(const RunConfig& c, bool with_water_and_s
     // Beside an SPH run, the SPH's water table: clipped to the ground (no ponded water).
     if (c.analysis != Analysis::LimitEquilibrium && !c.water.phreatic.empty())
       s.water.phreatic = clipped_phreatic_surface(c);
-    // Rain: its pore pressure at the start of the main phase.
+    // Rain: its pore pressure at the start of the main phase (held at rain.evaluate_at but in a dynamic run).
     if (c.rain.enabled) {
-      const auto rain = rain_pore_pressure(c);
+      const auto rain = rain_pore_pressure_on_profile(c);
       apply_rain(s.water, rain, rain->rain_time(0.0));
     }
     s.seismic = c.seismic;
@@ -58,183 +59,14 @@ SlopeSection limit_equilibrium_section(const RunConfig& c, bool with_water_and_s
   return s;
 }
 
-std::shared_ptr<const RainPorePressure> rain_pore_pressure(const RunConfig& c) {
-  const auto& k = c.rain.infiltration;
-  return std::make_shared<const RainPorePressure>(k.hydrology, k.rain, c.slope.profile().surface, k.water_table_depth,
-                                                  c.rain.clock);
-}
-
-void apply_rain(PoreWater& w, const std::shared_ptr<const RainPorePressure>& rain, double t_rain) {
-  // The initial table, parallel to the ground, sets where the soil weighs its saturated unit weight
-  // (as the SPH's particles, saturate_below_water_table); the rain's head gives u.
-  w.phreatic.clear();
-  for (const auto& p : rain->ground()) w.phreatic.push_back({p[0], p[1] - rain->water_table_depth()});
-  w.pressure_field = [rain, gw = w.unit_weight, t_rain](double x, double z) {
-    return gw * std::max(rain->head(x, z, t_rain), 0.0);
-  };
-}
-
-std::vector<std::array<double, 2>> clipped_phreatic_surface(const RunConfig& c) {
-  const auto ground = c.slope.profile();
-  PoreWater w = c.water;
-  std::vector<std::array<double, 2>> out;
-  const int n = 4000;
-  for (int k = 0; k <= n; ++k) {
-    const double x = ground.x_left + (ground.x_right - ground.x_left) * k / n;
-    out.push_back({x, std::min(w.level_at(x), surface_at(ground.surface, x))});
-  }
-  return out;
-}
-
-std::vector<std::array<double, 2>> section_water_table(const RunConfig& c) {
-  std::vector<std::array<double, 2>> cut;
-  for (const auto& p : c.section.profile) {
-    const double z = c.section.water_table->elevation(p.x, p.y);
-    if (!std::isfinite(z))
-      throw InputError("the water table raster has no value at the section's point (" + csv_number(p.x) + ", " +
-                           csv_number(p.y) + ") (s = " + csv_number(p.s) +
-                           " m): it must cover the section, without nodata",
-                       c.config_source, "water.table_raster", c.water_table_raster);
-    cut.push_back({p.s, z});
-  }
-  return cut;
-}
-
-std::shared_ptr<const WaterTableGrid> section_water_table_grid(const RunConfig& c) {
-  const auto& P = c.section.profile;
-  const double dx = c.numerics.spacing, width = strip_width(c), half = 0.5 * width;
-  auto g = std::make_shared<WaterTableGrid>();
-  const double length = P.back().s - P.front().s;
-  g->x0 = P.front().s;
-  g->nx = std::max(2, static_cast<int>(std::ceil(length / dx)) + 1);
-  g->dx = length / (g->nx - 1);
-  g->y0 = 0.0;
-  g->ny = std::max(2, static_cast<int>(std::ceil(width / dx)) + 1);
-  g->dy = width / (g->ny - 1);
-  for (int j = 0; j < g->ny; ++j)
-    for (int i = 0; i < g->nx; ++i) {
-      const Vec2 q = section_map_point(P, g->x0 + i * g->dx, g->y0 + j * g->dy - half);
-      const double zw = c.section.water_table->elevation(q.x(), q.y()), zg = c.section.terrain->elevation(q.x(), q.y());
-      if (!std::isfinite(zw))
-        throw InputError("the water table raster has no value at (" + csv_number(q.x()) + ", " + csv_number(q.y()) +
-                             ") on the 3D strip: it must cover the strip, without nodata",
-                         c.config_source, "water.table_raster", c.water_table_raster);
-      if (!std::isfinite(zg))
-        throw InputError("the 3D section strip leaves the DSM's data at (" + csv_number(q.x()) + ", " +
-                             csv_number(q.y()) + "): narrow geometry.width or move the polyline",
-                         c.config_source, "geometry.width", csv_number(c.width));
-      g->table.push_back(zw);
-      g->ground.push_back(zg);
-    }
-  return g;
-}
-
-PoreWaterSettings pore_water_settings(const RunConfig& c) {
-  PoreWaterSettings pw;
-  if (c.scenario == ScenarioType::Section && c.section.water_table) {
-    // A DSM section: the raster cut along the section (2D, clipped to the profile) or over the strip (3D).
-    pw.density = c.numerics.gravity > 0.0 ? c.water.unit_weight / c.numerics.gravity : 1000.0;
-    pw.history_times = c.water_history_times;
-    pw.history_offsets = c.water_history_offsets;
-    if (c.dimension == 2) {
-      pw.phreatic = section_water_table(c);
-      pw.ground = section_profile(c).surface;
-    } else {
-      pw.table = section_water_table_grid(c);
-    }
-    return pw;
-  }
-  if (!(c.water.active() || c.rain.enabled) || c.scenario != ScenarioType::Slope || c.dimension != 2) return pw;
-  pw.density = c.numerics.gravity > 0.0 ? c.water.unit_weight / c.numerics.gravity : 1000.0;
-  if (c.rain.enabled) {
-    pw.rain = rain_pore_pressure(c);
-    return pw;
-  }
-  if (c.water.ru > 0.0) {
-    // u = r_u σ_v: the soil column above the particle in the slope's initial profile and layers, as
-    // Bishop's slices take it (limit_equilibrium.cpp, column_of).
-    ProfileDomain d = c.slope.profile();
-    apply_layers(d, c);
-    pw.ru = c.water.ru;
-    pw.overburden.ground = d.surface;
-    pw.overburden.tops = d.layer_materials.empty() ? std::vector<double>{} : d.layer_tops;
-    if (d.layer_materials.empty())
-      pw.overburden.densities = {c.materials.front().density};
-    else
-      for (const int m : d.layer_materials)
-        pw.overburden.densities.push_back(c.materials[static_cast<std::size_t>(m)].density);
-    return pw;
-  }
-  pw.phreatic = c.water.phreatic;
-  pw.ground = c.slope.profile().surface;
-  pw.history_times = c.water_history_times;
-  pw.history_offsets = c.water_history_offsets;
-  return pw;
-}
-
 namespace {
-
-/// The checks of water.table_raster: a DSM section, one source of water, the raster covering the
-/// section (or strip) and lying below the ground somewhere.
-void validate_water_table(const RunConfig& c) {
-  if (c.water_table_raster.empty()) return;
-  const std::string& src = c.config_source;
-  const char* key = "water.table_raster";
-  if (c.scenario != ScenarioType::Section)
-    throw InputError("a water table raster needs a DSM section (run.scenario = section); a slope takes water.phreatic",
-                     src, key, c.water_table_raster);
-  if (!c.water.phreatic.empty() || c.water.ru > 0.0 || c.rain.enabled)
-    throw InputError("one source of pore water at a time: water.table_raster, water.phreatic, water.ru or rain", src,
-                     key, c.water_table_raster);
-  if (!c.section.water_table) return;
-  bool below = false;
-  if (c.dimension == 2) {
-    const auto cut = section_water_table(c);
-    for (std::size_t k = 0; k < cut.size(); ++k) below = below || cut[k][1] < c.section.profile[k].z;
-  } else {
-    const auto g = section_water_table_grid(c);
-    for (std::size_t k = 0; k < g->table.size(); ++k) below = below || g->table[k] < g->ground[k];
-  }
-  if (!below)
-    throw InputError("the water table lies above the ground over the whole section", src, key, c.water_table_raster);
-}
-
-/// The checks of [rain] in sph-slope: one source of water, the 2D slope, a dynamic run, β > 0 on
-/// every segment of the ground.
-void validate_rain(const RunConfig& c) {
-  const std::string& src = c.config_source;
-  if (!c.water.phreatic.empty() || c.water.ru > 0.0)
-    throw InputError("one source of pore water at a time: rain, water.phreatic or water.ru", src, "rain.enabled",
-                     "true");
-  if (c.scenario != ScenarioType::Slope || c.dimension != 2)
-    throw InputError("rain needs the 2D slope scenario", src, "rain.enabled", "true");
-  if (c.analysis != Analysis::Dynamic)
-    throw InputError(
-        "rain is a loading history of the main phase: it needs run.analysis = dynamic (the strength reduction "
-        "and the limit-equilibrium analysis take water.phreatic or water.ru)",
-        src, "rain.enabled", "true");
-  const auto& h = c.rain.infiltration.hydrology;
-  const auto ground = c.slope.profile().surface;
-  for (std::size_t k = 1; k < ground.size(); ++k) {
-    const double dx = ground[k][0] - ground[k - 1][0], dz = ground[k][1] - ground[k - 1][1];
-    const double cos2 = dx * dx / (dx * dx + dz * dz);
-    if (dx > 0.0 && !(h.steady_flux / h.conductivity < cos2))
-      throw InputError("the long-term infiltration I_ZLT/K_s must be below cos^2 of the slope's face (" +
-                           std::to_string(cos2) + "): no steady slope-parallel flow otherwise",
-                       src, "hydrology.steady_infiltration", std::to_string(h.steady_flux));
-  }
-}
-
+SlopeSection section_of(const RunConfig& c, bool residual = false);
 }  // namespace
 
 void validate_water_and_seismic(const RunConfig& c) {
-  validate_water_table(c);
+  validate_water_sources(c);
   const bool water = c.water.active();
   const bool le = c.analysis == Analysis::LimitEquilibrium;
-  if (water && (c.scenario != ScenarioType::Slope || c.dimension != 2))
-    throw InputError("pore water needs the 2D slope scenario", c.config_source,
-                     c.water.phreatic.empty() ? "water.ru" : "water.phreatic");
-  if (c.rain.enabled) validate_rain(c);
   const auto& ht = c.water_history_times;
   if (ht.size() != c.water_history_offsets.size())
     throw InputError("needs as many offsets as water.history_times (" + std::to_string(ht.size()) + ")",
@@ -242,9 +74,9 @@ void validate_water_and_seismic(const RunConfig& c) {
   for (std::size_t k = 1; k < ht.size(); ++k)
     if (!(ht[k] > ht[k - 1]))
       throw InputError("must increase", c.config_source, "water.history_times", std::to_string(ht[k]));
-  if (!ht.empty() && c.water.phreatic.empty() && c.water_table_raster.empty())
-    throw InputError("a water-table history needs water.phreatic or water.table_raster", c.config_source,
-                     "water.history_times");
+  if (!ht.empty() && c.water.phreatic.empty() && c.water_table_raster.empty() && c.pore_pressure_raster.empty())
+    throw InputError("a water-table history needs water.phreatic, water.table_raster or water.pore_pressure_raster",
+                     c.config_source, "water.history_times");
   if (c.analysis == Analysis::Dynamic && (c.seismic.kh != 0.0 || c.seismic.kv != 0.0))
     throw InputError(
         "the pseudo-static coefficients are for the limit-equilibrium analysis and the strength reduction; a "
@@ -265,8 +97,10 @@ void validate_water_and_seismic(const RunConfig& c) {
     throw InputError("the earthquake must end within 10^4 s (Newmark samples it every millisecond)", c.config_source,
                      "earthquake.duration", std::to_string(c.numerics.earthquake.end_time()));
   if (!water && !le) return;
-  auto s = limit_equilibrium_section(c, true);  // InputError naming run.scenario for other scenarios
-  s.water.phreatic = c.water.phreatic;          // the table as given (above the ground everywhere?)
+  // The section's 2D profile (a 3D slope's, a DSM section's along its polyline); the limit-equilibrium
+  // analysis: InputError naming run.scenario for other scenarios than the 2D slope.
+  auto s = c.scenario == ScenarioType::Section && !le ? section_of(c) : limit_equilibrium_section(c, true);
+  s.water.phreatic = c.water.phreatic;  // the table as given (above the ground everywhere?)
   try {
     s.validate_water("water.");
   } catch (const InputError& e) {
@@ -436,9 +270,9 @@ class LimitEquilibriumRun final : public SimulationModel {
 namespace {
 
 /// The limit-equilibrium section of a 2D slope or DSM-section scenario, at peak strength or with the
-/// residual strengths of a softening soil; a slope with the config's pore water and seismic
+/// residual strengths of a softening soil, with the config's pore water; a slope with its seismic
 /// coefficients.
-SlopeSection section_of(const RunConfig& c, bool residual = false) {
+SlopeSection section_of(const RunConfig& c, bool residual) {
   ProfileDomain d;
   if (c.scenario == ScenarioType::Slope) {
     d = c.slope.profile();
@@ -454,12 +288,17 @@ SlopeSection section_of(const RunConfig& c, bool residual = false) {
     soils.push_back({m.density * c.numerics.gravity, coh, phi, sat * c.numerics.gravity});
   }
   auto s = SlopeSection::from_profile(d, soils);
-  if (c.scenario == ScenarioType::Section && c.section.water_table) {
-    // The raster's table cut along the section, clipped to the ground as the SPH's.
-    s.water = c.water;
-    const auto cut = section_water_table(c);
-    for (std::size_t k = 0; k < cut.size(); ++k)
-      s.water.phreatic.push_back({cut[k][0], std::min(cut[k][1], c.section.profile[k].z)});
+  if (c.scenario == ScenarioType::Section) {
+    s.water = c.water;  // r_u as given: on the cover's and the base's column (column_of)
+    if (c.section.water_table || c.section.pore_pressure) {
+      // The raster's table cut along the section, clipped to the ground as the SPH's.
+      const auto cut = section_water_table(c);
+      for (std::size_t k = 0; k < cut.size(); ++k)
+        s.water.phreatic.push_back({cut[k][0], std::min(cut[k][1], c.section.profile[k].z)});
+    } else if (c.rain.enabled) {
+      const auto rain = rain_pore_pressure_on_profile(c);
+      apply_rain(s.water, rain, rain->rain_time(0.0));
+    }
   }
   if (c.scenario == ScenarioType::Slope) {
     // The pore water (clipped to the ground as the SPH's) and the pseudo-static coefficients of the
@@ -516,7 +355,7 @@ namespace {
 /// rain's pore pressure at the rain's time of the run's end t_end (s).
 nlohmann::json rain_summary(const RunConfig& c, double t_end) {
   const auto& k = c.rain.infiltration;
-  const auto rain = rain_pore_pressure(c);
+  const auto rain = rain_pore_pressure_on_profile(c);
   nlohmann::json clock = nlohmann::json::array();
   for (const auto& p : c.rain.clock) clock.push_back({p[0], p[1]});
   nlohmann::json r = {{"intensity_m_per_s", k.rain.intensities},
@@ -530,8 +369,9 @@ nlohmann::json rain_summary(const RunConfig& c, double t_end) {
                       {"clock_times_s", clock},
                       {"rain_time_at_start_s", rain->rain_time(0.0)},
                       {"rain_time_at_end_s", rain->rain_time(t_end)}};
+  if (c.analysis != Analysis::Dynamic) r["evaluate_at_s"] = c.rain.evaluate_at;
   r["bishop_factor_at_end"] = nullptr;
-  if (has_shear_strength(c.model)) try {
+  if (has_shear_strength(c.model) && c.dimension == 2) try {
       auto s = section_of(c);
       apply_rain(s.water, rain, rain->rain_time(t_end));
       r["bishop_factor_at_end"] = bishop_critical_circle(s).factor;
@@ -549,10 +389,12 @@ nlohmann::json water_summary(const RunConfig& c, double t_end) {
                       {"unit_weight_N_per_m3", w.unit_weight},
                       {"pore_pressure", w.head_loss_correction ? "head_loss_corrected" : "vertical_head"}};
   j["source"] =
-      !c.water_table_raster.empty()
+      !c.pore_pressure_raster.empty() ? "pore_pressure_raster"
+      : !c.water_table_raster.empty()
           ? "table_raster"
           : (c.rain.enabled ? "rain" : (!w.phreatic.empty() ? "phreatic_surface" : (w.ru > 0.0 ? "ru" : "none")));
   if (!c.water_table_raster.empty()) j["table_raster"] = c.water_table_raster;
+  if (!c.pore_pressure_raster.empty()) j["pore_pressure_raster"] = c.pore_pressure_raster;
   if (!c.water_history_times.empty()) {
     j["history_times_s"] = c.water_history_times;
     j["history_offsets_m"] = c.water_history_offsets;

@@ -47,7 +47,8 @@ constexpr const char* kSolverStateAttribute = "sph_solver_state";
 }  // namespace
 
 template <int Dim>
-void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int64_t step, std::size_t count) {
+void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int64_t step, bool pore_pressure,
+                  std::size_t count) {
   const std::size_t n = std::min(count, s.size());
   std::vector<FieldView> v;
   add_view<Position<Dim>>(v, s, n);
@@ -67,13 +68,15 @@ void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int6
   add_view<Clamped>(v, s, n);
   add_internal_variables(v, s, n, std::type_identity<ConstitutiveModel>{});
   add_view<PositionAtBuild<Dim>>(v, s, n);
+  if (pore_pressure) add_view<PorePressure>(v, s, n);
   w.write(t, step, v);
 }
 
 template <int Dim>
 void write_snapshot(SnapshotWriter& w, const SphSolver<Dim>& solver, std::int64_t step) {
   // Over several ranks each writes its owned particles (the writer joins them) and the same state.
-  write_fields<Dim>(w, solver.store(), solver.time(), step, solver.owned_count());
+  write_fields<Dim>(w, solver.store(), solver.time(), step, solver.settings().pore_water.active(),
+                    solver.owned_count());
   const SolverState st = solver.state();
   char buf[160];
   std::snprintf(buf, sizeof buf, "snapshot %zu step %lld dt %a builds %lld", w.snapshot_count() - 1,
@@ -184,8 +187,8 @@ GeostaticReport geostatic_with_progress(SphSolver<Dim>& solver, double dur, cons
   return rep;
 }
 
-template void write_fields<2>(SnapshotWriter&, const SphStore<2>&, double, std::int64_t, std::size_t);
-template void write_fields<3>(SnapshotWriter&, const SphStore<3>&, double, std::int64_t, std::size_t);
+template void write_fields<2>(SnapshotWriter&, const SphStore<2>&, double, std::int64_t, bool, std::size_t);
+template void write_fields<3>(SnapshotWriter&, const SphStore<3>&, double, std::int64_t, bool, std::size_t);
 template void write_snapshot<2>(SnapshotWriter&, const SphSolver<2>&, std::int64_t);
 template void write_snapshot<3>(SnapshotWriter&, const SphSolver<3>&, std::int64_t);
 template Restart load_restart<2>(const std::filesystem::path&, SphStore<2>&);

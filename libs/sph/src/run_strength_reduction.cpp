@@ -85,9 +85,9 @@ class StrengthReductionRun final : public SimulationModel {
   void write_snapshot(SnapshotWriter& w) const override {
     const std::size_t all = comm_ && comm_->rank() != 0 ? 0 : static_cast<std::size_t>(-1);
     if (!finished_)
-      write_fields<Dim>(w, *initial_, 0.0, 0, all);
+      write_fields<Dim>(w, *initial_, 0.0, 0, settings_.pore_water.active(), all);
     else if (mechanism_)
-      write_fields<Dim>(w, *mechanism_, trial_duration_, 1, all);
+      write_fields<Dim>(w, *mechanism_, trial_duration_, 1, settings_.pore_water.active(), all);
   }
   void draw_due_pngs(const std::filesystem::path&) override {}
   void write_outputs(const std::filesystem::path& out) const override;

@@ -8,6 +8,7 @@
 //   run_strength_reduction.cpp  run.analysis = strength_reduction
 //   run_validate.cpp            the checks before anything is built (validate)
 //   limit_equilibrium_run.cpp   run.analysis = limit_equilibrium and the static Bishop check
+//   run_pore_water.cpp          the pore water of a config: the solver's settings, the rasters, the checks
 // The templates below are instantiated for Dim = 2 and 3 in the file that defines them.
 
 #include <array>
@@ -68,10 +69,12 @@ std::vector<std::size_t> reported_structures(const RunConfig& c, const std::vect
 
 /// The fields written to snapshots: the state a restart needs plus what the issue asks to see.
 /// position_at_build (the positions of the last neighbour-list build) is restart state: the list,
-/// hence the Verlet-skin decisions and the order of the pair sums, is rebuilt from it. Only the
-/// first `count` particles (a rank's owned ones; a rank writing none of a state every rank holds: 0).
+/// hence the Verlet-skin decisions and the order of the pair sums, is rebuilt from it.
+/// `pore_pressure` (a run with pore water): pore_pressure too (Pa; recomputed from the position in
+/// every step, so a restart does not need it). Only the first `count` particles (a rank's owned
+/// ones; a rank writing none of a state every rank holds: 0).
 template <int Dim>
-void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int64_t step,
+void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int64_t step, bool pore_pressure = false,
                   std::size_t count = static_cast<std::size_t>(-1));
 
 /// A snapshot of the solver's store (its owned particles over several ranks, which write it together

@@ -55,24 +55,39 @@ void validate_water_and_seismic(const RunConfig& c);
 /// and the Bishop check beside it use (no ponded water, the ground a seepage face).
 std::vector<std::array<double, 2>> clipped_phreatic_surface(const RunConfig& c);
 
-/// The rain's pore pressure on the 2D slope of a config with rain.enabled (pore_pressure.hpp).
+// ---- run_pore_water.cpp
+
+/// The rain's pore pressure of a config with rain.enabled (pore_pressure.hpp) for the solver: under
+/// the ground polyline of the slope (2D, or uniform across a 3D width) or of a 2D DSM section, or
+/// under the ground grid of a 3D DSM strip. Its clock: rain.clock_times in a dynamic run, held at
+/// rain.evaluate_at in the other analyses.
 std::shared_ptr<const RainPorePressure> rain_pore_pressure(const RunConfig& c);
+
+/// The same under the ground polyline of the section's 2D profile in every dimension (Bishop's slices).
+std::shared_ptr<const RainPorePressure> rain_pore_pressure_on_profile(const RunConfig& c);
+
+/// The checks of the sources of pore water (InputError naming the key): one at a time; the rasters
+/// (water.table_raster, water.pore_pressure_raster) only on a DSM section, covering it (a table raster
+/// below the ground somewhere); a phreatic polyline on the slope; r_u and rain on the slope or a
+/// section; rain's β > 0 on every segment (cell) of the ground.
+void validate_water_sources(const RunConfig& c);
 
 /// Bishop's pore water of rain at the rain's time t_r (s): u from the rain's head on the slice bases,
 /// the initial table (parallel to the ground) for the saturated weights.
 void apply_rain(PoreWater& w, const std::shared_ptr<const RainPorePressure>& rain, double t_rain);
 
-/// The water table raster of a 2D DSM section cut along it: (s, z_w) at the profile's points.
-/// InputError naming water.table_raster where the raster has no value.
+/// The water table of a 2D DSM section's raster (water.table_raster, or the piezometric level of
+/// water.pore_pressure_raster) cut along it: (s, z_w) at the profile's points. InputError naming the
+/// raster's key where it has no value.
 std::vector<std::array<double, 2>> section_water_table(const RunConfig& c);
 
-/// The water table raster over a 3D DSM strip: z_w and the DSM's z_g on a grid of the strip's local
-/// coordinates at the particle spacing. InputError naming water.table_raster where the raster has no
-/// value (geometry.width where the strip leaves the DSM).
+/// The same over a 3D DSM strip: z_w and the DSM's z_g on a grid of the strip's local coordinates at
+/// the particle spacing. InputError naming the raster's key where it has no value (geometry.width
+/// where the strip leaves the DSM).
 std::shared_ptr<const WaterTableGrid> section_water_table_grid(const RunConfig& c);
 
-/// The solver's pore water of a config (dry unless [water] has a phreatic surface, r_u or a table
-/// raster on a section, or [rain] is enabled).
+/// The solver's pore water of a config (dry unless [water] has a phreatic surface, r_u or a raster
+/// on a section, or [rain] is enabled).
 PoreWaterSettings pore_water_settings(const RunConfig& c);
 
 /// Saturated density below the water table at the start (rain: the initial table): each soil particle of a material
@@ -92,7 +107,9 @@ void saturate_below_water_table(const RunConfig& c, SphStore<Dim>& s) {
     const auto k = static_cast<std::size_t>(mat[i]);
     const double sat = k < c.saturated_densities.size() ? c.saturated_densities[k] : 0.0;
     double level = 0.0;
-    if (pw.rain)
+    if (pw.rain && pw.rain->grid()) {
+      if constexpr (Dim == 3) level = pw.rain->initial_level(x[i][0], x[i][1]);
+    } else if (pw.rain)
       level = pw.rain->initial_level(x[i][0]);
     else if (pw.table)
       level = pw.table->level(x[i][0], x[i][Dim == 3 ? 1 : 0], 0.0);

@@ -31,7 +31,7 @@ int main(int argc, char** argv) {
   // runout: the installed case file, with an override, through the model's own key declarations.
   ConfigReader cfg = ConfigReader::from_file(data / "runout" / "valley_small.toml");
   cfg.apply_override("model.n=0.08");
-  const runout::RunoutCase c = runout::read_case(cfg);
+  const runout::RunConfig c = runout::read_config(cfg);
   cfg.finish();
   check(c.params.d0 == 2.5, "model.d0 read from the installed valley_small.toml (2.5 m)");
   check(std::get<runout::ModifiedManningFriction>(c.params.friction).n == 0.08, "model.n overridden to 0.08");
@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
   bool refused = false;
   try {
     ConfigReader bad = ConfigReader::from_string("[model]\nnn = 1\n", "bad.toml");
-    (void)runout::read_case(bad);
+    (void)runout::read_config(bad);
     bad.finish();
   } catch (const InputError& e) {
     refused = e.file() == "bad.toml" && std::string(e.what()).find("model.nn") != std::string::npos;

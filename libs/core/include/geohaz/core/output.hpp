@@ -44,6 +44,10 @@ void write_text_file(const std::filesystem::path& path, std::string_view text);
 /// exists and is not a directory.
 void make_output_dir(const std::filesystem::path& dir);
 
+/// `text` with &, <, >, " and ' replaced by their entities: safe in XML and HTML text and in
+/// attribute values quoted either way (XDMF, QGIS styles, SVG, the report's HTML).
+std::string xml_escape(std::string_view text);
+
 /// Remove leftover "*.partial" files from an output directory (after a failure).
 void remove_partial_files(const std::filesystem::path& dir);
 

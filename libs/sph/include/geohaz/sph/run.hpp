@@ -78,6 +78,9 @@ struct SectionInput {
   /// The water table raster (`water.table_raster`, the DSM's CRS): elevation of the table (m);
   /// null: none.
   std::shared_ptr<const Terrain> water_table;
+  /// The pore-pressure raster (`water.pore_pressure_raster`, the DSM's CRS): u (Pa) at the base of the
+  /// soil cover (vertical depth soil_thickness below the ground); null: none.
+  std::shared_ptr<const Terrain> pore_pressure;
 };
 
 /// What a run computes.
@@ -142,11 +145,14 @@ struct RunConfig {
   StrengthReductionSettings srm;
   /// Pore water of the section ([water]; PoreWater::unit_weight = water density × gravity): in
   /// Bishop's method and, as a prescribed pore pressure (solver.hpp PoreWaterSettings, the table
-  /// clipped to the ground), in the SPH solver of a 2D slope.
+  /// clipped to the ground), in the SPH solver of the slope and of a DSM section.
   PoreWater water;
   /// `water.table_raster` as given (resolved against the config's folder; "" none): the water table of
   /// a DSM section, loaded into section.water_table.
   std::string water_table_raster;
+  /// `water.pore_pressure_raster` as given (resolved; "" none): the pore pressure at the base of a DSM
+  /// section's soil cover, loaded into section.pore_pressure.
+  std::string pore_pressure_raster;
   /// Loading history of the water table in the main phase: times (s) and offsets Δz (m).
   std::vector<double> water_history_times, water_history_offsets;
   /// Saturated density per material (kg/m³; 0: the material's density), below the phreatic surface.
@@ -158,6 +164,9 @@ struct RunConfig {
     bool enabled = false;
     InfiltrationKeys infiltration;
     std::vector<std::array<double, 2>> clock;  ///< (t, t_r) pairs (s); empty: t_r = t
+    /// The rain's time t_r (s) whose pore pressure the strength reduction and the limit-equilibrium
+    /// analysis take (a dynamic run follows the clock); the reader's default: the end of the rain.
+    double evaluate_at = 0.0;
   } rain;
   /// Pseudo-static coefficients ([seismic]): in Bishop's method and in the strength-reduction trials.
   SeismicCoefficients seismic;
