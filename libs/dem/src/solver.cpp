@@ -202,8 +202,9 @@ void DemSolver::update_neighbours(double max_drift) {
   if (!u.rebuilt) return;
   if (u.reordered()) reorder(u.permutation);
   same_layout_ = false;
-  // The reaction window of the half-pair pass: the largest j − i of a listed pair (all j > i).
-  pair_blocks_ = nb_.blocks_for([](std::uint32_t, std::uint32_t) { return true; });
+  // The reaction window of the half-pair pass: the largest j − i of a listed pair (all j > i),
+  // found by the list build.
+  pair_blocks_ = PairBlocks::choose(nb_.size(), nb_.list().forward_reach());
 }
 
 void DemSolver::reorder(std::span<const std::uint32_t> order) {
