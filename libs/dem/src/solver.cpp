@@ -360,16 +360,19 @@ void DemSolver::update_wall_damping(const Law& law) {
 
 void DemSolver::reset_walls() {
   // Bounding boxes of the walls grown by the largest radius: a cheap reject before the distance.
+  // An inactive wall gets an empty box (lower corner +inf, upper −inf), so it rejects every disc.
   const std::size_t nw = walls.size();
-  wall_box_lo_.resize(nw);
-  wall_box_hi_.resize(nw);
+  wall_boxes_.resize(nw);
+  constexpr double inf = std::numeric_limits<double>::infinity();
   for (std::size_t k = 0; k < nw; ++k) {
     auto& wl = walls[k];
     wl.force.setZero();
     wl.stiffness = 0.0;
     wl.contacts = 0;
-    wall_box_lo_[k] = wl.a.cwiseMin(wl.b) - Vec2::Constant(1.1 * rmax_);  // 10 %: radii grow while packing
-    wall_box_hi_[k] = wl.a.cwiseMax(wl.b) + Vec2::Constant(1.1 * rmax_);
+    const Vec2 lo = wl.a.cwiseMin(wl.b) - Vec2::Constant(1.1 * rmax_);  // 10 %: radii grow while packing
+    const Vec2 hi = wl.a.cwiseMax(wl.b) + Vec2::Constant(1.1 * rmax_);
+    wall_boxes_[k] =
+        wl.active ? std::array<double, 4>{lo.x(), lo.y(), hi.x(), hi.y()} : std::array<double, 4>{inf, inf, -inf, -inf};
   }
 }
 
@@ -398,32 +401,37 @@ void DemSolver::wall_forces(const Law& law) {
   if (frag_mass || frag_roll) update_fragments();
   if (frag_roll) roll_moment_.assign(discs.size(), 0.0);
   reset_walls();
-  const auto& box_lo = wall_box_lo_;
-  const auto& box_hi = wall_box_hi_;
+  const bool any_terrain = terrain.size() > 0;
 #pragma omp parallel if (parallel_worth(n))
   {
     std::vector<Vec2> wf(nw, Vec2::Zero());
     std::vector<double> wk(nw, 0.0);
     std::vector<int> wn(nw, 0);
+    // The candidate test reads through private pointers (kept in registers across the loop).
+    const std::array<double, 4>* const boxes = wall_boxes_.data();
+    const std::uint8_t* const kinematic = kin.data();
+    const Vec2* const position = x.data();
+    const WallContacts::type* const history = WC.data();
 #pragma omp for schedule(static)
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
-      if (kin[i]) continue;
-      const Vec2 xi = x[i];
-      const double Ri = R[i];
-      const WallContacts::type& old = WC[i];
-      const bool had = old(0, 0) >= 0.0;  // slots are filled from the first one
+      if (kinematic[i]) continue;
+      const Vec2 xi = position[i];
+      const double px = xi.x(), py = xi.y();
+      const bool had = history[i](0, 0) >= 0.0;  // slots are filled from the first one
       // Most discs are far from every wall and terrain segment and had no wall contact: nothing
       // to do (decided before the contact table is set up; the same result as the full pass).
-      const auto in_box = [&](std::size_t k) {
-        return walls[k].active && (xi.array() >= box_lo[k].array()).all() && (xi.array() <= box_hi[k].array()).all();
+      const auto in_box = [=](std::size_t k) {
+        const std::array<double, 4>& b = boxes[k];
+        return px >= b[0] && py >= b[1] && px <= b[2] && py <= b[3];
       };
-      const auto [tb, te] = terrain.size() > 0
-                                ? terrain.candidates(xi.x())
-                                : std::pair<const std::uint32_t*, const std::uint32_t*>{nullptr, nullptr};
+      const auto [tb, te] = any_terrain ? terrain.candidates(px)
+                                        : std::pair<const std::uint32_t*, const std::uint32_t*>{nullptr, nullptr};
       bool candidate = had || tb != te;
       for (std::size_t k = 0; k < nw && !candidate; ++k) candidate = in_box(k);
       if (!candidate) continue;
+      const double Ri = R[i];
+      const WallContacts::type& old = WC[i];
       WallContacts::type now;
       now.row(0).setConstant(-1.0);
       now.row(1).setZero();
@@ -703,16 +711,17 @@ void DemSolver::check_state() const {
 }
 
 void DemSolver::step() {
-  auto& x = discs.get<Position<2>>();
-  auto& v = discs.get<Velocity<2>>();
-  auto& th = discs.get<Rotation>();
-  auto& w = discs.get<AngularVelocity>();
-  const auto& F = discs.get<Force>();
-  const auto& T = discs.get<Torque>();
-  const auto& m = discs.get<Mass>();
-  const auto& I = discs.get<Inertia>();
-  const auto& kin = discs.get<Kinematic>();
-  const auto& xb = discs.get<PositionAtBuild>();
+  // Raw pointers and locals, so the loop keeps them in registers across its stores.
+  Vec2* const x = discs.get<Position<2>>().data();
+  Vec2* const v = discs.get<Velocity<2>>().data();
+  double* const th = discs.get<Rotation>().data();
+  double* const w = discs.get<AngularVelocity>().data();
+  const Vec2* const F = discs.get<Force>().data();
+  const double* const T = discs.get<Torque>().data();
+  const double* const m = discs.get<Mass>().data();
+  const double* const I = discs.get<Inertia>().data();
+  const std::uint8_t* const kin = discs.get<Kinematic>().data();
+  const Vec2* const xb = discs.get<PositionAtBuild>().data();
   const double dt = dt_;
   const std::int64_t n = static_cast<std::int64_t>(discs.size());
   // 1. half kick + drift (and the largest displacement since the last list build)
@@ -720,13 +729,20 @@ void DemSolver::step() {
 #pragma omp parallel for schedule(static) reduction(max : dmax2) if (parallel_worth(n))
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
+    double vx = v[i].x(), vy = v[i].y(), wi = w[i];
     if (!kin[i]) {
-      v[i] += 0.5 * dt / m[i] * F[i];
-      w[i] += 0.5 * dt / I[i] * T[i];
+      const double hm = 0.5 * dt / m[i];
+      vx += hm * F[i].x();
+      vy += hm * F[i].y();
+      wi += 0.5 * dt / I[i] * T[i];
+      v[i] = Vec2(vx, vy);
+      w[i] = wi;
     }
-    x[i] += dt * v[i];
-    th[i] += dt * w[i];
-    dmax2 = std::max(dmax2, (x[i] - xb[i]).squaredNorm());
+    const double px = x[i].x() + dt * vx, py = x[i].y() + dt * vy;
+    x[i] = Vec2(px, py);
+    th[i] += dt * wi;
+    const double ex = px - xb[i].x(), ey = py - xb[i].y();
+    dmax2 = std::max(dmax2, ex * ex + ey * ey);
   }
   for (auto& wl : walls) {
     wl.a += dt * wl.velocity;
@@ -748,20 +764,22 @@ void DemSolver::step() {
 template <class Law>
 void DemSolver::finish_step(const Law& law) {
   // Gravity, Cundall's local damping, the second half kick, the blow-up check and the stiffness
-  // bound of the next time step, fused into one pass over the discs.
-  auto& F = discs.get<Force>();
-  auto& T = discs.get<Torque>();
-  auto& v = discs.get<Velocity<2>>();
-  auto& w = discs.get<AngularVelocity>();
-  const auto& x = discs.get<Position<2>>();
-  const auto& m = discs.get<Mass>();
-  const auto& I = discs.get<Inertia>();
-  const auto& R = discs.get<Radius>();
-  const auto& K = discs.get<StiffnessSum>();
-  const auto& kin = discs.get<Kinematic>();
-  const Vec2 g = settings.gravity;
+  // bound of the next time step, fused into one pass over the discs. Raw pointers and a local
+  // copy of the law, so its reference stiffnesses are loaded once, not after every store.
+  const Law lw = law;
+  Vec2* const F = discs.get<Force>().data();
+  double* const T = discs.get<Torque>().data();
+  Vec2* const v = discs.get<Velocity<2>>().data();
+  double* const w = discs.get<AngularVelocity>().data();
+  const Vec2* const x = discs.get<Position<2>>().data();
+  const double* const m = discs.get<Mass>().data();
+  const double* const I = discs.get<Inertia>().data();
+  const double* const R = discs.get<Radius>().data();
+  const auto* const K = discs.get<StiffnessSum>().data();
+  const std::uint8_t* const kin = discs.get<Kinematic>().data();
+  const double gx = settings.gravity.x(), gy = settings.gravity.y();
   const double alpha = settings.local_damping;
-  const double step_factor = wall_step_factor_;  // a local, so the loop does not reload it
+  const double step_factor = wall_step_factor_;
   const double dt = dt_;
   const double vmax2 = settings.max_speed * settings.max_speed;
   const std::int64_t n = static_cast<std::int64_t>(discs.size());
@@ -770,23 +788,31 @@ void DemSolver::finish_step(const Law& law) {
 #pragma omp parallel for schedule(static) reduction(max : inv2, bad) if (parallel_worth(n))
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
+    const double mi = m[i];
+    double vx = v[i].x(), vy = v[i].y();
     if (!kin[i]) {
-      Vec2 f = F[i] + m[i] * g;
+      double fx = F[i].x() + mi * gx, fy = F[i].y() + mi * gy;
       double tq = T[i];
       if (alpha > 0) {
-        for (int d = 0; d < 2; ++d) f[d] -= alpha * std::abs(f[d]) * sgn(v[i][d]);
+        fx -= alpha * std::abs(fx) * sgn(vx);
+        fy -= alpha * std::abs(fy) * sgn(vy);
         tq -= alpha * std::abs(tq) * sgn(w[i]);
       }
-      F[i] = f;
+      F[i] = Vec2(fx, fy);
       T[i] = tq;
-      v[i] += 0.5 * dt / m[i] * f;
+      const double hm = 0.5 * dt / mi;
+      vx += hm * fx;
+      vy += hm * fy;
+      v[i] = Vec2(vx, vy);
       w[i] += 0.5 * dt / I[i] * tq;
     }
-    if (!x[i].allFinite() || !v[i].allFinite() || v[i].squaredNorm() > vmax2) bad = std::max(bad, ii);
-    const double kn0 = law.reference_kn(R[i]) * step_factor, kt0 = law.reference_kt(R[i]);
+    // A non-finite or too fast velocity fails the comparison; the position is checked apart.
+    if (!(vx * vx + vy * vy <= vmax2) || !std::isfinite(x[i].x()) || !std::isfinite(x[i].y())) bad = std::max(bad, ii);
+    const double Ri = R[i];
+    const double kn0 = lw.reference_kn(Ri) * step_factor, kt0 = lw.reference_kt(Ri);
     const double ktr = std::max(K[i][0], std::max(kn0, kt0));
-    const double krot = std::max(K[i][1], kt0 * R[i] * R[i]);
-    inv2 = std::max(inv2, std::max(ktr / m[i], krot / I[i]));
+    const double krot = std::max(K[i][1], kt0 * Ri * Ri);
+    inv2 = std::max(inv2, std::max(ktr / mi, krot / I[i]));
   }
   // Servo walls: v = G (σ − σ_target) outward, G = α L / (Σk_n Δt).
   for (auto& wl : walls) {

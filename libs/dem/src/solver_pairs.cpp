@@ -189,7 +189,7 @@ void DemSolver::pair_forces(const Law& law_in) {
   }
   pb.gather(
       reactions, [](std::size_t) { return true; },
-      [&](std::size_t a, const PairReaction& r) {
+      [=](std::size_t a, const PairReaction& r) {  // by value: the pointers stay in registers
         F[a] += r.f;
         T[a] += r.tq;
         K[a] += Eigen::Vector2d(r.ktr, r.krot);

@@ -112,8 +112,8 @@ class DemSolver {
   void bond_forces();
   /// Zero the walls' force sums for this step and set their bounding boxes (grown by 1.1 R_max).
   void reset_walls();
-  std::vector<Vec2> wall_box_lo_, wall_box_hi_;
-  void update_neighbours(double max_drift);  // max_drift < 0: computed
+  std::vector<std::array<double, 4>> wall_boxes_;  ///< per wall: x_lo, y_lo, x_hi, y_hi (empty if inactive)
+  void update_neighbours(double max_drift);        // max_drift < 0: computed
   void reorder(std::span<const std::uint32_t> order);
   void rebuild_id_index();
   void rebuild_bond_index();
