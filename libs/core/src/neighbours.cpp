@@ -90,7 +90,12 @@ void CellList<Dim>::build(std::span<const Vec<Dim>> x, double cell_size, const P
   // Counting sort by cell (stable in particle index).
   cell_start_.assign(ncell + 1, 0);
   for (std::uint32_t c : cell_of_) ++cell_start_[c + 1];
-  for (std::size_t c = 0; c < ncell; ++c) cell_start_[c + 1] += cell_start_[c];
+  std::uint32_t most = 0;
+  for (std::size_t c = 0; c < ncell; ++c) {
+    most = std::max(most, cell_start_[c + 1]);
+    cell_start_[c + 1] += cell_start_[c];
+  }
+  max_occupancy_ = most;
   sorted_.resize(x.size());
   fill_.assign(cell_start_.begin(), cell_start_.end() - 1);  // reused: no allocation per build
   for (std::size_t i = 0; i < x.size(); ++i) sorted_[fill_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
@@ -147,6 +152,8 @@ void NeighbourList<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const
     std::size_t count = 0;
     const Vec<Dim>* const sx = sorted_x_.data();
     const std::uint32_t* const ids = sorted.data();
+    // At most this many candidates per particle: room for them is made once per particle.
+    const std::size_t most_candidates = static_cast<std::size_t>(detail::ipow(2 * R + 1, Dim)) * cells_.max_occupancy();
     // Every candidate is written, and the write kept (the cursor advanced) when it is a pair: no
     // branch on the distance. The periodic and half choices are hoisted out of the loop.
     const auto scan = [&](auto periodic_tag, auto half_tag) {
@@ -155,9 +162,7 @@ void NeighbourList<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const
       std::uint32_t band = 0;
       for (std::size_t i = begin; i < end; ++i) {
         const int nranges = cells_.template scan_ranges<R>(cell_of[i], ranges);
-        std::size_t candidates = 0;
-        for (int q = 0; q < nranges; ++q) candidates += ranges[q][1] - ranges[q][0];
-        if (buf.size() < count + candidates) buf.resize(std::max(2 * buf.size(), count + candidates + 1024));
+        if (buf.size() < count + most_candidates) buf.resize(std::max(2 * buf.size(), count + most_candidates + 1024));
         std::uint32_t* const row = buf.data() + count;
         std::uint32_t* out = row;
         const Vec<Dim> xi = x[i];

@@ -174,6 +174,8 @@ class CellList {
   std::span<const std::uint32_t> cell_start() const noexcept { return cell_start_; }
   /// Linear cell index of each particle.
   std::span<const std::uint32_t> cell_of() const noexcept { return cell_of_; }
+  /// The largest number of particles in one cell.
+  std::size_t max_occupancy() const noexcept { return max_occupancy_; }
   /// Linear index of the cell holding point p (p wrapped / clamped into the grid).
   std::uint32_t cell_index(const Vec<Dim>& p) const noexcept {
     std::uint32_t idx = 0;
@@ -205,6 +207,7 @@ class CellList {
   Vec<Dim> origin_ = Vec<Dim>::Zero();
   Vec<Dim> edge_ = Vec<Dim>::Ones();
   std::array<int, Dim> dims_{};
+  std::uint32_t max_occupancy_ = 0;
   std::vector<std::uint32_t> cell_of_, sorted_, cell_start_;
   std::vector<std::uint32_t> fill_;  // counting-sort cursors (scratch)
 };
