@@ -7,6 +7,7 @@
 #include <limits>
 #include <numeric>
 #include <sstream>
+#include <tuple>
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/parallel.hpp"
@@ -401,32 +402,27 @@ void DemSolver::wall_forces(const Law& law) {
   if (frag_mass || frag_roll) update_fragments();
   if (frag_roll) roll_moment_.assign(discs.size(), 0.0);
   reset_walls();
-  const bool any_terrain = terrain.size() > 0;
 #pragma omp parallel if (parallel_worth(n))
   {
     std::vector<Vec2> wf(nw, Vec2::Zero());
     std::vector<double> wk(nw, 0.0);
     std::vector<int> wn(nw, 0);
-    // The candidate test reads through private pointers (kept in registers across the loop).
-    const std::array<double, 4>* const boxes = wall_boxes_.data();
-    const std::uint8_t* const kinematic = kin.data();
-    const Vec2* const position = x.data();
-    const WallContacts::type* const history = WC.data();
+    // Private pointers for the candidate test: kept in registers.
+    const auto [boxes, kinematic, position, history] = std::tuple(wall_boxes_.data(), kin.data(), x.data(), WC.data());
 #pragma omp for schedule(static)
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
       if (kinematic[i]) continue;
       const Vec2 xi = position[i];
-      const double px = xi.x(), py = xi.y();
       const bool had = history[i](0, 0) >= 0.0;  // slots are filled from the first one
       // Most discs are far from every wall and terrain segment and had no wall contact: nothing
       // to do (decided before the contact table is set up; the same result as the full pass).
       const auto in_box = [=](std::size_t k) {
-        const std::array<double, 4>& b = boxes[k];
-        return px >= b[0] && py >= b[1] && px <= b[2] && py <= b[3];
+        return xi.x() >= boxes[k][0] && xi.y() >= boxes[k][1] && xi.x() <= boxes[k][2] && xi.y() <= boxes[k][3];
       };
-      const auto [tb, te] = any_terrain ? terrain.candidates(px)
-                                        : std::pair<const std::uint32_t*, const std::uint32_t*>{nullptr, nullptr};
+      const auto [tb, te] = terrain.size() > 0
+                                ? terrain.candidates(xi.x())
+                                : std::pair<const std::uint32_t*, const std::uint32_t*>{nullptr, nullptr};
       bool candidate = had || tb != te;
       for (std::size_t k = 0; k < nw && !candidate; ++k) candidate = in_box(k);
       if (!candidate) continue;

@@ -22,11 +22,27 @@ inline double rolling_inertia(double Ii, double mi, double Ri, double Ij, double
 
 }  // namespace
 
+// Each pair once, from its lower index i (the list is a half list): disc j's share (−F on j, its
+// own lever and the opposite rolling moment, the same stiffnesses) goes to the reaction buffer of
+// i's block and is added in fixed block order after the pass (core PairBlocks, as in the SPH and
+// runout pair passes), so the sums do not depend on the thread count. Evaluated from j, a contact
+// gives the same F_s and the opposite M_r to the last bit (the relative velocity and the normal
+// flip sign exactly), so this is the result of evaluating both sides up to the order of the sums.
+// The dashpot mass m* of a pair of two kinematic discs (a grip against itself) is the two-body
+// one, so their forces cancel exactly in the grip's reaction.
+// A local copy of the law and raw pointers: the compiler may then keep the law's constants and the
+// arrays' addresses in registers across the stores of the loop (through references to members it
+// must assume a store to a force array could change them).
+// Without a list rebuild since the last step, entry k of the history is the same pair as entry k
+// of the list: it is updated in place. After a rebuild a new table is written beside the old one,
+// whose entries are found by partner id (lookup_history). √(k_t/k_n) of the tangential dashpot is
+// taken once per pass when the law's stiffnesses do not depend on the overlap (the same quotient
+// and root as per contact, so the same bits). The pairs of a block are one lambda with `same` a
+// compile-time constant, so the loop of the steps without a rebuild (most steps) holds no call that
+// would spill its registers; captured by value, so the pointers and constants are the closure's
+// own, which no store in the loop can change, not the shared variables of the parallel region.
 template <class Law>
 void DemSolver::pair_forces(const Law& law_in) {
-  // A local copy of the law and raw pointers: the compiler may then keep the law's constants and
-  // the arrays' addresses in registers across the stores of the loop (through references to
-  // members it must assume a store to a force array could change them).
   const Law law = law_in;
   const Vec2* const x = discs.get<Position<2>>().data();
   const Vec2* const v = discs.get<Velocity<2>>().data();
@@ -45,9 +61,6 @@ void DemSolver::pair_forces(const Law& law_in) {
   const std::size_t npairs = nb_.list().indices().size();
   const std::size_t n = discs.size();
   const bool same_layout = same_layout_ && hist_.offsets.size() == n + 1;
-  // Without a list rebuild since the last step, entry k of the history is the same pair as entry
-  // k of the list: it is updated in place. After a rebuild a new table is written beside the old
-  // one, whose entries are found by partner id (lookup_history).
   PairHistory& out = same_layout ? hist_ : hist_next_;
   if (!same_layout) {
     out.offsets.assign(offsets.begin(), offsets.end());
@@ -66,29 +79,15 @@ void DemSolver::pair_forces(const Law& law_in) {
   const double f_t = contact.tangential_damping;
   const double mu_joint = settings.joint_friction;
   const bool any_joints = !joints_.empty();
-  // √(k_t/k_n) of the tangential dashpot, once per pass when the law's stiffnesses do not depend
-  // on the overlap (the same quotient and root as per contact, so the same bits).
   double kt_kn_root = 0.0;
   if constexpr (Law::constant_stiffness) {
     const ContactResponse c0 = law.evaluate(1.0, 1.0, 1.0, 2.0, zeta);
     kt_kn_root = std::sqrt(c0.kt / c0.kn);
   }
-  // Each pair once, from its lower index i (the list is a half list): disc j's share (−F on j, its
-  // own lever and the opposite rolling moment, the same stiffnesses) goes to the reaction buffer
-  // of i's block and is added in fixed block order after the pass (core PairBlocks, as in the SPH
-  // and runout pair passes), so the sums do not depend on the thread count. Evaluated from j, a
-  // contact gives the same F_s and the opposite M_r to the last bit (the relative velocity and
-  // the normal flip sign exactly), so this is the result of evaluating both sides up to the order
-  // of the sums. The dashpot mass m* of a pair of two kinematic discs (a grip against itself) is
-  // the two-body one, so their forces cancel exactly in the grip's reaction.
   const PairBlocks& pb = pair_blocks_;
   reactions_.resize(pb.slots());
   PairReaction* const reactions = reactions_.data();
   const auto nblocks = static_cast<std::int64_t>(pb.count());
-  // The block's pairs; `same` is a compile-time constant in the two instantiations, so the loop
-  // of the steps without a rebuild (most steps) holds no call that would spill its registers.
-  // Captured by value: the pointers and constants are then the closure's own, which no store in
-  // the loop can change, instead of the shared variables of the parallel region.
   const auto block = [=, this](std::size_t b, auto layout) {
     constexpr bool same = decltype(layout)::value;
     PairReaction* const react = pb.buffer(reactions, b);  // react[j]: the reactions on disc j
@@ -114,16 +113,12 @@ void DemSolver::pair_forces(const Law& law_in) {
         double nx = dx / r, ny = dy / r;
         double mu_c = mu, mu_rc = mu_r;
         if (any_joints) {
-          for (std::uint32_t q = joint_offsets_[id[i]]; q < joint_offsets_[id[i] + 1]; ++q) {
-            const JointPair& jp = joints_[joint_entries_[q]];
-            if (jp.id_a == id[j] || jp.id_b == id[j]) {
-              const bool along = jp.normal.x() * nx + jp.normal.y() * ny >= 0;
-              nx = along ? jp.normal.x() : -jp.normal.x();
-              ny = along ? jp.normal.y() : -jp.normal.y();
-              mu_c = mu_joint;
-              mu_rc = 0.0;
-              break;
-            }
+          if (const JointPair* jp = joint_between(id[i], id[j])) {
+            const bool along = jp->normal.x() * nx + jp->normal.y() * ny >= 0;
+            nx = along ? jp->normal.x() : -jp->normal.x();
+            ny = along ? jp->normal.y() : -jp->normal.y();
+            mu_c = mu_joint;
+            mu_rc = 0.0;
           }
         }
         const double tx = -ny, ty = nx;  // t = ẑ × n
@@ -187,16 +182,30 @@ void DemSolver::pair_forces(const Law& law_in) {
     else
       block(static_cast<std::size_t>(bb), std::false_type{});
   }
+  gather_pair_reactions();
+  if (!same_layout) {
+    std::swap(hist_, hist_next_);
+    same_layout_ = true;
+  }
+}
+
+void DemSolver::gather_pair_reactions() {
   // The fixed-order gather (PairBlocks::gather: disc a adds the reactions of the blocks whose
   // window holds it in ascending block order), looped block by block over the discs each block's
   // window holds instead of disc by disc over the blocks: the same additions in the same order
   // for every disc, without a window test per disc and block.
-#pragma omp parallel for schedule(static) if (parallel_worth(n))
+  Vec2* const F = discs.get<Force>().data();
+  double* const T = discs.get<Torque>().data();
+  auto* const K = discs.get<StiffnessSum>().data();
+  const PairReaction* const reactions = reactions_.data();
+  const PairBlocks& pb = pair_blocks_;
+  const auto nblocks = static_cast<std::int64_t>(pb.count());
+#pragma omp parallel for schedule(static) if (parallel_worth(discs.size()))
   for (std::int64_t bb = 0; bb < nblocks; ++bb) {
     const auto b = static_cast<std::size_t>(bb);
     const std::size_t begin = pb.first(b), end = pb.last(b);
     for (std::size_t c = pb.first_block_reaching(b); c <= b; ++c) {
-      const PairReaction* const r = pb.buffer(static_cast<const PairReaction*>(reactions), c);
+      const PairReaction* const r = pb.buffer(reactions, c);
       const std::size_t stop = std::min(end, c * pb.size + pb.window());
       for (std::size_t a = begin; a < stop; ++a) {
         F[a] += r[a].f;
@@ -205,10 +214,14 @@ void DemSolver::pair_forces(const Law& law_in) {
       }
     }
   }
-  if (!same_layout) {
-    std::swap(hist_, hist_next_);
-    same_layout_ = true;
+}
+
+const JointPair* DemSolver::joint_between(std::int64_t id_a, std::int64_t id_b) const {
+  for (std::uint32_t q = joint_offsets_[id_a]; q < joint_offsets_[id_a + 1]; ++q) {
+    const JointPair& jp = joints_[joint_entries_[q]];
+    if (jp.id_a == id_b || jp.id_b == id_b) return &jp;
   }
+  return nullptr;
 }
 
 void DemSolver::lookup_history(std::size_t i, std::size_t j, double& fs, double& mr) const {

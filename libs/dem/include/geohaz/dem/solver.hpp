@@ -130,6 +130,10 @@ class DemSolver {
   bool same_layout_ = false;  ///< hist_ was written with the current neighbour list
   /// The history (F_s, M_r as seen from i) of the contact of discs i < j after a list rebuild.
   void lookup_history(std::size_t i, std::size_t j, double& fs, double& mr) const;
+  /// Add the reactions of the half-pair pass to F, T and K in fixed block order.
+  void gather_pair_reactions();
+  /// The joint between discs id_a and id_b, or nullptr.
+  const JointPair* joint_between(std::int64_t id_a, std::int64_t id_b) const;
   /// Disc j's share of a pair evaluated from i (half-pair pass), in its block's buffer.
   struct PairReaction {
     Vec2 f = Vec2::Zero();
