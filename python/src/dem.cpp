@@ -33,7 +33,7 @@ namespace {
 /// The observer of a run from Python: the callback every `every` records (and at the start and end
 /// of each test), the progress line when not quiet and not writing files (run_case prints it
 /// then), and Ctrl-C.
-class PythonDemObserver : public DemObserver {
+class PythonDemObserver : public RunObserver {
  public:
   PythonDemObserver(py::object callback, int every, bool progress_line)
       : cb_(std::move(callback)), every_(every), progress_line_(progress_line) {}

@@ -14,6 +14,7 @@ void CellList<Dim>::build(std::span<const Vec<Dim>> x, double cell_size, const P
   if (!(cell_size > 0.0) || !std::isfinite(cell_size))
     throw std::invalid_argument("CellList: cell size must be positive and finite");
   periodic_ = periodic;
+  periodic_any_ = periodic.any();
   const std::int64_t n = static_cast<std::int64_t>(x.size());
   if (x.size() >= std::numeric_limits<std::uint32_t>::max())
     throw std::invalid_argument("CellList: too many particles for 32-bit indices");
@@ -89,29 +90,15 @@ void CellList<Dim>::build(std::span<const Vec<Dim>> x, double cell_size, const P
   // Counting sort by cell (stable in particle index).
   cell_start_.assign(ncell + 1, 0);
   for (std::uint32_t c : cell_of_) ++cell_start_[c + 1];
-  for (std::size_t c = 0; c < ncell; ++c) cell_start_[c + 1] += cell_start_[c];
+  std::uint32_t most = 0;
+  for (std::size_t c = 0; c < ncell; ++c) {
+    most = std::max(most, cell_start_[c + 1]);
+    cell_start_[c + 1] += cell_start_[c];
+  }
+  max_occupancy_ = most;
   sorted_.resize(x.size());
   fill_.assign(cell_start_.begin(), cell_start_.end() - 1);  // reused: no allocation per build
   for (std::size_t i = 0; i < x.size(); ++i) sorted_[fill_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
-}
-
-template <int Dim>
-std::uint32_t CellList<Dim>::cell_index(const Vec<Dim>& p) const noexcept {
-  std::uint32_t idx = 0;
-  std::uint32_t stride = 1;
-  for (int d = 0; d < Dim; ++d) {
-    double u = (p[d] - origin_[d]) / edge_[d];
-    int c = static_cast<int>(std::floor(u));
-    if (periodic_.axis[d]) {
-      c %= dims_[d];
-      if (c < 0) c += dims_[d];
-    } else {
-      c = std::clamp(c, 0, dims_[d] - 1);
-    }
-    idx += static_cast<std::uint32_t>(c) * stride;
-    stride *= static_cast<std::uint32_t>(dims_[d]);
-  }
-  return idx;
 }
 
 template <int Dim>
@@ -154,35 +141,64 @@ void NeighbourList<Dim>::build(std::span<const Vec<Dim>> x, double cutoff, const
   const int nthreads = omp_get_max_threads();
   if (thread_buffers_.size() < static_cast<std::size_t>(nthreads)) thread_buffers_.resize(nthreads);
 
-#pragma omp parallel num_threads(nthreads) if (parallel_worth(nn))
+  std::size_t reach = 0;
+#pragma omp parallel num_threads(nthreads) reduction(max : reach) if (parallel_worth(nn))
   {
     const int t = omp_get_thread_num();
     const int T = omp_get_num_threads();
     const std::size_t begin = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(T);
     const std::size_t end = n * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(T);
     auto& buf = thread_buffers_[t];
-    buf.clear();
-
-    typename CellList<Dim>::template ScanRanges<R> ranges;
-    for (std::size_t i = begin; i < end; ++i) {
-      const int nranges = cells_.template scan_ranges<R>(cell_of[i], ranges);
-      const Vec<Dim> xi = x[i];
-      const std::size_t before = buf.size();
-      for (int q = 0; q < nranges; ++q)
-        for (std::uint32_t s = ranges[q][0]; s < ranges[q][1]; ++s) {
-          const Vec<Dim> d = periodic_any_ ? per.min_image(xi - sorted_x_[s]) : Vec<Dim>(xi - sorted_x_[s]);
-          if (d.squaredNorm() < rc2 && (half ? sorted[s] > i : sorted[s] != i)) buf.push_back(sorted[s]);
-        }
-      offsets_[i + 1] = static_cast<std::uint32_t>(buf.size() - before);
-    }
+    std::size_t count = 0;
+    const Vec<Dim>* const sx = sorted_x_.data();
+    const std::uint32_t* const ids = sorted.data();
+    // At most this many candidates per particle: room for them is made once per particle.
+    const std::size_t most_candidates = static_cast<std::size_t>(detail::ipow(2 * R + 1, Dim)) * cells_.max_occupancy();
+    // Every candidate is written, and the write kept (the cursor advanced) when it is a pair: no
+    // branch on the distance. The periodic and half choices are hoisted out of the loop.
+    const auto scan = [&](auto periodic_tag, auto half_tag) {
+      constexpr bool periodic_axes = decltype(periodic_tag)::value, half_pairs = decltype(half_tag)::value;
+      typename CellList<Dim>::template ScanRanges<R> ranges;
+      std::uint32_t band = 0;
+      for (std::size_t i = begin; i < end; ++i) {
+        const int nranges = cells_.template scan_ranges<R>(cell_of[i], ranges);
+        if (buf.size() < count + most_candidates) buf.resize(std::max(2 * buf.size(), count + most_candidates + 1024));
+        std::uint32_t* const row = buf.data() + count;
+        std::uint32_t* out = row;
+        const Vec<Dim> xi = x[i];
+        const auto self = static_cast<std::uint32_t>(i);
+        for (int q = 0; q < nranges; ++q)
+          for (std::uint32_t s = ranges[q][0]; s < ranges[q][1]; ++s) {
+            Vec<Dim> d;
+            if constexpr (periodic_axes)
+              d = per.min_image(xi - sx[s]);
+            else
+              d = xi - sx[s];
+            const std::uint32_t j = ids[s];
+            const bool keep = d.squaredNorm() < rc2 && (half_pairs ? j > self : j != self);
+            *out = j;
+            out += keep;
+            if constexpr (half_pairs) band = std::max(band, keep ? j - self : 0u);
+          }
+        offsets_[i + 1] = static_cast<std::uint32_t>(out - row);
+        count += static_cast<std::size_t>(out - row);
+      }
+      return band;
+    };
+    if (periodic_any_)
+      reach = half ? scan(std::true_type{}, std::true_type{}) : scan(std::true_type{}, std::false_type{});
+    else
+      reach = half ? scan(std::false_type{}, std::true_type{}) : scan(std::false_type{}, std::false_type{});
 #pragma omp barrier
 #pragma omp single
     {
       for (std::size_t i = 0; i < n; ++i) offsets_[i + 1] += offsets_[i];
       indices_.resize(offsets_[n]);
     }
-    std::copy(buf.begin(), buf.end(), indices_.begin() + (n > 0 ? offsets_[begin] : 0));
+    std::copy(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(count),
+              indices_.begin() + (n > 0 ? offsets_[begin] : 0));
   }
+  forward_reach_ = reach;
 }
 
 template <int Dim>

@@ -155,7 +155,7 @@ namespace {
 /// unconfined), then consolidation by servo walls to σ_3 on all four sides. Returns the loaded
 /// sample's width and height (unconfined: the width of the discs' envelope).
 std::pair<double, double> consolidate(DemSolver& s, const LabTestSpec& spec, const BondedSample& sample,
-                                      const RunObserver& observe) {
+                                      const RecordCallback& observe) {
   s.walls = sample.packed.walls;  // bottom, right, top, left; frictionless platens and sides
   for (auto& w : s.walls) w.friction = 0.0;
   const bool confined = spec.confining_stress > 0;
@@ -264,7 +264,7 @@ void derive_lab_numbers(const DemSolver& s, const LabTestSpec& spec, bool tensio
 }  // namespace
 
 LabTestResult run_lab_test(const LabTestSpec& spec, const BondedSample& sample, DemSolver& s,
-                           const RunObserver& observe) {
+                           const RecordCallback& observe) {
   load_sample(s, sample, spec.material);
   s.settings.gravity = Vec2::Zero();
   s.settings.local_damping = spec.local_damping;
@@ -564,7 +564,7 @@ void motion(const DemSolver& s, double stop_speed, double& vmax, double& moving)
 
 /// Step from the release until the mass is at rest or runout_time has passed, recording the
 /// time series every record_interval (the trigger acceleration during trigger_duration).
-void run_out(DemSolver& s, const AvalancheSpec& spec, const RunObserver& observe, AvalancheResult& res) {
+void run_out(DemSolver& s, const AvalancheSpec& spec, const RecordCallback& observe, AvalancheResult& res) {
   const Vec2 g0 = s.settings.gravity;
   const double t_release = s.time();
   std::size_t last_events = s.events.size();
@@ -685,7 +685,7 @@ void measure_runout(const DemSolver& s, const AvalancheSpec& spec, double source
 
 }  // namespace
 
-AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const RunObserver& observe) {
+AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& s, const RecordCallback& observe) {
   check_avalanche_spec(spec);
   AvalancheResult res;
   Vec2 lo = spec.source[0], hi = spec.source[0];

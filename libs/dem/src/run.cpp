@@ -30,17 +30,17 @@ constexpr const char* kModel = "dem-avalanche";
 // ------------------------------------------------------------------------------------------
 // Observers
 
-void DemObservers::started(const DemSimulation& sim, const std::string& test, double t) {
+void RunObservers::started(const DemSimulation& sim, const std::string& test, double t) {
   for (auto* o : list_)
     if (o) o->started(sim, test, t);
 }
 
-void DemObservers::recorded(const DemSimulation& sim, const DemSolver& s, const std::string& phase) {
+void RunObservers::recorded(const DemSimulation& sim, const DemSolver& s, const std::string& phase) {
   for (auto* o : list_)
     if (o) o->recorded(sim, s, phase);
 }
 
-void DemObservers::finished(const DemSimulation& sim, const std::string& test, const DemSolver& s) {
+void RunObservers::finished(const DemSimulation& sim, const std::string& test, const DemSolver& s) {
   for (auto* o : list_)
     if (o) o->finished(sim, test, s);
 }
@@ -56,16 +56,16 @@ std::string lab_test_name(double sigma3) {
 
 DemSimulation::DemSimulation(RunConfig config) : config_(std::move(config)) {}
 
-void DemSimulation::run(DemObserver* observer) {
-  DemObserver none;
-  DemObserver& obs = observer ? *observer : none;
+void DemSimulation::run(RunObserver* observer) {
+  RunObserver none;
+  RunObserver& obs = observer ? *observer : none;
   if (is_lab())
     run_lab(obs);
   else
     run_avalanche_case(obs);
 }
 
-void DemSimulation::run_lab(DemObserver& observer) {
+void DemSimulation::run_lab(RunObserver& observer) {
   const RunConfig& c = config_;
   const bool tension = c.kind == TestKind::Tension;
   const std::vector<double> conf = tension ? std::vector<double>{0.0} : c.confining;
@@ -89,7 +89,7 @@ void DemSimulation::run_lab(DemObserver& observer) {
   }
 }
 
-void DemSimulation::run_avalanche_case(DemObserver& observer) {
+void DemSimulation::run_avalanche_case(RunObserver& observer) {
   avalanche_solver_ = std::make_unique<DemSolver>();
   avalanche_solver_->settings = config_.numerics;
   observer.started(*this, "avalanche", config_.avalanche.settle_time + config_.avalanche.runout_time);
@@ -311,7 +311,7 @@ void write_avalanche_pictures(const DemSimulation& sim, const fs::path& out) {
 /// them: lab tests one file each (snapshots_<test>.h5: the first loading record, every
 /// output.snapshot_every-th, and the final state); the avalanche one file (snapshots.h5: the first
 /// record, every snapshot_every-th of the run-out, and the final state).
-class OutputObserver : public DemObserver {
+class OutputObserver : public RunObserver {
  public:
   OutputObserver(fs::path out, bool quiet) : out_(std::move(out)), quiet_(quiet) {}
 
@@ -387,12 +387,12 @@ void write_outputs(const DemSimulation& sim, const fs::path& out) {
   write_text_file(out / "summary.json", summary_json(sim));
 }
 
-void run_case(DemSimulation& sim, const fs::path& out, bool quiet, DemObserver* extra) {
+void run_case(DemSimulation& sim, const fs::path& out, bool quiet, RunObserver* extra) {
   make_output_dir(out);
   write_text_file(out / "config.resolved.toml", sim.config().resolved);
   if (!quiet && sim.is_lab()) std::cerr << kModel << ": building the bonded sample\n";
   OutputObserver files(out, quiet);
-  DemObservers observers({&files, extra});
+  RunObservers observers({&files, extra});
   try {
     sim.run(&observers);
   } catch (const SimulationError&) {

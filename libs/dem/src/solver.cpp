@@ -7,6 +7,7 @@
 #include <limits>
 #include <numeric>
 #include <sstream>
+#include <tuple>
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/parallel.hpp"
@@ -41,11 +42,6 @@ double dashpot_step_factor(const Law& law, double z) {
   const double zeta = c.cn / (2.0 * std::sqrt(c.kn));
   const double g = zeta + std::sqrt(1.0 + zeta * zeta);
   return g * g;
-}
-
-/// Equivalent rolling inertia of Ai et al. (2011), eq. (12).
-inline double rolling_inertia(double Ii, double mi, double Ri, double Ij, double mj, double Rj) noexcept {
-  return 1.0 / (1.0 / (Ii + mi * Ri * Ri) + 1.0 / (Ij + mj * Rj * Rj));
 }
 
 /// Whether terrain segment k owns the contact of a disc at x. A vertex shared by two segments of a
@@ -207,8 +203,9 @@ void DemSolver::update_neighbours(double max_drift) {
   if (!u.rebuilt) return;
   if (u.reordered()) reorder(u.permutation);
   same_layout_ = false;
-  // The reaction window of the half-pair pass: the largest j − i of a listed pair (all j > i).
-  pair_blocks_ = nb_.blocks_for([](std::uint32_t, std::uint32_t) { return true; });
+  // The reaction window of the half-pair pass: the largest j − i of a listed pair (all j > i),
+  // found by the list build.
+  pair_blocks_ = PairBlocks::choose(nb_.size(), nb_.list().forward_reach());
 }
 
 void DemSolver::reorder(std::span<const std::uint32_t> order) {
@@ -240,162 +237,7 @@ void DemSolver::reorder(std::span<const std::uint32_t> order) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Forces
-
-template <class Law>
-void DemSolver::pair_forces(const Law& law) {
-  const auto& x = discs.get<Position<2>>();
-  const auto& v = discs.get<Velocity<2>>();
-  const auto& w = discs.get<AngularVelocity>();
-  const auto& R = discs.get<Radius>();
-  const auto& m = discs.get<Mass>();
-  const auto& I = discs.get<Inertia>();
-  const auto& id = discs.get<ParticleId>();
-  const auto& kin = discs.get<Kinematic>();
-  auto& F = discs.get<Force>();
-  auto& T = discs.get<Torque>();
-  auto& K = discs.get<StiffnessSum>();
-  const auto off = nb_.list().offsets();
-  const auto nbr = nb_.list().indices();
-  const std::size_t n = discs.size();
-  if (!same_layout_) hist_next_.offsets.assign(off.begin(), off.end());
-  hist_next_.partner.resize(nbr.size());
-  hist_next_.shear.resize(nbr.size());
-  hist_next_.roll.resize(nbr.size());
-  const double dt = dt_;
-  const double mu = contact.friction;
-  const double mu_r = contact.rolling_friction;
-  const double eta_r = contact.rolling_damping;
-  const double zeta = Law::pair_damping(contact.restitution);
-  const double f_t = contact.tangential_damping;
-  const double mu_joint = settings.joint_friction;
-  const bool same = same_layout_ && hist_.offsets.size() == n + 1;
-  const bool any_joints = !joints_.empty();
-  // Each pair once, from its lower index i (the list is a half list): disc j's share (−F on j, its
-  // own lever and the opposite rolling moment, the same stiffnesses) goes to the reaction buffer
-  // of i's block and is added in fixed block order after the pass (core PairBlocks, as in the SPH
-  // and runout pair passes), so the sums do not depend on the thread count. Evaluated from j, a
-  // contact gives the same F_s and the opposite M_r to the last bit (the relative velocity and
-  // the normal flip sign exactly), so this is the result of evaluating both sides up to the order
-  // of the sums. The dashpot mass m* of a pair of two kinematic discs (a grip against itself) is
-  // the two-body one, so their forces cancel exactly in the grip's reaction.
-  const PairBlocks& pb = pair_blocks_;
-  reactions_.resize(pb.slots());
-  const auto nblocks = static_cast<std::int64_t>(pb.count());
-#pragma omp parallel for schedule(static) if (parallel_worth(n))
-  for (std::int64_t bb = 0; bb < nblocks; ++bb) {
-    const auto b = static_cast<std::size_t>(bb);
-    PairReaction* react = pb.buffer(reactions_.data(), b);  // react[j]: the reactions on disc j
-    std::fill(react + pb.first(b), react + pb.window_end(b), PairReaction{});
-    for (std::size_t i = pb.first(b); i < pb.last(b); ++i) {
-      const Vec2 xi = x[i];
-      const double Ri = R[i];
-      Vec2 f = Vec2::Zero();
-      double tq = 0.0, ktr = 0.0, krot = 0.0;
-      for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
-        const std::uint32_t j = nbr[k];
-        const Vec2 d = xi - x[j];
-        const double r2 = d.squaredNorm();
-        const double Rs = Ri + R[j];
-        if (r2 >= Rs * Rs || r2 == 0.0) {
-          hist_next_.partner[k] = -1;
-          continue;
-        }
-        const double r = std::sqrt(r2);
-        const double delta = Rs - r;
-        Vec2 nrm = d / r;
-        double mu_c = mu, mu_rc = mu_r;
-        if (any_joints) {
-          for (std::uint32_t q = joint_offsets_[id[i]]; q < joint_offsets_[id[i] + 1]; ++q) {
-            const JointPair& jp = joints_[joint_entries_[q]];
-            if (jp.id_a == id[j] || jp.id_b == id[j]) {
-              nrm = jp.normal.dot(nrm) >= 0 ? jp.normal : Vec2(-jp.normal);
-              mu_c = mu_joint;
-              mu_rc = 0.0;
-              break;
-            }
-          }
-        }
-        const Vec2 t = perp(nrm);
-        const double meff = kin[j] == kin[i] ? m[i] * m[j] / (m[i] + m[j]) : (kin[j] ? m[i] : m[j]);
-        const double reff = Ri * R[j] / Rs;
-        const ContactResponse c = law.evaluate(delta, meff, reff, Rs, zeta);
-        // Levers to the common contact point (mid-overlap), so the pair of shear forces is a zero
-        // net couple and angular momentum is conserved exactly.
-        const double li = Ri - 0.5 * delta, lj = R[j] - 0.5 * delta;
-        const Vec2 vrel = v[i] - v[j] - (w[i] * li + w[j] * lj) * t;
-        const double vn = vrel.dot(nrm);
-        const double vt = vrel.dot(t);
-        const double fn = c.fn_elastic - c.cn * vn;
-        double fs = 0.0, mr = 0.0;
-        const std::int64_t pj = id[j];
-        if (same) {
-          if (hist_.partner[k] == pj) {
-            fs = hist_.shear[k];
-            mr = hist_.roll[k];
-          }
-        } else {
-          lookup_history(i, j, fs, mr);
-        }
-        // Tangential dashpot: the normal damping ratio (× f_t) on the tangential spring, same m*.
-        const double ct = f_t > 0.0 ? f_t * c.cn * std::sqrt(c.kt / c.kn) : 0.0;
-        const auto fr = CoulombFrictionRolling::update(
-            fs, mr, c.kt, c.kn, vt, fn, reff, w[i] - w[j], mu_c, mu_rc, eta_r, dt,
-            [&] { return rolling_inertia(I[i], m[i], Ri, I[j], m[j], R[j]); }, ct);
-        fs = fr.shear;
-        mr = fr.roll;
-        const double shear = fs + fr.shear_damping, roll = mr + fr.roll_damping;
-        const Vec2 fc = fn * nrm + shear * t;
-        const double k_tr = std::max(c.kn, c.kt);
-        f += fc;
-        tq += -li * shear + roll;
-        ktr += k_tr;
-        krot += c.kt * Ri * Ri + fr.kr;
-        PairReaction& rj = react[j];
-        rj.f -= fc;
-        rj.tq += -lj * shear - roll;
-        rj.ktr += k_tr;
-        rj.krot += c.kt * R[j] * R[j] + fr.kr;
-        hist_next_.partner[k] = pj;
-        hist_next_.shear[k] = fs;
-        hist_next_.roll[k] = mr;
-      }
-      F[i] = f;
-      T[i] = tq;
-      K[i] = Eigen::Vector2d(ktr, krot);
-    }
-  }
-  pb.gather(
-      reactions_.data(), [](std::size_t) { return true; },
-      [&](std::size_t a, const PairReaction& r) {
-        F[a] += r.f;
-        T[a] += r.tq;
-        K[a] += Eigen::Vector2d(r.ktr, r.krot);
-      },
-      [](std::size_t) {});
-  std::swap(hist_, hist_next_);
-  if (!same_layout_) hist_next_.offsets = hist_.offsets;
-  same_layout_ = true;
-}
-
-void DemSolver::lookup_history(std::size_t i, std::size_t j, double& fs, double& mr) const {
-  // By partner id: the pair's entry is in the segment of the disc that was its lower index when it
-  // was written (i's, or j's before a reordering swapped them; seen from j, M_r has the other sign).
-  const auto& id = discs.get<ParticleId>();
-  const std::int64_t pj = id[j], pi = id[i];
-  for (std::uint32_t q = hist_.offsets[i]; q < hist_.offsets[i + 1]; ++q)
-    if (hist_.partner[q] == pj) {
-      fs = hist_.shear[q];
-      mr = hist_.roll[q];
-      return;
-    }
-  for (std::uint32_t q = hist_.offsets[j]; q < hist_.offsets[j + 1]; ++q)
-    if (hist_.partner[q] == pi) {
-      fs = hist_.shear[q];
-      mr = -hist_.roll[q];
-      return;
-    }
-}
+// Forces (the disc–disc contacts, pair_forces, are in solver_pairs.cpp)
 
 void DemSolver::bond_forces() {
   const std::size_t nb = bonds.size();
@@ -519,16 +361,19 @@ void DemSolver::update_wall_damping(const Law& law) {
 
 void DemSolver::reset_walls() {
   // Bounding boxes of the walls grown by the largest radius: a cheap reject before the distance.
+  // An inactive wall gets an empty box (lower corner +inf, upper −inf), so it rejects every disc.
   const std::size_t nw = walls.size();
-  wall_box_lo_.resize(nw);
-  wall_box_hi_.resize(nw);
+  wall_boxes_.resize(nw);
+  constexpr double inf = std::numeric_limits<double>::infinity();
   for (std::size_t k = 0; k < nw; ++k) {
     auto& wl = walls[k];
     wl.force.setZero();
     wl.stiffness = 0.0;
     wl.contacts = 0;
-    wall_box_lo_[k] = wl.a.cwiseMin(wl.b) - Vec2::Constant(1.1 * rmax_);  // 10 %: radii grow while packing
-    wall_box_hi_[k] = wl.a.cwiseMax(wl.b) + Vec2::Constant(1.1 * rmax_);
+    const Vec2 lo = wl.a.cwiseMin(wl.b) - Vec2::Constant(1.1 * rmax_);  // 10 %: radii grow while packing
+    const Vec2 hi = wl.a.cwiseMax(wl.b) + Vec2::Constant(1.1 * rmax_);
+    wall_boxes_[k] =
+        wl.active ? std::array<double, 4>{lo.x(), lo.y(), hi.x(), hi.y()} : std::array<double, 4>{inf, inf, -inf, -inf};
   }
 }
 
@@ -557,25 +402,23 @@ void DemSolver::wall_forces(const Law& law) {
   if (frag_mass || frag_roll) update_fragments();
   if (frag_roll) roll_moment_.assign(discs.size(), 0.0);
   reset_walls();
-  const auto& box_lo = wall_box_lo_;
-  const auto& box_hi = wall_box_hi_;
 #pragma omp parallel if (parallel_worth(n))
   {
     std::vector<Vec2> wf(nw, Vec2::Zero());
     std::vector<double> wk(nw, 0.0);
     std::vector<int> wn(nw, 0);
+    // Private pointers for the candidate test: kept in registers.
+    const auto [boxes, kinematic, position, history] = std::tuple(wall_boxes_.data(), kin.data(), x.data(), WC.data());
 #pragma omp for schedule(static)
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
-      if (kin[i]) continue;
-      const Vec2 xi = x[i];
-      const double Ri = R[i];
-      const WallContacts::type& old = WC[i];
-      const bool had = old(0, 0) >= 0.0;  // slots are filled from the first one
+      if (kinematic[i]) continue;
+      const Vec2 xi = position[i];
+      const bool had = history[i](0, 0) >= 0.0;  // slots are filled from the first one
       // Most discs are far from every wall and terrain segment and had no wall contact: nothing
       // to do (decided before the contact table is set up; the same result as the full pass).
-      const auto in_box = [&](std::size_t k) {
-        return walls[k].active && (xi.array() >= box_lo[k].array()).all() && (xi.array() <= box_hi[k].array()).all();
+      const auto in_box = [=](std::size_t k) {
+        return xi.x() >= boxes[k][0] && xi.y() >= boxes[k][1] && xi.x() <= boxes[k][2] && xi.y() <= boxes[k][3];
       };
       const auto [tb, te] = terrain.size() > 0
                                 ? terrain.candidates(xi.x())
@@ -583,6 +426,8 @@ void DemSolver::wall_forces(const Law& law) {
       bool candidate = had || tb != te;
       for (std::size_t k = 0; k < nw && !candidate; ++k) candidate = in_box(k);
       if (!candidate) continue;
+      const double Ri = R[i];
+      const WallContacts::type& old = WC[i];
       WallContacts::type now;
       now.row(0).setConstant(-1.0);
       now.row(1).setZero();
@@ -862,16 +707,17 @@ void DemSolver::check_state() const {
 }
 
 void DemSolver::step() {
-  auto& x = discs.get<Position<2>>();
-  auto& v = discs.get<Velocity<2>>();
-  auto& th = discs.get<Rotation>();
-  auto& w = discs.get<AngularVelocity>();
-  const auto& F = discs.get<Force>();
-  const auto& T = discs.get<Torque>();
-  const auto& m = discs.get<Mass>();
-  const auto& I = discs.get<Inertia>();
-  const auto& kin = discs.get<Kinematic>();
-  const auto& xb = discs.get<PositionAtBuild>();
+  // Raw pointers and locals, so the loop keeps them in registers across its stores.
+  Vec2* const x = discs.get<Position<2>>().data();
+  Vec2* const v = discs.get<Velocity<2>>().data();
+  double* const th = discs.get<Rotation>().data();
+  double* const w = discs.get<AngularVelocity>().data();
+  const Vec2* const F = discs.get<Force>().data();
+  const double* const T = discs.get<Torque>().data();
+  const double* const m = discs.get<Mass>().data();
+  const double* const I = discs.get<Inertia>().data();
+  const std::uint8_t* const kin = discs.get<Kinematic>().data();
+  const Vec2* const xb = discs.get<PositionAtBuild>().data();
   const double dt = dt_;
   const std::int64_t n = static_cast<std::int64_t>(discs.size());
   // 1. half kick + drift (and the largest displacement since the last list build)
@@ -879,13 +725,20 @@ void DemSolver::step() {
 #pragma omp parallel for schedule(static) reduction(max : dmax2) if (parallel_worth(n))
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
+    double vx = v[i].x(), vy = v[i].y(), wi = w[i];
     if (!kin[i]) {
-      v[i] += 0.5 * dt / m[i] * F[i];
-      w[i] += 0.5 * dt / I[i] * T[i];
+      const double hm = 0.5 * dt / m[i];
+      vx += hm * F[i].x();
+      vy += hm * F[i].y();
+      wi += 0.5 * dt / I[i] * T[i];
+      v[i] = Vec2(vx, vy);
+      w[i] = wi;
     }
-    x[i] += dt * v[i];
-    th[i] += dt * w[i];
-    dmax2 = std::max(dmax2, (x[i] - xb[i]).squaredNorm());
+    const double px = x[i].x() + dt * vx, py = x[i].y() + dt * vy;
+    x[i] = Vec2(px, py);
+    th[i] += dt * wi;
+    const double ex = px - xb[i].x(), ey = py - xb[i].y();
+    dmax2 = std::max(dmax2, ex * ex + ey * ey);
   }
   for (auto& wl : walls) {
     wl.a += dt * wl.velocity;
@@ -907,20 +760,22 @@ void DemSolver::step() {
 template <class Law>
 void DemSolver::finish_step(const Law& law) {
   // Gravity, Cundall's local damping, the second half kick, the blow-up check and the stiffness
-  // bound of the next time step, fused into one pass over the discs.
-  auto& F = discs.get<Force>();
-  auto& T = discs.get<Torque>();
-  auto& v = discs.get<Velocity<2>>();
-  auto& w = discs.get<AngularVelocity>();
-  const auto& x = discs.get<Position<2>>();
-  const auto& m = discs.get<Mass>();
-  const auto& I = discs.get<Inertia>();
-  const auto& R = discs.get<Radius>();
-  const auto& K = discs.get<StiffnessSum>();
-  const auto& kin = discs.get<Kinematic>();
-  const Vec2 g = settings.gravity;
+  // bound of the next time step, fused into one pass over the discs. Raw pointers and a local
+  // copy of the law, so its reference stiffnesses are loaded once, not after every store.
+  const Law lw = law;
+  Vec2* const F = discs.get<Force>().data();
+  double* const T = discs.get<Torque>().data();
+  Vec2* const v = discs.get<Velocity<2>>().data();
+  double* const w = discs.get<AngularVelocity>().data();
+  const Vec2* const x = discs.get<Position<2>>().data();
+  const double* const m = discs.get<Mass>().data();
+  const double* const I = discs.get<Inertia>().data();
+  const double* const R = discs.get<Radius>().data();
+  const auto* const K = discs.get<StiffnessSum>().data();
+  const std::uint8_t* const kin = discs.get<Kinematic>().data();
+  const double gx = settings.gravity.x(), gy = settings.gravity.y();
   const double alpha = settings.local_damping;
-  const double step_factor = wall_step_factor_;  // a local, so the loop does not reload it
+  const double step_factor = wall_step_factor_;
   const double dt = dt_;
   const double vmax2 = settings.max_speed * settings.max_speed;
   const std::int64_t n = static_cast<std::int64_t>(discs.size());
@@ -929,23 +784,31 @@ void DemSolver::finish_step(const Law& law) {
 #pragma omp parallel for schedule(static) reduction(max : inv2, bad) if (parallel_worth(n))
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
+    const double mi = m[i];
+    double vx = v[i].x(), vy = v[i].y();
     if (!kin[i]) {
-      Vec2 f = F[i] + m[i] * g;
+      double fx = F[i].x() + mi * gx, fy = F[i].y() + mi * gy;
       double tq = T[i];
       if (alpha > 0) {
-        for (int d = 0; d < 2; ++d) f[d] -= alpha * std::abs(f[d]) * sgn(v[i][d]);
+        fx -= alpha * std::abs(fx) * sgn(vx);
+        fy -= alpha * std::abs(fy) * sgn(vy);
         tq -= alpha * std::abs(tq) * sgn(w[i]);
       }
-      F[i] = f;
+      F[i] = Vec2(fx, fy);
       T[i] = tq;
-      v[i] += 0.5 * dt / m[i] * f;
+      const double hm = 0.5 * dt / mi;
+      vx += hm * fx;
+      vy += hm * fy;
+      v[i] = Vec2(vx, vy);
       w[i] += 0.5 * dt / I[i] * tq;
     }
-    if (!x[i].allFinite() || !v[i].allFinite() || v[i].squaredNorm() > vmax2) bad = std::max(bad, ii);
-    const double kn0 = law.reference_kn(R[i]) * step_factor, kt0 = law.reference_kt(R[i]);
+    // A non-finite or too fast velocity fails the comparison; the position is checked apart.
+    if (!(vx * vx + vy * vy <= vmax2) || !std::isfinite(x[i].x()) || !std::isfinite(x[i].y())) bad = std::max(bad, ii);
+    const double Ri = R[i];
+    const double kn0 = lw.reference_kn(Ri) * step_factor, kt0 = lw.reference_kt(Ri);
     const double ktr = std::max(K[i][0], std::max(kn0, kt0));
-    const double krot = std::max(K[i][1], kt0 * R[i] * R[i]);
-    inv2 = std::max(inv2, std::max(ktr / m[i], krot / I[i]));
+    const double krot = std::max(K[i][1], kt0 * Ri * Ri);
+    inv2 = std::max(inv2, std::max(ktr / mi, krot / I[i]));
   }
   // Servo walls: v = G (σ − σ_target) outward, G = α L / (Σk_n Δt).
   for (auto& wl : walls) {

@@ -158,15 +158,10 @@ void read_hydrograph_table(const std::string& file, Hydrograph& q) {
   if (!(q.volume() > 0.0)) throw InputError("the hydrograph delivers no volume (all discharges zero)", file);
 }
 
-}  // namespace
-
-SpatialProcesses load_processes(const ProcessSpec& s, const RunoutParameters& p, const Raster& dsm,
-                                const GridSurface& surface) {
-  SpatialProcesses out;
-  const GridGeometry g = geometry_of(dsm);
-  out.grid = g;
-
-  // Friction zones: polygons with coefficient attributes, then per-coefficient rasters.
+/// Friction zones: polygons with coefficient attributes, then per-coefficient rasters, into
+/// out.friction (NaN outside the zones).
+void load_friction_zones(const ProcessSpec& s, const RunoutParameters& p, const Raster& dsm, const GridGeometry& g,
+                         SpatialProcesses& out) {
   // The ranges and units of the model.<name> keys (config.cpp).
   const std::array<std::pair<double, double>, kFrictionParameters> ranges{{{0.005, 0.5},
                                                                            {0.0, 2.0},
@@ -227,8 +222,10 @@ SpatialProcesses load_processes(const ProcessSpec& s, const RunoutParameters& p,
     for (std::size_t c = 0; c < v.size(); ++c)
       if (std::isfinite(v[c])) f[c] = v[c];
   }
+}
 
-  // Forest: k_f = ½ C_D n d per cell.
+/// Forest: k_f = ½ C_D n d per cell, into out.forest_drag (none without s.forest).
+void load_forest(const ProcessSpec& s, const Raster& dsm, const GridGeometry& g, SpatialProcesses& out) {
   if (!s.forest.empty()) {
     std::vector<double> density(g.cells(), kNaN), diameter(g.cells(), kNaN);
     if (is_vector(s.forest)) {
@@ -272,8 +269,11 @@ SpatialProcesses load_processes(const ProcessSpec& s, const RunoutParameters& p,
           "forest.stem_density / forest.stem_diameter or the attributes)",
           s.forest, "forest.file");
   }
+}
 
-  // Erodible layer (m, vertical).
+/// Erodible layer (m, vertical), into out.erodible_depth; checked against the entrainment law.
+void load_erodible(const ProcessSpec& s, const RunoutParameters& p, const Raster& dsm, const GridGeometry& g,
+                   SpatialProcesses& out) {
   if (!s.erodible.empty()) {
     if (p.entrainment.law == EntrainmentLaw::None)
       throw InputError("an erodible layer is given but entrainment.law = none (choose growth or shear)", s.erodible,
@@ -308,8 +308,11 @@ SpatialProcesses load_processes(const ProcessSpec& s, const RunoutParameters& p,
                          " needs an erodible layer (entrainment.file: depth raster or polygons)",
                      "config", "entrainment.file");
   }
+}
 
-  // Inflow hydrograph.
+/// Inflow hydrograph at a point or short line, into out.inflows (none without s.hydrograph).
+void load_inflow(const ProcessSpec& s, const RunoutParameters& p, const GridSurface& surface, const GridGeometry& g,
+                 SpatialProcesses& out) {
   if (!s.hydrograph.empty()) {
     Hydrograph q;
     q.source = s.hydrograph;
@@ -344,6 +347,19 @@ SpatialProcesses load_processes(const ProcessSpec& s, const RunoutParameters& p,
     q.speed = s.inflow_speed;
     out.inflows.push_back(std::move(q));
   }
+}
+
+}  // namespace
+
+SpatialProcesses load_processes(const ProcessSpec& s, const RunoutParameters& p, const Raster& dsm,
+                                const GridSurface& surface) {
+  SpatialProcesses out;
+  const GridGeometry g = geometry_of(dsm);
+  out.grid = g;
+  load_friction_zones(s, p, dsm, g, out);
+  load_forest(s, dsm, g, out);
+  load_erodible(s, p, dsm, g, out);
+  load_inflow(s, p, surface, g, out);
   return out;
 }
 

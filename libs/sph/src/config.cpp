@@ -32,7 +32,8 @@ WallType wall(ConfigReader& r, const char* key, const char* def) {
 /// [run] and [strength_reduction]: dimension, scenario, analysis, times, restart.
 void read_run(ConfigReader& r, RunConfig& c) {
   // [run]
-  c.dimension = static_cast<int>(r.get_int("run.dimension", 2, Range::closed(2, 3), {"1", "2 (plane strain) or 3"}));
+  c.dimension =
+      static_cast<int>(r.get_int("run.dimension", c.dimension, Range::closed(2, 3), {"1", "2 (plane strain) or 3"}));
   const auto sc = r.get_choice("run.scenario", "slope", {"slope", "column", "biaxial", "section", "block"},
                                {"",
                                 "scenario type: parametric slope, granular column collapse, biaxial specimen, "
@@ -76,16 +77,16 @@ void read_run(ConfigReader& r, RunConfig& c) {
                             "a trial fails when its largest displacement grew by more than this fraction of its "
                             "final value over the last quarter of the trial"});
   }
-  c.end_time = r.get("run.end_time", 1.0, Range::positive(), {"s", "simulated time of the main phase"});
-  c.output_interval = r.get("run.output_interval", 0.01, Range::positive(), {"s", "time-series interval"});
-  c.snapshot_interval = r.get("run.snapshot_interval", 0.1, Range::non_negative(),
+  c.end_time = r.get("run.end_time", c.end_time, Range::positive(), {"s", "simulated time of the main phase"});
+  c.output_interval = r.get("run.output_interval", c.output_interval, Range::positive(), {"s", "time-series interval"});
+  c.snapshot_interval = r.get("run.snapshot_interval", c.snapshot_interval, Range::non_negative(),
                               {"s", "HDF5 snapshot interval (0: first and last only)"});
   c.velocity_png_times = r.get_array("run.velocity_png_times", {}, Range::non_negative(),
                                      {"s", "times of quick-look PNGs of the speed field"});
   c.rest_speed =
-      r.get("run.rest_speed", 0.005, Range::positive(), {"m/s", "max speed below which the mass is at rest"});
+      r.get("run.rest_speed", c.rest_speed, Range::positive(), {"m/s", "max speed below which the mass is at rest"});
   c.stop_at_rest =
-      r.get_bool("run.stop_at_rest", false,
+      r.get_bool("run.stop_at_rest", c.stop_at_rest,
                  {"", "stop when max speed < rest_speed (after max(0.05 s, end_time/10) and any shaking)"});
   const auto restart = r.get_string("run.restart", "",
                                     {"",
@@ -261,18 +262,19 @@ void read_numerics(ConfigReader& r, RunConfig& c) {
 void read_geostatic_and_earthquake(ConfigReader& r, RunConfig& c) {
   auto& n = c.numerics;
   // [geostatic]
-  c.geostatic = r.get_bool("geostatic.enabled", true, {"", "apply gravity gradually before the main phase"});
-  c.geostatic_duration = r.get("geostatic.duration", 0.0, Range::non_negative(), {"s", "0: 20 H / c_p"});
-  c.geostatic_damping =
-      r.get("geostatic.damping", 0.7, Range::closed_open(0.0, 1.0), {"1", "Cundall zeta while loading"});
-  c.geostatic_elastic = r.get_bool("geostatic.elastic", true, {"", "linear-elastic soil while loading"});
+  c.geostatic = r.get_bool("geostatic.enabled", c.geostatic, {"", "apply gravity gradually before the main phase"});
+  c.geostatic_duration =
+      r.get("geostatic.duration", c.geostatic_duration, Range::non_negative(), {"s", "0: 20 H / c_p"});
+  c.geostatic_damping = r.get("geostatic.damping", c.geostatic_damping, Range::closed_open(0.0, 1.0),
+                              {"1", "Cundall zeta while loading"});
+  c.geostatic_elastic = r.get_bool("geostatic.elastic", c.geostatic_elastic, {"", "linear-elastic soil while loading"});
   if (c.geostatic && n.total_lagrangian)
     throw InputError(
         "total_lagrangian takes no geostatic phase (its reference configuration is the start of the "
         "main phase): set geostatic.enabled = false and load with numerics.gravity and numerics.damping",
         r.source(), "numerics.formulation", "total_lagrangian");
   c.rest_tolerance =
-      r.get("geostatic.rest_tolerance", 0.01, Range::positive(), {"1", "at rest: max|v| < tol sqrt(g H)"});
+      r.get("geostatic.rest_tolerance", c.rest_tolerance, Range::positive(), {"1", "at rest: max|v| < tol sqrt(g H)"});
 
   // [earthquake]
   const auto eq = r.get_choice("earthquake.type", "none", {"none", "sine", "record"},
@@ -311,7 +313,7 @@ void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
     throw InputError("needs pairs x, z of at least two points", r.source(), "water.phreatic",
                      std::to_string(line.size()) + " numbers");
   for (std::size_t k = 0; k + 1 < line.size(); k += 2) w.phreatic.push_back({line[k], line[k + 1]});
-  w.ru = r.get("water.ru", 0.0, Range::closed_open(0.0, 1.0),
+  w.ru = r.get("water.ru", w.ru, Range::closed_open(0.0, 1.0),
                {"1",
                 "pore-pressure ratio r_u = u / (gamma h): u = r_u times the vertical overburden stress on Bishop's "
                 "slice bases and at every SPH particle (slope, DSM section: the column of its cover and base; 2D "
@@ -349,7 +351,7 @@ void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
       c.pore_pressure_raster = std::filesystem::path(pore).is_absolute() ? pore : (r.base_dir() / pore).string();
   }
   // [rain] and [hydrology]: the keys and reader of slope-stability (infiltration.hpp), here a loading history.
-  c.rain.enabled = r.get_bool("rain.enabled", false,
+  c.rain.enabled = r.get_bool("rain.enabled", c.rain.enabled,
                               {"",
                                "rain infiltration (Iverson 2000, as slope-stability: [rain], [hydrology]) as the "
                                "pore pressure: over time in a dynamic run, at rain.evaluate_at in the strength "
@@ -379,27 +381,27 @@ void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
                        std::to_string(clock[k + 1]));
     c.rain.clock.push_back({clock[k], clock[k + 1]});
   }
-  c.seismic.kh = r.get("seismic.kh", 0.0, Range::closed_open(0.0, 1.0),
+  c.seismic.kh = r.get("seismic.kh", c.seismic.kh, Range::closed_open(0.0, 1.0),
                        {"1",
                         "horizontal pseudo-static coefficient: a force k_h W in the direction of sliding "
                         "(limit-equilibrium analysis and strength-reduction trials)"});
-  c.seismic.kv = r.get("seismic.kv", 0.0, Range::closed(-0.5, 0.5),
+  c.seismic.kv = r.get("seismic.kv", c.seismic.kv, Range::closed(-0.5, 0.5),
                        {"1", "vertical pseudo-static coefficient, positive upward: the weight becomes (1 - k_v) W"});
 }
 
 void read_output(ConfigReader& r, RunConfig& c) {
   // [output]
-  c.failed_threshold = r.get("output.failed_threshold", 0.01, Range::positive(),
+  c.failed_threshold = r.get("output.failed_threshold", c.failed_threshold, Range::positive(),
                              {"m", "displacement above which soil counts as failed (failed mass, slip surface)"});
   c.front_thickness =
-      r.get("output.front_thickness", 0.0, Range::non_negative(),
+      r.get("output.front_thickness", c.front_thickness, Range::non_negative(),
             {"m", "deposit thickness that defines the front (0: 2 spacings); fix it to compare resolutions"});
   c.bulking_factor =
-      r.get("output.bulking_factor", 1.0, Range::closed(1.0, 3.0), {"1", "volume factor for release.h5"});
-  c.write_release =
-      r.get_bool("output.release", true, {"", "section scenario: write release.h5 and release_thickness.tif"});
+      r.get("output.bulking_factor", c.bulking_factor, Range::closed(1.0, 3.0), {"1", "volume factor for release.h5"});
+  c.write_release = r.get_bool("output.release", c.write_release,
+                               {"", "section scenario: write release.h5 and release_thickness.tif"});
   c.structure_forces =
-      r.get_bool("output.structure_forces", true,
+      r.get_bool("output.structure_forces", c.structure_forces,
                  {"",
                   "sum the force the soil exerts on each wall and pile: structure_forces.csv (N/m and N m/m per unit "
                   "thickness in 2D, N and N m in 3D), peaks in summary.json, structure_forces.png"});
@@ -429,11 +431,13 @@ void read_geometry(ConfigReader& r, RunConfig& c, bool describe) {
   const bool is3d = c.dimension == 3;
   if (c.scenario == ScenarioType::Slope || describe) {
     auto& g = c.slope;
-    g.height = r.get("slope.height", 0.25, Range::positive(), {"m", "slope height above the base"});
-    g.gradient = r.get("slope.gradient", 1.5, Range::non_negative(), {"1", "face gradient H:V (1.5 = 1.5H:1V)"});
-    g.crest_length = r.get("slope.crest_length", 0.3, Range::non_negative(), {"m", "flat crest behind the face"});
-    g.front_length = r.get("slope.front_length", 0.6, Range::non_negative(), {"m", "flat ground in front of the toe"});
-    g.base_thickness = r.get("slope.base_thickness", 0.05, Range::non_negative(),
+    g.height = r.get("slope.height", g.height, Range::positive(), {"m", "slope height above the base"});
+    g.gradient = r.get("slope.gradient", g.gradient, Range::non_negative(), {"1", "face gradient H:V (1.5 = 1.5H:1V)"});
+    g.crest_length =
+        r.get("slope.crest_length", g.crest_length, Range::non_negative(), {"m", "flat crest behind the face"});
+    g.front_length =
+        r.get("slope.front_length", g.front_length, Range::non_negative(), {"m", "flat ground in front of the toe"});
+    g.base_thickness = r.get("slope.base_thickness", g.base_thickness, Range::non_negative(),
                              {"m", "soil base under everything (at most 10 slope heights)"});
     // A deeper base does not change a slope's mechanism (Taylor's 1937 chart reaches a depth factor
     // of 4, beyond which it is the infinitely deep case) but multiplies the particle count: fuzz
@@ -442,34 +446,36 @@ void read_geometry(ConfigReader& r, RunConfig& c, bool describe) {
       throw InputError("must be at most 10 slope heights (10 x slope.height = " + std::to_string(10.0 * g.height) +
                            " m): a deeper base does not change the slope's mechanism",
                        r.source(), "slope.base_thickness", std::to_string(g.base_thickness));
-    g.cut_depth =
-        r.get("slope.cut_depth", 0.0, Range::non_negative(), {"m", "upper cut: depth below the crest (0: none)"});
-    g.cut_gradient = r.get("slope.cut_gradient", 2.0, Range::positive(), {"1", "upper cut gradient H:V"});
+    g.cut_depth = r.get("slope.cut_depth", g.cut_depth, Range::non_negative(),
+                        {"m", "upper cut: depth below the crest (0: none)"});
+    g.cut_gradient = r.get("slope.cut_gradient", g.cut_gradient, Range::positive(), {"1", "upper cut gradient H:V"});
     c.layer_tops =
         r.get_array("slope.layer_tops", {}, Range::non_negative(), {"m", "layer tops (elevations, ascending)"});
     const auto lm = r.get_array("slope.layer_materials", {}, Range::closed(0, 1000),
                                 {"1", "material index per layer, bottom first (one more than layer_tops)"});
     for (double v : lm) c.layer_materials.push_back(static_cast<int>(v));
-    c.piles.enabled = r.get_bool("piles.enabled", false, {"", "a row of rigid piles across the width (3D)"});
+    c.piles.enabled = r.get_bool("piles.enabled", c.piles.enabled, {"", "a row of rigid piles across the width (3D)"});
     {  // read even when disabled, so that --set piles.enabled=false works on a config with piles
       const auto pos = r.get_choice("piles.position", "middle", {"lower", "middle", "upper"},
                                     {"", "row position on the face: lower 1/4, middle 1/2, upper 3/4 of the face"});
       c.piles.position = pos == "lower" ? 0.25 : (pos == "middle" ? 0.5 : 0.75);
-      c.piles.diameter = r.get("piles.diameter", 0.02, Range::positive(), {"m", "pile diameter"});
-      c.piles.spacing = r.get("piles.spacing", 0.05, Range::positive(), {"m", "centre spacing across the width"});
+      c.piles.diameter = r.get("piles.diameter", c.piles.diameter, Range::positive(), {"m", "pile diameter"});
+      c.piles.spacing =
+          r.get("piles.spacing", c.piles.spacing, Range::positive(), {"m", "centre spacing across the width"});
     }
   }
   if (c.scenario == ScenarioType::Column || describe) {
-    c.column_width = r.get("column.width", 0.1, Range::positive(), {"m", "column width L0 (against the left wall)"});
+    c.column_width =
+        r.get("column.width", c.column_width, Range::positive(), {"m", "column width L0 (against the left wall)"});
     c.column_height =
-        r.get("column.height", 0.1, Range::positive(), {"m", "column height H0 (aspect ratio a = H0/L0)"});
-    c.floor_length = r.get("column.floor_length", 0.4, Range::positive(), {"m", "floor beyond the column"});
+        r.get("column.height", c.column_height, Range::positive(), {"m", "column height H0 (aspect ratio a = H0/L0)"});
+    c.floor_length = r.get("column.floor_length", c.floor_length, Range::positive(), {"m", "floor beyond the column"});
   }
   if (c.scenario == ScenarioType::Biaxial || describe) {
-    c.biaxial.width = r.get("biaxial.width", 0.05, Range::positive(), {"m", "specimen width"});
-    c.biaxial.height = r.get("biaxial.height", 0.1, Range::positive(), {"m", "specimen height"});
-    c.biaxial_strain_rate =
-        r.get("biaxial.strain_rate", 0.5, {}, {"1/s", "axial strain rate (> 0 compression, < 0 tension)"});
+    c.biaxial.width = r.get("biaxial.width", c.biaxial.width, Range::positive(), {"m", "specimen width"});
+    c.biaxial.height = r.get("biaxial.height", c.biaxial.height, Range::positive(), {"m", "specimen height"});
+    c.biaxial_strain_rate = r.get("biaxial.strain_rate", c.biaxial_strain_rate, {},
+                                  {"1/s", "axial strain rate (> 0 compression, < 0 tension)"});
     if (!describe && c.biaxial_strain_rate == 0.0)
       throw InputError("must be non-zero", r.source(), "biaxial.strain_rate", "0");
     // An element test needs a specimen of element shape (height/width 2 is usual); a slender column
@@ -480,7 +486,7 @@ void read_geometry(ConfigReader& r, RunConfig& c, bool describe) {
                        std::to_string(c.biaxial.height) + " with biaxial.width " + std::to_string(c.biaxial.width));
   }
   if (is3d || describe) {
-    c.width = r.get("geometry.width", 0.1, Range::positive(),
+    c.width = r.get("geometry.width", c.width, Range::positive(),
                     {"m", "3D width (axis y); a 3D DSM section: the strip width, centred on the polyline"});
     c.periodic_width = r.get_bool(
         "geometry.periodic", c.scenario != ScenarioType::Section,
@@ -497,8 +503,8 @@ void read_walls_clamp_and_initial_velocity(ConfigReader& r, RunConfig& c, bool d
   c.right_wall = wall(r, "walls.right", right_default);
   c.bottom_wall = wall(r, "walls.bottom", block ? "none" : "fixed");
   if (block || describe) {
-    c.block_length = r.get("block.length", 1.0, Range::positive(), {"m", "block scenario: length along x"});
-    c.block_height = r.get("block.height", 0.1, Range::positive(), {"m", "block scenario: height along z"});
+    c.block_length = r.get("block.length", c.block_length, Range::positive(), {"m", "block scenario: length along x"});
+    c.block_height = r.get("block.height", c.block_height, Range::positive(), {"m", "block scenario: height along z"});
   }
   // [clamp] and [initial_velocity]: any scenario.
   c.clamp_boxes = r.get_array("clamp.boxes", {}, {},
@@ -516,9 +522,10 @@ void read_walls_clamp_and_initial_velocity(ConfigReader& r, RunConfig& c, bool d
               : type == "cantilever_mode" ? InitialVelocity::Type::CantileverMode
                                           : InitialVelocity::Type::None;
     iv.value = r.get_array("initial_velocity.value", {}, {}, {"m/s", "uniform: one component per axis"});
-    iv.amplitude = r.get("initial_velocity.amplitude", 0.0, {}, {"m/s", "cantilever_mode: v_z at the free end"});
-    iv.root = r.get("initial_velocity.root", 0.0, {}, {"m", "cantilever_mode: x of the clamped end"});
-    iv.length = r.get("initial_velocity.length", 1.0, Range::positive(), {"m", "cantilever_mode: free length"});
+    iv.amplitude =
+        r.get("initial_velocity.amplitude", iv.amplitude, {}, {"m/s", "cantilever_mode: v_z at the free end"});
+    iv.root = r.get("initial_velocity.root", iv.root, {}, {"m", "cantilever_mode: x of the clamped end"});
+    iv.length = r.get("initial_velocity.length", iv.length, Range::positive(), {"m", "cantilever_mode: free length"});
   }
 }
 
@@ -548,21 +555,22 @@ void read_section(ConfigReader& r, RunConfig& c, bool describe) {
   if (c.scenario == ScenarioType::Section || describe) {
     const auto dsm = r.get_string("section.dsm", "", {"", "DSM raster (GeoTIFF, projected CRS)"});
     const auto poly = r.get_array("section.polyline", {}, {}, {"m", "x0, y0, x1, y1, ... in the DSM CRS"});
-    c.section.soil_thickness =
-        r.get("section.soil_thickness", 2.0, Range::positive(), {"m", "soil layer thickness below the surface"});
+    c.section.soil_thickness = r.get("section.soil_thickness", c.section.soil_thickness, Range::positive(),
+                                     {"m", "soil layer thickness below the surface"});
     c.section.bedrock = r.get_choice("section.base", "bedrock", {"bedrock", "fill"},
                                      {"",
                                       "bedrock: soil and base layers follow the surface on fixed bedrock "
                                       "particles; fill: the base fills down to a flat bottom"}) == "bedrock";
-    c.section.base_thickness = r.get("section.base_thickness", 2.0, Range::positive(),
+    c.section.base_thickness = r.get("section.base_thickness", c.section.base_thickness, Range::positive(),
                                      {"m",
                                       "base layer under the soil (bedrock: parallel to the surface; fill: "
                                       "below the lowest soil)"});
-    c.section.soil_material = static_cast<int>(
-        r.get_int("section.soil_material", 1, Range::closed(0, 1000), {"1", "material index of the soil layer"}));
-    c.section.base_material = static_cast<int>(
-        r.get_int("section.base_material", 0, Range::closed(0, 1000), {"1", "material index of the base"}));
-    c.section.release_width = r.get("section.release_width", 10.0, Range::positive(),
+    c.section.soil_material =
+        static_cast<int>(r.get_int("section.soil_material", c.section.soil_material, Range::closed(0, 1000),
+                                   {"1", "material index of the soil layer"}));
+    c.section.base_material = static_cast<int>(r.get_int("section.base_material", c.section.base_material,
+                                                         Range::closed(0, 1000), {"1", "material index of the base"}));
+    c.section.release_width = r.get("section.release_width", c.section.release_width, Range::positive(),
                                     {"m", "width W over which the plane-strain failed mass is spread for release.h5"});
     if (!describe) {
       if (dsm.empty()) throw InputError("the section scenario needs section.dsm", r.source(), "section.dsm");

@@ -87,6 +87,33 @@ class CellList {
   template <int R>
   int scan_ranges(std::uint32_t cell, ScanRanges<R>& ranges) const noexcept {
     const auto c = cell_coords(cell);
+    if (!periodic_any_) {
+      // No periodic axis: the candidate coordinates are the clipped offsets, none repeats; the
+      // same ranges in the same order as the general case below, without its bookkeeping.
+      std::array<int, Dim> lo, hi;
+      for (int d = 0; d < Dim; ++d) {
+        lo[d] = std::max(c[d] - R, 0);
+        hi[d] = std::min(c[d] + R, dims_[d] - 1);
+      }
+      int n = 0;
+      const auto row = [&](std::uint32_t base) {
+        ranges[n++] = {cell_start_[base + static_cast<std::uint32_t>(lo[0])],
+                       cell_start_[base + static_cast<std::uint32_t>(hi[0]) + 1]};
+      };
+      const auto d0 = static_cast<std::uint32_t>(dims_[0]);
+      if constexpr (Dim == 1) {
+        row(0);
+      } else if constexpr (Dim == 2) {
+        for (int y = lo[1]; y <= hi[1]; ++y) row(static_cast<std::uint32_t>(y) * d0);
+      } else {
+        static_assert(Dim == 3);
+        const auto d1 = static_cast<std::uint32_t>(dims_[1]);
+        for (int z = lo[2]; z <= hi[2]; ++z)
+          for (int y = lo[1]; y <= hi[1]; ++y)
+            row((static_cast<std::uint32_t>(z) * d1 + static_cast<std::uint32_t>(y)) * d0);
+      }
+      return n;
+    }
     std::array<std::array<int, 2 * R + 1>, Dim> cand{};
     std::array<int, Dim> ncand{};
     for (int d = 1; d < Dim; ++d) {
@@ -147,17 +174,40 @@ class CellList {
   std::span<const std::uint32_t> cell_start() const noexcept { return cell_start_; }
   /// Linear cell index of each particle.
   std::span<const std::uint32_t> cell_of() const noexcept { return cell_of_; }
+  /// The largest number of particles in one cell.
+  std::size_t max_occupancy() const noexcept { return max_occupancy_; }
   /// Linear index of the cell holding point p (p wrapped / clamped into the grid).
-  std::uint32_t cell_index(const Vec<Dim>& p) const noexcept;
+  std::uint32_t cell_index(const Vec<Dim>& p) const noexcept {
+    std::uint32_t idx = 0;
+    std::uint32_t stride = 1;
+    for (int d = 0; d < Dim; ++d) {
+      const double u = (p[d] - origin_[d]) / edge_[d];
+      // floor(u) without the library call (no SSE4.1 rounding in the baseline x86-64 build):
+      // truncation, one down for negative non-integers; the same integer for every finite u in range.
+      int c = static_cast<int>(u);
+      c -= static_cast<double>(c) > u;
+      if (periodic_.axis[d]) {
+        c %= dims_[d];
+        if (c < 0) c += dims_[d];
+      } else {
+        c = std::clamp(c, 0, dims_[d] - 1);
+      }
+      idx += static_cast<std::uint32_t>(c) * stride;
+      stride *= static_cast<std::uint32_t>(dims_[d]);
+    }
+    return idx;
+  }
   /// Cell coordinates (per axis) from a linear index.
   std::array<int, Dim> cell_coords(std::uint32_t c) const noexcept;
   const Periodicity<Dim>& periodicity() const noexcept { return periodic_; }
 
  private:
   Periodicity<Dim> periodic_;
+  bool periodic_any_ = false;
   Vec<Dim> origin_ = Vec<Dim>::Zero();
   Vec<Dim> edge_ = Vec<Dim>::Ones();
   std::array<int, Dim> dims_{};
+  std::uint32_t max_occupancy_ = 0;
   std::vector<std::uint32_t> cell_of_, sorted_, cell_start_;
   std::vector<std::uint32_t> fill_;  // counting-sort cursors (scratch)
 };
@@ -178,6 +228,9 @@ class NeighbourList {
   double cutoff() const noexcept { return cutoff_; }
   /// Total number of (ordered) pairs i→j stored.
   std::size_t pair_count() const noexcept { return indices_.size(); }
+  /// Half lists: the largest j − i of a stored pair (the reach of PairBlocks for a pass over all of
+  /// them), found during the build; 0 for a full list.
+  std::size_t forward_reach() const noexcept { return forward_reach_; }
   /// The neighbours of particle i.
   std::span<const std::uint32_t> neighbours(std::size_t i) const noexcept {
     return {indices_.data() + offsets_[i], indices_.data() + offsets_[i + 1]};
@@ -217,8 +270,9 @@ class NeighbourList {
   CellList<Dim> cells_;
   double cutoff_ = 0.0;
   bool periodic_any_ = false;
+  std::size_t forward_reach_ = 0;
   std::vector<std::uint32_t> offsets_, indices_;
-  std::vector<std::vector<std::uint32_t>> thread_buffers_;  // reused between builds
+  std::vector<std::vector<std::uint32_t>> thread_buffers_;  // reused between builds (their size is capacity)
   std::vector<Vec<Dim>> sorted_x_;                          // positions in cell order, reused
 };
 

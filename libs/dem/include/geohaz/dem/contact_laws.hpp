@@ -84,6 +84,8 @@ struct LinearSpringCoulomb {
   // k_n/k_s = 2.5 (Potyondy & Cundall 2004); config.cpp derives its defaults from these.
   double kn = 2 * 20e9;        ///< normal stiffness (N/m per m thickness)
   double ks = 2 * 20e9 / 2.5;  ///< shear stiffness (N/m per m thickness)
+  /// k_n and k_t do not depend on the overlap (the solver computes √(k_t/k_n) once per step).
+  static constexpr bool constant_stiffness = true;
 
   /// \param zeta damping ratio from the restitution coefficient (damping_ratio_from_restitution).
   ContactResponse evaluate(double delta, double meff, double /*reff*/, double /*slice*/, double zeta) const noexcept {
@@ -116,6 +118,8 @@ struct HertzMindlin {
   double youngs = 20e9;              ///< particle Young's modulus E (Pa)
   double poisson = 0.25;             ///< Poisson's ratio ν
   double reference_overlap = 0.005;  ///< δ/R used for the time step of a disc with no contact yet
+  /// S_n and S_t grow with the contact radius √(R*δ).
+  static constexpr bool constant_stiffness = false;
 
   double estar() const noexcept { return youngs / (2.0 * (1.0 - poisson * poisson)); }
   double gstar() const noexcept { return youngs / (4.0 * (2.0 - poisson) * (1.0 + poisson)); }
@@ -152,10 +156,13 @@ struct HertzMindlin {
 ///   pair_damping(e), wall_damping(e)  z giving restitution e for a disc–disc (unclamped) and a
 ///                          disc–wall (clamped to F_n ≥ 0) contact;
 ///   normal_energy(F_el, δ) elastic energy stored in the normal spring (J/m);
-///   reference_kn(R), reference_kt(R)  stiffnesses for the time step of a disc with no contact.
+///   reference_kn(R), reference_kt(R)  stiffnesses for the time step of a disc with no contact;
+///   constant_stiffness     whether k_n and k_t are the same at every overlap (then the solver
+///                          computes factors of them once per step instead of per contact).
 template <class L>
 concept DemContactLaw = requires(const L& l, double x) {
   { L::name } -> std::convertible_to<const char*>;
+  { L::constant_stiffness } -> std::convertible_to<bool>;
   { L::summary } -> std::convertible_to<const char*>;
   { l.evaluate(x, x, x, x, x) } -> std::same_as<ContactResponse>;
   { L::pair_damping(x) } -> std::same_as<double>;

@@ -45,7 +45,7 @@ BondedSample build_bonded_sample(const PackingSpec& packing, const MaterialSpec&
 void load_sample(DemSolver& s, const BondedSample& sample, const MaterialSpec& material);
 
 /// Called while a test runs: the solver, and a phase name ("consolidation", "loading", "settling", "runout").
-using RunObserver = std::function<void(const DemSolver&, const std::string& phase)>;
+using RecordCallback = std::function<void(const DemSolver&, const std::string& phase)>;
 
 enum class LabTest { BiaxialCompression, BiaxialTension };
 
@@ -89,7 +89,7 @@ struct LabTestResult {
 
 /// Run a laboratory test on `sample` (the solver is left in its final state for output).
 LabTestResult run_lab_test(const LabTestSpec& spec, const BondedSample& sample, DemSolver& solver,
-                           const RunObserver& observe = {});
+                           const RecordCallback& observe = {});
 
 /// Least-squares Mohr–Coulomb envelope from peak (σ_3, σ_1) pairs: σ_1 = a + b σ_3,
 /// φ = asin((b − 1)/(b + 1)), c = a (1 − sin φ)/(2 cos φ); failure plane at 45° + φ/2 to σ_3's plane.
@@ -186,7 +186,7 @@ struct AvalancheResult {
 void check_avalanche_spec(const AvalancheSpec& spec);
 
 /// Run a rock avalanche (the solver is left in its final state).
-AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& solver, const RunObserver& observe = {});
+AvalancheResult run_avalanche(const AvalancheSpec& spec, DemSolver& solver, const RecordCallback& observe = {});
 
 /// Fragments: clusters of discs joined by intact bonds (union–find). Writes the Fragment field
 /// and returns the sizes, descending.

@@ -40,9 +40,9 @@ class DemSimulation;
 
 /// Sees a run as it goes (progress bars, snapshot writers, a Python callback). Default: nothing.
 /// Called once per record of the drivers (every few tens of steps), never per disc or pair.
-class DemObserver {
+class RunObserver {
  public:
-  virtual ~DemObserver() = default;
+  virtual ~RunObserver() = default;
   /// A test starts: a lab test by its name, or "avalanche"; `expected_time` is the simulated time
   /// it should last (s; lab: max strain × height / (2 × loading velocity); avalanche: settle +
   /// run-out time).
@@ -54,15 +54,15 @@ class DemObserver {
 };
 
 /// Several observers called in turn (null entries skipped).
-class DemObservers : public DemObserver {
+class RunObservers : public RunObserver {
  public:
-  explicit DemObservers(std::vector<DemObserver*> list) : list_(std::move(list)) {}
+  explicit RunObservers(std::vector<RunObserver*> list) : list_(std::move(list)) {}
   void started(const DemSimulation& sim, const std::string& test, double t) override;
   void recorded(const DemSimulation& sim, const DemSolver& s, const std::string& phase) override;
   void finished(const DemSimulation& sim, const std::string& test, const DemSolver& s) override;
 
  private:
-  std::vector<DemObserver*> list_;
+  std::vector<RunObserver*> list_;
 };
 
 /// One dem-avalanche run: the lab tests of one bonded sample, or one rock avalanche.
@@ -72,7 +72,7 @@ class DemSimulation {
   explicit DemSimulation(RunConfig config);
 
   /// Build the sample and run every test (lab) or the avalanche. SimulationError on a blow-up.
-  void run(DemObserver* observer = nullptr);
+  void run(RunObserver* observer = nullptr);
 
   const RunConfig& config() const noexcept { return config_; }
   /// A lab run (biaxial compression or tension), not an avalanche.
@@ -87,8 +87,8 @@ class DemSimulation {
   const DemSolver& avalanche_solver() const noexcept { return *avalanche_solver_; }
 
  private:
-  void run_lab(DemObserver& observer);
-  void run_avalanche_case(DemObserver& observer);
+  void run_lab(RunObserver& observer);
+  void run_avalanche_case(RunObserver& observer);
 
   RunConfig config_;
   BondedSample sample_;
@@ -119,6 +119,6 @@ void write_outputs(const DemSimulation& sim, const std::filesystem::path& out);
 /// run with snapshots (snapshots[_<test>].h5) and progress on stderr (unless quiet; the warnings
 /// always), call `extra` too (may be null), and write the outputs. On a SimulationError the lab
 /// tests finished so far still get their tables and pictures (no summary), then it goes on.
-void run_case(DemSimulation& sim, const std::filesystem::path& out, bool quiet, DemObserver* extra = nullptr);
+void run_case(DemSimulation& sim, const std::filesystem::path& out, bool quiet, RunObserver* extra = nullptr);
 
 }  // namespace geohaz::dem

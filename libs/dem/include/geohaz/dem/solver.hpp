@@ -112,8 +112,8 @@ class DemSolver {
   void bond_forces();
   /// Zero the walls' force sums for this step and set their bounding boxes (grown by 1.1 R_max).
   void reset_walls();
-  std::vector<Vec2> wall_box_lo_, wall_box_hi_;
-  void update_neighbours(double max_drift);  // max_drift < 0: computed
+  std::vector<std::array<double, 4>> wall_boxes_;  ///< per wall: x_lo, y_lo, x_hi, y_hi (empty if inactive)
+  void update_neighbours(double max_drift);        // max_drift < 0: computed
   void reorder(std::span<const std::uint32_t> order);
   void rebuild_id_index();
   void rebuild_bond_index();
@@ -130,6 +130,10 @@ class DemSolver {
   bool same_layout_ = false;  ///< hist_ was written with the current neighbour list
   /// The history (F_s, M_r as seen from i) of the contact of discs i < j after a list rebuild.
   void lookup_history(std::size_t i, std::size_t j, double& fs, double& mr) const;
+  /// Add the reactions of the half-pair pass to F, T and K in fixed block order.
+  void gather_pair_reactions();
+  /// The joint between discs id_a and id_b, or nullptr.
+  const JointPair* joint_between(std::int64_t id_a, std::int64_t id_b) const;
   /// Disc j's share of a pair evaluated from i (half-pair pass), in its block's buffer.
   struct PairReaction {
     Vec2 f = Vec2::Zero();
