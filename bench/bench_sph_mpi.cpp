@@ -24,6 +24,7 @@ using namespace geohaz::sph;
 
 int main(int argc, char** argv) {
   geohaz::mpi::Session session(argc, argv);
+  const auto world = geohaz::mpi::world_communicator(session);
   const int steps = argc > 1 ? std::atoi(argv[1]) : 20;
   const double scale = argc > 2 ? std::atof(argv[2]) : 1.0;
   MaterialParams m;
@@ -49,7 +50,7 @@ int main(int argc, char** argv) {
   s.domain_hi = sc.domain_hi;
   const std::size_t total = sc.store.size();
   SphSolver<3> solver(std::move(sc.store), {m}, DruckerPrager{}, s);
-  if (session.world()) solver.distribute(session.world());
+  if (world) solver.distribute(world);
   solver.step();  // warm-up: the partition, the first list and sort
   const auto t0 = std::chrono::steady_clock::now();
   for (int i = 0; i < steps; ++i) solver.step();
@@ -59,7 +60,7 @@ int main(int argc, char** argv) {
   const double ghosts = dom ? static_cast<double>(dom->stats().ghosts) : 0.0;
   const double bytes = solver.bytes_per_particle() * static_cast<double>(solver.store().size()) / std::max(owned, 1.0);
   std::vector<double> mine{sec, ghosts / std::max(owned, 1.0), bytes};
-  std::vector<double> all = session.world() ? session.world()->all_gather(mine) : mine;
+  std::vector<double> all = world ? world->all_gather(mine) : mine;
   double tmax = 0.0, halo = 0.0, bmax = 0.0;
   for (std::size_t r = 0; r < all.size() / 3; ++r) {
     tmax = std::max(tmax, all[3 * r]);

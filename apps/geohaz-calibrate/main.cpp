@@ -89,7 +89,7 @@ int run(int argc, char** argv, const World& world) {
     return kExitOk;
   }
   if (common.config.empty()) throw InputError("no calibration config given (positional argument)", "command line");
-  const int threads = setup_threads(apps::threads_per_rank(common.threads));
+  const int threads = setup_threads(mpi::threads_per_rank(common.threads));
   const bool quiet = common.quiet || world.rank != 0;
 
   // Every rank reads and checks the same config (all fail alike, nothing written).

@@ -80,7 +80,7 @@ int run(int argc, char** argv, const World& world) {
   }
   if (common.config.empty()) throw InputError("no ensemble config given (positional argument)", "command line");
   // Threads per rank: the cores of the node shared between its ranks unless given.
-  const int threads = setup_threads(apps::threads_per_rank(common.threads));
+  const int threads = setup_threads(mpi::threads_per_rank(common.threads));
   const bool quiet = common.quiet || world.rank != 0;
 
   // Every rank reads and checks the same config (deterministic: all fail alike, nothing written).

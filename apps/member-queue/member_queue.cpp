@@ -4,8 +4,6 @@
 /// {member, payload...} as doubles (tag kTagAssign); a negative member means stop.
 #include "member_queue.hpp"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
@@ -13,12 +11,10 @@
 
 #include "geohaz/core/app.hpp"
 #include "geohaz/core/errors.hpp"
+#include "geohaz/mpi/session.hpp"
 
 #ifdef GEOHAZ_HAVE_MPI
 #include <mpi.h>
-#endif
-#if defined(__SANITIZE_ADDRESS__)
-#include <sanitizer/lsan_interface.h>
 #endif
 
 namespace geohaz::apps {
@@ -28,13 +24,6 @@ namespace {
 [[maybe_unused]] constexpr int kTagRequest = 1, kTagAssign = 2;
 
 #ifdef GEOHAZ_HAVE_MPI
-/// Whether an MPI launcher (mpirun/mpiexec of Open MPI or MPICH, srun with PMI/PMIx) started us.
-bool launched_by_mpi() {
-  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"})
-    if (std::getenv(v)) return true;
-  return false;
-}
-
 /// Wait for a request without spinning (see member_queue.hpp): up to one member's time.
 void wait_quietly(MPI_Request* request) {
   int done = 0;
@@ -55,56 +44,17 @@ int World::broadcast(int value) const {
   return value;
 }
 
-int local_ranks() {
-  for (const char* v : {"OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS", "SLURM_NTASKS_PER_NODE"})
-    if (const char* s = std::getenv(v)) {
-      const int n = std::atoi(s);
-      if (n > 0) return n;
-    }
-  return 1;
-}
-
-int threads_per_rank(int requested) {
-  return requested > 0 ? requested : std::max(1, omp_get_num_procs() / local_ranks());
-}
-
 int run_mpi_app(const char* app, int argc, char** argv, const std::function<int(const World&)>& body) {
+  const mpi::Session session(argc, argv);  // MPI_Init when launched by mpirun; MPI_Finalize at the end
   World world;
-#ifdef GEOHAZ_HAVE_MPI
-  if (launched_by_mpi()) {
-    int provided = 0;
-#if defined(__SANITIZE_ADDRESS__)
-    __lsan_disable();  // what Open MPI allocates in its init is its own business (see below)
-#endif
-    MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
-#if defined(__SANITIZE_ADDRESS__)
-    __lsan_enable();
-#endif
-    world.mpi = true;
-    MPI_Comm_rank(MPI_COMM_WORLD, &world.rank);
-    MPI_Comm_size(MPI_COMM_WORLD, &world.size);
-  }
-#endif
+  world.mpi = session.active();
+  world.rank = session.rank();
+  world.size = session.size();
   const std::string name = world.rank == 0 ? app : std::string(app) + " (rank " + std::to_string(world.rank) + ")";
   const int code = run_main(name, [&] { return body(world); });
-#ifdef GEOHAZ_HAVE_MPI
-  if (world.mpi) {
-    // An error on one rank while others wait for it would hang the job: end them all. (Input
-    // errors happen on every rank alike before any message is exchanged.)
-    if (code != kExitOk && code != kExitInputError) MPI_Abort(MPI_COMM_WORLD, code);
-#if defined(__SANITIZE_ADDRESS__)
-    // Under the sanitizers (scripts/test --sanitize): the leak check of our own code runs here, while
-    // Open MPI still holds its memory; it then skips the end-of-process check, which would report
-    // what MPI_Finalize leaves behind (Open MPI 4.1 frees its components' tables only partly, in
-    // libraries built without frame pointers, so no lsan.supp pattern can match those 2-frame stacks
-    // short of the slow unwinder). Allocations of Open MPI's own threads are in scripts/lsan.supp.
-    __lsan_do_leak_check();
-#endif
-    MPI_Finalize();
-  }
-#else
-  (void)argc, (void)argv;
-#endif
+  // An error on one rank while others wait for it would hang the job: end them all. (Input
+  // errors happen on every rank alike before any message is exchanged.)
+  if (code != kExitOk && code != kExitInputError) session.abort(code);
   return code;
 }
 

@@ -4,9 +4,10 @@
 /// MPI-free, so this lives under apps/). Built without MPI (GEOHAZ_HAVE_MPI undefined) it is the
 /// one-rank version of the same calls.
 ///
-/// - `run_mpi_app`: main() of an app that may run under mpirun: MPI_Init only when an MPI launcher
-///   started the process, the app's body inside run_main's exit-code mapping, MPI_Abort when one
-///   rank fails otherwise than on input (the others would wait for it), MPI_Finalize.
+/// - `run_mpi_app`: main() of an app that may run under mpirun: the MPI start-up of every such app
+///   (geohaz/mpi/session.hpp: MPI_Init only when an MPI launcher started the process, MPI_Finalize),
+///   the app's body inside run_main's exit-code mapping, MPI_Abort when one rank fails otherwise
+///   than on input (the others would wait for it). Threads per rank: mpi::threads_per_rank.
 /// - `MemberQueue` (rank 0) and `request_member` (the other ranks): dynamic distribution of
 ///   independent members, one member per request, rank 0 computing too. Rank 0 keeps the queue in
 ///   the order it was filled and answers the other ranks between its own members' time steps (it is
@@ -20,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "geohaz/mpi/session.hpp"
 #include "geohaz/runout/run.hpp"
 
 namespace geohaz::apps {
@@ -31,13 +33,6 @@ struct World {
   /// Rank 0's `value` on every rank (itself without MPI).
   int broadcast(int value) const;
 };
-
-/// Ranks on this node (Open MPI, MPICH or Slurm's variables; 1 when none is set): the node's cores
-/// are shared between them when the user does not give --threads.
-int local_ranks();
-
-/// Threads per rank: `requested`, or (0) the node's cores shared between its ranks.
-int threads_per_rank(int requested);
 
 /// main() of an app that runs alone or under mpirun: `body(world)` inside run_main (exit codes of
 /// geohaz/core/app.hpp), the error messages of a rank other than 0 naming the rank.

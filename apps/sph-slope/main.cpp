@@ -7,9 +7,7 @@
 #ifdef GEOHAZ_SPH_MPI
 #include <omp.h>
 
-#include <algorithm>
 #include <array>
-#include <cstdlib>
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/mpi/mpi_communicator.hpp"
@@ -22,25 +20,10 @@
 using namespace geohaz;
 using namespace geohaz::sph;
 
-#ifdef GEOHAZ_SPH_MPI
-namespace {
-/// Ranks on this node (Open MPI, MPICH or Slurm; 1 when none is set): the cores are shared between
-/// them unless --threads says otherwise.
-int local_ranks() {
-  for (const char* v : {"OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS", "SLURM_NTASKS_PER_NODE"})
-    if (const char* s = std::getenv(v)) {
-      const int n = std::atoi(s);
-      if (n > 0) return n;
-    }
-  return 1;
-}
-}  // namespace
-#endif
-
 int main(int argc, char** argv) {
 #ifdef GEOHAZ_SPH_MPI
-  geohaz::mpi::Session session(argc, argv);
-  const std::shared_ptr<const Communicator> comm = session.world();
+  const geohaz::mpi::Session session(argc, argv);  // MPI_Init when launched by mpirun (apps/mpi-communicator)
+  const std::shared_ptr<const Communicator> comm = geohaz::mpi::world_communicator(session);
 #endif
   ConfigApp app;
   // The MPI build names itself (--version, messages, the default output folder), as its package does.
@@ -67,14 +50,15 @@ int main(int argc, char** argv) {
     validate(cfg);  // everything checked before the output directory is created
 #ifdef GEOHAZ_SPH_MPI
     if (comm) {
-      if (opts.threads == 0) omp_set_num_threads(std::max(1, omp_get_num_procs() / local_ranks()));
-      // Rank 0 alone writes the outputs; the others start when it has its output folder (the
-      // folder policy may refuse it: exit 2 on every rank, not a hang).
+      if (opts.threads == 0) omp_set_num_threads(geohaz::mpi::threads_per_rank(0));
+      // Rank 0 writes the outputs, every rank its part of the snapshots into the same folder; the
+      // others start when rank 0 has checked (and cleaned) the folder (the folder policy may refuse
+      // it: exit 2 on every rank, not a hang).
       std::array<double, 1> refused{0.0};
       if (comm->rank() != 0) {
         comm->max_all(refused);
         if (refused[0] > 0.0) return kExitInputError;
-        return run_case(cfg, {}, true, comm);
+        return run_case(cfg, opts.out, true, comm);
       }
       bool started = false;
       try {

@@ -597,5 +597,116 @@ TEST(Snapshot, SameStepAndTimeIsWrittenOnce) {
   expect_xdmf_consistent(tmp.path() / "twice.xmf", rd, "twice.h5");
 }
 
+/// Two processes (the test forks) behind core's Communicator, joined by two pipes: enough for the
+/// snapshot writer of several processes, whose only collective call is all_gather.
+class PipeCommunicator final : public Communicator {
+ public:
+  PipeCommunicator(int rank, int to_peer, int from_peer) : rank_(rank), to_(to_peer), from_(from_peer) {}
+  int rank() const override { return rank_; }
+  int size() const override { return 2; }
+  std::vector<double> all_gather(std::span<const double> v) const override {
+    const std::size_t bytes = v.size() * sizeof(double);
+    if (::write(to_, v.data(), bytes) != static_cast<ssize_t>(bytes)) throw std::runtime_error("pipe write");
+    std::vector<double> peer(v.size());
+    std::size_t got = 0;
+    while (got < bytes) {
+      const ssize_t r = ::read(from_, reinterpret_cast<char*>(peer.data()) + got, bytes - got);
+      if (r <= 0) throw std::runtime_error("pipe read");
+      got += static_cast<std::size_t>(r);
+    }
+    std::vector<double> out(v.begin(), v.end());
+    out.insert(rank_ == 0 ? out.end() : out.begin(), peer.begin(), peer.end());
+    return out;
+  }
+  void max_all(std::span<double>) const override { throw std::logic_error("not used"); }
+  void sum_all(std::span<std::int64_t>) const override { throw std::logic_error("not used"); }
+  std::vector<std::byte> all_gather_bytes(std::span<const std::byte>) const override {
+    throw std::logic_error("not used");
+  }
+  std::vector<std::int64_t> exchange_counts(std::span<const std::int64_t>) const override {
+    throw std::logic_error("not used");
+  }
+  void exchange(std::span<const std::byte>, std::span<const std::int64_t>, std::span<std::byte>,
+                std::span<const std::int64_t>) const override {
+    throw std::logic_error("not used");
+  }
+
+ private:
+  int rank_, to_, from_;
+};
+
+/// Rows [first, last) of a store.
+Store rows_of(const Store& full, std::size_t first, std::size_t last) {
+  Store s = full;
+  std::vector<std::uint8_t> drop(full.size(), 1);
+  for (std::size_t i = first; i < last; ++i) drop[i] = 0;
+  s.remove_if(drop);
+  return s;
+}
+
+// Issue #36: a run over two processes writes its snapshots through part files, one per process, and
+// the file itself reads as one dataset per field with every particle, in rank order: here three
+// snapshots of 8 particles split 5/3, 2/6 and 0/8 (a rank without particles) between the ranks.
+TEST(Snapshot, TwoProcessesWriteOneFileThroughTheirPartFiles) {
+  TempDir tmp("parts");
+  const fs::path h5 = tmp.path() / "run.h5";
+  const std::size_t split[3] = {5, 2, 0};
+  int p01[2], p10[2];
+  ASSERT_EQ(::pipe(p01), 0);
+  ASSERT_EQ(::pipe(p10), 0);
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  const int rank = pid == 0 ? 1 : 0;
+  int failed = 0;
+  try {
+    auto comm = rank == 0 ? std::make_shared<PipeCommunicator>(0, p01[1], p10[0])
+                          : std::make_shared<PipeCommunicator>(1, p10[1], p01[0]);
+    SnapshotWriter w(h5, "test", 2, "key = 1\n", comm);
+    w.set_attribute("note", "rank 0's");
+    for (int k = 0; k < 3; ++k) {
+      const Store full = make_store(8, k);
+      const Store mine = rank == 0 ? rows_of(full, 0, split[k]) : rows_of(full, split[k], 8);
+      w.write(mine, 0.5 * k, 10 * k);
+    }
+    w.write(rows_of(make_store(8, 2), 0, rank == 0 ? 0 : 8), 1.0, 20);  // the same state again: nothing written
+    EXPECT_EQ(w.snapshot_count(), 3u);
+  } catch (const std::exception& e) {
+    failed = 1;
+    if (rank == 0) ADD_FAILURE() << e.what();
+  }
+  if (rank == 1) ::_exit(failed);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "the second process failed";
+  ASSERT_EQ(failed, 0);
+
+  EXPECT_TRUE(fs::exists(tmp.path() / "run.rank0000.h5"));
+  EXPECT_TRUE(fs::exists(tmp.path() / "run.rank0001.h5"));
+  EXPECT_FALSE(fs::exists(tmp.path() / "run.rank0001.xmf"));  // one XDMF file for the run
+  {
+    SnapshotReader r(h5);
+    ASSERT_EQ(r.snapshot_count(), 3u);
+    EXPECT_EQ(r.attribute("note"), "rank 0's");
+    EXPECT_EQ(r.attribute("ranks"), "2");
+    EXPECT_EQ(r.attribute("resolved_config"), "key = 1\n");
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(r.time(static_cast<std::size_t>(k)), 0.5 * k);
+      EXPECT_EQ(r.step(static_cast<std::size_t>(k)), 10 * k);
+      expect_snapshot_equals(r, static_cast<std::size_t>(k), make_store(8, k));
+    }
+    expect_xdmf_consistent(tmp.path() / "run.xmf", r, "run.h5");
+    // A part file alone is a snapshot file of that rank's particles.
+    SnapshotReader part(tmp.path() / "run.rank0001.h5");
+    EXPECT_EQ(part.read(0, "position").count, 3u);
+  }
+  // From another working directory (the parts are found beside the file), and not without them.
+  const fs::path cwd = fs::current_path();
+  fs::current_path(fs::temp_directory_path());
+  EXPECT_EQ(SnapshotReader(h5).read(1, "density").count, 8u);
+  fs::current_path(cwd);
+  fs::remove(tmp.path() / "run.rank0001.h5");
+  EXPECT_THROW(SnapshotReader{h5}, InputError);
+}
+
 }  // namespace
 }  // namespace geohaz

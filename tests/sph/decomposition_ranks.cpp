@@ -182,12 +182,13 @@ int run(const char* name, Case<Dim> c, int steps, const std::shared_ptr<const Co
 
 int main(int argc, char** argv) {
   geohaz::mpi::Session session(argc, argv);
+  const auto world = geohaz::mpi::world_communicator(session);
   const std::string name = argc > 1 ? argv[1] : "column2d";
   const int steps = argc > 2 ? std::atoi(argv[2]) : 100;
   try {
-    if (name == "column2d") return run<2>("column2d", column2d(), steps, session.world());
-    if (name == "slope3d") return run<3>("slope3d", slope3d(), steps, session.world());
-    if (name == "block2d") return run<2>("block2d", block2d(), steps, session.world());
+    if (name == "column2d") return run<2>("column2d", column2d(), steps, world);
+    if (name == "slope3d") return run<3>("slope3d", slope3d(), steps, world);
+    if (name == "block2d") return run<2>("block2d", block2d(), steps, world);
     std::fprintf(stderr, "unknown case %s (column2d, slope3d, block2d)\n", name.c_str());
     return 2;
   } catch (const std::exception& e) {

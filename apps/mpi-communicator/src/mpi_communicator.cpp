@@ -4,14 +4,10 @@
 
 #include <mpi.h>
 
-#include <cstdlib>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
-
-#if defined(__SANITIZE_ADDRESS__)
-#include <sanitizer/lsan_interface.h>
-#endif
 
 namespace geohaz::mpi {
 
@@ -95,42 +91,9 @@ class WorldCommunicator final : public Communicator {
 
 }  // namespace
 
-bool launched_by_mpi() {
-  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"})
-    if (std::getenv(v)) return true;
-  return false;
-}
-
-Session::Session(int& argc, char**& argv) {
-  if (!launched_by_mpi()) return;
-  int provided = 0;
-#if defined(__SANITIZE_ADDRESS__)
-  __lsan_disable();  // what Open MPI allocates in its init is its own business
-#endif
-  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
-#if defined(__SANITIZE_ADDRESS__)
-  __lsan_enable();
-#endif
-  active_ = true;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
-  MPI_Comm_size(MPI_COMM_WORLD, &size_);
-  world_ = std::make_shared<WorldCommunicator>();
-}
-
-Session::~Session() {
-  if (!active_) return;
-  world_.reset();
-#if defined(__SANITIZE_ADDRESS__)
-  // The leak check of our own code runs here, while Open MPI still holds its memory; it then skips
-  // the end-of-process check, which would report what MPI_Finalize leaves behind (Open MPI 4.1;
-  // apps/member-queue/member_queue.cpp explains). Open MPI's own threads: scripts/lsan.supp.
-  __lsan_do_leak_check();
-#endif
-  MPI_Finalize();
-}
-
-void Session::abort(int code) const {
-  if (active_) MPI_Abort(MPI_COMM_WORLD, code);
+std::shared_ptr<const Communicator> world_communicator(const Session& session) {
+  if (!session.active()) return nullptr;
+  return std::make_shared<WorldCommunicator>();
 }
 
 }  // namespace geohaz::mpi

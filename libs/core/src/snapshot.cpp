@@ -26,6 +26,17 @@
 ///    write(store) -> read -> load_field is an exact round trip; for the symmetric tensors (stress,
 ///    strain rate) both orders coincide. Datasets with rows, cols > 1 carry an attribute
 ///    storage_order = "column-major" to say so.
+///  - Several processes (a Communicator of more than one rank; issue #36): each rank writes its own
+///    particles into its part file, <stem>.rank<q>.h5 beside the file (the layout above, without
+///    the XDMF helpers), with the serial HDF5 library; rank 0 writes the file itself, whose datasets
+///    are HDF5 virtual datasets (VDS, HDF5 >= 1.10) joining the parts in rank order: every reader
+///    (ours, h5py, h5dump, ParaView through the one XDMF file) sees one dataset per field with every
+///    particle. Rank 0 writes a snapshot's group only after every rank has flushed its part (the
+///    gather of the counts orders them), so a kill leaves no index entry pointing at a missing part.
+///    A missing part file would read as zeros through the VDS: the root attribute "part_files" lists
+///    them, and the reader refuses the file when one is missing. A parallel HDF5 library would write
+///    one file, but it cannot be linked beside the serial one the libraries and the Python module
+///    use (the same symbols), so the normal build stays serial.
 
 #include "geohaz/core/snapshot.hpp"
 
@@ -48,107 +59,11 @@
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
 #include "geohaz/core/resources.hpp"
+#include "hdf5_common.hpp"
 
 namespace geohaz {
+using namespace hdf5;
 namespace {
-
-/// Owns one HDF5 identifier and closes it with the matching H5?close function.
-class Hid {
- public:
-  using Closer = herr_t (*)(hid_t);
-  Hid() = default;
-  Hid(hid_t id, Closer close) noexcept : id_(id), close_(close) {}
-  Hid(Hid&& o) noexcept : id_(std::exchange(o.id_, H5I_INVALID_HID)), close_(o.close_) {}
-  Hid& operator=(Hid&& o) noexcept {
-    if (this != &o) {
-      reset();
-      id_ = std::exchange(o.id_, H5I_INVALID_HID);
-      close_ = o.close_;
-    }
-    return *this;
-  }
-  Hid(const Hid&) = delete;
-  Hid& operator=(const Hid&) = delete;
-  ~Hid() { reset(); }
-  void reset() noexcept {
-    if (id_ >= 0 && close_ != nullptr) close_(id_);
-    id_ = H5I_INVALID_HID;
-  }
-  hid_t get() const noexcept { return id_; }
-  bool valid() const noexcept { return id_ >= 0; }
-  /// Give the identifier up without closing it (see the file comment on failed writes).
-  void release() noexcept { id_ = H5I_INVALID_HID; }
-
- private:
-  hid_t id_ = H5I_INVALID_HID;
-  Closer close_ = nullptr;
-};
-
-/// The innermost description on HDF5's error stack (then cleared), e.g. "unable to open file".
-std::string hdf5_error_detail() {
-  std::string detail;
-  H5Ewalk2(
-      H5E_DEFAULT, H5E_WALK_UPWARD,
-      [](unsigned n, const H5E_error2_t* err, void* data) -> herr_t {
-        auto* out = static_cast<std::string*>(data);
-        if (err->desc != nullptr && err->desc[0] != '\0') {
-          if (!out->empty()) out->append("; ");
-          out->append(err->desc);
-        }
-        return n >= 1 ? 1 : 0;  // the two innermost entries carry the useful reason
-      },
-      &detail);
-  H5Eclear2(H5E_DEFAULT);
-  std::replace(detail.begin(), detail.end(), '\n', ' ');  // one line per message
-  return detail;
-}
-
-/// Turns failing HDF5 calls into exceptions naming the file and the object.
-struct Hdf5Context {
-  std::string file;
-  bool input = false;           ///< reader: InputError; writer: IoError
-  mutable bool failed = false;  ///< a call failed (the writer then leaves its file unclosed)
-
-  [[noreturn]] void fail(const std::string& what) const {
-    failed = true;
-    std::string msg = what;
-    const std::string detail = hdf5_error_detail();
-    if (!detail.empty()) msg += " (HDF5: " + detail + ")";
-    if (input) throw InputError(msg, file);
-    throw IoError(msg, file);
-  }
-  Hid own(hid_t id, Hid::Closer close, const std::string& what) const {
-    if (id < 0) fail(what);
-    return Hid(id, close);
-  }
-  void call(herr_t status, const std::string& what) const {
-    if (status < 0) fail(what);
-  }
-};
-
-void silence_hdf5_errors() {
-  // No clean-up at exit: every identifier we open is closed by its Hid, except the file of a writer
-  // whose write failed, which HDF5 can neither flush nor close (see the file comment). Must come
-  // before the library initialises itself, i.e. before any other HDF5 call.
-  static const bool no_atexit = [] { return H5dont_atexit() >= 0; }();
-  (void)no_atexit;
-  // The default handler prints the whole stack to stderr; we report through exceptions instead.
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-}
-
-hid_t native_type(ScalarType t) {
-  switch (t) {
-    case ScalarType::Float64:
-      return H5T_NATIVE_DOUBLE;
-    case ScalarType::Int64:
-      return H5T_NATIVE_INT64;
-    case ScalarType::Int32:
-      return H5T_NATIVE_INT32;
-    case ScalarType::UInt8:
-      return H5T_NATIVE_UINT8;
-  }
-  throw std::invalid_argument("unknown ScalarType");
-}
 
 /// XDMF NumberType and Precision of a stored type.
 std::pair<const char*, int> xdmf_number_type(ScalarType t) {
@@ -165,148 +80,37 @@ std::pair<const char*, int> xdmf_number_type(ScalarType t) {
   throw std::invalid_argument("unknown ScalarType");
 }
 
-/// Shortest text that reads back to the same double.
-std::string format_double(double v) {
-  char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
-
-std::string snapshot_name(std::size_t k) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%06zu", k);
-  return buf;
-}
-
 /// Name of the Polyvertex connectivity dataset (0..n-1) for n particles, shared by all snapshots of
 /// that size.
 std::string vertex_index_name(std::size_t n) {
   return "vertices_" + std::to_string(n);
 }
 
-constexpr const char* kSnapshotsGroup = "/snapshots";
-/// Helper datasets for the XDMF file only (Polyvertex connectivity); not particle fields.
-constexpr const char* kXdmfGroup = "/xdmf";
-constexpr const char* kLinesLabel = "lines";
-
-Hid file_access_plist(const Hdf5Context& ctx) {
-  Hid fapl = ctx.own(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "cannot create a file access property list");
-  // No file lock (see the file comment).
-  ctx.call(H5Pset_file_locking(fapl.get(), false, true), "cannot disable HDF5 file locking");
-  return fapl;
+/// The part file of rank q beside the index `h5_path`: snapshots.h5 -> snapshots.rank0003.h5.
+std::string part_file_name(const std::filesystem::path& h5_path, int q) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, ".rank%04d", q);
+  return h5_path.stem().string() + buf + h5_path.extension().string();
 }
 
-// ---- attributes -------------------------------------------------------------------------------
-
-void delete_attribute_if_present(const Hdf5Context& ctx, hid_t obj, const std::string& name) {
-  const htri_t exists = H5Aexists(obj, name.c_str());
-  if (exists < 0) ctx.fail("cannot query attribute '" + name + "'");
-  if (exists > 0) ctx.call(H5Adelete(obj, name.c_str()), "cannot replace attribute '" + name + "'");
-}
-
-/// A variable-length UTF-8 string attribute (no 64 KiB header limit for long resolved configs; read
-/// as str by h5py).
-void write_string_attribute(const Hdf5Context& ctx, hid_t obj, const std::string& name, const std::string& value) {
-  delete_attribute_if_present(ctx, obj, name);
-  const std::string what = "cannot write attribute '" + name + "'";
-  Hid type = ctx.own(H5Tcopy(H5T_C_S1), H5Tclose, what);
-  ctx.call(H5Tset_size(type.get(), H5T_VARIABLE), what);
-  ctx.call(H5Tset_cset(type.get(), H5T_CSET_UTF8), what);
-  Hid space = ctx.own(H5Screate(H5S_SCALAR), H5Sclose, what);
-  Hid attr = ctx.own(H5Acreate2(obj, name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose, what);
-  const char* p = value.c_str();
-  ctx.call(H5Awrite(attr.get(), type.get(), &p), what);
-}
-
-void write_numeric_attribute(const Hdf5Context& ctx, hid_t obj, const std::string& name, hid_t type,
-                             const void* value) {
-  delete_attribute_if_present(ctx, obj, name);
-  const std::string what = "cannot write attribute '" + name + "'";
-  Hid space = ctx.own(H5Screate(H5S_SCALAR), H5Sclose, what);
-  Hid attr = ctx.own(H5Acreate2(obj, name.c_str(), type, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose, what);
-  ctx.call(H5Awrite(attr.get(), type, value), what);
-}
-
-/// Attribute as text, nullopt if absent. Strings (fixed or variable length) as they are; integers and
-/// floats formatted; arrays joined with spaces.
-std::optional<std::string> read_attribute_text(const Hdf5Context& ctx, hid_t obj, const std::string& where,
-                                               const std::string& name) {
-  const htri_t exists = H5Aexists(obj, name.c_str());
-  if (exists < 0) ctx.fail("cannot query attribute '" + name + "' of " + where);
-  if (exists == 0) return std::nullopt;
-  const std::string what = "cannot read attribute '" + name + "' of " + where;
-  Hid attr = ctx.own(H5Aopen(obj, name.c_str(), H5P_DEFAULT), H5Aclose, what);
-  Hid type = ctx.own(H5Aget_type(attr.get()), H5Tclose, what);
-  Hid space = ctx.own(H5Aget_space(attr.get()), H5Sclose, what);
-  const hssize_t n = H5Sget_simple_extent_npoints(space.get());
-  if (n < 0) ctx.fail(what);
-  const H5T_class_t cls = H5Tget_class(type.get());
-  if (cls == H5T_STRING) {
-    if (n != 1) ctx.fail(what + ": string arrays are not supported");
-    const htri_t vlen = H5Tis_variable_str(type.get());
-    if (vlen < 0) ctx.fail(what);
-    Hid mem = ctx.own(H5Tcopy(H5T_C_S1), H5Tclose, what);
-    if (vlen > 0) {
-      ctx.call(H5Tset_size(mem.get(), H5T_VARIABLE), what);
-      ctx.call(H5Tset_cset(mem.get(), H5Tget_cset(type.get())), what);
-      char* buf = nullptr;
-      ctx.call(H5Aread(attr.get(), mem.get(), &buf), what);
-      std::string s = buf != nullptr ? buf : "";
-      H5Dvlen_reclaim(mem.get(), space.get(), H5P_DEFAULT, &buf);
-      return s;
-    }
-    const std::size_t size = H5Tget_size(type.get());
-    if (size == 0) ctx.fail(what);
-    ctx.call(H5Tset_size(mem.get(), size), what);
-    std::string s(size, '\0');
-    ctx.call(H5Aread(attr.get(), mem.get(), s.data()), what);
-    s.resize(std::min(s.find('\0'), s.size()));
-    return s;
+/// Run `body` on every rank; when it throws IoError on any rank, every rank throws (the failing one
+/// its own error, the others one naming the first failing rank), so no rank waits for another in a
+/// later collective call.
+template <class Body>
+void all_ranks_or_throw(const Communicator& comm, const std::filesystem::path& path, const std::string& what,
+                        Body&& body) {
+  std::optional<IoError> error;
+  try {
+    body();
+  } catch (const IoError& e) {
+    error = e;
   }
-  std::ostringstream out;
-  if (cls == H5T_INTEGER) {
-    std::vector<long long> v(static_cast<std::size_t>(n));
-    ctx.call(H5Aread(attr.get(), H5T_NATIVE_LLONG, v.data()), what);
-    for (std::size_t i = 0; i < v.size(); ++i) out << (i ? " " : "") << v[i];
-  } else if (cls == H5T_FLOAT) {
-    std::vector<double> v(static_cast<std::size_t>(n));
-    ctx.call(H5Aread(attr.get(), H5T_NATIVE_DOUBLE, v.data()), what);
-    for (std::size_t i = 0; i < v.size(); ++i) out << (i ? " " : "") << format_double(v[i]);
-  } else {
-    ctx.fail(what + ": unsupported attribute type");
-  }
-  return out.str();
-}
-
-/// A numeric scalar attribute converted to T (H5Aread converts); fails when it is absent.
-template <class T>
-T read_numeric_attribute(const Hdf5Context& ctx, hid_t obj, const std::string& where, const std::string& name,
-                         hid_t mem_type) {
-  const std::string what = "cannot read attribute '" + name + "' of " + where;
-  Hid attr = ctx.own(H5Aopen(obj, name.c_str(), H5P_DEFAULT), H5Aclose, what);
-  Hid space = ctx.own(H5Aget_space(attr.get()), H5Sclose, what);
-  if (H5Sget_simple_extent_npoints(space.get()) != 1) ctx.fail(what + ": not a scalar");
-  T v{};
-  ctx.call(H5Aread(attr.get(), mem_type, &v), what);
-  return v;
-}
-
-/// Names of the links in a group, in creation order when tracked (fields as declared), else by name.
-std::vector<std::string> link_names(const Hdf5Context& ctx, hid_t group, const std::string& where) {
-  std::vector<std::string> names;
-  auto collect = [](hid_t, const char* name, const H5L_info_t*, void* data) -> herr_t {
-    static_cast<std::vector<std::string>*>(data)->emplace_back(name);
-    return 0;
-  };
-  hsize_t idx = 0;
-  if (H5Literate(group, H5_INDEX_CRT_ORDER, H5_ITER_INC, &idx, collect, &names) < 0) {
-    H5Eclear2(H5E_DEFAULT);
-    names.clear();
-    idx = 0;
-    if (H5Literate(group, H5_INDEX_NAME, H5_ITER_INC, &idx, collect, &names) < 0)
-      ctx.fail("cannot list the contents of " + where);
-  }
-  return names;
+  const std::vector<double> failed = comm.all_gather(std::vector<double>{error ? 1.0 : 0.0});
+  if (error) throw *error;
+  for (std::size_t q = 0; q < failed.size(); ++q)
+    if (failed[q] > 0.0)
+      throw IoError("rank " + std::to_string(q) + " could not " + what + " (its message names the reason)",
+                    path.string());
 }
 
 }  // namespace
@@ -318,6 +122,7 @@ std::vector<std::string> link_names(const Hdf5Context& ctx, hid_t group, const s
 struct SnapshotWriter::Impl {
   struct FieldMeta {
     std::string label;
+    std::string unit;
     ScalarType type;
     int rows, cols;
   };
@@ -333,26 +138,68 @@ struct SnapshotWriter::Impl {
   std::filesystem::path h5_path, xmf_path;
   std::string model;
   int dimension = 0;
+  bool xdmf = true;  ///< write the XDMF companion (not for the part files of several processes)
   Hdf5Context ctx;
   Hid file, snapshots, xdmf_helpers;
   std::vector<Entry> entries;
   std::set<std::size_t> vertex_indices;  ///< particle counts whose /xdmf/vertices_<n> exists
+  // Several processes (see "Several processes" in the file comment): every rank's part file, the
+  // ranks, and (rank 0) the part files' names for the index.
+  std::unique_ptr<Impl> part;
+  std::shared_ptr<const Communicator> comm;
+  std::vector<std::string> part_names;
 
+  bool writes_index() const { return !comm || comm->rank() == 0; }
   void flush() { ctx.call(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "cannot flush"); }
   /// IoError unless the file system and the file size limit leave room for `bytes` more.
   void check_room(double bytes, const std::string& what) const;
   ~Impl() {
     if (ctx.failed) file.release();  // see the file comment: closing it would crash HDF5 at exit
   }
+  /// Create the file with its root attributes and groups.
+  void create(const std::string& resolved_config);
   void ensure_vertex_index(std::size_t n);
   void write_fields(hid_t group, const std::string& gpath, std::span<const FieldView> fields,
                     std::span<const std::uint32_t> lines);
+  /// Snapshot `name` of this file, fields written in full (one process, or a rank's part file).
+  void write_group(const std::string& name, double time, std::int64_t step, std::span<const FieldView> fields,
+                   std::span<const std::uint32_t> lines);
+  /// Snapshot `name` of the index file: every field a virtual dataset joining the parts, `counts[q]`
+  /// particles of rank q's part file.
+  void write_virtual_group(const std::string& name, double time, std::int64_t step, const Entry& e,
+                           const std::vector<std::size_t>& counts);
+  static Entry entry_of(double time, std::int64_t step, std::size_t n, std::span<const FieldView> fields,
+                        std::size_t line_count);
   std::string xdmf_text() const;
-  void write_xdmf() const { write_text_file(xmf_path, xdmf_text()); }
+  void write_xdmf() const {
+    if (xdmf) write_text_file(xmf_path, xdmf_text());
+  }
 };
 
+void SnapshotWriter::Impl::create(const std::string& resolved_config) {
+  ctx.file = h5_path.string();
+  ctx.input = false;
+  // Room for the root attributes and HDF5's superblock, heaps and B-trees.
+  check_room(static_cast<double>(resolved_config.size()) + 32.0 * 1024.0, "a new snapshot file");
+  Hid fapl = file_access_plist(ctx);
+  file = ctx.own(H5Fcreate(h5_path.string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose,
+                 "cannot create the snapshot file");
+  const hid_t root = file.get();
+  write_string_attribute(ctx, root, "model", model);
+  write_string_attribute(ctx, root, "version", GEOHAZ_VERSION);
+  const std::int32_t dim = dimension;
+  write_numeric_attribute(ctx, root, "dimension", H5T_NATIVE_INT32, &dim);
+  write_string_attribute(ctx, root, "resolved_config", resolved_config);
+  snapshots = ctx.own(H5Gcreate2(root, kSnapshotsGroup, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
+                      std::string("cannot create group ") + kSnapshotsGroup);
+  xdmf_helpers = ctx.own(H5Gcreate2(root, kXdmfGroup, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
+                         std::string("cannot create group ") + kXdmfGroup);
+  flush();
+  write_xdmf();
+}
+
 SnapshotWriter::SnapshotWriter(const std::filesystem::path& h5_path, std::string model, int dimension,
-                               std::string resolved_config)
+                               std::string resolved_config, std::shared_ptr<const Communicator> comm)
     : impl_(std::make_unique<Impl>()) {
   if (dimension != 2 && dimension != 3)
     throw std::invalid_argument("SnapshotWriter: dimension must be 2 or 3, got " + std::to_string(dimension));
@@ -364,26 +211,38 @@ SnapshotWriter::SnapshotWriter(const std::filesystem::path& h5_path, std::string
   m.model = std::move(model);
   m.dimension = dimension;
   m.ctx.file = h5_path.string();
-  m.ctx.input = false;
   silence_hdf5_errors();
-
-  // Room for the root attributes and HDF5's superblock, heaps and B-trees.
-  m.check_room(static_cast<double>(resolved_config.size()) + 32.0 * 1024.0, "a new snapshot file");
-  Hid fapl = file_access_plist(m.ctx);
-  m.file = m.ctx.own(H5Fcreate(h5_path.string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose,
-                     "cannot create the snapshot file");
-  const hid_t root = m.file.get();
-  write_string_attribute(m.ctx, root, "model", m.model);
-  write_string_attribute(m.ctx, root, "version", GEOHAZ_VERSION);
-  const std::int32_t dim = dimension;
-  write_numeric_attribute(m.ctx, root, "dimension", H5T_NATIVE_INT32, &dim);
-  write_string_attribute(m.ctx, root, "resolved_config", resolved_config);
-  m.snapshots = m.ctx.own(H5Gcreate2(root, kSnapshotsGroup, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
-                          std::string("cannot create group ") + kSnapshotsGroup);
-  m.xdmf_helpers = m.ctx.own(H5Gcreate2(root, kXdmfGroup, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
-                             std::string("cannot create group ") + kXdmfGroup);
-  m.flush();
-  m.write_xdmf();
+  if (!comm || comm->size() == 1) {
+    m.create(resolved_config);
+    return;
+  }
+  m.comm = std::move(comm);
+  const int ranks = m.comm->size(), rank = m.comm->rank();
+  for (int q = 0; q < ranks; ++q) m.part_names.push_back(part_file_name(h5_path, q));
+  // Rank 0 creates the index first (the others' part files go beside it), then every rank its part;
+  // a failure on any rank fails every rank (IoError), none waits for another.
+  all_ranks_or_throw(*m.comm, m.h5_path, "create the snapshot file", [&] {
+    if (rank != 0) return;
+    m.create(resolved_config);
+    const double count = ranks;
+    write_numeric_attribute(m.ctx, m.file.get(), "ranks", H5T_NATIVE_DOUBLE, &count);
+    std::string names;
+    for (const auto& p : m.part_names) names += p + "\n";
+    write_string_attribute(m.ctx, m.file.get(), "part_files", names);
+    m.flush();
+  });
+  all_ranks_or_throw(*m.comm, m.h5_path, "create its part file", [&] {
+    m.part = std::make_unique<Impl>();
+    m.part->h5_path = m.h5_path.parent_path() / m.part_names[static_cast<std::size_t>(rank)];
+    m.part->model = m.model;
+    m.part->dimension = dimension;
+    m.part->xdmf = false;
+    m.part->create("part " + std::to_string(rank) + " of " + std::to_string(ranks) + " of " +
+                   m.h5_path.filename().string() + " (the run's config is in that file)");
+    const double r = rank;
+    write_numeric_attribute(m.part->ctx, m.part->file.get(), "rank", H5T_NATIVE_DOUBLE, &r);
+    m.part->flush();
+  });
 }
 
 SnapshotWriter::~SnapshotWriter() = default;
@@ -413,11 +272,13 @@ void SnapshotWriter::Impl::check_room(double bytes, const std::string& what) con
 }
 
 void SnapshotWriter::set_attribute(const std::string& name, const std::string& value) {
+  if (!impl_->writes_index()) return;
   write_string_attribute(impl_->ctx, impl_->file.get(), name, value);
   impl_->flush();
 }
 
 void SnapshotWriter::set_attribute(const std::string& name, double value) {
+  if (!impl_->writes_index()) return;
   write_numeric_attribute(impl_->ctx, impl_->file.get(), name, H5T_NATIVE_DOUBLE, &value);
   impl_->flush();
 }
@@ -481,6 +342,57 @@ void SnapshotWriter::Impl::write_fields(hid_t group, const std::string& gpath, s
   }
 }
 
+void SnapshotWriter::Impl::write_group(const std::string& name, double time, std::int64_t step,
+                                       std::span<const FieldView> fields, std::span<const std::uint32_t> lines) {
+  const std::string gpath = std::string(kSnapshotsGroup) + "/" + name;
+  const std::size_t n = fields.empty() ? 0 : fields.front().count;
+  {
+    // Checked before the file is touched, so a full disk leaves the snapshots so far readable.
+    double bytes = 16.0 * 1024.0;  // group, attributes, B-tree and heap growth
+    for (const FieldView& f : fields) {
+      const std::size_t elem = f.type == ScalarType::Float64 || f.type == ScalarType::Int64 ? 8
+                               : f.type == ScalarType::Int32                                ? 4
+                                                                                            : 1;
+      bytes += static_cast<double>(f.count) * f.rows * f.cols * static_cast<double>(elem) + 1024.0;
+    }
+    bytes += 4.0 * static_cast<double>(lines.size() + (vertex_indices.count(n) || !xdmf ? 0 : n));
+    check_room(1.1 * bytes, "snapshot " + name);
+  }
+  try {
+    // Track creation order so the reader lists fields in the order the store declares them.
+    Hid gcpl = ctx.own(H5Pcreate(H5P_GROUP_CREATE), H5Pclose, "cannot create group " + gpath);
+    ctx.call(H5Pset_link_creation_order(gcpl.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED),
+             "cannot create group " + gpath);
+    Hid group = ctx.own(H5Gcreate2(snapshots.get(), name.c_str(), H5P_DEFAULT, gcpl.get(), H5P_DEFAULT), H5Gclose,
+                        "cannot create group " + gpath);
+    write_fields(group.get(), gpath, fields, lines);
+    if (xdmf) ensure_vertex_index(n);
+    write_numeric_attribute(ctx, group.get(), "time", H5T_NATIVE_DOUBLE, &time);
+    write_numeric_attribute(ctx, group.get(), "step", H5T_NATIVE_INT64, &step);
+    const std::int64_t count = static_cast<std::int64_t>(n);
+    // Written last: marks the snapshot complete (see the file comment).
+    write_numeric_attribute(ctx, group.get(), "particle_count", H5T_NATIVE_INT64, &count);
+  } catch (...) {
+    // Remove the partial group so the next write can reuse the name; the reader ignores it anyway.
+    H5Ldelete(snapshots.get(), name.c_str(), H5P_DEFAULT);
+    H5Eclear2(H5E_DEFAULT);
+    throw;
+  }
+  flush();
+  entries.push_back(entry_of(time, step, n, fields, lines.size() / 2));
+  write_xdmf();
+}
+
+SnapshotWriter::Impl::Entry SnapshotWriter::Impl::entry_of(double time, std::int64_t step, std::size_t n,
+                                                           std::span<const FieldView> fields, std::size_t line_count) {
+  Entry e{time, step, n, line_count, {}};
+  for (const FieldView& f : fields)
+    if (f.label == "position") e.fields.push_back({"position", std::string(f.unit), f.type, f.rows, f.cols});
+  for (const FieldView& f : fields)
+    if (f.label != "position") e.fields.push_back({std::string(f.label), std::string(f.unit), f.type, f.rows, f.cols});
+  return e;
+}
+
 void SnapshotWriter::write(double time, std::int64_t step, std::span<const FieldView> fields,
                            std::span<const std::uint32_t> lines) {
   Impl& m = *impl_;
@@ -511,59 +423,95 @@ void SnapshotWriter::write(double time, std::int64_t step, std::span<const Field
       throw std::invalid_argument("SnapshotWriter::write: field '" + std::string(f.label) + "' has " +
                                   std::to_string(f.count) + " entries, position has " + std::to_string(n));
   if (lines.size() % 2 != 0) throw std::invalid_argument("SnapshotWriter::write: lines must be index pairs");
+  if (m.comm && !lines.empty())
+    throw std::invalid_argument("SnapshotWriter::write: lines are not written by several processes");
   for (std::uint32_t i : lines)
     if (i >= n)
       throw std::invalid_argument("SnapshotWriter::write: line index " + std::to_string(i) + " >= particle count " +
                                   std::to_string(n));
 
-  if (m.ctx.failed)
+  if (m.ctx.failed || (m.part && m.part->ctx.failed))
     throw IoError("an earlier write to this file failed; no further snapshot is written", m.h5_path.string());
   // The same step and time as the previous snapshot is the same state: writing it again would
   // list every particle twice at that time in ParaView (a run ending on a snapshot time).
   if (!m.entries.empty() && m.entries.back().step == step && m.entries.back().time == time) return;
 
   const std::string name = snapshot_name(m.entries.size());
-  const std::string gpath = std::string(kSnapshotsGroup) + "/" + name;
-  {
-    // Checked before the file is touched, so a full disk leaves the snapshots so far readable.
-    double bytes = 16.0 * 1024.0;  // group, attributes, B-tree and heap growth
-    for (const FieldView& f : fields) {
-      const std::size_t elem = f.type == ScalarType::Float64 || f.type == ScalarType::Int64 ? 8
-                               : f.type == ScalarType::Int32                                ? 4
-                                                                                            : 1;
-      bytes += static_cast<double>(f.count) * f.rows * f.cols * static_cast<double>(elem) + 1024.0;
-    }
-    bytes += 4.0 * static_cast<double>(lines.size() + (m.vertex_indices.count(n) ? 0 : n));
-    m.check_room(1.1 * bytes, "snapshot " + name);
+  if (!m.comm) {
+    m.write_group(name, time, step, fields, lines);
+    return;
   }
+  // Several processes: every rank its part, then (when all have written theirs) rank 0 the index.
+  all_ranks_or_throw(*m.comm, m.h5_path, "write its part of snapshot " + name,
+                     [&] { m.part->write_group(name, time, step, fields, lines); });
+  const std::vector<double> counts = m.comm->all_gather(std::vector<double>{static_cast<double>(n)});
+  std::vector<std::size_t> per_rank;
+  std::size_t total = 0;
+  for (double c : counts) {
+    per_rank.push_back(static_cast<std::size_t>(c));
+    total += per_rank.back();
+  }
+  Impl::Entry e = Impl::entry_of(time, step, total, fields, 0);
+  if (m.writes_index()) m.write_virtual_group(name, time, step, e, per_rank);
+  m.entries.push_back(std::move(e));
+  if (m.writes_index()) m.write_xdmf();
+}
+
+void SnapshotWriter::Impl::write_virtual_group(const std::string& name, double time, std::int64_t step, const Entry& e,
+                                               const std::vector<std::size_t>& counts) {
+  const std::string gpath = std::string(kSnapshotsGroup) + "/" + name;
+  check_room(16.0 * 1024.0 + 2048.0 * static_cast<double>(e.fields.size() * counts.size()) +
+                 (vertex_indices.count(e.count) ? 0.0 : 4.0 * static_cast<double>(e.count)),
+             "snapshot " + name);
   try {
-    // Track creation order so the reader lists fields in the order the store declares them.
-    Hid gcpl = m.ctx.own(H5Pcreate(H5P_GROUP_CREATE), H5Pclose, "cannot create group " + gpath);
-    m.ctx.call(H5Pset_link_creation_order(gcpl.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED),
-               "cannot create group " + gpath);
-    Hid group = m.ctx.own(H5Gcreate2(m.snapshots.get(), name.c_str(), H5P_DEFAULT, gcpl.get(), H5P_DEFAULT), H5Gclose,
-                          "cannot create group " + gpath);
-    m.write_fields(group.get(), gpath, fields, lines);
-    m.ensure_vertex_index(n);
-    write_numeric_attribute(m.ctx, group.get(), "time", H5T_NATIVE_DOUBLE, &time);
-    write_numeric_attribute(m.ctx, group.get(), "step", H5T_NATIVE_INT64, &step);
-    const std::int64_t count = static_cast<std::int64_t>(n);
-    // Written last: marks the snapshot complete (see the file comment).
-    write_numeric_attribute(m.ctx, group.get(), "particle_count", H5T_NATIVE_INT64, &count);
+    Hid gcpl = ctx.own(H5Pcreate(H5P_GROUP_CREATE), H5Pclose, "cannot create group " + gpath);
+    ctx.call(H5Pset_link_creation_order(gcpl.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED),
+             "cannot create group " + gpath);
+    Hid group = ctx.own(H5Gcreate2(snapshots.get(), name.c_str(), H5P_DEFAULT, gcpl.get(), H5P_DEFAULT), H5Gclose,
+                        "cannot create group " + gpath);
+    for (const FieldMeta& f : e.fields) {
+      const std::string what = "cannot write the virtual dataset " + gpath + "/" + f.label;
+      const int comps = f.rows * f.cols, rank = comps == 1 ? 1 : 2;
+      const hsize_t dims[2] = {e.count, static_cast<hsize_t>(comps)};
+      Hid space = ctx.own(H5Screate_simple(rank, dims, nullptr), H5Sclose, what);
+      Hid dcpl = ctx.own(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, what);
+      hsize_t offset = 0;
+      for (std::size_t q = 0; q < counts.size(); ++q) {
+        if (counts[q] == 0) continue;
+        const hsize_t part_dims[2] = {counts[q], static_cast<hsize_t>(comps)};
+        const hsize_t start[2] = {offset, 0};
+        Hid source = ctx.own(H5Screate_simple(rank, part_dims, nullptr), H5Sclose, what);
+        ctx.call(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, part_dims, nullptr), what);
+        // The part's name relative to this file: HDF5 looks for it beside the index.
+        ctx.call(H5Pset_virtual(dcpl.get(), space.get(), part_names[q].c_str(), (gpath + "/" + f.label).c_str(),
+                                source.get()),
+                 what);
+        offset += counts[q];
+      }
+      ctx.call(H5Sselect_all(space.get()), what);
+      const hid_t type = native_type(f.type);
+      Hid dset =
+          ctx.own(H5Dcreate2(group.get(), f.label.c_str(), type, space.get(), H5P_DEFAULT, dcpl.get(), H5P_DEFAULT),
+                  H5Dclose, what);
+      write_string_attribute(ctx, dset.get(), "unit", f.unit);
+      if (comps > 1) {
+        const std::int32_t rows = f.rows, cols = f.cols;
+        write_numeric_attribute(ctx, dset.get(), "rows", H5T_NATIVE_INT32, &rows);
+        write_numeric_attribute(ctx, dset.get(), "cols", H5T_NATIVE_INT32, &cols);
+        if (f.rows > 1 && f.cols > 1) write_string_attribute(ctx, dset.get(), "storage_order", "column-major");
+      }
+    }
+    ensure_vertex_index(e.count);
+    write_numeric_attribute(ctx, group.get(), "time", H5T_NATIVE_DOUBLE, &time);
+    write_numeric_attribute(ctx, group.get(), "step", H5T_NATIVE_INT64, &step);
+    const std::int64_t count = static_cast<std::int64_t>(e.count);
+    write_numeric_attribute(ctx, group.get(), "particle_count", H5T_NATIVE_INT64, &count);  // last: complete
   } catch (...) {
-    // Remove the partial group so the next write can reuse the name; the reader ignores it anyway.
-    H5Ldelete(m.snapshots.get(), name.c_str(), H5P_DEFAULT);
+    H5Ldelete(snapshots.get(), name.c_str(), H5P_DEFAULT);
     H5Eclear2(H5E_DEFAULT);
     throw;
   }
-  m.flush();
-
-  Impl::Entry e{time, step, n, lines.size() / 2, {}};
-  e.fields.push_back({"position", position->type, position->rows, position->cols});
-  for (const FieldView& f : fields)
-    if (&f != position) e.fields.push_back({std::string(f.label), f.type, f.rows, f.cols});
-  m.entries.push_back(std::move(e));
-  m.write_xdmf();
+  flush();
 }
 
 // XDMF companion.
@@ -656,176 +604,6 @@ std::string SnapshotWriter::Impl::xdmf_text() const {
     << "  </Domain>\n"
     << "</Xdmf>\n";
   return x.str();
-}
-
-// ============================================================================================
-// Reader
-// ============================================================================================
-
-struct SnapshotReader::Impl {
-  struct Snapshot {
-    std::string name;
-    double time;
-    std::int64_t step;
-    std::int64_t count;
-  };
-  std::filesystem::path path;
-  Hdf5Context ctx;
-  Hid file, snapshots;
-  std::vector<Snapshot> list;
-
-  const Snapshot& at(std::size_t k) const {
-    if (k >= list.size())
-      throw std::out_of_range("snapshot " + std::to_string(k) + " requested, " + path.string() + " has " +
-                              std::to_string(list.size()));
-    return list[k];
-  }
-  std::string group_path(std::size_t k) const { return std::string(kSnapshotsGroup) + "/" + at(k).name; }
-  Hid open_group(std::size_t k) const {
-    return ctx.own(H5Gopen2(snapshots.get(), at(k).name.c_str(), H5P_DEFAULT), H5Gclose,
-                   "cannot open group " + group_path(k));
-  }
-  bool has_link(hid_t group, const std::string& name, const std::string& where) const {
-    const htri_t r = H5Lexists(group, name.c_str(), H5P_DEFAULT);
-    if (r < 0) ctx.fail("cannot query " + where + "/" + name);
-    return r > 0;
-  }
-};
-
-SnapshotReader::SnapshotReader(const std::filesystem::path& h5_path) : impl_(std::make_unique<Impl>()) {
-  Impl& m = *impl_;
-  m.path = h5_path;
-  m.ctx.file = h5_path.string();
-  m.ctx.input = true;
-  silence_hdf5_errors();
-  std::error_code ec;
-  if (!std::filesystem::exists(h5_path, ec)) throw InputError("snapshot file does not exist", m.ctx.file);
-  if (std::filesystem::is_directory(h5_path, ec))
-    throw InputError("snapshot file is a directory, expected an HDF5 file", m.ctx.file);
-  const htri_t is_hdf5 = H5Fis_hdf5(m.ctx.file.c_str());
-  if (is_hdf5 <= 0) {
-    H5Eclear2(H5E_DEFAULT);
-    throw InputError("not an HDF5 file (expected a geohaz snapshot file written by SnapshotWriter)", m.ctx.file);
-  }
-  Hid fapl = file_access_plist(m.ctx);
-  m.file = m.ctx.own(H5Fopen(m.ctx.file.c_str(), H5F_ACC_RDONLY, fapl.get()), H5Fclose, "cannot open the HDF5 file");
-  if (!m.has_link(m.file.get(), "snapshots", ""))
-    throw InputError("not a geohaz snapshot file: it has no /snapshots group", m.ctx.file);
-  m.snapshots = m.ctx.own(H5Gopen2(m.file.get(), kSnapshotsGroup, H5P_DEFAULT), H5Gclose,
-                          std::string("cannot open group ") + kSnapshotsGroup);
-
-  std::vector<std::string> names = link_names(m.ctx, m.snapshots.get(), kSnapshotsGroup);
-  // Zero-padded names sort numerically by (length, text), also past 999999 snapshots.
-  std::sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) {
-    return a.size() != b.size() ? a.size() < b.size() : a < b;
-  });
-  for (const std::string& name : names) {
-    const std::string where = std::string(kSnapshotsGroup) + "/" + name;
-    Hid g = m.ctx.own(H5Gopen2(m.snapshots.get(), name.c_str(), H5P_DEFAULT), H5Gclose, "cannot open group " + where);
-    const htri_t complete = H5Aexists(g.get(), "particle_count");
-    if (complete < 0) m.ctx.fail("cannot query " + where);
-    if (complete == 0) continue;  // cut off by a kill while being written
-    Impl::Snapshot s;
-    s.name = name;
-    s.time = read_numeric_attribute<double>(m.ctx, g.get(), where, "time", H5T_NATIVE_DOUBLE);
-    s.step = read_numeric_attribute<std::int64_t>(m.ctx, g.get(), where, "step", H5T_NATIVE_INT64);
-    s.count = read_numeric_attribute<std::int64_t>(m.ctx, g.get(), where, "particle_count", H5T_NATIVE_INT64);
-    m.list.push_back(std::move(s));
-  }
-}
-
-SnapshotReader::~SnapshotReader() = default;
-
-std::size_t SnapshotReader::snapshot_count() const {
-  return impl_->list.size();
-}
-double SnapshotReader::time(std::size_t k) const {
-  return impl_->at(k).time;
-}
-std::int64_t SnapshotReader::step(std::size_t k) const {
-  return impl_->at(k).step;
-}
-
-std::vector<std::string> SnapshotReader::fields(std::size_t k) const {
-  const Impl& m = *impl_;
-  Hid g = m.open_group(k);
-  std::vector<std::string> out;
-  for (std::string& name : link_names(m.ctx, g.get(), m.group_path(k)))
-    if (name != kLinesLabel) out.push_back(std::move(name));
-  return out;
-}
-
-bool SnapshotReader::has_field(std::size_t k, std::string_view label) const {
-  const Impl& m = *impl_;
-  if (label.empty() || label == kLinesLabel || label.find('/') != std::string_view::npos) return false;
-  Hid g = m.open_group(k);
-  return m.has_link(g.get(), std::string(label), m.group_path(k));
-}
-
-FieldData SnapshotReader::read(std::size_t k, std::string_view label) const {
-  const Impl& m = *impl_;
-  const std::string where = m.group_path(k) + "/" + std::string(label);
-  if (!has_field(k, label)) {
-    std::string have;
-    for (const std::string& f : fields(k)) have += (have.empty() ? "" : ", ") + f;
-    throw InputError(
-        "snapshot " + m.group_path(k) + " has no field '" + std::string(label) + "' (fields: " + have + ")",
-        m.ctx.file);
-  }
-  Hid g = m.open_group(k);
-  const std::string what = "cannot read dataset " + where;
-  Hid dset = m.ctx.own(H5Dopen2(g.get(), std::string(label).c_str(), H5P_DEFAULT), H5Dclose, what);
-  Hid space = m.ctx.own(H5Dget_space(dset.get()), H5Sclose, what);
-  const int rank = H5Sget_simple_extent_ndims(space.get());
-  if (rank < 1 || rank > 2) m.ctx.fail(what + ": expected a 1-D or 2-D dataset, rank is " + std::to_string(rank));
-  hsize_t dims[2] = {0, 1};
-  if (H5Sget_simple_extent_dims(space.get(), dims, nullptr) < 0) m.ctx.fail(what);
-  FieldData d;
-  d.count = static_cast<std::size_t>(dims[0]);
-  const int comps = rank == 1 ? 1 : static_cast<int>(dims[1]);
-  d.rows = comps;
-  d.cols = 1;
-  if (comps > 1 && H5Aexists(dset.get(), "rows") > 0 && H5Aexists(dset.get(), "cols") > 0) {
-    d.rows = read_numeric_attribute<std::int32_t>(m.ctx, dset.get(), where, "rows", H5T_NATIVE_INT32);
-    d.cols = read_numeric_attribute<std::int32_t>(m.ctx, dset.get(), where, "cols", H5T_NATIVE_INT32);
-    if (d.rows < 1 || d.cols < 1 || d.rows * d.cols != comps)
-      m.ctx.fail(what + ": rows x cols does not match the dataset's " + std::to_string(comps) + " components");
-  }
-  d.unit = read_attribute_text(m.ctx, dset.get(), where, "unit").value_or("");
-  d.values.resize(d.count * static_cast<std::size_t>(comps));
-  if (!d.values.empty())
-    m.ctx.call(H5Dread(dset.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, d.values.data()), what);
-  return d;
-}
-
-std::vector<std::uint32_t> SnapshotReader::lines(std::size_t k) const {
-  const Impl& m = *impl_;
-  Hid g = m.open_group(k);
-  if (!m.has_link(g.get(), kLinesLabel, m.group_path(k))) return {};
-  const std::string what = "cannot read dataset " + m.group_path(k) + "/" + kLinesLabel;
-  Hid dset = m.ctx.own(H5Dopen2(g.get(), kLinesLabel, H5P_DEFAULT), H5Dclose, what);
-  Hid space = m.ctx.own(H5Dget_space(dset.get()), H5Sclose, what);
-  hsize_t dims[2] = {0, 0};
-  if (H5Sget_simple_extent_ndims(space.get()) != 2) m.ctx.fail(what + ": expected n_lines x 2");
-  if (H5Sget_simple_extent_dims(space.get(), dims, nullptr) < 0 || dims[1] != 2)
-    m.ctx.fail(what + ": expected n_lines x 2");
-  std::vector<std::uint32_t> out(static_cast<std::size_t>(dims[0] * 2));
-  if (!out.empty()) m.ctx.call(H5Dread(dset.get(), H5T_NATIVE_UINT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), what);
-  return out;
-}
-
-std::string SnapshotReader::attribute(const std::string& name) const {
-  return read_attribute_text(impl_->ctx, impl_->file.get(), "/", name).value_or("");
-}
-
-int SnapshotReader::dimension() const {
-  const Impl& m = *impl_;
-  const htri_t exists = H5Aexists(m.file.get(), "dimension");
-  if (exists <= 0) throw InputError("snapshot file has no 'dimension' attribute", m.ctx.file);
-  const auto d = read_numeric_attribute<std::int32_t>(m.ctx, m.file.get(), "/", "dimension", H5T_NATIVE_INT32);
-  if (d != 2 && d != 3)
-    throw InputError("snapshot file has dimension " + std::to_string(d) + ", expected 2 or 3", m.ctx.file);
-  return d;
 }
 
 }  // namespace geohaz

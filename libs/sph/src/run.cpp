@@ -17,19 +17,21 @@ namespace geohaz::sph {
 
 struct SphSimulation::Impl {
   std::unique_ptr<SimulationModel> model;
+  std::shared_ptr<const Communicator> comm;  // over several ranks; null on one process
 };
 
 SphSimulation::SphSimulation(const RunConfig& cfg, bool quiet, std::shared_ptr<const Communicator> comm)
     : cfg_(cfg), impl_(std::make_unique<Impl>()) {
-  if (comm) {
-    check_distributable(cfg);
-    impl_->model = make_dynamic_run(cfg, quiet, std::move(comm));
-  } else if (cfg.analysis == Analysis::LimitEquilibrium)
+  if (comm) check_distributable(cfg);
+  impl_->comm = comm;
+  // The limit-equilibrium analysis has no particles: every rank computes it (a few milliseconds), rank
+  // 0 writes it.
+  if (cfg.analysis == Analysis::LimitEquilibrium)
     impl_->model = make_limit_equilibrium_run(cfg, quiet);
   else if (cfg.analysis == Analysis::StrengthReduction)
-    impl_->model = make_strength_reduction_run(cfg, quiet);
+    impl_->model = make_strength_reduction_run(cfg, quiet, std::move(comm));
   else
-    impl_->model = make_dynamic_run(cfg, quiet);
+    impl_->model = make_dynamic_run(cfg, quiet, std::move(comm));
 }
 
 SphSimulation::~SphSimulation() = default;
@@ -60,16 +62,23 @@ ParticleFields SphSimulation::particles() const {
 }
 
 /// The files of a run made during it (the output folder, the resolved config, the snapshots and
-/// the velocity PNGs) and the progress lines on stderr; passes every event on to `next`.
+/// the velocity PNGs) and the progress lines on stderr; passes every event on to `next`. Over several
+/// ranks every rank has one with the same folder: rank 0 makes the folder and writes the files, every
+/// rank its part of the snapshots (the writer is collective, and so are the model's snapshot and
+/// picture calls), in the same order on every rank.
 class SphRunFiles final : public RunObserver {
  public:
   SphRunFiles(const SphSimulation& sim, std::filesystem::path out, bool quiet, RunObserver* next)
       : model_(*sim.impl_->model), cfg_(sim.config()), out_(std::move(out)), quiet_(quiet), next_(next) {
     if (out_.empty()) return;
-    make_output_dir(out_);
-    write_text_file(out_ / "config.resolved.toml", cfg_.resolved_config);
+    const auto& comm = sim.impl_->comm;
+    if (!comm || comm->rank() == 0) {
+      make_output_dir(out_);
+      write_text_file(out_ / "config.resolved.toml", cfg_.resolved_config);
+    }
     if (cfg_.analysis == Analysis::LimitEquilibrium) return;  // no particles
-    snaps_ = std::make_unique<SnapshotWriter>(out_ / "snapshots.h5", "sph-slope", cfg_.dimension, cfg_.resolved_config);
+    snaps_ = std::make_unique<SnapshotWriter>(out_ / "snapshots.h5", "sph-slope", cfg_.dimension, cfg_.resolved_config,
+                                              comm);
     snaps_->set_attribute("scenario", scenario_name(cfg_.scenario));
     snaps_->set_attribute("units", "SI: m, s, kg, Pa");
     if (cfg_.analysis == Analysis::StrengthReduction)
@@ -88,10 +97,8 @@ class SphRunFiles final : public RunObserver {
     }
     if (next_) next_->progress(sim, p);
   }
-  // The snapshot points are the same on every rank of a distributed run (the gather is collective);
-  // only the rank with the output folder writes.
+  // The snapshot points are the same on every rank of a distributed run (the writer is collective).
   void started(const SphSimulation& sim) override {
-    model_.gather_for_output();
     if (snaps_) model_.write_snapshot(*snaps_);
     next_snap_ = sim.time() + cfg_.snapshot_interval;
     if (cfg_.analysis == Analysis::Dynamic) main_.emplace("sph-slope", cfg_.end_time, quiet_);
@@ -104,7 +111,6 @@ class SphRunFiles final : public RunObserver {
   void stepped(const SphSimulation& sim) override {
     if (main_) main_->update(sim.time(), sim.step_count(), sim.particle_count());
     if (cfg_.snapshot_interval > 0.0 && sim.time() >= next_snap_ - 1e-12) {
-      model_.gather_for_output();
       if (snaps_) model_.write_snapshot(*snaps_);
       next_snap_ += cfg_.snapshot_interval;
     }
@@ -112,7 +118,6 @@ class SphRunFiles final : public RunObserver {
   }
   void finished(const SphSimulation& sim) override {
     if (main_) main_->finish(sim.time(), sim.step_count(), sim.particle_count());
-    model_.gather_for_output();
     if (snaps_) model_.write_snapshot(*snaps_);
     if (next_) next_->finished(sim);
   }
@@ -136,15 +141,17 @@ void write_outputs(const SphSimulation& sim, const std::filesystem::path& out) {
 }
 
 void run_with_outputs(SphSimulation& sim, const std::filesystem::path& out, bool quiet, RunObserver* observer) {
+  // Over several ranks the files are rank 0's (SphRunFiles); every rank runs the collective parts.
+  const bool writes = !out.empty() && (!sim.impl_->comm || sim.impl_->comm->rank() == 0);
   SphRunFiles files(sim, out, quiet, observer);
   try {
     sim.run(&files);
   } catch (const SimulationError&) {
-    if (!out.empty() && sim.main_phase_started()) files.model().write_partial(out);
+    if (writes && sim.main_phase_started()) files.model().write_partial(out);
     throw;
   }
   files.close();
-  if (!out.empty()) write_outputs(sim, out);
+  if (writes) write_outputs(sim, out);
 }
 
 int run_case(const RunConfig& cfg, const std::filesystem::path& out, bool quiet,

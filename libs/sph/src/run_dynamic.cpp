@@ -100,13 +100,8 @@ class DynamicRun final : public SimulationModel {
   std::vector<NamedTable> tables() const override;
   ParticleFields particles() const override { return fields_of(state()); }
   void write_snapshot(SnapshotWriter& w) const override {
-    if (solver_.domain())  // the gathered state, without the solver state (check_distributable)
-      write_fields<Dim>(w, view_, solver_.time(), step_offset_ + solver_.step_count(),
-                        solver_.settings().pore_water.active());
-    else
-      sph::write_snapshot<Dim>(w, solver_, step_offset_ + solver_.step_count());
+    sph::write_snapshot<Dim>(w, solver_, step_offset_ + solver_.step_count());
   }
-  void gather_for_output() override { refresh_view(); }
   void draw_due_pngs(const std::filesystem::path& out) override;
   void write_outputs(const std::filesystem::path& out) const override;
   void write_partial(const std::filesystem::path& out) const override;
@@ -130,6 +125,8 @@ class DynamicRun final : public SimulationModel {
   /// gathered copy of the last refresh_view() (every output point calls it on every rank).
   const SphStore<Dim>& state() const { return solver_.domain() ? view_ : solver_.store(); }
   void refresh_view(bool force = false);
+  /// This process writes the files (one process, or rank 0 of several).
+  bool root() const { return !solver_.domain() || solver_.domain()->rank() == 0; }
   void record_decomposition();
 
   const RunConfig& c_;
@@ -161,6 +158,9 @@ class DynamicRun final : public SimulationModel {
   SphStore<Dim> view_;
   std::int64_t view_step_ = -1;
   nlohmann::json decomposition_;
+  // Over several ranks: the ranks, until the solver is distributed at the start of run() (after a
+  // restart file is read in full).
+  std::shared_ptr<const Communicator> comm_;
 };
 
 template <int Dim>
@@ -181,7 +181,7 @@ DynamicRun<Dim>::DynamicRun(const RunConfig& c, bool quiet, std::shared_ptr<cons
     for (const auto& s : b_.sc.structures) bases.push_back(s.base);
     solver_.track_structures(std::move(bases));
   }
-  if (comm) solver_.distribute(std::move(comm));
+  comm_ = std::move(comm);
   for (const auto& m : solver_.materials()) rho0_.push_back(m.density);
   if (c_.geostatic && c_.restart.empty() && c_.scenario != ScenarioType::Biaxial)
     geostatic_duration(c_, href_, solver_.max_wave_speed());  // checked now
@@ -218,10 +218,12 @@ void DynamicRun<Dim>::print_header() const {
 
 template <int Dim>
 void DynamicRun<Dim>::run(const SphSimulation& self, RunObserver* obs) {
-  if (!c_.restart.empty())
+  if (!c_.restart.empty()) {
     load_restart_state();
-  else if (c_.geostatic && c_.scenario != ScenarioType::Biaxial)
-    geostatic_phase(self, obs);
+  } else {
+    if (comm_) solver_.distribute(comm_);
+    if (c_.geostatic && c_.scenario != ScenarioType::Biaxial) geostatic_phase(self, obs);
+  }
   if (c_.scenario == ScenarioType::Biaxial) move_platens();
   if (c_.restart.empty()) set_initial_velocity<Dim>(c_, solver_.store());
   refresh_view(true);
@@ -233,10 +235,13 @@ void DynamicRun<Dim>::run(const SphSimulation& self, RunObserver* obs) {
 
 template <int Dim>
 void DynamicRun<Dim>::load_restart_state() {
+  // Every rank reads the whole file (written on any number of ranks), then keeps its share.
   const Restart rs = load_restart<Dim>(c_.restart, solver_.store());
-  // With the solver state the run continues exactly as the one that wrote the file; without it
-  // (files of older versions) from the snapshot's particles, with Δt from the wave speed and a
-  // fresh neighbour list: the same physics, another round-off.
+  if (comm_) solver_.distribute(comm_);
+  // With the solver state the run continues exactly as the one that wrote the file (on as many
+  // ranks; on another count within round-off: other pair-sum orders); without it (files of older
+  // versions) from the snapshot's particles, with Δt from the wave speed and a fresh neighbour list:
+  // the same physics, another round-off.
   if (rs.state)
     solver_.resume(*rs.state);
   else
@@ -423,7 +428,7 @@ SeriesRow DynamicRun<Dim>::record() {
                           settings_.earthquake.horizontal(solver_.time())};
   if (!free_end_.empty()) row.push_back(tip_displacement());
   if (settings_.pore_water.active()) {
-    const auto& S = solver_.store();
+    const auto& S = state();  // over several ranks every particle, not this rank's share
     double umax = 0.0;
     for (std::size_t i = 0; i < S.size(); ++i)
       if (S.template get<ParticleKind>()[i] == kSoil) umax = std::max(umax, S.template get<PorePressure>()[i]);
@@ -459,12 +464,16 @@ void DynamicRun<Dim>::record_biaxial() {
 template <int Dim>
 void DynamicRun<Dim>::draw_due_pngs(const std::filesystem::path& out) {
   while (next_png_ < png_times_.size() && solver_.time() >= png_times_[next_png_] - 1e-12) {
-    std::vector<double> v(solver_.store().size());
-    for (std::size_t i = 0; i < v.size(); ++i) v[i] = solver_.store().template get<Velocity<Dim>>()[i].norm();
-    const double vm = *std::max_element(v.begin(), v.end());
-    std::ostringstream name;
-    name << "velocity_t" << std::fixed << std::setprecision(3) << png_times_[next_png_] << ".png";
-    draw_particles<Dim>(out / name.str(), solver_.store(), v, vm, c_.numerics.spacing, "speed (m/s)");
+    refresh_view();  // over several ranks the whole state (collective), drawn by rank 0
+    const auto& S = state();
+    if (root()) {
+      std::vector<double> v(S.size());
+      for (std::size_t i = 0; i < v.size(); ++i) v[i] = S.template get<Velocity<Dim>>()[i].norm();
+      const double vm = v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
+      std::ostringstream name;
+      name << "velocity_t" << std::fixed << std::setprecision(3) << png_times_[next_png_] << ".png";
+      draw_particles<Dim>(out / name.str(), S, v, vm, c_.numerics.spacing, "speed (m/s)");
+    }
     ++next_png_;
   }
 }

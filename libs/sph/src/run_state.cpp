@@ -1,5 +1,6 @@
 // The state an sph-slope analysis starts from and keeps: the geostatic phase, the snapshots
 // (snapshots.h5) and the restart from their last one, the particle fields as flat arrays.
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -12,28 +13,29 @@ namespace geohaz::sph {
 
 namespace {
 
+/// The first `n` particles' values of a field.
 template <class Tag, class Store>
-void add_view(std::vector<FieldView>& v, const Store& s) {
+void add_view(std::vector<FieldView>& v, const Store& s, std::size_t n) {
   using Tr = FieldTraits<typename Tag::type>;
   const auto& a = s.template get<Tag>();
-  v.push_back({Tag::label, Tag::unit, scalar_type_of<typename Tr::scalar>(), a.data(), a.size(), Tr::rows, Tr::cols});
+  v.push_back({Tag::label, Tag::unit, scalar_type_of<typename Tr::scalar>(), a.data(), n, Tr::rows, Tr::cols});
 }
 
 /// The internal variables of every constitutive model (constitutive.hpp), each once.
 template <int Dim, class... Tags>
-void add_fields_once(std::vector<FieldView>& v, const SphStore<Dim>& s, FieldList<Tags...>) {
+void add_fields_once(std::vector<FieldView>& v, const SphStore<Dim>& s, std::size_t n, FieldList<Tags...>) {
   [[maybe_unused]] auto once = [&](auto tag) {
     using Tag = decltype(tag);
     for (const auto& f : v)
       if (f.label == Tag::label) return;
-    add_view<Tag>(v, s);
+    add_view<Tag>(v, s, n);
   };
   (once(Tags{}), ...);
 }
 template <int Dim, class... Models>
-void add_internal_variables(std::vector<FieldView>& v, const SphStore<Dim>& s,
+void add_internal_variables(std::vector<FieldView>& v, const SphStore<Dim>& s, std::size_t n,
                             std::type_identity<std::variant<Models...>>) {
-  (add_fields_once(v, s, typename Models::InternalVariables{}), ...);
+  (add_fields_once(v, s, n, typename Models::InternalVariables{}), ...);
 }
 
 /// The solver state of the last snapshot (SolverState), as a root attribute: a snapshot group has
@@ -45,32 +47,36 @@ constexpr const char* kSolverStateAttribute = "sph_solver_state";
 }  // namespace
 
 template <int Dim>
-void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int64_t step, bool pore_pressure) {
+void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int64_t step, bool pore_pressure,
+                  std::size_t count) {
+  const std::size_t n = std::min(count, s.size());
   std::vector<FieldView> v;
-  add_view<Position<Dim>>(v, s);
-  add_view<Velocity<Dim>>(v, s);
-  add_view<Displacement<Dim>>(v, s);
-  add_view<Stress>(v, s);
-  add_view<PlasticStrain>(v, s);
-  add_view<Density>(v, s);
-  add_view<MaterialId>(v, s);
-  add_view<StressFree>(v, s);
-  add_view<ParticleKind>(v, s);
-  add_view<Mass>(v, s);
-  add_view<WallNormal<Dim>>(v, s);
-  add_view<LayerNormal<Dim>>(v, s);
-  add_view<StructureId>(v, s);
-  add_view<ParticleId>(v, s);
-  add_view<Clamped>(v, s);
-  add_internal_variables(v, s, std::type_identity<ConstitutiveModel>{});
-  add_view<PositionAtBuild<Dim>>(v, s);
-  if (pore_pressure) add_view<PorePressure>(v, s);
+  add_view<Position<Dim>>(v, s, n);
+  add_view<Velocity<Dim>>(v, s, n);
+  add_view<Displacement<Dim>>(v, s, n);
+  add_view<Stress>(v, s, n);
+  add_view<PlasticStrain>(v, s, n);
+  add_view<Density>(v, s, n);
+  add_view<MaterialId>(v, s, n);
+  add_view<StressFree>(v, s, n);
+  add_view<ParticleKind>(v, s, n);
+  add_view<Mass>(v, s, n);
+  add_view<WallNormal<Dim>>(v, s, n);
+  add_view<LayerNormal<Dim>>(v, s, n);
+  add_view<StructureId>(v, s, n);
+  add_view<ParticleId>(v, s, n);
+  add_view<Clamped>(v, s, n);
+  add_internal_variables(v, s, n, std::type_identity<ConstitutiveModel>{});
+  add_view<PositionAtBuild<Dim>>(v, s, n);
+  if (pore_pressure) add_view<PorePressure>(v, s, n);
   w.write(t, step, v);
 }
 
 template <int Dim>
 void write_snapshot(SnapshotWriter& w, const SphSolver<Dim>& solver, std::int64_t step) {
-  write_fields<Dim>(w, solver.store(), solver.time(), step, solver.settings().pore_water.active());
+  // Over several ranks each writes its owned particles (the writer joins them) and the same state.
+  write_fields<Dim>(w, solver.store(), solver.time(), step, solver.settings().pore_water.active(),
+                    solver.owned_count());
   const SolverState st = solver.state();
   char buf[160];
   std::snprintf(buf, sizeof buf, "snapshot %zu step %lld dt %a builds %lld", w.snapshot_count() - 1,
@@ -181,8 +187,8 @@ GeostaticReport geostatic_with_progress(SphSolver<Dim>& solver, double dur, cons
   return rep;
 }
 
-template void write_fields<2>(SnapshotWriter&, const SphStore<2>&, double, std::int64_t, bool);
-template void write_fields<3>(SnapshotWriter&, const SphStore<3>&, double, std::int64_t, bool);
+template void write_fields<2>(SnapshotWriter&, const SphStore<2>&, double, std::int64_t, bool, std::size_t);
+template void write_fields<3>(SnapshotWriter&, const SphStore<3>&, double, std::int64_t, bool, std::size_t);
 template void write_snapshot<2>(SnapshotWriter&, const SphSolver<2>&, std::int64_t);
 template void write_snapshot<3>(SnapshotWriter&, const SphSolver<3>&, std::int64_t);
 template Restart load_restart<2>(const std::filesystem::path&, SphStore<2>&);

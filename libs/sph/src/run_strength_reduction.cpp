@@ -2,6 +2,7 @@
 // from the geostatic state (or a restart) bisecting F, the Bishop circle beside it (docs/sph.md,
 // "Factor of safety by strength reduction").
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -17,13 +18,25 @@ namespace geohaz::sph {
 namespace {
 
 template <int Dim>
-double max_soil_displacement(const SphStore<Dim>& s) {
+double max_soil_displacement(const SphStore<Dim>& s, std::size_t n) {
   double u = 0.0;
   const auto& d = s.template get<Displacement<Dim>>();
   const auto& k = s.template get<ParticleKind>();
-  for (std::size_t i = 0; i < s.size(); ++i)
+  for (std::size_t i = 0; i < n; ++i)
     if (k[i] == kSoil) u = std::max(u, d[i].norm());
   return u;
+}
+template <int Dim>
+double max_soil_displacement(const SphStore<Dim>& s) {
+  return max_soil_displacement(s, s.size());
+}
+
+/// Over every rank of a distributed solver (collective): its owned particles' largest displacement.
+template <int Dim>
+double max_soil_displacement(const SphSolver<Dim>& s) {
+  std::array<double, 1> u{max_soil_displacement(s.store(), s.owned_count())};
+  if (s.domain()) s.domain()->comm().max_all(u);
+  return u[0];
 }
 
 /// One strength-reduction trial: its factor and what decided it.
@@ -58,22 +71,23 @@ SolverSettings<Dim> trial_settings(const RunConfig& c, const Scenario<Dim>& sc) 
 template <int Dim>
 class StrengthReductionRun final : public SimulationModel {
  public:
-  StrengthReductionRun(const RunConfig& c, bool quiet);
+  StrengthReductionRun(const RunConfig& c, bool quiet, std::shared_ptr<const Communicator> comm);
   void run(const SphSimulation& self, RunObserver* obs) override;
   double time() const override { return 0.0; }
   std::int64_t step_count() const override { return trial_steps_; }
-  std::size_t particle_count() const override { return geo_.store().size(); }
+  std::size_t particle_count() const override { return b_.sc.soil_count + b_.sc.boundary_count; }
   bool main_phase_started() const override { return false; }
   nlohmann::json summary() const override;
   std::vector<NamedTable> tables() const override;
   ParticleFields particles() const override { return mechanism_ ? fields_of(*mechanism_) : ParticleFields{}; }
   /// Before the trials the geostatic state (snapshot 0), after them the failed trial at the
-  /// critical factor (snapshot 1).
+  /// critical factor (snapshot 1). Over several ranks every rank holds both whole: rank 0 writes them.
   void write_snapshot(SnapshotWriter& w) const override {
+    const std::size_t all = comm_ && comm_->rank() != 0 ? 0 : static_cast<std::size_t>(-1);
     if (!finished_)
-      write_fields<Dim>(w, *initial_, 0.0, 0, settings_.pore_water.active());
+      write_fields<Dim>(w, *initial_, 0.0, 0, settings_.pore_water.active(), all);
     else if (mechanism_)
-      write_fields<Dim>(w, *mechanism_, trial_duration_, 1, settings_.pore_water.active());
+      write_fields<Dim>(w, *mechanism_, trial_duration_, 1, settings_.pore_water.active(), all);
   }
   void draw_due_pngs(const std::filesystem::path&) override {}
   void write_outputs(const std::filesystem::path& out) const override;
@@ -109,10 +123,12 @@ class StrengthReductionRun final : public SimulationModel {
   std::string bishop_note_;
   std::vector<std::array<double, 2>> circle_;
   bool finished_ = false;
+  std::shared_ptr<const Communicator> comm_;  // over several ranks: the geostatic phase and each trial
 };
 
 template <int Dim>
-StrengthReductionRun<Dim>::StrengthReductionRun(const RunConfig& c, bool quiet)
+StrengthReductionRun<Dim>::StrengthReductionRun(const RunConfig& c, bool quiet,
+                                                std::shared_ptr<const Communicator> comm)
     : c_(c),
       quiet_(quiet),
       wall0_(std::chrono::steady_clock::now()),
@@ -120,7 +136,8 @@ StrengthReductionRun<Dim>::StrengthReductionRun(const RunConfig& c, bool quiet)
       settings_(trial_settings<Dim>(c, b_.sc)),
       href_(b_.sc.reference_height),
       geo_(std::move(b_.sc.store), c.materials, c.model, settings_),
-      cmax_(geo_.max_wave_speed()) {
+      cmax_(geo_.max_wave_speed()),
+      comm_(std::move(comm)) {
   if (c_.restart.empty()) geostatic_duration(c_, href_, cmax_);  // checked before anything is written
 }
 
@@ -143,11 +160,14 @@ void StrengthReductionRun<Dim>::geostatic_state(const SphSimulation& self, RunOb
     for (auto& u : geo_.store().template get<Displacement<Dim>>()) u.setZero();
     phase_summary_["restart"] = {{"file", c_.restart.string()}, {"time_s", rs.time}};
   } else {
+    if (comm_) geo_.distribute(comm_);
     const double dur = geostatic_duration(c_, href_, cmax_);
     const auto rep = geostatic_with_progress(geo_, dur, c_, self, obs);
     phase_summary_["geostatic"] = {{"duration_s", dur}, {"steps", rep.steps}, {"max_speed_m_per_s", rep.max_speed}};
   }
-  initial_ = geo_.store();
+  // Over several ranks every rank keeps the whole state (gathered, by particle id): each trial starts
+  // from it and spreads it over the ranks again.
+  initial_ = geo_.domain() ? geo_.gathered_store() : geo_.store();
 }
 
 /// One trial with every strength divided by F; true when it fails.
@@ -157,19 +177,20 @@ bool StrengthReductionRun<Dim>::trial(double F, const SphSimulation& self, RunOb
   SrmTrial t;
   t.factor = F;
   SphSolver<Dim> s(*initial_, reduced_strength(c_.model, c_.materials, F), c_.model, settings_);
-  RunProgress p{"trial", 0.0, T, 0, s.store().size(), F, false};
+  if (comm_) s.distribute(comm_);
+  RunProgress p{"trial", 0.0, T, 0, initial_->size(), F, false};
   double u75 = -1.0;
   try {
     while (s.time() < T) {
       s.step();
-      if (u75 < 0.0 && s.time() >= 0.75 * T) u75 = max_soil_displacement(s.store());
+      if (u75 < 0.0 && s.time() >= 0.75 * T) u75 = max_soil_displacement(s);
       if (obs && s.step_count() % 50 == 0) {
         p.time = s.time();
         p.steps = s.step_count();
         obs->progress(self, p);
       }
     }
-    t.displacement = max_soil_displacement(s.store());
+    t.displacement = max_soil_displacement(s);
     t.growth = t.displacement - std::max(u75, 0.0);
     // Failure: the displacement has not converged, or (once the stable reference exists) it lies
     // beyond the knee of the F–displacement curve. SPH follows a failing mass to a new equilibrium
@@ -177,8 +198,9 @@ bool StrengthReductionRun<Dim>::trial(double F, const SphSimulation& self, RunOb
     t.failed = t.growth > c_.srm.growth_ratio * t.displacement ||
                (u_ref_ >= 0.0 && t.displacement > c_.srm.knee_ratio * std::max(u_ref_, 1e-3 * c_.numerics.spacing));
   } catch (const SimulationError& e) {
+    // Over several ranks every rank stops at the same step (the state check is reduced over them).
     t.failed = t.blew_up = true;
-    t.displacement = max_soil_displacement(s.store());
+    t.displacement = max_soil_displacement(s);
     if (!quiet_) std::fprintf(stderr, "sph-slope: trial F = %.4g stopped (%s): counted as failed\n", F, e.what());
   }
   t.steps = s.step_count();
@@ -193,7 +215,7 @@ bool StrengthReductionRun<Dim>::trial(double F, const SphSimulation& self, RunOb
     std::fprintf(stderr, "sph-slope: trial F = %.4f: max displacement %.4g m, last-quarter growth %.3g m -> %s\n", F,
                  t.displacement, t.growth, t.failed ? "fails" : "stable");
   trials_.push_back(t);
-  if (t.failed) mechanism_ = s.store();
+  if (t.failed) mechanism_ = s.domain() ? s.gathered_store() : s.store();
   return t.failed;
 }
 
@@ -366,9 +388,10 @@ nlohmann::json StrengthReductionRun<Dim>::summary() const {
 
 }  // namespace
 
-std::unique_ptr<SimulationModel> make_strength_reduction_run(const RunConfig& c, bool quiet) {
-  if (c.dimension == 2) return std::make_unique<StrengthReductionRun<2>>(c, quiet);
-  return std::make_unique<StrengthReductionRun<3>>(c, quiet);
+std::unique_ptr<SimulationModel> make_strength_reduction_run(const RunConfig& c, bool quiet,
+                                                             std::shared_ptr<const Communicator> comm) {
+  if (c.dimension == 2) return std::make_unique<StrengthReductionRun<2>>(c, quiet, std::move(comm));
+  return std::make_unique<StrengthReductionRun<3>>(c, quiet, std::move(comm));
 }
 
 }  // namespace geohaz::sph

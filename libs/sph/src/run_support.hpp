@@ -71,11 +71,15 @@ std::vector<std::size_t> reported_structures(const RunConfig& c, const std::vect
 /// position_at_build (the positions of the last neighbour-list build) is restart state: the list,
 /// hence the Verlet-skin decisions and the order of the pair sums, is rebuilt from it.
 /// `pore_pressure` (a run with pore water): pore_pressure too (Pa; recomputed from the position in
-/// every step, so a restart does not need it).
+/// every step, so a restart does not need it). Only the first `count` particles (a rank's owned
+/// ones; a rank writing none of a state every rank holds: 0).
 template <int Dim>
-void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int64_t step, bool pore_pressure = false);
+void write_fields(SnapshotWriter& w, const SphStore<Dim>& s, double t, std::int64_t step, bool pore_pressure = false,
+                  std::size_t count = static_cast<std::size_t>(-1));
 
-/// A snapshot of the solver's store and, as a root attribute, its solver state (SolverState).
+/// A snapshot of the solver's store (its owned particles over several ranks, which write it together
+/// through a SnapshotWriter of several processes) and, as a root attribute, its solver state
+/// (SolverState, the same on every rank).
 template <int Dim>
 void write_snapshot(SnapshotWriter& w, const SphSolver<Dim>& solver, std::int64_t step);
 

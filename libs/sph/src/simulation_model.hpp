@@ -30,11 +30,10 @@ class SimulationModel {
   virtual std::vector<NamedTable> tables() const = 0;
   virtual ParticleFields particles() const = 0;
   /// The state a snapshot shows now (SphRunFiles: at the start, at snapshot times, at the end).
+  /// Over several ranks collective: every rank writes its part through the same writer.
   virtual void write_snapshot(SnapshotWriter& w) const = 0;
-  /// Over several ranks: gather the whole state for write_snapshot (collective: every rank calls it
-  /// where rank 0 may write a snapshot). Nothing on one process.
-  virtual void gather_for_output() {}
-  /// Quick-look PNGs whose time has come (before a main-phase step).
+  /// Quick-look PNGs whose time has come (before a main-phase step). Over several ranks collective
+  /// (the whole state is gathered for a picture), rank 0 draws.
   virtual void draw_due_pngs(const std::filesystem::path& out) = 0;
   /// Every output of a finished run into `out`; a line on stderr unless quiet.
   virtual void write_outputs(const std::filesystem::path& out) const = 0;
@@ -140,7 +139,9 @@ std::unique_ptr<SimulationModel> make_limit_equilibrium_run(const RunConfig& c, 
 std::unique_ptr<SimulationModel> make_dynamic_run(const RunConfig& c, bool quiet,
                                                   std::shared_ptr<const Communicator> comm = nullptr);
 
-/// The analysis run.analysis = strength_reduction (run_strength_reduction.cpp) in the config's dimension.
-std::unique_ptr<SimulationModel> make_strength_reduction_run(const RunConfig& c, bool quiet);
+/// The analysis run.analysis = strength_reduction (run_strength_reduction.cpp) in the config's dimension;
+/// with `comm` the geostatic phase and every trial over its ranks.
+std::unique_ptr<SimulationModel> make_strength_reduction_run(const RunConfig& c, bool quiet,
+                                                             std::shared_ptr<const Communicator> comm = nullptr);
 
 }  // namespace geohaz::sph

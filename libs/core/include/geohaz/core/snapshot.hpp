@@ -11,6 +11,12 @@
 /// Each snapshot is flushed when written, so a run killed mid-way leaves a readable file with the
 /// snapshots written so far; the .xmf file is rewritten (atomically) after each snapshot.
 /// The position field (label "position") is the XDMF geometry; every other field an attribute.
+///
+/// Several processes (a run spread over MPI ranks, issue #36) write one such file together: each
+/// rank its own particles into a part file beside it (snapshots.rank0001.h5, ...), and the file
+/// itself joins the parts into one dataset per field (HDF5 virtual datasets), so a reader, ParaView
+/// through the XDMF file, or h5py sees every particle as from one process (root attributes "ranks"
+/// and "part_files" say it was written so; the part files must stay beside it).
 
 #include <cstdint>
 #include <filesystem>
@@ -20,6 +26,7 @@
 #include <string_view>
 #include <vector>
 
+#include "geohaz/core/communicator.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/particles.hpp"
 
@@ -58,7 +65,12 @@ class SnapshotWriter {
   /// \param model     "sph-slope", "debris-runout", "dem-avalanche".
   /// \param dimension 2 or 3 (geometry of the "position" field).
   /// \param resolved_config TOML text stored as an attribute.
-  SnapshotWriter(const std::filesystem::path& h5_path, std::string model, int dimension, std::string resolved_config);
+  /// \param comm     over several ranks (collective from here on: every rank constructs the writer
+  ///                 with the same arguments and calls write() in the same order, each with its own
+  ///                 particles; set_attribute is rank 0's): the part files and the joining file
+  ///                 above. Null or one rank: one file, as one process writes it.
+  SnapshotWriter(const std::filesystem::path& h5_path, std::string model, int dimension, std::string resolved_config,
+                 std::shared_ptr<const Communicator> comm = nullptr);
   ~SnapshotWriter();
   SnapshotWriter(const SnapshotWriter&) = delete;
   SnapshotWriter& operator=(const SnapshotWriter&) = delete;

@@ -301,6 +301,7 @@ class SphSimulation {
  private:
   friend class SphRunFiles;
   friend void write_outputs(const SphSimulation& sim, const std::filesystem::path& out);
+  friend void run_with_outputs(SphSimulation& sim, const std::filesystem::path& out, bool quiet, RunObserver* observer);
   struct Impl;
   const RunConfig& cfg_;
   std::unique_ptr<Impl> impl_;
@@ -319,16 +320,16 @@ void run_with_outputs(SphSimulation& sim, const std::filesystem::path& out, bool
 
 /// The whole `sph-slope` run of a validated config: build, run with outputs into `out` (created).
 /// Returns the process exit code (0). With `comm`, over its ranks (SphSimulation): every rank calls
-/// it, rank 0 with the output folder, the others with an empty `out` (they write nothing).
+/// it with the same `out`; rank 0 makes the folder and writes the outputs, every rank its part of
+/// the snapshots (core SnapshotWriter over several processes; the folder must be on a file system
+/// every rank sees).
 int run_case(const RunConfig& cfg, const std::filesystem::path& out, bool quiet,
              std::shared_ptr<const Communicator> comm = nullptr);
 
 /// What a run over several ranks cannot do yet (issue #36; docs/sph.md, "Domain decomposition"):
-/// InputError naming the key for the strength reduction and the limit-equilibrium analysis
-/// (run.analysis), a restart (run.restart), quick-look PNGs during the run (run.velocity_png_times)
-/// and the total-Lagrangian formulation (numerics.formulation). The dynamic analysis runs, with its
-/// series, summary, outputs and snapshots (written by rank 0 from the gathered state, without the
-/// solver state: a restart from them continues on one process with a fresh neighbour list).
+/// InputError naming the key for the total-Lagrangian formulation (numerics.formulation). Every
+/// analysis runs (the dynamic one and the strength reduction with the particles over the ranks, the
+/// limit-equilibrium one on every rank alike), with its outputs, snapshots and restarts.
 void check_distributable(const RunConfig& cfg);
 
 }  // namespace geohaz::sph

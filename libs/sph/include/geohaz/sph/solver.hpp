@@ -210,7 +210,9 @@ class SphSolver {
   /// Continue from a restored store (all fields of the snapshot, PositionAtBuild included) and the
   /// state written with it: the neighbour list is rebuilt from the positions of its last build, in
   /// the store's order, so that the Verlet-skin decisions and the order of every pair sum are those
-  /// of the run that wrote the snapshot.
+  /// of the run that wrote the snapshot. Over several ranks (after distribute(), from a file of any
+  /// rank count) the first step partitions and builds the lists afresh: the same pairs, summed in
+  /// another order (round-off).
   void resume(const SolverState& s);
   /// Scale of gravity (0..1) used by the next steps.
   void set_gravity_factor(double f) noexcept { gravity_factor_ = f; }
