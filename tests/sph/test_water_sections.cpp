@@ -34,6 +34,7 @@
 #include "geohaz/sph/summary_keys.hpp"
 #include "run_command.hpp"
 #include "summary_keys_check.hpp"
+#include "utm_crs.hpp"
 
 namespace {
 
@@ -51,15 +52,7 @@ constexpr double kG = 9.81, kGammaW = 1000.0 * kG;
 const double kSlope = std::atan(0.5);  // the plane's inclination (rad)
 
 std::string utm(int zone) {
-  const int cm = -183 + 6 * zone;
-  return "PROJCS[\"WGS 84 / UTM zone " + std::to_string(zone) +
-         "N\",GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],PRIMEM["
-         "\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]],PROJECTION[\"Transverse_Mercator\"],PARAMETER["
-         "\"latitude_of_origin\",0],PARAMETER[\"central_meridian\"," +
-         std::to_string(cm) +
-         "],PARAMETER[\"scale_factor\",0.9996],PARAMETER[\"false_easting\",500000],PARAMETER[\"false_northing\",0],"
-         "UNIT[\"metre\",1],AUTHORITY[\"EPSG\",\"" +
-         std::to_string(32600 + zone) + "\"]]";
+  return geohaz::testing::utm_wkt(zone);
 }
 
 /// The ground: a plane falling 0.5 m per m eastwards from 60 m, 120 m × 40 m at 2 m cells.

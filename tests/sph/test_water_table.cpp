@@ -21,6 +21,7 @@
 #include "geohaz/sph/config.hpp"
 #include "geohaz/sph/run.hpp"
 #include "run_command.hpp"
+#include "utm_crs.hpp"
 
 namespace {
 
@@ -36,15 +37,7 @@ constexpr double kX0 = 500000.0, kY0 = 4000000.0;  // the DSM's north-west corne
 constexpr double kGammaW = 1000.0 * 9.81;
 
 std::string utm(int zone) {
-  const int cm = -183 + 6 * zone;
-  return "PROJCS[\"WGS 84 / UTM zone " + std::to_string(zone) +
-         "N\",GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],PRIMEM["
-         "\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]],PROJECTION[\"Transverse_Mercator\"],PARAMETER["
-         "\"latitude_of_origin\",0],PARAMETER[\"central_meridian\"," +
-         std::to_string(cm) +
-         "],PARAMETER[\"scale_factor\",0.9996],PARAMETER[\"false_easting\",500000],PARAMETER[\"false_northing\",0],"
-         "UNIT[\"metre\",1],AUTHORITY[\"EPSG\",\"" +
-         std::to_string(32600 + zone) + "\"]]";
+  return geohaz::testing::utm_wkt(zone);
 }
 
 /// The ground: a plane falling 0.5 m per m eastwards from 60 m (26.6°), 120 m × 40 m at 2 m cells.

@@ -168,6 +168,15 @@ struct SnapshotWriter::Impl {
   /// particles of rank q's part file.
   void write_virtual_group(const std::string& name, double time, std::int64_t step, const Entry& e,
                            const std::vector<std::size_t>& counts);
+  /// The group /snapshots/`name` (path `gpath`), tracking creation order so the reader lists fields
+  /// in the order the store declares them.
+  Hid create_snapshot_group(const std::string& name, const std::string& gpath) {
+    Hid gcpl = ctx.own(H5Pcreate(H5P_GROUP_CREATE), H5Pclose, "cannot create group " + gpath);
+    ctx.call(H5Pset_link_creation_order(gcpl.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED),
+             "cannot create group " + gpath);
+    return ctx.own(H5Gcreate2(snapshots.get(), name.c_str(), H5P_DEFAULT, gcpl.get(), H5P_DEFAULT), H5Gclose,
+                   "cannot create group " + gpath);
+  }
   static Entry entry_of(double time, std::int64_t step, std::size_t n, std::span<const FieldView> fields,
                         std::size_t line_count);
   std::string xdmf_text() const;
@@ -359,12 +368,7 @@ void SnapshotWriter::Impl::write_group(const std::string& name, double time, std
     check_room(1.1 * bytes, "snapshot " + name);
   }
   try {
-    // Track creation order so the reader lists fields in the order the store declares them.
-    Hid gcpl = ctx.own(H5Pcreate(H5P_GROUP_CREATE), H5Pclose, "cannot create group " + gpath);
-    ctx.call(H5Pset_link_creation_order(gcpl.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED),
-             "cannot create group " + gpath);
-    Hid group = ctx.own(H5Gcreate2(snapshots.get(), name.c_str(), H5P_DEFAULT, gcpl.get(), H5P_DEFAULT), H5Gclose,
-                        "cannot create group " + gpath);
+    Hid group = create_snapshot_group(name, gpath);
     write_fields(group.get(), gpath, fields, lines);
     if (xdmf) ensure_vertex_index(n);
     write_numeric_attribute(ctx, group.get(), "time", H5T_NATIVE_DOUBLE, &time);
@@ -464,11 +468,7 @@ void SnapshotWriter::Impl::write_virtual_group(const std::string& name, double t
                  (vertex_indices.count(e.count) ? 0.0 : 4.0 * static_cast<double>(e.count)),
              "snapshot " + name);
   try {
-    Hid gcpl = ctx.own(H5Pcreate(H5P_GROUP_CREATE), H5Pclose, "cannot create group " + gpath);
-    ctx.call(H5Pset_link_creation_order(gcpl.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED),
-             "cannot create group " + gpath);
-    Hid group = ctx.own(H5Gcreate2(snapshots.get(), name.c_str(), H5P_DEFAULT, gcpl.get(), H5P_DEFAULT), H5Gclose,
-                        "cannot create group " + gpath);
+    Hid group = create_snapshot_group(name, gpath);
     for (const FieldMeta& f : e.fields) {
       const std::string what = "cannot write the virtual dataset " + gpath + "/" + f.label;
       const int comps = f.rows * f.cols, rank = comps == 1 ? 1 : 2;
