@@ -418,7 +418,22 @@ INSTANTIATE_TEST_SUITE_P(DemValidation, SingleBlockOutlineResolution,
                                            BlockResolutionCase{0.2, 1, 10, false, 0, 0.65, true, 0.35},
                                            BlockResolutionCase{0.4, 1, 10, true, 0, 0.65, true, 0.35},
                                            BlockResolutionCase{0.4, 1, 10, true, 2e10, 0.65, true, 0.35},
-                                           BlockResolutionCase{0.2, 1, 10, true, 0, 0.65, true, 0.35}));
+                                           BlockResolutionCase{0.2, 1, 10, true, 0, 0.65, true, 0.35}),
+                         // Names from the fields (gtest would print the struct's bytes, padding included,
+                         // so the ctest names changed from one build to the next).
+                         [](const ::testing::TestParamInfo<BlockResolutionCase>& info) {
+                           const BlockResolutionCase& c = info.param;
+                           const auto milli = [](double v) { return std::to_string(std::lround(v * 1000.0)); };
+                           std::string name = "R" + milli(c.radius) + "mm_seeds" + std::to_string(c.first_seed) + "to" +
+                                              std::to_string(c.last_seed);
+                           if (c.fragment_damping) name += "_fragmentDamping";
+                           if (c.bond_modulus > 0.0)
+                             name += "_bondE" + std::to_string(std::lround(c.bond_modulus / 1e9)) + "GPa";
+                           name += "_rolling" + milli(c.terrain_rolling) + "milli";
+                           if (c.fragment_rolling) name += "_fragmentLever";
+                           name += "_restitution" + milli(c.terrain_restitution) + "milli";
+                           return name;
+                         });
 
 TEST(DemValidation, SingleBlockOutlineResolutionFigure) {
   // Collects the JSON files of SingleBlockOutlineResolution (run those first; skipped when none
