@@ -12,7 +12,10 @@ when:
   - the handed volume lies outside the range documented in docs/workflow.md (the DEMO_VOLUME_RANGE
     line there, so the docs and this check cannot drift apart);
   - the report page does not open in headless Chromium with every image decoded and no error (the
-    page's own #page-check marks, as tests/report/test_report_browser.cpp reads them).
+    page's own #page-check marks, as tests/report/test_report_browser.cpp reads them);
+  - the report's PDF (report.pdf, the page printed by Chromium for a client) is missing, is not a PDF,
+    has a page that is not A4, or has fewer pages than the overview plus one per run (each run
+    starts a new page, docs/report.md).
 Exit 0 when all hold, 1 otherwise. Uses only the Python standard library and Debian's chromium.
 """
 import json
@@ -78,6 +81,31 @@ def page_marks(html, problems):
     print(f"check-demo: report page: {decoded} of {images} images decoded, no error")
 
 
+A4_PT = (595.28, 841.89)  # ISO 216, 210 mm x 297 mm in PostScript points
+
+
+def pdf_pages(pdf, runs, problems):
+    """The page tree as Chromium's PDF writer (Skia) leaves it: one uncompressed page dictionary
+    with its /MediaBox per page, so the standard library suffices (the report's own test uses
+    poppler-utils, tests/report/test_report_browser.cpp)."""
+    if not pdf.is_file():
+        fail(f"{pdf} was not written", problems)
+        return
+    data = pdf.read_bytes()
+    if not data.startswith(b"%PDF-"):
+        fail(f"{pdf}: not a PDF file (starts with {data[:8]!r})", problems)
+        return
+    pages = len(re.findall(rb"/Type\s*/Page(?![a-zA-Z])", data))
+    boxes = [tuple(float(v) for v in m.split()) for m in re.findall(rb"/MediaBox\s*\[([^\]]*)\]", data)]
+    not_a4 = [b for b in boxes if len(b) != 4 or abs(b[2] - b[0] - A4_PT[0]) > 1.0 or abs(b[3] - b[1] - A4_PT[1]) > 1.0]
+    if pages < 1 + runs:
+        fail(f"{pdf}: {pages} pages, fewer than the overview plus one per run ({1 + runs})", problems)
+    elif not boxes or not_a4:
+        fail(f"{pdf}: page sizes {sorted(set(not_a4 or boxes))} are not A4 ({A4_PT[0]} x {A4_PT[1]} pt)", problems)
+    else:
+        print(f"check-demo: report PDF: {pages} A4 pages, {len(data) / 1e6:.1f} MB")
+
+
 def main():
     out = Path(sys.argv[1] if len(sys.argv) > 1 else ROOT / "results" / "demo").resolve()
     problems = []
@@ -111,6 +139,8 @@ def main():
         fail(f"{html} was not written", problems)
     else:
         page_marks(html, problems)
+    runs = sum(1 for d in out.iterdir() if (d / "summary.json").is_file()) if out.is_dir() else 0
+    pdf_pages(out / "report.pdf", runs, problems)
     if problems:
         print(f"check-demo: {len(problems)} problem(s) in {out}", file=sys.stderr)
         return 1
