@@ -409,10 +409,18 @@ const char* kStyle =
     "ul.files{columns:3;font-size:85%}.map-problem{color:#c00;font-weight:bold}"
     ".bar{display:inline-block;height:0.8em;background:#4a6fa5}"
     // Print (geohaz-report --pdf, or the browser's own print): A4, each run from a new page,
-    // figures and tables never cut, pictures as wide as the page allows.
+    // figures and tables never cut, pictures as large as the page allows. A picture taller than the
+    // page (a map of a valley running north-south) cannot avoid a break, so Chromium cut it and put
+    // its legend alone on the next page: no picture is taller than the 273 mm of A4 inside the
+    // margins less room for its caption (the width follows, keeping its aspect). Nothing is wider
+    // than the page either: a table of many columns whose values do not break (the SPH run's
+    // structure loads and materials) made Chromium lay the page out wider and scale it all down to
+    // A4, and a map limited by the page's height came out at 0.67 of it; in print the cells wrap.
     "@page{size:A4;margin:12mm}@media print{body{margin:0;max-width:none;font-size:10pt}"
     "section{break-before:page;border-top:none}figure,table,tr,svg,img{break-inside:avoid}"
-    "img{max-width:100%;height:auto}figure{display:block;margin:0 0 4mm 0}figcaption{max-width:none}"
+    "img{max-width:100%;max-height:230mm;width:auto;height:auto}figure{display:block;margin:0 0 4mm 0}"
+    "figcaption{max-width:none}table{max-width:100%}td,th{font-size:8pt;padding:1px 4px;"
+    "overflow-wrap:anywhere}td.v{white-space:normal}"
     "details{display:block}details>summary{list-style:none}}";
 
 // The page checks itself on load: every image decoded, no resource or script error. The result is

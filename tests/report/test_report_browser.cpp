@@ -322,6 +322,47 @@ TEST(ReportInBrowser, CalibrationShowsBestSetAcceptableSetMorrisMapAndProfile) {
 
 // Issue #33 item 6: `geohaz-report --pdf` prints the page to an A4 PDF, each run from a new page.
 // pdfinfo gives the page count and size, pdftoppm renders the first page, which must not be blank.
+namespace {
+
+// Adds to a run's summary a table the report shows open (the barriers), 12 columns of values that
+// do not break on screen (td.v is nowrap there), about 1,700 px wide: as the SPH run's tables of
+// structure loads and materials, which made Chromium lay the printed page out wider than A4 and
+// scale it down, so a map limited by the page's height came out at 0.67 of it.
+void write_wide_table(const fs::path& summary) {
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(summary));
+  for (const char* name : {"check dam upstream", "check dam downstream"}) {
+    nlohmann::json row = {{"name", name}};
+    for (int k = 0; k < 11; ++k) row["load_" + std::to_string(k)] = std::to_string(k + 1) + "23.456 kN/m at 12.5 s";
+    j["barriers"].push_back(row);
+  }
+  write_file(summary, j.dump(1));
+}
+
+// A map taller than wide, as a valley running north-south gives (the demo's run-out): printed at
+// the page's width it would be taller than A4.
+void write_tall_map(const fs::path& png) {
+  geohaz::Raster tall;
+  tall.nx = 40;
+  tall.ny = 160;
+  tall.geotransform = {600000.0, 5.0, 0.0, 5100000.0, 0.0, -5.0};
+  tall.data.resize(static_cast<std::size_t>(tall.nx) * tall.ny);
+  geohaz::Raster speed = tall;
+  for (int r = 0; r < tall.ny; ++r)
+    for (int c = 0; c < tall.nx; ++c) {
+      tall.at(c, r) = 1500.0 - 4.0 * r + 0.5 * std::abs(c - 20.0);
+      speed.at(c, r) = std::abs(c - 20) < 4 ? 0.1 * r : 0.0;
+    }
+  geohaz::QuicklookOptions o;
+  o.title = "peak speed";
+  o.unit = "m/s";
+  o.overlay_min = 0.01;
+  o.scale_bar = true;
+  o.north_arrow = true;
+  geohaz::write_quicklook_png(png, tall, &speed, o);
+}
+
+}  // namespace
+
 TEST(ReportInBrowser, PdfIsA4WithARunPerPageAndAFirstPageThatShowsSomething) {
   if (geohaz::report::find_chromium().empty()) GTEST_SKIP() << "chromium is not installed (scripts/setup)";
   if (run_command("command -v pdfinfo && command -v pdftoppm").code != 0)
@@ -331,6 +372,8 @@ TEST(ReportInBrowser, PdfIsA4WithARunPerPageAndAFirstPageThatShowsSomething) {
   fs::remove_all(root);
   make_results(root / "results");
   const fs::path results = root / "results";
+  write_tall_map(results / "1-runout" / "max_speed.png");
+  write_wide_table(results / "1-runout" / "summary.json");
   const auto gen = run_command(std::string("'") + GEOHAZ_REPORT_EXE + "' '" + results.string() + "' --pdf");
   ASSERT_EQ(gen.code, 0) << gen.output;
   ASSERT_TRUE(fs::exists(results / "report.pdf"));
@@ -347,6 +390,34 @@ TEST(ReportInBrowser, PdfIsA4WithARunPerPageAndAFirstPageThatShowsSomething) {
   EXPECT_LE(pages, 8) << info.output;
   const auto text = run_command("pdftotext -f 2 -l 2 '" + (results / "report.pdf").string() + "' -");
   EXPECT_EQ(text.output.rfind("1-runout", 0), 0u) << text.output.substr(0, 200);  // page 2 opens the first run
+  // No picture is cut by a page break: a cut leaves the rest of the picture (a map's legend) alone on
+  // the next page, a page without text; every page of the report carries a heading or a caption.
+  for (int p = 1; p <= pages; ++p) {
+    const auto page = run_command("pdftotext -f " + std::to_string(p) + " -l " + std::to_string(p) + " '" +
+                                  (results / "report.pdf").string() + "' -");
+    EXPECT_NE(page.output.find_first_not_of(" \t\n\f"), std::string::npos) << "page " << p << " has no text";
+  }
+  // The tall map printed at its full size, 230 mm high (the print style's max-height), not shrunk
+  // with the whole page to fit a wide table: its printed height from pdfimages' resolution.
+  const geohaz::Image tall = geohaz::read_image(results / "1-runout" / "max_speed.png");
+  const auto list = run_command("pdfimages -list '" + (results / "report.pdf").string() + "'");
+  ASSERT_EQ(list.code, 0) << list.output;
+  std::istringstream rows(list.output);
+  std::string line;
+  double printed_mm = -1.0;
+  while (std::getline(rows, line)) {
+    // page num type width height color comp bpc enc interp object ID x-ppi y-ppi size ratio
+    std::istringstream f(line);
+    std::string page, num, type, enc, interp, object, id, colour;
+    int width = 0, height = 0, comp = 0, bpc = 0;
+    double xppi = 0.0, yppi = 0.0;
+    if (!(f >> page >> num >> type >> width >> height >> colour >> comp >> bpc >> enc >> interp >> object >> id >>
+          xppi >> yppi))
+      continue;
+    if (type == "image" && width == tall.width && height == tall.height && yppi > 0.0)
+      printed_mm = height / yppi * 25.4;
+  }
+  EXPECT_NEAR(printed_mm, 230.0, 230.0 * 0.03) << list.output;
   const auto ppm = run_command("pdftoppm -f 1 -l 1 -r 40 -png '" + (results / "report.pdf").string() + "' '" +
                                (root / "page").string() + "'");
   ASSERT_EQ(ppm.code, 0) << ppm.output;
