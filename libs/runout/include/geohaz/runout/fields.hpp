@@ -123,10 +123,11 @@ struct Leaving {
   static constexpr const char* unit = "1";
 };
 
-/// Memory of the Herschel–Bulkley step (friction/herschel_bulkley.hpp), whose Newton iteration
-/// starts from the particle's last basal state: the excess basal shear stress ζ = τ_b − τ_y of its
-/// last moving step (Pa) and the shear rate at the bed there, γ̇_b = (ζ/K)^{1/n} (1/s). Zero (no
-/// memory: a cold start) for the other laws, at rest and for new particles.
+/// Memory of the Herschel–Bulkley and Bingham steps (friction/herschel_bulkley.hpp, bingham.hpp),
+/// whose root finders start from the particle's last basal state: the excess basal shear stress
+/// ζ = τ_b − τ_y of its last moving step (Pa) and the shear rate at the bed there, γ̇_b = (ζ/K)^{1/n}
+/// (Bingham: ζ/μ_B; 1/s). Zero (no memory: a cold start) for the other laws, at rest and for new
+/// particles.
 struct BasalExcessStress {
   using type = double;
   static constexpr const char* label = "basal_excess_stress";
