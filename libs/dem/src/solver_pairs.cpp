@@ -88,8 +88,14 @@ void DemSolver::pair_forces(const Law& law_in) {
   reactions_.resize(pb.slots());
   PairReaction* const reactions = reactions_.data();
   const auto nblocks = static_cast<std::int64_t>(pb.count());
-  const auto block = [=, this](std::size_t b, auto layout) {
+  // Without rolling resistance (μ_r ≤ 0: every contact's μ_r is 0, a joint's too) and without
+  // joints, a second version of the loop: its μ_r is the constant 0, so the compiler drops the
+  // rolling branch of the friction update (roll = 0 there as before) and what only it reads (R*
+  // of the linear law, ω_i − ω_j), and the joint test.
+  const bool plain = !(mu_r > 0.0) && !any_joints;
+  const auto block = [=, this](std::size_t b, auto layout, auto general_tag) {
     constexpr bool same = decltype(layout)::value;
+    constexpr bool general = decltype(general_tag)::value;
     PairReaction* const react = pb.buffer(reactions, b);  // react[j]: the reactions on disc j
     std::fill(react + pb.first(b), react + pb.window_end(b), PairReaction{});
     for (std::size_t i = pb.first(b); i < pb.last(b); ++i) {
@@ -111,8 +117,8 @@ void DemSolver::pair_forces(const Law& law_in) {
         const double r = std::sqrt(r2);
         const double delta = Rs - r;
         double nx = dx / r, ny = dy / r;
-        double mu_c = mu, mu_rc = mu_r;
-        if (any_joints) {
+        double mu_c = mu, mu_rc = general ? mu_r : 0.0;
+        if (general && any_joints) {
           if (const JointPair* jp = joint_between(id[i], id[j])) {
             const bool along = jp->normal.x() * nx + jp->normal.y() * ny >= 0;
             nx = along ? jp->normal.x() : -jp->normal.x();
@@ -177,10 +183,15 @@ void DemSolver::pair_forces(const Law& law_in) {
   };
 #pragma omp parallel for schedule(static) if (parallel_worth(n))
   for (std::int64_t bb = 0; bb < nblocks; ++bb) {
-    if (same_layout)
-      block(static_cast<std::size_t>(bb), std::true_type{});
+    const auto b = static_cast<std::size_t>(bb);
+    if (same_layout && plain)
+      block(b, std::true_type{}, std::false_type{});
+    else if (same_layout)
+      block(b, std::true_type{}, std::true_type{});
+    else if (plain)
+      block(b, std::false_type{}, std::false_type{});
     else
-      block(static_cast<std::size_t>(bb), std::false_type{});
+      block(b, std::false_type{}, std::true_type{});
   }
   gather_pair_reactions();
   if (!same_layout) {
