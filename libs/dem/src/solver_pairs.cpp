@@ -88,11 +88,13 @@ void DemSolver::pair_forces(const Law& law_in) {
   reactions_.resize(pb.slots());
   PairReaction* const reactions = reactions_.data();
   const auto nblocks = static_cast<std::int64_t>(pb.count());
-  // Without rolling resistance (μ_r ≤ 0: every contact's μ_r is 0, a joint's too) and without
-  // joints, a second version of the loop: its μ_r is the constant 0, so the compiler drops the
-  // rolling branch of the friction update (roll = 0 there as before) and what only it reads (R*
-  // of the linear law, ω_i − ω_j), and the joint test.
-  const bool plain = !(mu_r > 0.0) && !any_joints;
+  // Without rolling resistance (μ_r ≤ 0: every contact's μ_r is 0, a joint's too), joints and
+  // kinematic discs, a second version of the loop: its μ_r is the constant 0, so the compiler drops
+  // the rolling branch of the friction update (roll = 0 there as before) and what only it reads (R*
+  // of the linear law, ω_i − ω_j), and the joint test; every m* is the two-body one.
+  std::uint8_t any_kinematic = 0;
+  for (std::size_t i = 0; i < n; ++i) any_kinematic |= kin[i];
+  const bool plain = !(mu_r > 0.0) && !any_joints && !any_kinematic;
   const auto block = [=, this](std::size_t b, auto layout, auto general_tag) {
     constexpr bool same = decltype(layout)::value;
     constexpr bool general = decltype(general_tag)::value;
@@ -129,7 +131,7 @@ void DemSolver::pair_forces(const Law& law_in) {
         }
         const double tx = -ny, ty = nx;  // t = ẑ × n
         const double mj = m[j];
-        const double meff = kin[j] == kini ? mi * mj / (mi + mj) : (kin[j] ? mi : mj);
+        const double meff = !general || kin[j] == kini ? mi * mj / (mi + mj) : (kin[j] ? mi : mj);
         const double reff = Ri * Rj / Rs;
         const ContactResponse c = law.evaluate(delta, meff, reff, Rs, zeta);
         // Levers to the common contact point (mid-overlap), so the pair of shear forces is a zero
