@@ -193,6 +193,7 @@ void DemSolver::initialise() {
   }
   update_neighbours(-1.0);  // configure() asked for a rebuild
   same_layout_ = false;
+  near_valid_ = false;
   update_time_step();
 }
 
@@ -203,6 +204,7 @@ void DemSolver::update_neighbours(double max_drift) {
   if (!u.rebuilt) return;
   if (u.reordered()) reorder(u.permutation);
   same_layout_ = false;
+  near_valid_ = false;  // the wall candidates go with the positions of the build
   // The reaction window of the half-pair pass: the largest j − i of a listed pair (all j > i),
   // found by the list build.
   pair_blocks_ = PairBlocks::choose(nb_.size(), nb_.list().forward_reach());
@@ -377,6 +379,55 @@ void DemSolver::reset_walls() {
   }
 }
 
+void DemSolver::update_wall_candidates() {
+  const std::size_t n = discs.size(), nw = walls.size();
+  bool valid = near_valid_ && near_wall_.size() == n && near_boxes_.size() == nw;
+  for (std::size_t k = 0; k < nw && valid; ++k) {
+    const auto& now = wall_boxes_[k];
+    const auto& was = near_boxes_[k];
+    valid = now[0] >= was[0] && now[1] >= was[1] && now[2] <= was[2] && now[3] <= was[3];
+  }
+  if (valid) return;
+  // A disc stays within h of its position at the list build (the rebuild rule, drift ≤ skin/2;
+  // 1 % more for the rounding of that test); each wall may move by up to h before the flags are
+  // set again, so a disc is flagged within 2h of a wall's box. Terrain is static.
+  const double h = 0.505 * skin_;
+  near_boxes_.resize(nw);
+  flag_boxes_.resize(nw);
+  for (std::size_t k = 0; k < nw; ++k) {
+    const auto& b = wall_boxes_[k];
+    near_boxes_[k] = {b[0] - h, b[1] - h, b[2] + h, b[3] + h};
+    flag_boxes_[k] = {Vec2(b[0] - 2 * h, b[1] - 2 * h), Vec2(b[2] + 2 * h, b[3] + 2 * h)};
+  }
+  near_wall_.resize(n);
+  const Vec2* const xb = discs.get<PositionAtBuild>().data();
+  const double* const R = discs.get<Radius>().data();
+  const auto* const WC = discs.get<WallContacts>().data();
+  const auto* const boxes = flag_boxes_.data();
+  std::uint8_t* const near = near_wall_.data();
+  const bool any_terrain = terrain.size() > 0;
+  const double reach = 1.1 * rmax_;  // as the wall boxes (radii grow while packing)
+  const auto nn = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(static) if (parallel_worth(nn))
+  for (std::int64_t ii = 0; ii < nn; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    const Vec2 p = xb[i];
+    bool flag = WC[i](0, 0) >= 0.0;
+    // In box k iff lo − p ≤ 0 and p − hi ≤ 0 on both axes (a difference of two doubles is
+    // positive exactly when the first is larger); both axes at once, no early exit.
+    for (std::size_t k = 0; k < nw; ++k) flag |= (boxes[k][0] - p).cwiseMax(p - boxes[k][1]).maxCoeff() <= 0.0;
+    near[i] = flag;
+  }
+  if (any_terrain) {
+#pragma omp parallel for schedule(static) if (parallel_worth(nn))
+    for (std::int64_t ii = 0; ii < nn; ++ii) {
+      const auto i = static_cast<std::size_t>(ii);
+      if (!near[i]) near[i] = terrain.near(xb[i], h, std::max(reach, R[i]));
+    }
+  }
+  near_valid_ = true;
+}
+
 template <class Law>
 void DemSolver::wall_forces(const Law& law) {
   const std::size_t nw = walls.size();
@@ -402,17 +453,21 @@ void DemSolver::wall_forces(const Law& law) {
   if (frag_mass || frag_roll) update_fragments();
   if (frag_roll) roll_moment_.assign(discs.size(), 0.0);
   reset_walls();
+  update_wall_candidates();
 #pragma omp parallel if (parallel_worth(n))
   {
     std::vector<Vec2> wf(nw, Vec2::Zero());
     std::vector<double> wk(nw, 0.0);
     std::vector<int> wn(nw, 0);
     // Private pointers for the candidate test: kept in registers.
-    const auto [boxes, kinematic, position, history] = std::tuple(wall_boxes_.data(), kin.data(), x.data(), WC.data());
+    const auto [boxes, kinematic, position, history, near] =
+        std::tuple(wall_boxes_.data(), kin.data(), x.data(), WC.data(), near_wall_.data());
 #pragma omp for schedule(static)
     for (std::int64_t ii = 0; ii < n; ++ii) {
       const auto i = static_cast<std::size_t>(ii);
-      if (kinematic[i]) continue;
+      // Far from every wall and terrain segment since the list build, without a wall contact
+      // then (update_wall_candidates): none now either; the tests below would find nothing.
+      if (!near[i] || kinematic[i]) continue;
       const Vec2 xi = position[i];
       const bool had = history[i](0, 0) >= 0.0;  // slots are filled from the first one
       // Most discs are far from every wall and terrain segment and had no wall contact: nothing

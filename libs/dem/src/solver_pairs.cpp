@@ -88,8 +88,16 @@ void DemSolver::pair_forces(const Law& law_in) {
   reactions_.resize(pb.slots());
   PairReaction* const reactions = reactions_.data();
   const auto nblocks = static_cast<std::int64_t>(pb.count());
-  const auto block = [=, this](std::size_t b, auto layout) {
+  // Without rolling resistance (μ_r ≤ 0: every contact's μ_r is 0, a joint's too), joints and
+  // kinematic discs, a second version of the loop: its μ_r is the constant 0, so the compiler drops
+  // the rolling branch of the friction update (roll = 0 there as before) and what only it reads (R*
+  // of the linear law, ω_i − ω_j), and the joint test; every m* is the two-body one.
+  std::uint8_t any_kinematic = 0;
+  for (std::size_t i = 0; i < n; ++i) any_kinematic |= kin[i];
+  const bool plain = !(mu_r > 0.0) && !any_joints && !any_kinematic;
+  const auto block = [=, this](std::size_t b, auto layout, auto general_tag) {
     constexpr bool same = decltype(layout)::value;
+    constexpr bool general = decltype(general_tag)::value;
     PairReaction* const react = pb.buffer(reactions, b);  // react[j]: the reactions on disc j
     std::fill(react + pb.first(b), react + pb.window_end(b), PairReaction{});
     for (std::size_t i = pb.first(b); i < pb.last(b); ++i) {
@@ -111,8 +119,8 @@ void DemSolver::pair_forces(const Law& law_in) {
         const double r = std::sqrt(r2);
         const double delta = Rs - r;
         double nx = dx / r, ny = dy / r;
-        double mu_c = mu, mu_rc = mu_r;
-        if (any_joints) {
+        double mu_c = mu, mu_rc = general ? mu_r : 0.0;
+        if (general && any_joints) {
           if (const JointPair* jp = joint_between(id[i], id[j])) {
             const bool along = jp->normal.x() * nx + jp->normal.y() * ny >= 0;
             nx = along ? jp->normal.x() : -jp->normal.x();
@@ -123,7 +131,7 @@ void DemSolver::pair_forces(const Law& law_in) {
         }
         const double tx = -ny, ty = nx;  // t = ẑ × n
         const double mj = m[j];
-        const double meff = kin[j] == kini ? mi * mj / (mi + mj) : (kin[j] ? mi : mj);
+        const double meff = !general || kin[j] == kini ? mi * mj / (mi + mj) : (kin[j] ? mi : mj);
         const double reff = Ri * Rj / Rs;
         const ContactResponse c = law.evaluate(delta, meff, reff, Rs, zeta);
         // Levers to the common contact point (mid-overlap), so the pair of shear forces is a zero
@@ -177,10 +185,15 @@ void DemSolver::pair_forces(const Law& law_in) {
   };
 #pragma omp parallel for schedule(static) if (parallel_worth(n))
   for (std::int64_t bb = 0; bb < nblocks; ++bb) {
-    if (same_layout)
-      block(static_cast<std::size_t>(bb), std::true_type{});
+    const auto b = static_cast<std::size_t>(bb);
+    if (same_layout && plain)
+      block(b, std::true_type{}, std::false_type{});
+    else if (same_layout)
+      block(b, std::true_type{}, std::true_type{});
+    else if (plain)
+      block(b, std::false_type{}, std::false_type{});
     else
-      block(static_cast<std::size_t>(bb), std::false_type{});
+      block(b, std::false_type{}, std::true_type{});
   }
   gather_pair_reactions();
   if (!same_layout) {

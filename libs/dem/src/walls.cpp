@@ -64,6 +64,23 @@ std::pair<const std::uint32_t*, const std::uint32_t*> TerrainSegments::candidate
   return {index_.data() + start_[c], index_.data() + start_[c + 1]};
 }
 
+bool TerrainSegments::near(const Vec2& p, double dx, double reach) const noexcept {
+  if (start_.empty()) return false;
+  const double nb = static_cast<double>(start_.size() - 1);
+  const double u0 = (p.x() - dx - x0_) / dx_, u1 = (p.x() + dx - x0_) / dx_;
+  if (!(u1 >= 0) || !(u0 < nb)) return false;  // candidates() is empty along the whole interval
+  const auto c0 = static_cast<std::size_t>(std::max(u0, 0.0));
+  const auto c1 = static_cast<std::size_t>(std::min(u1, nb - 1.0));
+  const double g = reach + dx;
+  for (std::uint32_t q = start_[c0]; q < start_[c1 + 1]; ++q) {
+    const WallSegment& s = segs_[index_[q]];
+    if (p.x() >= std::min(s.a.x(), s.b.x()) - g && p.x() <= std::max(s.a.x(), s.b.x()) + g &&
+        p.y() >= std::min(s.a.y(), s.b.y()) - g && p.y() <= std::max(s.a.y(), s.b.y()) + g)
+      return true;
+  }
+  return false;
+}
+
 double TerrainSegments::elevation(double x) const noexcept {
   double z = std::numeric_limits<double>::quiet_NaN();
   for (const auto& s : segs_) {

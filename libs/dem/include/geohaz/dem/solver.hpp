@@ -113,7 +113,17 @@ class DemSolver {
   /// Zero the walls' force sums for this step and set their bounding boxes (grown by 1.1 R_max).
   void reset_walls();
   std::vector<std::array<double, 4>> wall_boxes_;  ///< per wall: x_lo, y_lo, x_hi, y_hi (empty if inactive)
-  void update_neighbours(double max_drift);        // max_drift < 0: computed
+  /// Per disc, whether the wall pass must look at it (near_wall_): it had a wall contact, or its
+  /// position at the list build lies within skin of a wall box or near a terrain segment. No disc
+  /// drifts more than skin/2 from that position before the next build, so the others cannot touch
+  /// a wall while each wall's box stays inside near_boxes_ (its box when the flags were set,
+  /// grown by skin/2). Set again after every list build and whenever a wall leaves its box.
+  void update_wall_candidates();
+  std::vector<std::uint8_t> near_wall_;
+  std::vector<std::array<double, 4>> near_boxes_;
+  std::vector<std::array<Vec2, 2>> flag_boxes_;  // lower and upper corners, grown by skin
+  bool near_valid_ = false;
+  void update_neighbours(double max_drift);  // max_drift < 0: computed
   void reorder(std::span<const std::uint32_t> order);
   void rebuild_id_index();
   void rebuild_bond_index();

@@ -72,6 +72,10 @@ class TerrainSegments {
   const WallSegment& segment(std::size_t k) const noexcept { return segs_[k]; }
   /// Segments whose x-range (expanded by max_reach) covers x: [begin, end) into index().
   std::pair<const std::uint32_t*, const std::uint32_t*> candidates(double x) const noexcept;
+  /// Whether a disc whose centre stays within dx of p along each axis (its drift since p) could be
+  /// within reach of a segment that candidates() lists for its position: a segment of the bins of
+  /// [p.x − dx, p.x + dx] whose bounding box grown by reach + dx holds p.
+  bool near(const Vec2& p, double dx, double reach) const noexcept;
   /// Terrain elevation (highest segment) under x, or NaN.
   double elevation(double x) const noexcept;
   const std::vector<WallSegment>& segments() const noexcept { return segs_; }
