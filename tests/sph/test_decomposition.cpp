@@ -127,8 +127,45 @@ nlohmann::json summary(const fs::path& dir) {
   return nlohmann::json::parse(in);
 }
 
+/// A CSV file of numbers: its header and its rows.
+std::pair<std::string, std::vector<std::vector<double>>> read_csv(const fs::path& path) {
+  std::ifstream in(path);
+  std::string header, line;
+  std::getline(in, header);
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::istringstream is(line);
+    std::string cell;
+    while (std::getline(is, cell, ',')) row.push_back(cell.empty() ? 0.0 : std::stod(cell));
+    rows.push_back(row);
+  }
+  return {header, rows};
+}
+
+/// The tables a distributed run makes by reductions over the ranks (series rows, the final
+/// profiles; docs/sph.md "Outputs by reduction") against one process: the same columns and rows,
+/// every value within `tolerance` (relative to the larger, or absolute below 1).
+void expect_same_tables(const fs::path& one, const fs::path& many, double tolerance,
+                        std::vector<std::string> files = {"series.csv", "surface_final.csv", "slip_surface.csv"}) {
+  for (const auto& f : files) {
+    const auto [ha, a] = read_csv(one / f);
+    const auto [hb, b] = read_csv(many / f);
+    EXPECT_EQ(ha, hb) << f;
+    ASSERT_EQ(a.size(), b.size()) << f;
+    if (f != "slip_surface.csv") EXPECT_FALSE(a.empty()) << f;  // no slip in a short run: empty alike
+    for (std::size_t r = 0; r < a.size(); ++r) {
+      ASSERT_EQ(a[r].size(), b[r].size()) << f << " row " << r;
+      for (std::size_t c = 0; c < a[r].size(); ++c)
+        EXPECT_LE(std::abs(a[r][c] - b[r][c]), tolerance * std::max({1.0, std::abs(a[r][c]), std::abs(b[r][c])}))
+            << f << " row " << r << " column " << c << ": " << a[r][c] << " vs " << b[r][c];
+    }
+  }
+}
+
 /// sph-slope on one process and sph-slope-mpi on np ranks with the same arguments: both succeed,
-/// and the summaries' numbers agree to `tolerance` (relative to the larger, or absolute below 1).
+/// and the summaries' numbers agree to `tolerance` (relative to the larger, or absolute below 1),
+/// as do the series and the final profiles (expect_same_tables).
 void expect_same_summary(const std::string& name, const std::string& args, int np, const std::vector<std::string>& keys,
                          double tolerance) {
   const fs::path one = kWork / (name + "_one"), many = kWork / (name + "_np" + std::to_string(np));
@@ -153,6 +190,7 @@ void expect_same_summary(const std::string& name, const std::string& args, int n
   }
   for (const char* f : {"series.csv", "snapshots.h5", "snapshots.xmf", "final_displacement.png", "summary.json"})
     EXPECT_TRUE(fs::exists(many / f)) << f;
+  expect_same_tables(one, many, tolerance);
 }
 
 }  // namespace
@@ -171,6 +209,21 @@ TEST(SphDecomposition, SphSlopeMpiOnTwoRanksGivesTheSummaryOfOneProcess) {
                       {"runout_m", "front_m", "tip_m", "max_speed_m_per_s", "final_max_speed_m_per_s",
                        "max_displacement_m", "max_plastic_strain", "failed_area_m2_per_m"},
                       1e-9);
+}
+
+// The series columns made of the free end (a clamped region: tip_displacement_m, a mean over the
+// particles of the free end, which are every rank's) and the biaxial stresses (means over the
+// specimen), reduced over the ranks.
+TEST(SphDecomposition, SphSlopeMpiBiaxialWithAClampedRegionGivesTheTablesOfOneProcess) {
+  if (!have_mpi()) GTEST_SKIP() << "built without MPI (GEOHAZ_MPI)";
+  expect_same_summary("biaxial",
+                      "--config " + (kData / "biaxial.toml").string() +
+                          " --set numerics.spacing=0.005 --set run.end_time=0.004 --set run.output_interval=0.0005"
+                          " --set run.snapshot_interval=0 --set clamp.boxes=[0,0,0.01,0.1] --quiet",
+                      2, {"max_displacement_m", "max_plastic_strain"}, 1e-9);
+  const auto [header, rows] = read_csv(kWork / "biaxial_np2" / "series.csv");
+  EXPECT_NE(header.find("tip_displacement_m"), std::string::npos) << header;
+  expect_same_tables(kWork / "biaxial_one", kWork / "biaxial_np2", 1e-9, {"stress_strain.csv"});
 }
 
 TEST(SphDecomposition, SphSlopeMpi3DPeriodicSlopeWithPilesOnFourRanks) {

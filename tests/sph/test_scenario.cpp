@@ -118,6 +118,58 @@ TEST(Scenario, PilesIn3DAndRejectedIn2D) {
   EXPECT_THROW(build_profile<3>(d, 0.01, {1800.0}, 1.2), InputError);
 }
 
+/// The blocks a scenario built by shares keeps (BuildShare, a rank's share of a distributed run)
+/// are the consecutive blocks of the whole scenario, field for field (the block the decomposition's
+/// scatter keeps), with the whole scenario's counts; count_only keeps none; visit sees every particle.
+template <int Dim>
+void expect_shares_join_to_whole(const ProfileDomain& d, int parts) {
+  const auto whole = build_profile<Dim>(d, 0.01, {1800.0}, 1.2);
+  std::size_t at = 0;
+  for (int p = 0; p < parts; ++p) {
+    const auto part = build_profile<Dim>(d, 0.01, {1800.0}, 1.2, BuildShare<Dim>{p, parts, false, {}});
+    EXPECT_EQ(part.soil_count, whole.soil_count);
+    EXPECT_EQ(part.boundary_count, whole.boundary_count);
+    EXPECT_EQ(part.structures.size(), whole.structures.size());
+    const std::size_t n = whole.store.size();
+    EXPECT_EQ(part.store.size(), n * (p + 1) / parts - n * p / parts);
+    for (std::size_t i = 0; i < part.store.size(); ++i, ++at) {
+      ASSERT_EQ(part.store.template get<ParticleId>()[i], whole.store.template get<ParticleId>()[at]);
+      ASSERT_EQ(part.store.template get<Position<Dim>>()[i], whole.store.template get<Position<Dim>>()[at]);
+      ASSERT_EQ(part.store.template get<Mass>()[i], whole.store.template get<Mass>()[at]);
+      ASSERT_EQ(part.store.template get<ParticleKind>()[i], whole.store.template get<ParticleKind>()[at]);
+      ASSERT_EQ(part.store.template get<StructureId>()[i], whole.store.template get<StructureId>()[at]);
+      ASSERT_EQ(part.store.template get<LayerNormal<Dim>>()[i], whole.store.template get<LayerNormal<Dim>>()[at]);
+    }
+  }
+  EXPECT_EQ(at, whole.store.size());
+  std::size_t seen = 0, soil = 0;
+  const auto none =
+      build_profile<Dim>(d, 0.01, {1800.0}, 1.2, BuildShare<Dim>{0, 1, true, [&](const Vec<Dim>&, Kind k) {
+                                                                   ++seen;
+                                                                   soil += k == Kind::Soil;
+                                                                 }});
+  EXPECT_EQ(none.store.size(), 0u);
+  EXPECT_EQ(seen, whole.store.size());
+  std::size_t whole_soil = 0;  // soil_count also counts the piles' particles (made with the soil columns)
+  for (const auto k : whole.store.template get<ParticleKind>())
+    whole_soil += k == static_cast<std::uint8_t>(Kind::Soil);
+  EXPECT_EQ(soil, whole_soil);
+}
+
+TEST(Scenario, SharesOfAScenarioAreTheBlocksOfTheWhole) {
+  SlopeGeometry g;
+  auto d = g.profile();
+  expect_shares_join_to_whole<2>(d, 3);
+  d.width = 0.06;
+  d.piles = {{0.5, 0.03, 0.03}};
+  expect_shares_join_to_whole<3>(d, 4);
+  const auto biax = build_biaxial<2>({}, 0.005, 1800.0, 1.2);
+  const auto half = build_biaxial<2>({}, 0.005, 1800.0, 1.2, BuildShare<2>{1, 2, false, {}});
+  EXPECT_EQ(half.soil_count, biax.soil_count);
+  ASSERT_EQ(half.store.size(), biax.store.size() - biax.store.size() / 2);
+  EXPECT_EQ(half.store.get<Position<2>>()[0], biax.store.get<Position<2>>()[biax.store.size() / 2]);
+}
+
 TEST(Diagnostics, FrontSurfaceSlipAndFailedMass) {
   ProfileDomain d;
   d.surface = {{0.0, 0.1}, {0.1, 0.1}, {0.1, 0.0}, {0.5, 0.0}};

@@ -1,6 +1,7 @@
 /// \file snapshot_reader.cpp
 /// The reader of HDF5 particle snapshots (snapshot.hpp; the layout and the choices in snapshot.cpp).
 #include <algorithm>
+#include <limits>
 #include <sstream>
 
 #include "geohaz/core/snapshot.hpp"
@@ -123,6 +124,23 @@ bool SnapshotReader::has_field(std::size_t k, std::string_view label) const {
 }
 
 FieldData SnapshotReader::read(std::size_t k, std::string_view label) const {
+  return read(k, label, 0, std::numeric_limits<std::size_t>::max());
+}
+
+std::size_t SnapshotReader::rows(std::size_t k, std::string_view label) const {
+  const Impl& m = *impl_;
+  if (!has_field(k, label)) return 0;
+  const std::string what = "cannot read dataset " + m.group_path(k) + "/" + std::string(label);
+  Hid g = m.open_group(k);
+  Hid dset = m.ctx.own(H5Dopen2(g.get(), std::string(label).c_str(), H5P_DEFAULT), H5Dclose, what);
+  Hid space = m.ctx.own(H5Dget_space(dset.get()), H5Sclose, what);
+  hsize_t dims[2] = {0, 1};
+  if (H5Sget_simple_extent_ndims(space.get()) < 1 || H5Sget_simple_extent_dims(space.get(), dims, nullptr) < 0)
+    m.ctx.fail(what);
+  return static_cast<std::size_t>(dims[0]);
+}
+
+FieldData SnapshotReader::read(std::size_t k, std::string_view label, std::size_t first, std::size_t count) const {
   const Impl& m = *impl_;
   const std::string where = m.group_path(k) + "/" + std::string(label);
   if (!has_field(k, label)) {
@@ -140,8 +158,13 @@ FieldData SnapshotReader::read(std::size_t k, std::string_view label) const {
   if (rank < 1 || rank > 2) m.ctx.fail(what + ": expected a 1-D or 2-D dataset, rank is " + std::to_string(rank));
   hsize_t dims[2] = {0, 1};
   if (H5Sget_simple_extent_dims(space.get(), dims, nullptr) < 0) m.ctx.fail(what);
+  const auto total = static_cast<std::size_t>(dims[0]);
+  if (count == std::numeric_limits<std::size_t>::max()) count = total - std::min(first, total);
+  if (first > total || count > total - first)
+    m.ctx.fail(what + ": rows " + std::to_string(first) + " to " + std::to_string(first + count) + " asked of " +
+               std::to_string(total));
   FieldData d;
-  d.count = static_cast<std::size_t>(dims[0]);
+  d.count = count;
   const int comps = rank == 1 ? 1 : static_cast<int>(dims[1]);
   d.rows = comps;
   d.cols = 1;
@@ -153,8 +176,16 @@ FieldData SnapshotReader::read(std::size_t k, std::string_view label) const {
   }
   d.unit = read_attribute_text(m.ctx, dset.get(), where, "unit").value_or("");
   d.values.resize(d.count * static_cast<std::size_t>(comps));
-  if (!d.values.empty())
+  if (d.values.empty()) return d;
+  if (count == total) {
     m.ctx.call(H5Dread(dset.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, d.values.data()), what);
+    return d;
+  }
+  // A block of rows: the hyperslab [first, first + count) × all components of the file's space.
+  const hsize_t start[2] = {static_cast<hsize_t>(first), 0}, extent[2] = {static_cast<hsize_t>(count), dims[1]};
+  m.ctx.call(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, extent, nullptr), what);
+  Hid mem = m.ctx.own(H5Screate_simple(rank, extent, nullptr), H5Sclose, what);
+  m.ctx.call(H5Dread(dset.get(), H5T_NATIVE_DOUBLE, mem.get(), space.get(), H5P_DEFAULT, d.values.data()), what);
   return d;
 }
 

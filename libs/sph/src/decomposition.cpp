@@ -59,8 +59,7 @@ DomainDecomposition<Dim>::DomainDecomposition(std::shared_ptr<const Communicator
 template <int Dim>
 void DomainDecomposition<Dim>::scatter(SphStore<Dim>& s) {
   const std::size_t n = s.size();
-  const std::size_t first = n * static_cast<std::size_t>(rank_) / static_cast<std::size_t>(size_);
-  const std::size_t last = n * static_cast<std::size_t>(rank_ + 1) / static_cast<std::size_t>(size_);
+  const auto [first, last] = block(n, rank_, size_);
   std::vector<std::uint8_t> drop(n, 1);
   std::fill(drop.begin() + static_cast<std::ptrdiff_t>(first), drop.begin() + static_cast<std::ptrdiff_t>(last), 0);
   s.remove_if(drop);
@@ -290,11 +289,21 @@ void DomainDecomposition<Dim>::rebuild(SphStore<Dim>& s, double halo, bool repar
 }
 
 template <int Dim>
-SphStore<Dim> DomainDecomposition<Dim>::gather(const SphStore<Dim>& s) const {
+SphStore<Dim> DomainDecomposition<Dim>::gather(const SphStore<Dim>& s, bool root_only) const {
   constexpr std::size_t bytes = kStateBytes<Dim>;
   std::vector<std::byte> mine(owned_ * bytes);
   for (std::size_t i = 0; i < owned_; ++i) pack_state<Dim>(s, i, mine.data() + i * bytes);
-  const std::vector<std::byte> all = comm_->all_gather_bytes(mine);
+  std::vector<std::byte> all;
+  if (root_only) {  // a personalised exchange in which every rank sends to rank 0 only
+    std::vector<std::int64_t> send(static_cast<std::size_t>(size_), 0);
+    send[0] = static_cast<std::int64_t>(mine.size());
+    const std::vector<std::int64_t> recv = comm_->exchange_counts(send);
+    all.resize(static_cast<std::size_t>(std::accumulate(recv.begin(), recv.end(), std::int64_t{0})));
+    comm_->exchange(mine, send, all, recv);
+  } else {
+    all = comm_->all_gather_bytes(mine);
+  }
+  mine = {};
   SphStore<Dim> out;
   const std::size_t n = all.size() / bytes;
   out.resize(n);
@@ -303,6 +312,61 @@ SphStore<Dim> DomainDecomposition<Dim>::gather(const SphStore<Dim>& s) const {
   std::vector<std::uint32_t> perm(n);
   std::iota(perm.begin(), perm.end(), 0u);
   std::sort(perm.begin(), perm.end(), [&](std::uint32_t p, std::uint32_t q) { return id[p] < id[q]; });
+  out.reorder(perm);
+  return out;
+}
+
+template <int Dim>
+SphStore<Dim> DomainDecomposition<Dim>::id_block(const SphStore<Dim>& s) const {
+  constexpr std::size_t bytes = kStateBytes<Dim>;
+  const auto& id = s.template get<ParticleId>();
+  std::vector<std::int64_t> count{static_cast<std::int64_t>(owned_)};
+  comm_->sum_all(count);
+  const auto n = static_cast<std::size_t>(count[0]);
+  std::vector<double> range{0.0, 0.0};  // −min id, max id
+  range[0] = range[1] = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < owned_; ++i) {
+    range[0] = std::max(range[0], -static_cast<double>(id[i]));
+    range[1] = std::max(range[1], static_cast<double>(id[i]));
+  }
+  comm_->max_all(range);
+  SphStore<Dim> out;
+  if (n > 0 && (range[0] != 0.0 || range[1] != static_cast<double>(n - 1))) {  // ids not 0 … n−1
+    out = gather(s);
+    const auto [first, last] = block(n, rank_, size_);
+    std::vector<std::uint8_t> drop(out.size(), 1);
+    std::fill(drop.begin() + static_cast<std::ptrdiff_t>(first), drop.begin() + static_cast<std::ptrdiff_t>(last), 0);
+    out.remove_if(drop);
+    return out;
+  }
+  // The rank of an id: the last q with block start n·q/p ≤ id.
+  std::vector<std::size_t> start(static_cast<std::size_t>(size_));
+  for (int q = 0; q < size_; ++q) start[static_cast<std::size_t>(q)] = block(n, q, size_).first;
+  const auto dest_of = [&](std::int64_t v) {
+    return static_cast<int>(std::upper_bound(start.begin(), start.end(), static_cast<std::size_t>(v)) - start.begin()) -
+           1;
+  };
+  std::vector<std::int64_t> send(static_cast<std::size_t>(size_), 0);
+  for (std::size_t i = 0; i < owned_; ++i) ++send[static_cast<std::size_t>(dest_of(id[i]))];
+  std::vector<std::size_t> cursor(static_cast<std::size_t>(size_), 0);
+  for (int q = 1; q < size_; ++q)
+    cursor[static_cast<std::size_t>(q)] =
+        cursor[static_cast<std::size_t>(q) - 1] + static_cast<std::size_t>(send[static_cast<std::size_t>(q) - 1]);
+  std::vector<std::byte> buf(owned_ * bytes);
+  for (std::size_t i = 0; i < owned_; ++i)
+    pack_state<Dim>(s, i, buf.data() + cursor[static_cast<std::size_t>(dest_of(id[i]))]++ * bytes);
+  for (auto& c : send) c *= static_cast<std::int64_t>(bytes);
+  const std::vector<std::int64_t> recv = comm_->exchange_counts(send);
+  std::vector<std::byte> in(static_cast<std::size_t>(std::accumulate(recv.begin(), recv.end(), std::int64_t{0})));
+  comm_->exchange(buf, send, in, recv);
+  buf = {};
+  const std::size_t m = in.size() / bytes;
+  out.resize(m);
+  for (std::size_t k = 0; k < m; ++k) unpack_state<Dim>(out, k, in.data() + k * bytes);
+  const auto& oid = out.template get<ParticleId>();
+  std::vector<std::uint32_t> perm(m);
+  std::iota(perm.begin(), perm.end(), 0u);
+  std::sort(perm.begin(), perm.end(), [&](std::uint32_t p, std::uint32_t q) { return oid[p] < oid[q]; });
   out.reorder(perm);
   return out;
 }

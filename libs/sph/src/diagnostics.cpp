@@ -2,16 +2,51 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 
 namespace geohaz::sph {
 
 namespace {
 constexpr std::uint8_t kSoil = static_cast<std::uint8_t>(Kind::Soil);
+
+/// The particles a diagnostic loops over: the whole store, or this rank's owned ones.
+template <int Dim>
+std::size_t count_of(const SphStore<Dim>& s, const OverRanks& over) {
+  return over.comm ? over.owned : s.size();
 }
 
+/// Per-bin maxima (take_max) or minima of every rank, merged (collective; exact).
+void reduce_bins(const OverRanks& over, std::map<long, double>& bins, bool take_max) {
+  if (!over.comm) return;
+  std::vector<double> mine;
+  mine.reserve(2 * bins.size());
+  for (const auto& [b, v] : bins) {
+    mine.push_back(static_cast<double>(b));
+    mine.push_back(v);
+  }
+  const auto* p = reinterpret_cast<const std::byte*>(mine.data());
+  const std::vector<std::byte> all = over.comm->all_gather_bytes({p, mine.size() * sizeof(double)});
+  std::vector<double> v(all.size() / sizeof(double));
+  std::memcpy(v.data(), all.data(), v.size() * sizeof(double));
+  for (std::size_t k = 0; k + 1 < v.size(); k += 2) {
+    auto [it, inserted] = bins.emplace(static_cast<long>(v[k]), v[k + 1]);
+    if (!inserted) it->second = take_max ? std::max(it->second, v[k + 1]) : std::min(it->second, v[k + 1]);
+  }
+}
+
+/// Sums of every rank's partial sums, added in rank order (collective).
+void sum_in_rank_order(const OverRanks& over, std::vector<double>& sums) {
+  if (!over.comm) return;
+  const std::vector<double> all = over.comm->all_gather(sums);
+  std::fill(sums.begin(), sums.end(), 0.0);
+  for (std::size_t r = 0; r < all.size() / sums.size(); ++r)
+    for (std::size_t k = 0; k < sums.size(); ++k) sums[k] += all[r * sums.size() + k];
+}
+}  // namespace
+
 template <int Dim>
-SeriesRow series_row(const SphStore<Dim>& s, const DiagnosticFrame& f) {
+SeriesRow series_row(const SphStore<Dim>& s, const DiagnosticFrame& f, const OverRanks& over) {
   const auto& x = s.template get<Position<Dim>>();
   const auto& v = s.template get<Velocity<Dim>>();
   const auto& u = s.template get<Displacement<Dim>>();
@@ -25,7 +60,7 @@ SeriesRow series_row(const SphStore<Dim>& s, const DiagnosticFrame& f) {
   std::map<long, double> top;  // bin → highest particle top above base_top
   std::size_t count = 0, plastic = 0;
   double sum_speed = 0.0;
-  for (std::size_t i = 0; i < s.size(); ++i) {
+  for (std::size_t i = 0; i < count_of(s, over); ++i) {
     if (kind[i] != kSoil) continue;
     ++count;
     const double sp = v[i].norm();
@@ -43,6 +78,22 @@ SeriesRow series_row(const SphStore<Dim>& s, const DiagnosticFrame& f) {
       if (!inserted) it->second = std::max(it->second, t);
     }
   }
+  if (over.comm) {
+    std::vector<double> mx{r.max_speed, r.max_displacement, r.tip};
+    over.comm->max_all(mx);
+    r.max_speed = mx[0];
+    r.max_displacement = mx[1];
+    r.tip = mx[2];
+    std::vector<std::int64_t> n{static_cast<std::int64_t>(count), static_cast<std::int64_t>(plastic)};
+    over.comm->sum_all(n);
+    count = static_cast<std::size_t>(n[0]);
+    plastic = static_cast<std::size_t>(n[1]);
+    std::vector<double> sums{sum_speed, r.kinetic_energy};
+    sum_in_rank_order(over, sums);
+    sum_speed = sums[0];
+    r.kinetic_energy = sums[1];
+    reduce_bins(over, top, true);
+  }
   const double t_min = f.front_thickness > 0.0 ? f.front_thickness : f.front_min_layers * f.spacing;
   for (const auto& [b, t] : top)
     if (t >= t_min * (1.0 - 1e-9)) r.front = std::max(r.front, (static_cast<double>(b) + 1.0) * f.spacing);
@@ -59,18 +110,19 @@ SeriesRow series_row(const SphStore<Dim>& s, const DiagnosticFrame& f) {
 }
 
 template <int Dim>
-std::vector<std::array<double, 2>> free_surface(const SphStore<Dim>& s, double dx) {
+std::vector<std::array<double, 2>> free_surface(const SphStore<Dim>& s, double dx, const OverRanks& over) {
   const auto& x = s.template get<Position<Dim>>();
   const auto& kind = s.template get<ParticleKind>();
   const auto& sf = s.template get<StressFree>();
   std::map<long, double> top;
-  for (std::size_t i = 0; i < s.size(); ++i) {
+  for (std::size_t i = 0; i < count_of(s, over); ++i) {
     if (kind[i] != kSoil || sf[i]) continue;
     const long b = static_cast<long>(std::floor(x[i][0] / dx));
     const double z = x[i][Dim - 1] + 0.5 * dx;
     auto [it, inserted] = top.emplace(b, z);
     if (!inserted) it->second = std::max(it->second, z);
   }
+  reduce_bins(over, top, true);
   std::vector<std::array<double, 2>> out;
   out.reserve(top.size());
   for (auto& [b, z] : top) out.push_back({(static_cast<double>(b) + 0.5) * dx, z});
@@ -78,12 +130,13 @@ std::vector<std::array<double, 2>> free_surface(const SphStore<Dim>& s, double d
 }
 
 template <int Dim>
-std::vector<std::array<double, 2>> slip_surface(const SphStore<Dim>& s, double dx, double threshold) {
+std::vector<std::array<double, 2>> slip_surface(const SphStore<Dim>& s, double dx, double threshold,
+                                                const OverRanks& over) {
   const auto& x = s.template get<Position<Dim>>();
   const auto& u = s.template get<Displacement<Dim>>();
   const auto& kind = s.template get<ParticleKind>();
   std::map<long, double> low;
-  for (std::size_t i = 0; i < s.size(); ++i) {
+  for (std::size_t i = 0; i < count_of(s, over); ++i) {
     if (kind[i] != kSoil || u[i].norm() <= threshold) continue;
     const Vec<Dim> x0 = x[i] - u[i];
     const long b = static_cast<long>(std::floor(x0[0] / dx));
@@ -91,33 +144,43 @@ std::vector<std::array<double, 2>> slip_surface(const SphStore<Dim>& s, double d
     auto [it, inserted] = low.emplace(b, z);
     if (!inserted) it->second = std::min(it->second, z);
   }
+  reduce_bins(over, low, false);
   std::vector<std::array<double, 2>> out;
   for (auto& [b, z] : low) out.push_back({(static_cast<double>(b) + 0.5) * dx, z});
   return out;
 }
 
 template <int Dim>
-FailedMass failed_mass(const SphStore<Dim>& s, const std::vector<double>& rho0, double threshold) {
+FailedMass failed_mass(const SphStore<Dim>& s, const std::vector<double>& rho0, double threshold,
+                       const OverRanks& over) {
   const auto& u = s.template get<Displacement<Dim>>();
   const auto& m = s.template get<Mass>();
   const auto& kind = s.template get<ParticleKind>();
   const auto& mat = s.template get<MaterialId>();
   FailedMass f;
-  for (std::size_t i = 0; i < s.size(); ++i) {
+  for (std::size_t i = 0; i < count_of(s, over); ++i) {
     if (kind[i] != kSoil || u[i].norm() <= threshold) continue;
     ++f.count;
     f.volume += m[i] / rho0[static_cast<std::size_t>(mat[i])];
   }
+  if (over.comm) {
+    std::vector<std::int64_t> n{static_cast<std::int64_t>(f.count)};
+    over.comm->sum_all(n);
+    f.count = static_cast<std::size_t>(n[0]);
+    std::vector<double> v{f.volume};
+    sum_in_rank_order(over, v);
+    f.volume = v[0];
+  }
   return f;
 }
 
-template SeriesRow series_row<2>(const SphStore<2>&, const DiagnosticFrame&);
-template SeriesRow series_row<3>(const SphStore<3>&, const DiagnosticFrame&);
-template std::vector<std::array<double, 2>> free_surface<2>(const SphStore<2>&, double);
-template std::vector<std::array<double, 2>> free_surface<3>(const SphStore<3>&, double);
-template std::vector<std::array<double, 2>> slip_surface<2>(const SphStore<2>&, double, double);
-template std::vector<std::array<double, 2>> slip_surface<3>(const SphStore<3>&, double, double);
-template FailedMass failed_mass<2>(const SphStore<2>&, const std::vector<double>&, double);
-template FailedMass failed_mass<3>(const SphStore<3>&, const std::vector<double>&, double);
+template SeriesRow series_row<2>(const SphStore<2>&, const DiagnosticFrame&, const OverRanks&);
+template SeriesRow series_row<3>(const SphStore<3>&, const DiagnosticFrame&, const OverRanks&);
+template std::vector<std::array<double, 2>> free_surface<2>(const SphStore<2>&, double, const OverRanks&);
+template std::vector<std::array<double, 2>> free_surface<3>(const SphStore<3>&, double, const OverRanks&);
+template std::vector<std::array<double, 2>> slip_surface<2>(const SphStore<2>&, double, double, const OverRanks&);
+template std::vector<std::array<double, 2>> slip_surface<3>(const SphStore<3>&, double, double, const OverRanks&);
+template FailedMass failed_mass<2>(const SphStore<2>&, const std::vector<double>&, double, const OverRanks&);
+template FailedMass failed_mass<3>(const SphStore<3>&, const std::vector<double>&, double, const OverRanks&);
 
 }  // namespace geohaz::sph

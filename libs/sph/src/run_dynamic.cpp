@@ -2,13 +2,17 @@
 // series, structure loads, quick-looks, the release handed to debris-runout and the summary's
 // figures (docs/sph.md).
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <iomanip>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <optional>
+#include <span>
 #include <sstream>
 
 #include "geohaz/core/errors.hpp"
@@ -121,10 +125,30 @@ class DynamicRun final : public SimulationModel {
   ReleaseOutput release() const;
   void write_release(const std::filesystem::path& out, const ReleaseOutput& r) const;
   nlohmann::json summary_with(const ReleaseOutput& r) const;
-  /// The whole state the outputs read: the solver's store on one process; over several ranks the
-  /// gathered copy of the last refresh_view() (every output point calls it on every rank).
+  /// The whole state the pictures, the release and particles() read: the solver's store on one
+  /// process; over several ranks, on rank 0, the copy gathered there by the last refresh_view()
+  /// (every picture point and the end call it on every rank; the other ranks' copy is empty).
   const SphStore<Dim>& state() const { return solver_.domain() ? view_ : solver_.store(); }
   void refresh_view(bool force = false);
+  /// What the diagnostics reduce over: this rank's owned particles and the ranks (one process:
+  /// the whole store).
+  OverRanks over() const {
+    const auto* d = solver_.domain();
+    return d ? OverRanks{&d->comm(), d->owned()} : OverRanks{};
+  }
+  /// The maximum, and the sums in rank order, of every rank's values (collective over several
+  /// ranks; the values themselves on one process).
+  double max_over_ranks(double v) const;
+  std::vector<double> sum_over_ranks(std::vector<double> v) const;
+  /// The final state's profiles and figures (collective over several ranks: reductions over the
+  /// ranks, at the end of the main phase; on one process made from the store when asked).
+  struct Finals {
+    std::vector<std::array<double, 2>> surface, slip;
+    FailedMass failed;
+    double max_displacement = 0.0, max_plastic_strain = 0.0;
+  };
+  Finals make_finals() const;
+  Finals finals() const { return solver_.domain() ? finals_ : make_finals(); }
   /// This process writes the files (one process, or rank 0 of several).
   bool root() const { return !solver_.domain() || solver_.domain()->rank() == 0; }
   void record_decomposition();
@@ -157,9 +181,10 @@ class DynamicRun final : public SimulationModel {
   // decomposition's figures for summary.json.
   SphStore<Dim> view_;
   std::int64_t view_step_ = -1;
+  Finals finals_;
   nlohmann::json decomposition_;
   // Over several ranks: the ranks, until the solver is distributed at the start of run() (after a
-  // restart file is read in full).
+  // restart file's block is read).
   std::shared_ptr<const Communicator> comm_;
 };
 
@@ -168,7 +193,7 @@ DynamicRun<Dim>::DynamicRun(const RunConfig& c, bool quiet, std::shared_ptr<cons
     : c_(c),
       quiet_(quiet),
       wall0_(std::chrono::steady_clock::now()),
-      b_(build<Dim>(c)),
+      b_(build<Dim>(c, share_of(comm.get()))),
       settings_(settings_for<Dim>(c, b_.sc)),
       soil_count_(b_.sc.soil_count),
       boundary_count_(b_.sc.boundary_count),
@@ -221,12 +246,11 @@ void DynamicRun<Dim>::run(const SphSimulation& self, RunObserver* obs) {
   if (!c_.restart.empty()) {
     load_restart_state();
   } else {
-    if (comm_) solver_.distribute(comm_);
+    if (comm_) solver_.distribute(comm_, true);  // built by share
     if (c_.geostatic && c_.scenario != ScenarioType::Biaxial) geostatic_phase(self, obs);
   }
   if (c_.scenario == ScenarioType::Biaxial) move_platens();
   if (c_.restart.empty()) set_initial_velocity<Dim>(c_, solver_.store());
-  refresh_view(true);
   mark_free_end();
   start_main_phase();
   if (obs) obs->started(self);
@@ -235,9 +259,9 @@ void DynamicRun<Dim>::run(const SphSimulation& self, RunObserver* obs) {
 
 template <int Dim>
 void DynamicRun<Dim>::load_restart_state() {
-  // Every rank reads the whole file (written on any number of ranks), then keeps its share.
-  const Restart rs = load_restart<Dim>(c_.restart, solver_.store());
-  if (comm_) solver_.distribute(comm_);
+  // Every rank reads its block of the file's rows (written on any number of ranks).
+  const Restart rs = load_restart<Dim>(c_.restart, solver_.store(), share_of(comm_.get()));
+  if (comm_) solver_.distribute(comm_, true);
   // With the solver state the run continues exactly as the one that wrote the file (on as many
   // ranks; on another count within round-off: other pair-sum orders); without it (files of older
   // versions) from the snapshot's particles, with Δt from the wave speed and a fresh neighbour list:
@@ -287,35 +311,63 @@ void DynamicRun<Dim>::move_platens() {
 template <int Dim>
 void DynamicRun<Dim>::mark_free_end() {
   if (c_.clamp_boxes.empty()) return;
-  const auto& S = state();
+  const auto& S = solver_.store();
+  const std::size_t n = solver_.owned_count();
   const auto& x = S.template get<Position<Dim>>();
   const auto& u = S.template get<Displacement<Dim>>();
   const auto& id = S.template get<ParticleId>();
   double xmax = -1e300;
   std::int64_t idmax = 0;
-  for (std::size_t i = 0; i < S.size(); ++i) {
+  for (std::size_t i = 0; i < n; ++i) {
     idmax = std::max(idmax, id[i]);
     if (S.template get<ParticleKind>()[i] == kSoil) xmax = std::max(xmax, x[i][0] - u[i][0]);
   }
-  free_end_.assign(static_cast<std::size_t>(idmax) + 1, 0);
-  for (std::size_t i = 0; i < S.size(); ++i)
+  xmax = max_over_ranks(xmax);
+  idmax = static_cast<std::int64_t>(max_over_ranks(static_cast<double>(idmax)));
+  std::vector<std::int64_t> mine;  // the free end's ids on this rank; over several ranks every rank's
+  for (std::size_t i = 0; i < n; ++i)
     if (S.template get<ParticleKind>()[i] == kSoil && !S.template get<Clamped>()[i] &&
         x[i][0] - u[i][0] >= xmax - 0.5 * c_.numerics.spacing)
-      free_end_[static_cast<std::size_t>(id[i])] = 1;
+      mine.push_back(id[i]);
+  if (const auto* d = solver_.domain()) {
+    const auto all = d->comm().all_gather_bytes(std::as_bytes(std::span<const std::int64_t>(mine)));
+    mine.resize(all.size() / sizeof(std::int64_t));
+    std::memcpy(mine.data(), all.data(), all.size());
+  }
+  free_end_.assign(static_cast<std::size_t>(idmax) + 1, 0);
+  for (const std::int64_t k : mine) free_end_[static_cast<std::size_t>(k)] = 1;
 }
 
 template <int Dim>
 double DynamicRun<Dim>::tip_displacement() const {
-  const auto& S = state();
+  const auto& S = solver_.store();
   const auto& id = S.template get<ParticleId>();
-  double sum = 0.0;
-  int count = 0;
-  for (std::size_t i = 0; i < S.size(); ++i)
+  std::vector<double> sum{0.0, 0.0};  // Σ u_z, count
+  for (std::size_t i = 0; i < solver_.owned_count(); ++i)
     if (free_end_[static_cast<std::size_t>(id[i])]) {
-      sum += S.template get<Displacement<Dim>>()[i][Dim - 1];
-      ++count;
+      sum[0] += S.template get<Displacement<Dim>>()[i][Dim - 1];
+      sum[1] += 1.0;
     }
-  return sum / std::max(count, 1);
+  sum = sum_over_ranks(std::move(sum));
+  return sum[0] / std::max(sum[1], 1.0);
+}
+
+template <int Dim>
+double DynamicRun<Dim>::max_over_ranks(double v) const {
+  if (!solver_.domain()) return v;
+  std::array<double, 1> a{v};
+  solver_.domain()->comm().max_all(a);
+  return a[0];
+}
+
+template <int Dim>
+std::vector<double> DynamicRun<Dim>::sum_over_ranks(std::vector<double> v) const {
+  if (!solver_.domain()) return v;
+  const std::vector<double> all = solver_.domain()->comm().all_gather(v);
+  std::fill(v.begin(), v.end(), 0.0);
+  for (std::size_t r = 0; r < all.size() / v.size(); ++r)
+    for (std::size_t k = 0; k < v.size(); ++k) v[k] += all[r * v.size() + k];
+  return v;
 }
 
 template <int Dim>
@@ -366,6 +418,8 @@ void DynamicRun<Dim>::main_phase(const SphSimulation& self, RunObserver* obs) {
   last_ = record();
   finished_ = true;
   record_decomposition();
+  if (solver_.domain()) finals_ = make_finals();
+  refresh_view(true);  // for rank 0's pictures and release
   if (obs) obs->finished(self);
 }
 
@@ -373,7 +427,8 @@ void DynamicRun<Dim>::main_phase(const SphSimulation& self, RunObserver* obs) {
 template <int Dim>
 void DynamicRun<Dim>::refresh_view(bool force) {
   if (!solver_.domain() || (!force && view_step_ == solver_.step_count())) return;
-  view_ = solver_.gathered_store();
+  view_ = SphStore<Dim>{};
+  view_ = solver_.gathered_store(true);
   view_step_ = solver_.step_count();
 }
 
@@ -405,12 +460,15 @@ void DynamicRun<Dim>::record_decomposition() {
 /// A row of the series (and of the structure loads, and of the biaxial curve).
 template <int Dim>
 SeriesRow DynamicRun<Dim>::record() {
-  refresh_view();
-  const auto r = series_row(state(), b_.frame);
+  // Reductions over the ranks' owned particles: no rank holds the whole state.
+  const auto& S = solver_.store();
+  const std::size_t n = solver_.owned_count();
+  const auto r = series_row(S, b_.frame, over());
   double runout = r.runout, nrun = r.normalised_runout;
   if (c_.scenario == ScenarioType::Section) {
     runout = 0.0;
-    for (const auto& u : state().template get<Displacement<Dim>>()) runout = std::max(runout, std::abs(u[0]));
+    for (std::size_t i = 0; i < n; ++i) runout = std::max(runout, std::abs(S.template get<Displacement<Dim>>()[i][0]));
+    runout = max_over_ranks(runout);
     nrun = runout / b_.frame.base_length;
   }
   max_runout_ = std::max(max_runout_, runout);
@@ -428,10 +486,10 @@ SeriesRow DynamicRun<Dim>::record() {
                           settings_.earthquake.horizontal(solver_.time())};
   if (!free_end_.empty()) row.push_back(tip_displacement());
   if (settings_.pore_water.active()) {
-    const auto& S = state();  // over several ranks every particle, not this rank's share
     double umax = 0.0;
-    for (std::size_t i = 0; i < S.size(); ++i)
+    for (std::size_t i = 0; i < n; ++i)
       if (S.template get<ParticleKind>()[i] == kSoil) umax = std::max(umax, S.template get<PorePressure>()[i]);
+    umax = max_over_ranks(umax);
     if (umax > max_pore_pressure_) {
       max_pore_pressure_ = umax;
       max_pore_pressure_time_ = solver_.time();
@@ -447,17 +505,16 @@ SeriesRow DynamicRun<Dim>::record() {
 /// The mean axial and lateral stress of the specimen.
 template <int Dim>
 void DynamicRun<Dim>::record_biaxial() {
-  const auto& S = state();
-  double sa = 0, sl = 0;
-  int n = 0;
-  for (std::size_t i = 0; i < S.size(); ++i)
+  const auto& S = solver_.store();
+  std::vector<double> sum{0.0, 0.0, 0.0};  // Σ σ_axial, Σ σ_lateral, count
+  for (std::size_t i = 0; i < solver_.owned_count(); ++i)
     if (S.template get<ParticleKind>()[i] == kSoil) {
-      sa += S.template get<Stress>()[i](Dim - 1, Dim - 1);
-      sl += S.template get<Stress>()[i](0, 0);
-      ++n;
+      sum[0] += S.template get<Stress>()[i](Dim - 1, Dim - 1);
+      sum[1] += S.template get<Stress>()[i](0, 0);
+      sum[2] += 1.0;
     }
-  sa /= std::max(n, 1);
-  sl /= std::max(n, 1);
+  sum = sum_over_ranks(std::move(sum));
+  const double sa = sum[0] / std::max(sum[2], 1.0), sl = sum[1] / std::max(sum[2], 1.0);
   biaxial_.rows.push_back({solver_.time(), c_.biaxial_strain_rate * solver_.time(), sa, sl, sa - sl});
 }
 
@@ -483,8 +540,9 @@ std::vector<NamedTable> DynamicRun<Dim>::tables() const {
   std::vector<NamedTable> t{{"series", series_}};
   if (!structures_.empty()) t.push_back({"structure_forces", structures_.table()});
   if (c_.scenario == ScenarioType::Biaxial) t.push_back({"stress_strain", biaxial_});
-  t.push_back({"surface_final", xz_table(free_surface(state(), c_.numerics.spacing))});
-  t.push_back({"slip_surface", xz_table(slip_surface(state(), c_.numerics.spacing, c_.failed_threshold))});
+  const Finals f = finals();
+  t.push_back({"surface_final", xz_table(f.surface)});
+  t.push_back({"slip_surface", xz_table(f.slip)});
   return t;
 }
 
@@ -504,7 +562,7 @@ void DynamicRun<Dim>::write_outputs(const std::filesystem::path& out) const {
   const nlohmann::json summary = summary_with(rel);
   write_text_file(out / "summary.json", summary.dump(2) + "\n");
   if (!quiet_) {
-    const auto fm = failed_mass(state(), rho0_, c_.failed_threshold);
+    const auto fm = finals().failed;
     std::fprintf(stderr, "sph-slope: t = %.4g s, run-out %.4g m (normalised %.4g), failed %s %.4g, outputs in %s\n",
                  solver_.time(), summary["runout_m"].get<double>(), summary["normalised_runout"].get<double>(),
                  Dim == 2 ? "area (m^2/m)" : "volume (m^3)", fm.volume, out.string().c_str());
@@ -597,9 +655,31 @@ void DynamicRun<Dim>::write_release(const std::filesystem::path& out, const Rele
 }
 
 template <int Dim>
+typename DynamicRun<Dim>::Finals DynamicRun<Dim>::make_finals() const {
+  const auto& S = solver_.store();
+  const std::size_t n = solver_.owned_count();
+  const auto o = over();
+  Finals f;
+  f.surface = free_surface(S, c_.numerics.spacing, o);
+  f.slip = slip_surface(S, c_.numerics.spacing, c_.failed_threshold, o);
+  f.failed = failed_mass(S, rho0_, c_.failed_threshold, o);
+  const auto& ep = S.template get<PlasticStrain>();
+  double umax = 0.0, epmax = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (S.template get<ParticleKind>()[i] == kSoil)
+      umax = std::max(umax, S.template get<Displacement<Dim>>()[i].norm());
+    epmax = std::max(epmax, ep[i]);
+  }
+  f.max_displacement = max_over_ranks(umax);
+  epmax = max_over_ranks(epmax);
+  f.max_plastic_strain = std::isfinite(epmax) ? epmax : 0.0;
+  return f;
+}
+
+template <int Dim>
 nlohmann::json DynamicRun<Dim>::summary_with(const ReleaseOutput& rel) const {
-  const auto& S = state();
   const auto& mats = solver_.materials();
+  const Finals fin = finals();
   nlohmann::json s = summary_header<Dim>(c_, solver_, soil_count_);
   s["boundary_particles"] = boundary_count_;
   s["smoothing_length_m"] = solver_.smoothing_length();
@@ -612,12 +692,8 @@ nlohmann::json DynamicRun<Dim>::summary_with(const ReleaseOutput& rel) const {
   }
   s.update(phase_summary_);
   if (!structures_.empty()) s["structures"] = structures_.summary();
-  double umax = 0.0;
-  for (std::size_t i = 0; i < S.size(); ++i)
-    if (S.template get<ParticleKind>()[i] == kSoil)
-      umax = std::max(umax, S.template get<Displacement<Dim>>()[i].norm());
-  const auto& ep = S.template get<PlasticStrain>();
-  s["max_plastic_strain"] = ep.empty() ? 0.0 : *std::max_element(ep.begin(), ep.end());
+  const double umax = fin.max_displacement;
+  s["max_plastic_strain"] = fin.max_plastic_strain;
   const bool section = c_.scenario == ScenarioType::Section;
   s["end_time_s"] = solver_.time();
   s["steps"] = solver_.step_count();
@@ -633,7 +709,7 @@ nlohmann::json DynamicRun<Dim>::summary_with(const ReleaseOutput& rel) const {
   s["failed_threshold_m"] = c_.failed_threshold;
   s["front_thickness_m"] =
       b_.frame.front_thickness > 0.0 ? b_.frame.front_thickness : b_.frame.front_min_layers * b_.frame.spacing;
-  const auto fm = failed_mass(S, rho0_, c_.failed_threshold);
+  const auto& fm = fin.failed;
   s["failed_particles"] = fm.count;
   s[Dim == 2 ? "failed_area_m2_per_m" : "failed_volume_m3"] = fm.volume;
   s["time_to_rest_s"] = last_.max_speed < c_.rest_speed ? nlohmann::json(last_moving_ - t_start_) : nlohmann::json();

@@ -3,8 +3,10 @@
 // and the map geometry of a DSM section.
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "geohaz/core/errors.hpp"
 #include "run_support.hpp"
@@ -33,40 +35,63 @@ double strip_width(const RunConfig& c) {
 
 namespace {
 
-/// Mark the soil particles inside the clamped regions (clamp.boxes); a box without soil is bad input.
+/// The clamped regions (clamp.boxes) of a config; a box whose corners are not ordered is bad input.
 template <int Dim>
-void clamp_regions(const RunConfig& c, SphStore<Dim>& S) {
-  const std::size_t per = 2 * Dim;
-  if (c.clamp_boxes.size() % per != 0)
-    throw InputError("needs " + std::to_string(per) + " numbers per box (lower corner, then upper corner, m)",
-                     c.config_source, "clamp.boxes", std::to_string(c.clamp_boxes.size()) + " numbers");
-  const auto& x = S.template get<Position<Dim>>();
-  const auto& kind = S.template get<ParticleKind>();
-  auto& cl = S.template get<Clamped>();
-  for (std::size_t b = 0; b < c.clamp_boxes.size(); b += per) {
-    Vec<Dim> lo, hi;
-    for (int d = 0; d < Dim; ++d) {
-      lo[d] = c.clamp_boxes[b + d];
-      hi[d] = c.clamp_boxes[b + Dim + d];
-    }
-    std::ostringstream box;
-    for (std::size_t k = 0; k < per; ++k) box << (k ? ", " : "[") << csv_number(c.clamp_boxes[b + k]);
-    box << "]";
-    if (!(lo.array() < hi.array()).all())
-      throw InputError("box " + std::to_string(b / per) + ": every lower corner coordinate must be below the upper one",
-                       c.config_source, "clamp.boxes", box.str());
-    std::size_t held = 0;
-    for (std::size_t i = 0; i < S.size(); ++i)
-      if (kind[i] == kSoil && (x[i].array() >= lo.array()).all() && (x[i].array() <= hi.array()).all()) {
-        cl[i] = 1;
-        ++held;
+struct ClampBoxes {
+  std::vector<Vec<Dim>> lo, hi;
+  std::vector<std::string> text;  // as the config gives it, for messages
+  std::vector<std::size_t> held;  // soil particles made inside, kept or not (counted by visit)
+
+  explicit ClampBoxes(const RunConfig& c) {
+    const std::size_t per = 2 * Dim;
+    if (c.clamp_boxes.size() % per != 0)
+      throw InputError("needs " + std::to_string(per) + " numbers per box (lower corner, then upper corner, m)",
+                       c.config_source, "clamp.boxes", std::to_string(c.clamp_boxes.size()) + " numbers");
+    for (std::size_t b = 0; b < c.clamp_boxes.size(); b += per) {
+      Vec<Dim> l, h;
+      for (int d = 0; d < Dim; ++d) {
+        l[d] = c.clamp_boxes[b + d];
+        h[d] = c.clamp_boxes[b + Dim + d];
       }
-    if (held == 0)
-      throw InputError(
-          "box " + std::to_string(b / per) + " holds no soil particle: a clamped region must overlap the body",
-          c.config_source, "clamp.boxes", box.str());
+      std::ostringstream box;
+      for (std::size_t k = 0; k < per; ++k) box << (k ? ", " : "[") << csv_number(c.clamp_boxes[b + k]);
+      box << "]";
+      if (!(l.array() < h.array()).all())
+        throw InputError(
+            "box " + std::to_string(b / per) + ": every lower corner coordinate must be below the upper one",
+            c.config_source, "clamp.boxes", box.str());
+      lo.push_back(l);
+      hi.push_back(h);
+      text.push_back(box.str());
+    }
+    held.assign(lo.size(), 0);
   }
-}
+  bool inside(std::size_t b, const Vec<Dim>& x) const {
+    return (x.array() >= lo[b].array()).all() && (x.array() <= hi[b].array()).all();
+  }
+  /// The builder's visitor: counts every soil particle made in each box.
+  std::function<void(const Vec<Dim>&, Kind)> counter() {
+    if (lo.empty()) return {};
+    return [this](const Vec<Dim>& x, Kind k) {
+      if (k != Kind::Soil) return;
+      for (std::size_t b = 0; b < lo.size(); ++b)
+        if (inside(b, x)) ++held[b];
+    };
+  }
+  /// Mark the kept soil particles inside the boxes; a box without soil in the whole scenario is bad input.
+  void apply(const RunConfig& c, SphStore<Dim>& S) const {
+    const auto& x = S.template get<Position<Dim>>();
+    const auto& kind = S.template get<ParticleKind>();
+    auto& cl = S.template get<Clamped>();
+    for (std::size_t b = 0; b < lo.size(); ++b) {
+      for (std::size_t i = 0; i < S.size(); ++i)
+        if (kind[i] == kSoil && inside(b, x[i])) cl[i] = 1;
+      if (held[b] == 0)
+        throw InputError("box " + std::to_string(b) + " holds no soil particle: a clamped region must overlap the body",
+                         c.config_source, "clamp.boxes", text[b]);
+    }
+  }
+};
 
 }  // namespace
 
@@ -115,7 +140,9 @@ ProfileDomain section_profile(const RunConfig& c) {
 }
 
 template <int Dim>
-Built<Dim> build(const RunConfig& c) {
+Built<Dim> build(const RunConfig& c, const Share& share) {
+  ClampBoxes<Dim> clamp(c);
+  BuildShare<Dim> keep{share.part, share.parts, share.count_only, clamp.counter()};
   std::vector<double> rho;
   for (const auto& m : c.materials) rho.push_back(m.density);
   const double dx = c.numerics.spacing, hf = c.numerics.h_factor;
@@ -134,7 +161,7 @@ Built<Dim> build(const RunConfig& c) {
           d.piles.push_back({xp, y, c.piles.diameter});
         d.pile_top_margin = 2.0 * dx;
       }
-      b.sc = build_profile<Dim>(d, dx, rho, hf);
+      b.sc = build_profile<Dim>(d, dx, rho, hf, keep);
       b.frame.toe_x = c.slope.toe_x();
       b.frame.base_length = c.slope.base_length();
       b.frame.base_top = c.slope.base_thickness;
@@ -147,7 +174,7 @@ Built<Dim> build(const RunConfig& c) {
       d.x_left = 0.0;
       d.x_right = a + c.floor_length;
       apply_walls(d, c);
-      b.sc = build_profile<Dim>(d, dx, rho, hf);
+      b.sc = build_profile<Dim>(d, dx, rho, hf, keep);
       b.frame.toe_x = a;
       b.frame.base_length = a;
       b.frame.base_top = 0.0;
@@ -159,14 +186,14 @@ Built<Dim> build(const RunConfig& c) {
       d.x_left = 0.0;
       d.x_right = c.block_length;
       apply_walls(d, c);
-      b.sc = build_profile<Dim>(d, dx, rho, hf);
+      b.sc = build_profile<Dim>(d, dx, rho, hf, keep);
       b.frame.toe_x = c.block_length;
       b.frame.base_length = c.block_length;
       b.frame.base_top = -1e300;
       break;
     }
     case ScenarioType::Biaxial: {
-      b.sc = build_biaxial<Dim>(c.biaxial, dx, rho.front(), hf);
+      b.sc = build_biaxial<Dim>(c.biaxial, dx, rho.front(), hf, keep);
       b.frame.toe_x = c.biaxial.width;
       b.frame.base_length = c.biaxial.width;
       b.frame.base_top = -1e300;
@@ -200,7 +227,7 @@ Built<Dim> build(const RunConfig& c) {
           return z;
         };
       }
-      b.sc = build_profile<Dim>(d, dx, rho, hf);
+      b.sc = build_profile<Dim>(d, dx, rho, hf, keep);
       b.frame.toe_x = d.x_left;  // run-out on a section: reported as the largest horizontal displacement
       b.frame.base_length = d.x_right - d.x_left;
       b.frame.base_top = 1e300;  // no particle counts for the front
@@ -209,7 +236,7 @@ Built<Dim> build(const RunConfig& c) {
   }
   b.frame.spacing = dx;
   b.frame.front_thickness = c.front_thickness;
-  clamp_regions<Dim>(c, b.sc.store);
+  clamp.apply(c, b.sc.store);
   saturate_below_water_table<Dim>(c, b.sc.store);
   return b;
 }
@@ -269,8 +296,8 @@ double cantilever_mode_shape(double xi) {
   return phi(std::clamp(xi, 0.0, 1.0)) / phi(1.0);
 }
 
-template Built<2> build<2>(const RunConfig&);
-template Built<3> build<3>(const RunConfig&);
+template Built<2> build<2>(const RunConfig&, const Share&);
+template Built<3> build<3>(const RunConfig&, const Share&);
 template SolverSettings<2> settings_for<2>(const RunConfig&, const Scenario<2>&);
 template SolverSettings<3> settings_for<3>(const RunConfig&, const Scenario<3>&);
 template std::vector<std::size_t> reported_structures<2>(const RunConfig&, const std::vector<Structure<2>>&);

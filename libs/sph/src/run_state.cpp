@@ -85,7 +85,7 @@ void write_snapshot(SnapshotWriter& w, const SphSolver<Dim>& solver, std::int64_
 }
 
 template <int Dim>
-Restart load_restart(const std::filesystem::path& path, SphStore<Dim>& s) {
+Restart load_restart(const std::filesystem::path& path, SphStore<Dim>& s, const Share& share) {
   SnapshotReader r(path);
   if (r.model() != "sph-slope")
     throw InputError("not an sph-slope snapshot file (model '" + r.model() + "')", path.string());
@@ -98,12 +98,16 @@ Restart load_restart(const std::filesystem::path& path, SphStore<Dim>& s) {
   for (const char* need : {"position", "velocity", "stress", "density", "mass", "material_id", "kind"})
     if (!r.has_field(k, need))
       throw InputError(std::string("restart snapshot lacks field '") + need + "'", path.string());
-  const auto pos = r.read(k, "position");
-  s.resize(pos.count);
+  // Over several ranks only this rank's block of rows, the block DomainDecomposition::scatter keeps
+  // of the whole file (hyperslabs: the other rows are never read).
+  const std::size_t n = r.rows(k, "position");
+  const std::size_t first = n * static_cast<std::size_t>(share.part) / static_cast<std::size_t>(share.parts);
+  const std::size_t last = n * static_cast<std::size_t>(share.part + 1) / static_cast<std::size_t>(share.parts);
+  s.resize(last - first);
   try {
     s.for_each_field([&](auto tag, auto&) {
       using Tag = decltype(tag);
-      if (r.has_field(k, Tag::label)) load_field<Tag>(r.read(k, Tag::label), s);
+      if (r.has_field(k, Tag::label)) load_field<Tag>(r.read(k, Tag::label, first, last - first), s);
     });
   } catch (const std::invalid_argument& e) {
     throw InputError(e.what(), path.string());
@@ -191,8 +195,8 @@ template void write_fields<2>(SnapshotWriter&, const SphStore<2>&, double, std::
 template void write_fields<3>(SnapshotWriter&, const SphStore<3>&, double, std::int64_t, bool, std::size_t);
 template void write_snapshot<2>(SnapshotWriter&, const SphSolver<2>&, std::int64_t);
 template void write_snapshot<3>(SnapshotWriter&, const SphSolver<3>&, std::int64_t);
-template Restart load_restart<2>(const std::filesystem::path&, SphStore<2>&);
-template Restart load_restart<3>(const std::filesystem::path&, SphStore<3>&);
+template Restart load_restart<2>(const std::filesystem::path&, SphStore<2>&, const Share&);
+template Restart load_restart<3>(const std::filesystem::path&, SphStore<3>&, const Share&);
 template ParticleFields fields_of<2>(const SphStore<2>&);
 template ParticleFields fields_of<3>(const SphStore<3>&);
 template GeostaticReport geostatic_with_progress<2>(SphSolver<2>&, double, const RunConfig&, const SphSimulation&,

@@ -81,11 +81,13 @@ class StrengthReductionRun final : public SimulationModel {
   std::vector<NamedTable> tables() const override;
   ParticleFields particles() const override { return mechanism_ ? fields_of(*mechanism_) : ParticleFields{}; }
   /// Before the trials the geostatic state (snapshot 0), after them the failed trial at the
-  /// critical factor (snapshot 1). Over several ranks every rank holds both whole: rank 0 writes them.
+  /// critical factor (snapshot 1). Over several ranks every rank writes its block of the geostatic
+  /// state by id (joined in rank order: the id order); rank 0 alone holds the failed trial, gathered
+  /// there (its pictures are drawn from it), and writes it.
   void write_snapshot(SnapshotWriter& w) const override {
     const std::size_t all = comm_ && comm_->rank() != 0 ? 0 : static_cast<std::size_t>(-1);
     if (!finished_)
-      write_fields<Dim>(w, *initial_, 0.0, 0, settings_.pore_water.active(), all);
+      write_fields<Dim>(w, *initial_, 0.0, 0, settings_.pore_water.active());
     else if (mechanism_)
       write_fields<Dim>(w, *mechanism_, trial_duration_, 1, settings_.pore_water.active(), all);
   }
@@ -111,9 +113,10 @@ class StrengthReductionRun final : public SimulationModel {
   SphSolver<Dim> geo_;
   double cmax_;                                              // largest P-wave speed (m/s)
   nlohmann::json phase_summary_ = nlohmann::json::object();  // "restart" or "geostatic"
-  std::optional<SphStore<Dim>> initial_;                     // the geostatic state every trial starts from
-  double trial_duration_ = 0.0;                              // T, s
-  double u_ref_ = -1.0;  // largest displacement of the f_min trial (the stable reference), m
+  std::optional<SphStore<Dim>> initial_;    // the geostatic state every trial starts from (a rank's block by id)
+  double initial_max_pore_pressure_ = 0.0;  // of the geostatic state's soil, over every rank
+  double trial_duration_ = 0.0;             // T, s
+  double u_ref_ = -1.0;                     // largest displacement of the f_min trial (the stable reference), m
   std::vector<SrmTrial> trials_;
   std::int64_t trial_steps_ = 0;
   std::optional<SphStore<Dim>> mechanism_;  // the store of the failed trial at the upper end of the bracket
@@ -132,7 +135,7 @@ StrengthReductionRun<Dim>::StrengthReductionRun(const RunConfig& c, bool quiet,
     : c_(c),
       quiet_(quiet),
       wall0_(std::chrono::steady_clock::now()),
-      b_(build<Dim>(c)),
+      b_(build<Dim>(c, share_of(comm.get()))),
       settings_(trial_settings<Dim>(c, b_.sc)),
       href_(b_.sc.reference_height),
       geo_(std::move(b_.sc.store), c.materials, c.model, settings_),
@@ -155,19 +158,27 @@ void StrengthReductionRun<Dim>::run(const SphSimulation& self, RunObserver* obs)
 template <int Dim>
 void StrengthReductionRun<Dim>::geostatic_state(const SphSimulation& self, RunObserver* obs) {
   if (!c_.restart.empty()) {
-    const Restart rs = load_restart<Dim>(c_.restart, geo_.store());
+    const Restart rs = load_restart<Dim>(c_.restart, geo_.store(), share_of(comm_.get()));
     for (auto& v : geo_.store().template get<Velocity<Dim>>()) v.setZero();
     for (auto& u : geo_.store().template get<Displacement<Dim>>()) u.setZero();
     phase_summary_["restart"] = {{"file", c_.restart.string()}, {"time_s", rs.time}};
   } else {
-    if (comm_) geo_.distribute(comm_);
+    if (comm_) geo_.distribute(comm_, true);  // built by share
     const double dur = geostatic_duration(c_, href_, cmax_);
     const auto rep = geostatic_with_progress(geo_, dur, c_, self, obs);
     phase_summary_["geostatic"] = {{"duration_s", dur}, {"steps", rep.steps}, {"max_speed_m_per_s", rep.max_speed}};
   }
-  // Over several ranks every rank keeps the whole state (gathered, by particle id): each trial starts
-  // from it and spreads it over the ranks again.
-  initial_ = geo_.domain() ? geo_.gathered_store() : geo_.store();
+  // Over several ranks every rank keeps its block of the state by particle id (the block a scatter
+  // of the whole state would keep; a restart's block of rows): each trial starts from it.
+  initial_ = geo_.domain() ? geo_.domain()->id_block(geo_.store()) : geo_.store();
+  if (settings_.pore_water.active()) {  // the trials' pore pressure: that of the geostatic state
+    std::vector<double> umax{0.0};
+    for (std::size_t i = 0; i < initial_->size(); ++i)
+      if (initial_->template get<ParticleKind>()[i] == kSoil)
+        umax[0] = std::max(umax[0], initial_->template get<PorePressure>()[i]);
+    if (comm_) comm_->max_all(umax);
+    initial_max_pore_pressure_ = umax[0];
+  }
 }
 
 /// One trial with every strength divided by F; true when it fails.
@@ -177,8 +188,8 @@ bool StrengthReductionRun<Dim>::trial(double F, const SphSimulation& self, RunOb
   SrmTrial t;
   t.factor = F;
   SphSolver<Dim> s(*initial_, reduced_strength(c_.model, c_.materials, F), c_.model, settings_);
-  if (comm_) s.distribute(comm_);
-  RunProgress p{"trial", 0.0, T, 0, initial_->size(), F, false};
+  if (comm_) s.distribute(comm_, true);
+  RunProgress p{"trial", 0.0, T, 0, particle_count(), F, false};
   double u75 = -1.0;
   try {
     while (s.time() < T) {
@@ -215,7 +226,7 @@ bool StrengthReductionRun<Dim>::trial(double F, const SphSimulation& self, RunOb
     std::fprintf(stderr, "sph-slope: trial F = %.4f: max displacement %.4g m, last-quarter growth %.3g m -> %s\n", F,
                  t.displacement, t.growth, t.failed ? "fails" : "stable");
   trials_.push_back(t);
-  if (t.failed) mechanism_ = s.domain() ? s.gathered_store() : s.store();
+  if (t.failed) mechanism_ = s.domain() ? s.gathered_store(true) : s.store();  // rank 0's outputs
   return t.failed;
 }
 
@@ -364,12 +375,7 @@ nlohmann::json StrengthReductionRun<Dim>::summary() const {
   s["seismic"] = {{"kh", c_.seismic.kh}, {"kv", c_.seismic.kv}};
   if (settings_.pore_water.active()) {  // the trials' pore pressure: that of the geostatic state
     s["water"] = water_summary(c_, 0.0);
-    double umax = 0.0;
-    if (initial_)
-      for (std::size_t i = 0; i < initial_->size(); ++i)
-        if (initial_->template get<ParticleKind>()[i] == kSoil)
-          umax = std::max(umax, initial_->template get<PorePressure>()[i]);
-    s["water"]["max_pore_pressure_Pa"] = umax;
+    s["water"]["max_pore_pressure_Pa"] = initial_max_pore_pressure_;
   }
 
   s["outcome"] = outcome_;

@@ -52,9 +52,22 @@ ProfileDomain section_profile(const RunConfig& c);
 /// material) when the config gives no layers.
 void apply_layers(ProfileDomain& d, const RunConfig& c);
 
-/// The particles of the configured scenario.
+/// Which particles `build` keeps: all (one process), block `part` of `parts` (a rank's share of a
+/// distributed run: BuildShare in scenario.hpp), or none (`count_only`: validate's dry run).
+struct Share {
+  int part = 0, parts = 1;
+  bool count_only = false;
+};
+
+/// A rank's share of a distributed run (all on one process: comm null).
+inline Share share_of(const Communicator* comm) {
+  return comm ? Share{comm->rank(), comm->size(), false} : Share{};
+}
+
+/// The particles of the configured scenario, as many as `share` keeps (the counts, structures and
+/// extents are the whole scenario's; a clamped region's soil is counted over all of it).
 template <int Dim>
-Built<Dim> build(const RunConfig& c);
+Built<Dim> build(const RunConfig& c, const Share& share = {});
 
 /// The solver settings of a config for its built scenario (the main phase).
 template <int Dim>
@@ -92,7 +105,7 @@ struct Restart {
 
 /// Replace the store by the last snapshot of a file written by sph-slope.
 template <int Dim>
-Restart load_restart(const std::filesystem::path& path, SphStore<Dim>& s);
+Restart load_restart(const std::filesystem::path& path, SphStore<Dim>& s, const Share& share = {});
 
 /// The fields of a store as flat arrays (ParticleFields).
 template <int Dim>

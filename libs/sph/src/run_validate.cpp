@@ -133,12 +133,14 @@ void validate(const RunConfig& c) {
         "initial_velocity.type = uniform needs one component per axis (" + std::to_string(c.dimension) + ", m/s)",
         c.config_source, "initial_velocity.value", std::to_string(c.initial_velocity.value.size()) + " numbers");
   check_resources(c);
-  // Build once (dry run) so that geometry errors surface before any output exists; the structure
-  // names of `output.structures` are checked against the scenario's.
+  // Build once (dry run, keeping no particle: a rank of a distributed run must not hold them all) so
+  // that geometry errors surface before any output exists; the structure names of
+  // `output.structures` are checked against the scenario's.
+  const Share dry{0, 1, true};
   if (c.dimension == 2)
-    (void)reported_structures(c, build<2>(c).sc.structures);
+    (void)reported_structures(c, build<2>(c, dry).sc.structures);
   else
-    (void)reported_structures(c, build<3>(c).sc.structures);
+    (void)reported_structures(c, build<3>(c, dry).sc.structures);
   if (!c.restart.empty() && !std::filesystem::exists(c.restart))
     throw InputError("restart file does not exist", c.config_source, "run.restart", c.restart.string());
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "geohaz/core/errors.hpp"
 
@@ -29,10 +30,18 @@ struct Builder {
   double dx;
   std::int64_t next_id = 0;
   std::int32_t structure = 0;  ///< StructureId of the boundary particles added next
+  /// The ids kept, [keep_lo, keep_hi) (BuildShare), and the visitor of every particle made.
+  std::int64_t keep_lo = 0, keep_hi = std::numeric_limits<std::int64_t>::max();
+  const std::function<void(const Vec<Dim>&, Kind)>* visit = nullptr;
   /// `layer` is the layering normal used to extrapolate stress into a boundary particle (default:
   /// vertical, flat-lying soil); soil particles get none.
   void add(const Vec<Dim>& p, Kind kind, int material, double density, const Vec<Dim>& normal,
            const Vec<Dim>& layer = Vec<Dim>::Unit(Dim - 1)) {
+    if (visit && *visit) (*visit)(p, kind);
+    if (next_id < keep_lo || next_id >= keep_hi) {
+      ++next_id;
+      return;
+    }
     const std::size_t i = store.append(1);
     store.template get<Position<Dim>>()[i] = p;
     store.template get<Density>()[i] = density;
@@ -47,6 +56,36 @@ struct Builder {
   }
 };
 
+/// Set a builder to keep block `part` of `parts` of n particles (BuildShare), reserving its room.
+template <int Dim>
+void keep_block(Builder<Dim>& B, const BuildShare<Dim>& share, std::int64_t n) {
+  B.visit = &share.visit;
+  if (share.count_only) {
+    B.keep_hi = 0;
+    return;
+  }
+  if (share.parts <= 1) return;
+  B.keep_lo = n * share.part / share.parts;
+  B.keep_hi = n * (share.part + 1) / share.parts;
+  B.store.reserve(static_cast<std::size_t>(B.keep_hi - B.keep_lo));
+}
+
+/// Build a scenario with `make(Builder&)` keeping `share`'s block: over several parts, a first
+/// pass counts the particles (keeping none) and the second keeps the block.
+template <int Dim, class Make>
+auto build_share(const BuildShare<Dim>& share, Make&& make) {
+  std::int64_t n = 0;
+  if (share.parts > 1 && !share.count_only) {
+    Builder<Dim> counter;
+    counter.keep_hi = 0;
+    (void)make(counter);
+    n = counter.next_id;
+  }
+  Builder<Dim> B;
+  keep_block(B, share, n);
+  return make(B);
+}
+
 Kind wall_kind(WallType t) {
   return t == WallType::Roller ? Kind::RollerWall : Kind::FixedWall;
 }
@@ -58,8 +97,9 @@ Kind wall_kind(WallType t) {
 template <int Dim>
 class ProfileBuilder {
  public:
-  ProfileBuilder(const ProfileDomain& dom, double dx, const std::vector<double>& densities, double h_factor)
-      : dom_(dom), dx_(dx), densities_(densities), h_factor_(h_factor) {}
+  ProfileBuilder(const ProfileDomain& dom, double dx, const std::vector<double>& densities, double h_factor,
+                 Builder<Dim>& B)
+      : dom_(dom), dx_(dx), densities_(densities), h_factor_(h_factor), B_(B) {}
 
   Scenario<Dim> build() {
     check();
@@ -76,7 +116,7 @@ class ProfileBuilder {
     bedrock_ = dom_.bedrock_depth > 0.0;
     add_structures();
     add_soil();
-    soil_count_ = B_.store.size();
+    soil_count_ = static_cast<std::size_t>(B_.next_id);  // made, kept or not
     if (soil_count_ == 0) throw InputError("the scenario contains no soil particles (check the geometry)");
     // Bottom wall, extended under the end walls and the optional floor extension.
     wall_rho_ = densities_[static_cast<std::size_t>(material_floor_)];
@@ -322,7 +362,7 @@ class ProfileBuilder {
     Scenario<Dim> sc;
     sc.soil_count = soil_count_;
     sc.store = std::move(B_.store);
-    sc.boundary_count = sc.store.size() - sc.soil_count;
+    sc.boundary_count = static_cast<std::size_t>(B_.next_id) - sc.soil_count;
     sc.structures = std::move(structures_);
     sc.spacing = dx_;
     const double span = (xb1_ - xb0_) + (wall_top_ - dom_.z_bottom);
@@ -358,7 +398,7 @@ class ProfileBuilder {
   double soil_zmax_ = -1e300;
   bool bedrock_ = false;
   Vec<Dim> ez_ = Vec<Dim>::Zero(), ex_ = Vec<Dim>::Zero();
-  Builder<Dim> B_;
+  Builder<Dim>& B_;
   std::vector<Structure<Dim>> structures_;
   std::int32_t s_bottom_ = -1, s_left_ = -1, s_right_ = -1, s_side0_ = -1, s_side1_ = -1, s_pile0_ = 0;
   std::size_t soil_count_ = 0;
@@ -367,9 +407,10 @@ class ProfileBuilder {
 }  // namespace
 
 template <int Dim>
-Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vector<double>& densities,
-                            double h_factor) {
-  return ProfileBuilder<Dim>(dom, dx, densities, h_factor).build();
+Scenario<Dim> build_profile(const ProfileDomain& dom, double dx, const std::vector<double>& densities, double h_factor,
+                            const BuildShare<Dim>& share) {
+  return build_share<Dim>(
+      share, [&](Builder<Dim>& B) { return ProfileBuilder<Dim>(dom, dx, densities, h_factor, B).build(); });
 }
 
 ProfileDomain SlopeGeometry::profile() const {
@@ -397,12 +438,12 @@ ProfileDomain SlopeGeometry::profile() const {
   return d;
 }
 
+namespace {
+
+/// build_biaxial's particles, kept as B says.
 template <int Dim>
-Scenario<Dim> build_biaxial(const BiaxialGeometry& g, double dx, double density, double h_factor) {
-  if (!(g.width >= 4 * dx && g.height >= 4 * dx))
-    throw InputError("the biaxial specimen must be at least 4 spacings wide and high");
+Scenario<Dim> biaxial_particles(const BiaxialGeometry& g, double dx, double density, double h_factor, Builder<Dim>& B) {
   const int layers = static_cast<int>(std::ceil(2.0 * h_factor)) + 1;
-  Builder<Dim> B;
   B.dx = dx;
   const int nx = static_cast<int>(std::lround(g.width / dx)), nz = static_cast<int>(std::lround(g.height / dx));
   const int ny = Dim == 3 ? static_cast<int>(std::ceil(4.0 * h_factor)) + 1 : 1;
@@ -420,7 +461,7 @@ Scenario<Dim> build_biaxial(const BiaxialGeometry& g, double dx, double density,
       for (int k = 0; k < nz; ++k)
         B.add(make((i + 0.5) * dx, (j + 0.5) * dx, (k + 0.5) * dx), Kind::Soil, 0, density, Vec<Dim>::Zero());
   Scenario<Dim> sc;
-  sc.soil_count = B.store.size();
+  sc.soil_count = static_cast<std::size_t>(B.next_id);
   // Platens a few spacings wider than the specimen (rough: full fixity).
   const int extra = layers;
   for (int j = 0; j < ny; ++j)
@@ -434,7 +475,7 @@ Scenario<Dim> build_biaxial(const BiaxialGeometry& g, double dx, double density,
   sc.store = std::move(B.store);
   sc.structures = {{"bottom_platen", make(0.5 * nx * dx, 0.5 * ny * dx, 0.0), -ez},
                    {"top_platen", make(0.5 * nx * dx, 0.5 * ny * dx, nz * dx), ez}};
-  sc.boundary_count = sc.store.size() - sc.soil_count;
+  sc.boundary_count = static_cast<std::size_t>(B.next_id) - sc.soil_count;
   sc.spacing = dx;
   sc.domain_lo = Vec<Dim>::Constant(-1e30);
   sc.domain_hi = Vec<Dim>::Constant(1e30);
@@ -455,9 +496,21 @@ Scenario<Dim> build_biaxial(const BiaxialGeometry& g, double dx, double density,
   return sc;
 }
 
-template Scenario<2> build_profile<2>(const ProfileDomain&, double, const std::vector<double>&, double);
-template Scenario<3> build_profile<3>(const ProfileDomain&, double, const std::vector<double>&, double);
-template Scenario<2> build_biaxial<2>(const BiaxialGeometry&, double, double, double);
-template Scenario<3> build_biaxial<3>(const BiaxialGeometry&, double, double, double);
+}  // namespace
+
+template <int Dim>
+Scenario<Dim> build_biaxial(const BiaxialGeometry& g, double dx, double density, double h_factor,
+                            const BuildShare<Dim>& share) {
+  if (!(g.width >= 4 * dx && g.height >= 4 * dx))
+    throw InputError("the biaxial specimen must be at least 4 spacings wide and high");
+  return build_share<Dim>(share, [&](Builder<Dim>& B) { return biaxial_particles(g, dx, density, h_factor, B); });
+}
+
+template Scenario<2> build_profile<2>(const ProfileDomain&, double, const std::vector<double>&, double,
+                                      const BuildShare<2>&);
+template Scenario<3> build_profile<3>(const ProfileDomain&, double, const std::vector<double>&, double,
+                                      const BuildShare<3>&);
+template Scenario<2> build_biaxial<2>(const BiaxialGeometry&, double, double, double, const BuildShare<2>&);
+template Scenario<3> build_biaxial<3>(const BiaxialGeometry&, double, double, double, const BuildShare<3>&);
 
 }  // namespace geohaz::sph

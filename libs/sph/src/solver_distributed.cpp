@@ -14,13 +14,16 @@
 namespace geohaz::sph {
 
 template <int Dim>
-void SphSolver<Dim>::distribute(std::shared_ptr<const Communicator> comm) {
+void SphSolver<Dim>::distribute(std::shared_ptr<const Communicator> comm, bool store_is_share) {
   if (nb_.builds() > 0 || domain_) throw std::logic_error("SphSolver::distribute: call it once, before the first step");
   if (settings_.total_lagrangian)
     throw InputError("the total-Lagrangian formulation does not run on several ranks yet (issue #36)", "",
                      "numerics.formulation", "total_lagrangian");
   domain_ = std::make_unique<DomainDecomposition<Dim>>(std::move(comm), settings_.periodic);
-  domain_->scatter(store_);
+  if (store_is_share)
+    domain_->adopt(store_);
+  else
+    domain_->scatter(store_);
   nb_.invalidate();
   max_drift_ = 0.0;
 }
@@ -107,8 +110,8 @@ void SphSolver<Dim>::reduce_over_ranks() {
 }
 
 template <int Dim>
-SphStore<Dim> SphSolver<Dim>::gathered_store() const {
-  if (domain_) return domain_->gather(store_);
+SphStore<Dim> SphSolver<Dim>::gathered_store(bool root_only) const {
+  if (domain_) return domain_->gather(store_, root_only);
   SphStore<Dim> out = store_;
   const auto& id = out.template get<ParticleId>();
   std::vector<std::uint32_t> perm(out.size());
@@ -118,16 +121,16 @@ SphStore<Dim> SphSolver<Dim>::gathered_store() const {
   return out;
 }
 
-template void SphSolver<2>::distribute(std::shared_ptr<const Communicator>);
-template void SphSolver<3>::distribute(std::shared_ptr<const Communicator>);
+template void SphSolver<2>::distribute(std::shared_ptr<const Communicator>, bool);
+template void SphSolver<3>::distribute(std::shared_ptr<const Communicator>, bool);
 template void SphSolver<2>::rebuild_distributed();
 template void SphSolver<3>::rebuild_distributed();
 template void SphSolver<2>::update_stress_ghosts();
 template void SphSolver<3>::update_stress_ghosts();
 template void SphSolver<2>::reduce_over_ranks();
 template void SphSolver<3>::reduce_over_ranks();
-template SphStore<2> SphSolver<2>::gathered_store() const;
-template SphStore<3> SphSolver<3>::gathered_store() const;
+template SphStore<2> SphSolver<2>::gathered_store(bool) const;
+template SphStore<3> SphSolver<3>::gathered_store(bool) const;
 
 // Passes 2 and 4 with ghosts (a soil pair with a ghost has no reaction: its owner sums it).
 template <int Dim>

@@ -134,6 +134,11 @@ class SnapshotReader {
   std::vector<std::string> fields(std::size_t k) const;
   bool has_field(std::size_t k, std::string_view label) const;
   FieldData read(std::size_t k, std::string_view label) const;
+  /// Rows [first, first + count) of a field only (an HDF5 hyperslab: a rank of a distributed
+  /// restart reads its block, not the whole file); InputError when they are not all there.
+  FieldData read(std::size_t k, std::string_view label, std::size_t first, std::size_t count) const;
+  /// The number of rows (particles) of a field of snapshot k, without reading it.
+  std::size_t rows(std::size_t k, std::string_view label) const;
   /// Line cells of snapshot k (empty if none).
   std::vector<std::uint32_t> lines(std::size_t k) const;
   /// Root attribute as text ("" if absent); numeric attributes are formatted.

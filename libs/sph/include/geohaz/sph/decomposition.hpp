@@ -35,6 +35,7 @@
 #include <cstring>
 #include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "geohaz/core/communicator.hpp"
@@ -77,6 +78,17 @@ class DomainDecomposition {
   /// Keep this rank's share of a store that every rank holds in full (the scenario builder's):
   /// a block of consecutive particles. The first rebuild then partitions them.
   void scatter(SphStore<Dim>& s);
+  /// Take a store that already is this rank's share (that block, made or read by block: BuildShare
+  /// in scenario.hpp, the restart's rows) as it is.
+  void adopt(const SphStore<Dim>& s) noexcept {
+    owned_ = s.size();
+    ghosts_ = 0;
+  }
+  /// The block of n particles that scatter keeps on `rank` of `ranks`: [first, last).
+  static std::pair<std::size_t, std::size_t> block(std::size_t n, int rank, int ranks) noexcept {
+    return {n * static_cast<std::size_t>(rank) / static_cast<std::size_t>(ranks),
+            n * static_cast<std::size_t>(rank + 1) / static_cast<std::size_t>(ranks)};
+  }
 
   /// Steps 1–5 of the file comment. `weights`: one per owned particle (its cost); `repartition`:
   /// recompute the boxes (always done at the first rebuild); `sort_cell` > 0: sort the owned
@@ -107,8 +119,15 @@ class DomainDecomposition {
   }
 
   /// Every rank's owned particles with every field, sorted by ParticleId, on every rank
-  /// (collective): the state the outputs of a run are made from.
-  SphStore<Dim> gather(const SphStore<Dim>& s) const;
+  /// (collective); `root_only`: on rank 0 only, the others get an empty store (the pictures and
+  /// the release a run's rank 0 makes: no other rank holds the whole state).
+  SphStore<Dim> gather(const SphStore<Dim>& s, bool root_only = false) const;
+
+  /// The block of the particles by id that scatter would keep of the gathered store, without
+  /// gathering it (collective): every owned particle goes to the rank whose block
+  /// (block(n, rank, size)) holds its id, with every field, sorted by id. Needs the ids to be
+  /// 0 … n−1 (as a scenario numbers them); otherwise the gather and scatter themselves.
+  SphStore<Dim> id_block(const SphStore<Dim>& s) const;
 
   /// The rank whose box holds x (x wrapped along periodic axes).
   int owner(const Vec<Dim>& x) const noexcept;

@@ -7,6 +7,7 @@
 #include <array>
 #include <vector>
 
+#include "geohaz/core/communicator.hpp"
 #include "geohaz/sph/fields.hpp"
 
 namespace geohaz::sph {
@@ -28,6 +29,17 @@ struct DiagnosticFrame {
   double front_thickness = 0.0;
 };
 
+/// Over several ranks (domain decomposition): each rank passes its owned particles, slots
+/// [0, owned) of its store, and the diagnostics are reduced over the ranks (collective: every rank
+/// calls them alike and gets the result). Maxima, minima, counts and the per-bin maxima and minima
+/// of the profiles are exact, so the same as on one process; the sums (kinetic energy, mean speed,
+/// failed volume) are the ranks' partial sums added in rank order: the one-process sum to round-off.
+/// Without a communicator: the whole store.
+struct OverRanks {
+  const Communicator* comm = nullptr;
+  std::size_t owned = 0;
+};
+
 /// One row of the time series.
 struct SeriesRow {
   double front = 0.0;              ///< front of the soil ≥ front_thickness (or front_min_layers·Δx) thick (m)
@@ -41,17 +53,18 @@ struct SeriesRow {
 };
 
 template <int Dim>
-SeriesRow series_row(const SphStore<Dim>& s, const DiagnosticFrame& f);
+SeriesRow series_row(const SphStore<Dim>& s, const DiagnosticFrame& f, const OverRanks& over = {});
 
 /// Free surface: for bins of width Δx along x, the highest soil particle top (z + Δx/2).
 /// Returns (x, z) pairs for the occupied bins (3D: over the whole width).
 template <int Dim>
-std::vector<std::array<double, 2>> free_surface(const SphStore<Dim>& s, double spacing);
+std::vector<std::array<double, 2>> free_surface(const SphStore<Dim>& s, double spacing, const OverRanks& over = {});
 
 /// Slip surface in the initial configuration: for bins along the initial x, the lowest initial
 /// elevation of particles displaced more than `threshold` (m). Returns (x, z) pairs.
 template <int Dim>
-std::vector<std::array<double, 2>> slip_surface(const SphStore<Dim>& s, double spacing, double threshold);
+std::vector<std::array<double, 2>> slip_surface(const SphStore<Dim>& s, double spacing, double threshold,
+                                                const OverRanks& over = {});
 
 /// Failed mass: soil particles displaced more than `threshold`.
 struct FailedMass {
@@ -59,6 +72,7 @@ struct FailedMass {
   double volume = 0.0;  ///< Σ m/ρ0: m³ in 3D, m² (per metre width) in 2D
 };
 template <int Dim>
-FailedMass failed_mass(const SphStore<Dim>& s, const std::vector<double>& reference_density, double threshold);
+FailedMass failed_mass(const SphStore<Dim>& s, const std::vector<double>& reference_density, double threshold,
+                       const OverRanks& over = {});
 
 }  // namespace geohaz::sph

@@ -87,14 +87,29 @@ struct Scenario {
   std::vector<Structure<Dim>> structures;
 };
 
+/// Which of a scenario's particles a builder keeps (domain decomposition, docs/sph.md "Domain
+/// decomposition"): the particles are numbered 0, 1, … (ParticleId) in the order they are made, and
+/// the builder keeps block `part` of `parts` blocks of consecutive ids, [n·part/parts,
+/// n·(part+1)/parts) of n, the block DomainDecomposition::scatter keeps of the whole store. With
+/// parts > 1 it makes the particles twice (first counting them), storing only its block: a rank's
+/// memory scales with its share. `count_only`: keep none (the dry run of validate). `visit`, if
+/// set, sees every particle made, kept or not (position, kind), once.
+template <int Dim>
+struct BuildShare {
+  int part = 0, parts = 1;
+  bool count_only = false;
+  std::function<void(const Vec<Dim>&, Kind)> visit;
+};
+
 /// Surface elevation of a profile at x (linear interpolation; first segment wins at a vertical step).
 double surface_at(const std::vector<std::array<double, 2>>& surface, double x);
 
 /// Fill a store from a profile domain. densities[k] is ρ0 of material k (for masses).
 /// Throws InputError when the domain is empty or inconsistent.
+/// `share`: the particles kept (BuildShare); the counts, structures and extents are the whole scenario's.
 template <int Dim>
 Scenario<Dim> build_profile(const ProfileDomain& dom, double spacing, const std::vector<double>& densities,
-                            double h_factor);
+                            double h_factor, const BuildShare<Dim>& share = {});
 
 /// Parametric slope (SPH-slope paper 2020, Fig. 3): base of thickness `base_thickness`, crest of length
 /// `crest_length` at height `height` above the base, face with gradient `gradient`:1 (H:V), front
@@ -116,6 +131,7 @@ struct BiaxialGeometry {
   double width = 0.05, height = 0.1;
 };
 template <int Dim>
-Scenario<Dim> build_biaxial(const BiaxialGeometry& g, double spacing, double density, double h_factor);
+Scenario<Dim> build_biaxial(const BiaxialGeometry& g, double spacing, double density, double h_factor,
+                            const BuildShare<Dim>& share = {});
 
 }  // namespace geohaz::sph

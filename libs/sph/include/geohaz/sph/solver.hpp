@@ -251,17 +251,20 @@ class SphSolver {
 
   /// Run over the ranks of `comm` (domain decomposition, decomposition.hpp): every rank constructs
   /// the solver with the same full store and calls this before the first step; each keeps a share,
-  /// and the first step partitions them. Collective from then on: every rank calls step() (and the
-  /// other collective calls below) in the same order. Throws InputError for what is not distributed
-  /// yet (the total-Lagrangian formulation).
-  void distribute(std::shared_ptr<const Communicator> comm);
+  /// and the first step partitions them. `store_is_share`: the store already is this rank's share
+  /// (the block DomainDecomposition::scatter would keep: a scenario built with BuildShare, the rows
+  /// of a restart file read by block), kept as it is. Collective from then on: every rank calls
+  /// step() (and the other collective calls below) in the same order. Throws InputError for what is
+  /// not distributed yet (the total-Lagrangian formulation).
+  void distribute(std::shared_ptr<const Communicator> comm, bool store_is_share = false);
   /// The decomposition (null on one process without distribute()).
   const DomainDecomposition<Dim>* domain() const noexcept { return domain_.get(); }
   /// Particles this rank owns: slots [0, owned_count()) of store() (the rest are ghosts).
   std::size_t owned_count() const noexcept { return domain_ ? domain_->owned() : store_.size(); }
   /// Every particle of every rank, sorted by ParticleId (collective); without distribute() a copy of
   /// the store in that order.
-  SphStore<Dim> gathered_store() const;
+  /// `root_only`: over several ranks on rank 0 only (the others get an empty store).
+  SphStore<Dim> gathered_store(bool root_only = false) const;
 
  private:
   // One step (solver_passes.cpp; 0, 5 and 6 in solver.cpp), the numbered passes of the file comment:
