@@ -84,27 +84,10 @@ void read_material(ConfigReader& r, RunConfig& c) {
   p.density = m.density =
       r.get("material.density", m.density, Range::positive(), {"kg/m^3", "disc density (discs are 1 m thick)"});
   // the choices and their sentences come from the one name table (contact_laws.hpp)
-  m.law = *contact_law_from_name(r.get_choice("material.contact_law",
-                                              std::visit([](const auto& l) { return std::string(l.name); }, m.law),
-                                              ContactLawNames::choices(), {"", ContactLawNames::help("contact law")}));
-  const double Ec = r.get("material.contact_modulus", LinearSpringCoulomb{}.kn / 2, Range::positive(),
-                          {"Pa", "linear law: contact modulus E_c, k_n = 2 E_c (PFC2D, unit thickness)"});
-  const double kratio = r.get("material.stiffness_ratio", LinearSpringCoulomb{}.kn / LinearSpringCoulomb{}.ks,
-                              Range::positive(), {"1", "linear law: k_n/k_s"});
-  const double E = r.get("material.youngs_modulus", HertzMindlin{}.youngs, Range::positive(),
-                         {"Pa", "Hertz-Mindlin: particle Young's modulus"});
-  const double nu = r.get("material.poisson_ratio", HertzMindlin{}.poisson, Range::closed_open(0.0, 0.5),
-                          {"1", "Hertz-Mindlin: particle Poisson's ratio"});
-  // One case per law and no generic one: a law added to ContactLaw without its case fails to compile.
-  std::visit(Overloaded{[&](LinearSpringCoulomb& l) {
-                          l.kn = 2 * Ec;
-                          l.ks = 2 * Ec / kratio;
-                        },
-                        [&](HertzMindlin& h) {
-                          h.youngs = E;
-                          h.poisson = nu;
-                        }},
-             m.law);
+  const std::string law = r.get_choice("material.contact_law", std::string(contact_law_name(m.law)),
+                                       ContactLawNames::choices(), {"", ContactLawNames::help("contact law")});
+  // The law's own coefficients (contact_laws.hpp, `parameters`); another law's key is an error.
+  m.law = ContactLawParameters::read(r, {"material.", "material.contact_law", "set material.contact_law"}, law);
   m.contact.friction =
       r.get("material.friction", m.contact.friction, Range::non_negative(), {"1", "contact friction coefficient mu"});
   m.contact.restitution = r.get("material.restitution", m.contact.restitution, Range::open_closed(0.0, 1.0),

@@ -1,5 +1,6 @@
 // The debris-runout configuration keys: declared once here (unit, default, range, help), read into
-// RunConfig. Defaults come from the structs of run.hpp / solver.hpp / basal_friction.hpp.
+// RunConfig. Defaults come from the structs of run.hpp / solver.hpp; the basal laws' coefficients
+// from their own declarations (friction/*.hpp, core/law_parameters.hpp).
 #include "geohaz/core/config.hpp"
 
 #include <algorithm>
@@ -18,164 +19,13 @@ namespace geohaz::runout {
 
 namespace {
 
-/// Which laws read each model.* coefficient key (a key given for another law is an error; the
-/// report labels a run's coefficients from this and the keys' declarations below).
-const std::vector<std::pair<const char*, std::vector<const char*>>>& friction_key_laws() {
-  const char* const manning = ModifiedManningFriction::name;
-  const char* const voellmy = VoellmyFriction::name;
-  const char* const coulomb = CoulombFriction::name;
-  const char* const vc = VoellmyCohesionFriction::name;
-  const char* const bingham = BinghamFriction::name;
-  const char* const hb = HerschelBulkleyFriction::name;
-  const char* const oj = OBrienJulienFriction::name;
-  const char* const pf = PouliquenForterreFriction::name;
-  static const std::vector<std::pair<const char*, std::vector<const char*>>> table{{"model.n", {manning, oj}},
-                                                                                   {"model.icr", {manning}},
-                                                                                   {"model.m", {manning}},
-                                                                                   {"model.mu", {voellmy, coulomb, vc}},
-                                                                                   {"model.xi", {voellmy, vc}},
-                                                                                   {"model.cohesion", {vc}},
-                                                                                   {"model.tau_y", {bingham, hb, oj}},
-                                                                                   {"model.viscosity", {bingham, oj}},
-                                                                                   {"model.consistency", {hb}},
-                                                                                   {"model.flow_index", {hb}},
-                                                                                   {"model.laminar_k", {oj}},
-                                                                                   {"model.cv", {oj}},
-                                                                                   {"model.yield_alpha", {oj}},
-                                                                                   {"model.yield_beta", {oj}},
-                                                                                   {"model.viscosity_alpha", {oj}},
-                                                                                   {"model.viscosity_beta", {oj}},
-                                                                                   {"model.delta1", {pf}},
-                                                                                   {"model.delta2", {pf}},
-                                                                                   {"model.hstop_length", {pf}},
-                                                                                   {"model.flow_rule_beta", {pf}},
-                                                                                   {"model.flow_rule_gamma", {pf}}};
-  return table;
-}
-
-/// The friction law named in the config, with its coefficients (defaults from the law structs).
-/// Each law's keys are model.<coefficient>; a key given for a law that does not use it is an error.
+/// The friction law named in the config, with its coefficients model.<key>: the keys, defaults,
+/// ranges, units and rules are each law's own declaration (friction/*.hpp); a key of a law that is
+/// not chosen is an error.
 BasalFriction read_friction(ConfigReader& cfg) {
-  const ModifiedManningFriction manning;
-  const VoellmyFriction voellmy;
-  const BinghamFriction bingham;
-  const HerschelBulkleyFriction hb;
-  const OBrienJulienFriction oj;
-  const PouliquenForterreFriction pf;
   const std::string law = cfg.get_choice("model.friction", ModifiedManningFriction::name, BasalFrictionNames::choices(),
                                          {"", BasalFrictionNames::help("basal shear law")});
-  const std::string where = cfg.source().empty() ? "command line" : cfg.source();
-  // δ₁, δ₂ are read in degrees (rounded to 0.01°; the law holds their tangents).
-  const auto deg_of = [](double t) { return std::round(std::atan(t) * 18000.0 / std::numbers::pi) / 100.0; };
-  const double n = cfg.get("model.n", manning.n, Range::closed(0.005, 0.5),
-                           {"s/m^(1/3)",
-                            "Manning roughness n (manning, obrien_julien: there the turbulent-dispersive n_td; "
-                            "0.02–0.1 for natural channels)"});
-  const double icr = cfg.get("model.icr", manning.i_cr, Range::closed(0.0, 2.0),
-                             {"1", "critical slope gradient i_cr (manning; tan of the stopping angle)"});
-  const double m =
-      cfg.get("model.m", manning.m, Range::closed(0.0, 2.0), {"1", "exponent of |v| in the yield term (manning)"});
-  const double mu = cfg.get("model.mu", voellmy.mu, Range::closed(0.0, 2.0),
-                            {"1", "Coulomb friction coefficient μ (voellmy, coulomb, voellmy_cohesion)"});
-  const double xi = cfg.get("model.xi", voellmy.xi, Range::open_closed(0.0, 1e5),
-                            {"m/s^2", "Voellmy turbulence coefficient ξ (voellmy, voellmy_cohesion)"});
-  const double cohesion =
-      cfg.get("model.cohesion", 0.0, Range::closed(0.0, 1e6),
-              {"Pa", "cohesion C of the RAMMS form (voellmy_cohesion; no published range for debris, docs/runout.md)"});
-  const double tau_y =
-      cfg.get("model.tau_y", bingham.tau_y, Range::closed(0.0, 1e6),
-              {"Pa", "yield stress τ_y (bingham, herschel_bulkley, obrien_julien; mud matrices 0.1 Pa to a few kPa)"});
-  const double viscosity =
-      cfg.get("model.viscosity", bingham.viscosity, Range::open_closed(1e-6, 1e6),
-              {"Pa*s", "Bingham (plastic) viscosity μ_B, η (bingham, obrien_julien; mud matrices 0.01–100)"});
-  const double consistency = cfg.get("model.consistency", hb.consistency, Range::open_closed(1e-6, 1e6),
-                                     {"Pa*s^n", "consistency K of τ = τ_y + K γ̇^n (herschel_bulkley)"});
-  const double flow_index = cfg.get("model.flow_index", hb.flow_index, Range::closed(0.1, 2.0),
-                                    {"1", "flow index n of τ = τ_y + K γ̇^n (herschel_bulkley; muds ≈ 1/3)"});
-  const double laminar_k =
-      cfg.get("model.laminar_k", oj.laminar_k, Range::closed(1.0, 1e5),
-              {"1", "laminar resistance K of the viscous slope Kη U/(8ρ g h²) (obrien_julien; 24 smooth plane)"});
-  const double cv =
-      cfg.get("model.cv", 0.0, Range::closed(0.0, 0.65),
-              {"1",
-               "volumetric sediment concentration C_v (obrien_julien: τ_y = yield_alpha·exp(yield_beta·C_v), η = "
-               "viscosity_alpha·exp(viscosity_beta·C_v), O'Brien & Julien 1988; 0: model.tau_y and "
-               "model.viscosity)"});
-  // Defaults: Aspen Pit 1 of O'Brien & Julien (1988), 0.181 dyn/cm² and 0.036 P in SI.
-  const double ya = cfg.get("model.yield_alpha", 0.0181, Range::open_closed(0.0, 1e6),
-                            {"Pa", "α₂ of τ_y = α₂ exp(β₂ C_v) (obrien_julien with model.cv)"});
-  const double yb = cfg.get("model.yield_beta", 25.7, Range::closed(0.0, 100.0),
-                            {"1", "β₂ of τ_y = α₂ exp(β₂ C_v) (obrien_julien with model.cv)"});
-  const double va = cfg.get("model.viscosity_alpha", 0.0036, Range::open_closed(0.0, 1e6),
-                            {"Pa*s", "α₁ of η = α₁ exp(β₁ C_v) (obrien_julien with model.cv)"});
-  const double vb = cfg.get("model.viscosity_beta", 22.1, Range::closed(0.0, 100.0),
-                            {"1", "β₁ of η = α₁ exp(β₁ C_v) (obrien_julien with model.cv)"});
-  const double delta1 = cfg.get("model.delta1", deg_of(pf.tan_delta1), Range::open_closed(0.0, 60.0),
-                                {"deg", "δ₁: slope below which no layer flows (pouliquen)"});
-  const double delta2 = cfg.get("model.delta2", deg_of(pf.tan_delta2), Range::open_closed(0.0, 80.0),
-                                {"deg", "δ₂ > δ₁: slope above which no layer stops (pouliquen)"});
-  const double length =
-      cfg.get("model.hstop_length", pf.length, Range::open_closed(0.0, 100.0),
-              {"m", "L of h_stop(θ) = L (tan δ₂ − tan θ)/(tan θ − tan δ₁) (pouliquen; a few grain diameters)"});
-  const double beta = cfg.get("model.flow_rule_beta", pf.beta, Range::open_closed(0.0, 10.0),
-                              {"1", "β of the flow rule u/√(g h cos θ) = β h/h_stop − γ (pouliquen)"});
-  const double gamma = cfg.get("model.flow_rule_gamma", pf.gamma, Range::closed(0.0, 10.0),
-                               {"1", "γ of the flow rule u/√(g h cos θ) = β h/h_stop − γ (pouliquen)"});
-  // A coefficient the chosen law does not use is a mistake, not something to ignore silently.
-  const auto used_by = [&](const char* key, const std::vector<const char*>& laws) {
-    if (!cfg.has(key)) return;
-    for (const char* l : laws)
-      if (law == l) return;
-    std::string names;
-    for (const char* l : laws) names += (names.empty() ? "" : " or ") + std::string(l);
-    throw InputError(std::string(key) + " is given but model.friction = " + law + " does not use it (it belongs to " +
-                         names + "; set model.friction or --friction)",
-                     where, key);
-  };
-  for (const auto& [key, laws] : friction_key_laws()) used_by(key, laws);
-  const char* const vc = VoellmyCohesionFriction::name;
-  if (law == vc && cohesion > 0.0 && mu > 1.0)
-    throw InputError("voellmy_cohesion needs model.mu ≤ 1 with a cohesion (the RAMMS term (1 − μ) C would be negative)",
-                     where, "model.mu", std::to_string(mu));
-  if (law == OBrienJulienFriction::name && cv > 0.0)
-    for (const char* k : {"model.tau_y", "model.viscosity"})
-      if (cfg.has(k))
-        throw InputError(std::string(k) +
-                             " and model.cv both set: with model.cv the yield stress and viscosity come "
-                             "from the concentration (give one or the other)",
-                         where, k);
-  if (law == PouliquenForterreFriction::name && !(delta2 > delta1))
-    throw InputError("model.delta2 must exceed model.delta1 (" + std::to_string(delta1) + " deg)", where,
-                     "model.delta2", std::to_string(delta2));
-  const auto tan_deg = [](double d) { return std::tan(d * std::numbers::pi / 180.0); };
-  // One case per law and no generic one: a law added to BasalFriction without its case fails to compile.
-  BasalFriction f = *BasalFrictionNames::from_name(law);  // get_choice has checked the name
-  std::visit(Overloaded{[&](ModifiedManningFriction& l) {
-                          l = ModifiedManningFriction{n, icr, m};
-                        },
-                        [&](VoellmyFriction& l) {
-                          l = VoellmyFriction{mu, xi};
-                        },
-                        [&](CoulombFriction& l) { l = CoulombFriction{mu}; },
-                        [&](VoellmyCohesionFriction& l) {
-                          l = VoellmyCohesionFriction{mu, xi, cohesion};
-                        },
-                        [&](BinghamFriction& l) {
-                          l = BinghamFriction{tau_y, viscosity};
-                        },
-                        [&](HerschelBulkleyFriction& l) {
-                          l = HerschelBulkleyFriction{tau_y, consistency, flow_index};
-                        },
-                        [&](OBrienJulienFriction& l) {
-                          l = cv > 0.0
-                                  ? OBrienJulienFriction{ya * std::exp(yb * cv), va * std::exp(vb * cv), laminar_k, n}
-                                  : OBrienJulienFriction{tau_y, viscosity, laminar_k, n};
-                        },
-                        [&](PouliquenForterreFriction& l) {
-                          l = PouliquenForterreFriction{tan_deg(delta1), tan_deg(delta2), length, beta, gamma};
-                        }},
-             f);
-  return f;
+  return BasalFrictionParameters::read(cfg, {"model.", "model.friction", "set model.friction or --friction"}, law);
 }
 
 /// A path given in the config: relative to the config file's folder when it does not exist as
@@ -220,13 +70,13 @@ void read_processes(ConfigReader& cfg, RunConfig& c) {
     throw InputError("entrainment.law = shear needs entrainment.coefficient > 0 (m/(s*Pa))", cfg.source(),
                      "entrainment.coefficient", "0");
 
-  s.zones = resolve(
-      cfg, "zones.file",
-      cfg.get_string("zones.file", "",
-                     {"",
-                      "friction zones: polygons whose attributes (the law's coefficients: n, icr, m, mu, xi, cohesion, "
-                      "tau_y, viscosity, consistency, flow_index, delta1, delta2) override the "
-                      "global coefficients inside them"}));
+  std::string zone_names;
+  for (const char* n : kFrictionParameterNames) (zone_names += zone_names.empty() ? "" : ", ") += n;
+  s.zones =
+      resolve(cfg, "zones.file",
+              cfg.get_string("zones.file", "",
+                             {"", "friction zones: polygons whose attributes (the law's coefficients: " + zone_names +
+                                      ") override the global coefficients inside them"}));
   for (int k = 0; k < kFrictionParameters; ++k) {
     const std::string name = kFrictionParameterNames[static_cast<std::size_t>(k)];
     s.zone_rasters[static_cast<std::size_t>(k)] =
@@ -490,26 +340,10 @@ RunConfig read_config(ConfigReader& cfg) {
 }
 
 std::vector<FrictionKey> friction_keys(std::string_view law) {
-  ConfigReader d = ConfigReader::describe();
-  (void)read_config(d);
-  const std::vector<KeyReference> refs = d.reference();
-  const std::vector<std::string> names = BasalFrictionNames::choices();
   std::vector<FrictionKey> out;
-  for (const auto& [key, laws] : friction_key_laws()) {
-    if (std::find_if(laws.begin(), laws.end(), [&](const char* l) { return law == l; }) == laws.end()) continue;
-    const auto r = std::find_if(refs.begin(), refs.end(), [&](const KeyReference& k) { return k.key == key; });
-    if (r == refs.end()) continue;
-    // The help text is "<label> (<laws>[; notes])": the label ends where the list of laws begins.
-    std::string label = r->help;
-    for (std::size_t at = label.find(" ("); at != std::string::npos; at = label.find(" (", at + 1)) {
-      const std::string_view rest = std::string_view(label).substr(at + 2);
-      if (std::any_of(names.begin(), names.end(), [&](const std::string& n) { return rest.rfind(n, 0) == 0; })) {
-        label.resize(at);
-        break;
-      }
-    }
-    out.push_back({key, label, r->unit});
-  }
+  for (const auto& k : BasalFrictionParameters::keys())
+    if (std::find(k.laws.begin(), k.laws.end(), law) != k.laws.end())
+      out.push_back({"model." + std::string(k.spec.key), std::string(k.spec.meaning), std::string(k.spec.unit)});
   return out;
 }
 

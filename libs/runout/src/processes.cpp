@@ -116,6 +116,15 @@ void check_range(const std::vector<double>& f, double lo, double hi, const std::
                        key, num(v));
 }
 
+/// The same against a law coefficient's declared range (friction zones).
+void check_range(const std::vector<double>& f, const ParamSpec& spec, const std::string& file, const std::string& key) {
+  const std::string unit = spec.unit == "1" ? "" : std::string(spec.unit);
+  for (double v : f)
+    if (std::isfinite(v) && !spec.range.contains(v))
+      throw InputError(key + " must be in " + spec.range.str() + " " + unit + " (found " + num(v) + ")", file, key,
+                       num(v));
+}
+
 /// The CSV table of an inflow hydrograph: time (s), discharge (m³/s), one row per line, an optional
 /// header line, '#' comments.
 void read_hydrograph_table(const std::string& file, Hydrograph& q) {
@@ -162,21 +171,6 @@ void read_hydrograph_table(const std::string& file, Hydrograph& q) {
 /// out.friction (NaN outside the zones).
 void load_friction_zones(const ProcessSpec& s, const RunoutParameters& p, const Raster& dsm, const GridGeometry& g,
                          SpatialProcesses& out) {
-  // The ranges and units of the model.<name> keys (config.cpp).
-  const std::array<std::pair<double, double>, kFrictionParameters> ranges{{{0.005, 0.5},
-                                                                           {0.0, 2.0},
-                                                                           {0.0, 2.0},
-                                                                           {0.0, 2.0},
-                                                                           {1e-9, 1e5},
-                                                                           {0.0, 1e6},
-                                                                           {0.0, 1e6},
-                                                                           {1e-6, 1e6},
-                                                                           {1e-6, 1e6},
-                                                                           {0.1, 2.0},
-                                                                           {0.0, 60.0},
-                                                                           {0.0, 80.0}}};
-  const std::array<const char*, kFrictionParameters> units{"s/m^(1/3)", "",     "",       "", "m/s^2", "Pa",
-                                                           "Pa",        "Pa*s", "Pa*s^n", "", "deg",   "deg"};
   const std::string law = friction_name(p.friction);
   const auto law_has = [&](int k) { return has_parameter(p.friction, k); };
   std::string law_keys;
@@ -196,7 +190,7 @@ void load_friction_zones(const ProcessSpec& s, const RunoutParameters& p, const 
       }
       std::vector<Polygon> polys;
       const auto v = attribute_of(s.zones, name, dsm, polys);
-      check_range(v, ranges[k].first, ranges[k].second, s.zones, name, units[k]);
+      check_range(v, zone_parameter(k), s.zones, name);
       auto& f = out.friction[static_cast<std::size_t>(k)];
       f.assign(g.cells(), kNaN);
       paint(polys, v, g, f);
@@ -216,7 +210,7 @@ void load_friction_zones(const ProcessSpec& s, const RunoutParameters& p, const 
                            "' is given but the " + law + " law has no such coefficient",
                        file, key);
     const auto v = raster_on_grid(file, dsm, key);
-    check_range(v, ranges[k].first, ranges[k].second, file, key, units[k]);
+    check_range(v, zone_parameter(k), file, key);
     auto& f = out.friction[static_cast<std::size_t>(k)];
     if (f.empty()) f.assign(g.cells(), kNaN);
     for (std::size_t c = 0; c < v.size(); ++c)

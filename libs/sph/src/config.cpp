@@ -129,31 +129,16 @@ void read_model_and_materials(ConfigReader& r, RunConfig& c) {
                       {"kg/m^3", "density rho0 (soils 1500-2300, water 1000, rock 2500-3000)"});
     p.young = m.get("young", p.young, Range::positive(), {"Pa", "Young's modulus E"});
     p.poisson = m.get("poisson", p.poisson, Range::closed_open(0.0, 0.5), {"1", "Poisson's ratio"});
-    p.cohesion = m.get("cohesion", p.cohesion, Range::non_negative(), {"Pa", "cohesion c (Drucker-Prager)"});
-    p.friction = kDeg * m.get("friction", 30.0, Range::closed_open(0.0, 90.0), {"deg", "friction angle phi"});
-    p.dilatancy = kDeg * m.get("dilatancy", p.dilatancy / kDeg, Range::closed_open(0.0, 90.0),
-                               {"deg", "dilatancy angle psi (<= phi)"});
-    p.yield_stress =
-        m.get("yield_stress", p.yield_stress, Range::positive(), {"Pa", "uniaxial yield stress (von Mises)"});
-    p.viscosity =
-        m.get("viscosity", p.viscosity, Range::non_negative(), {"Pa s", "dynamic viscosity (Newtonian fluid)"});
-    p.residual_cohesion =
-        m.get("residual_cohesion", p.cohesion, Range::non_negative(),
-              {"Pa", "residual cohesion c_r <= cohesion (drucker_prager_softening; default: cohesion)"});
-    p.residual_friction =
-        kDeg *
-        m.get("residual_friction", p.friction / kDeg, Range::closed_open(0.0, 90.0),
-              {"deg", "residual friction angle phi_r <= friction (drucker_prager_softening; default: friction)"});
-    p.softening_strain =
-        m.get("softening_strain", p.softening_strain, Range::positive(),
-              {"1", "plastic strain (sum of plastic multipliers) over which c and phi fall to residual"});
-    if (p.residual_cohesion > p.cohesion)
-      throw InputError("residual cohesion must not exceed the peak cohesion (" + std::to_string(p.cohesion) + " Pa)",
-                       r.source(), "material.residual_cohesion", std::to_string(p.residual_cohesion));
-    if (p.residual_friction > p.friction + 1e-12)
-      throw InputError(
-          "residual friction must not exceed the peak friction angle (" + std::to_string(p.friction / kDeg) + " deg)",
-          r.source(), "material.residual_friction", std::to_string(p.residual_friction / kDeg));
+    // The models' own keys (constitutive.hpp, `parameters`). A [[material]] describes a soil that
+    // several models may be run on (the tests switch model.constitutive over one file), so every
+    // model's keys are read, land in p and are checked by their model's rules, whichever runs.
+    const auto all = ConstitutiveModelParameters::read_all(
+        m, {"", "model.constitutive", "set model.constitutive", false, "material."}, constitutive_model_name(c.model));
+    for (const std::string_view name : ConstitutiveModelNames::names) {
+      const ParamValues v = ConstitutiveModelParameters::values_of(all, name);
+      ConstitutiveModelParameters::check(name, v, r.source(), "material.");
+      set_model_parameters(*constitutive_model_from_name(name), p, v);
+    }
     p.fit = dpfit;
     const double sat = m.get("saturated_density", 0.0, Range::closed(0.0, 30000.0),
                              {"kg/m^3",
@@ -163,9 +148,6 @@ void read_model_and_materials(ConfigReader& r, RunConfig& c) {
       throw InputError("must not be below the material's density (" + std::to_string(p.density) + " kg/m^3)",
                        r.source(), "material.saturated_density", std::to_string(sat));
     c.saturated_densities.push_back(sat);
-    if (p.dilatancy > p.friction + 1e-12)
-      throw InputError("dilatancy must not exceed the friction angle", r.source(), "material.dilatancy",
-                       std::to_string(p.dilatancy / kDeg));
     c.materials.push_back(p);
   }
 }

@@ -30,11 +30,11 @@ struct Range {
   bool min_open = false;  ///< true: value must be > min (not ≥)
   bool max_open = false;  ///< true: value must be < max (not ≤)
 
-  static Range positive() { return {0.0, std::numeric_limits<double>::infinity(), true, false}; }
-  static Range non_negative() { return {0.0, std::numeric_limits<double>::infinity(), false, false}; }
-  static Range closed(double a, double b) { return {a, b, false, false}; }
-  static Range open_closed(double a, double b) { return {a, b, true, false}; }
-  static Range closed_open(double a, double b) { return {a, b, false, true}; }
+  static constexpr Range positive() { return {0.0, std::numeric_limits<double>::infinity(), true, false}; }
+  static constexpr Range non_negative() { return {0.0, std::numeric_limits<double>::infinity(), false, false}; }
+  static constexpr Range closed(double a, double b) { return {a, b, false, false}; }
+  static constexpr Range open_closed(double a, double b) { return {a, b, true, false}; }
+  static constexpr Range closed_open(double a, double b) { return {a, b, false, true}; }
   bool contains(double v) const noexcept;
   /// Human-readable, e.g. "(0, inf)" or "[0, 90]".
   std::string str() const;

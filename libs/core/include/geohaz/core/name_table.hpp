@@ -4,8 +4,9 @@
 /// contact laws, runout basal friction laws): each alternative declares its config name `name`
 /// and a sentence `summary`, and the table is built from the variant, so a law added to the
 /// variant is in the config's choices, its help text and `from_name` with no other edit.
-/// Setting a law's parameters from the config is an exhaustive `std::visit(Overloaded{...})`
-/// with one case per law and no generic one, so a law without its case fails to compile.
+/// A law's parameters are its own declaration (law_parameters.hpp), read generically; an
+/// exhaustive `std::visit(Overloaded{...})` (one case per law, no generic one) remains for code
+/// that must treat each law by name, so a law without its case fails to compile.
 
 #include <array>
 #include <optional>

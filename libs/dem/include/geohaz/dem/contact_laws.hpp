@@ -19,12 +19,14 @@
 #include <array>
 #include <cmath>
 #include <concepts>
+#include <cstddef>
 #include <numbers>
 #include <optional>
 #include <string_view>
 #include <type_traits>
 #include <variant>
 
+#include "geohaz/core/law_parameters.hpp"
 #include "geohaz/core/name_table.hpp"
 
 namespace geohaz::dem {
@@ -81,9 +83,15 @@ struct LinearSpringCoulomb {
   static constexpr const char* name = "linear";
   static constexpr const char* summary = "linear spring-dashpot + Coulomb friction (Cundall & Strack 1979)";
   // dem-avalanche's defaults: contact modulus E_c = 20 GPa (k_n = 2 E_c, PFC2D at unit thickness),
-  // k_n/k_s = 2.5 (Potyondy & Cundall 2004); config.cpp derives its defaults from these.
-  double kn = 2 * 20e9;        ///< normal stiffness (N/m per m thickness)
-  double ks = 2 * 20e9 / 2.5;  ///< shear stiffness (N/m per m thickness)
+  // k_n/k_s = 2.5 (Potyondy & Cundall 2004), read as material.contact_modulus, .stiffness_ratio.
+  static constexpr std::array<ParamSpec, 2> parameters{
+      {{"contact_modulus", 20e9, Range::positive(), "Pa", "contact modulus E_c, k_n = 2 E_c", "PFC2D, unit thickness"},
+       {"stiffness_ratio", 2.5, Range::positive(), "1", "k_n/k_s"}}};
+  double kn = 2 * parameters[0].def;                      ///< normal stiffness (N/m per m thickness)
+  double ks = 2 * parameters[0].def / parameters[1].def;  ///< shear stiffness (N/m per m thickness)
+  static LinearSpringCoulomb from_parameters(const ParamValues& v) {
+    return {2 * v["contact_modulus"], 2 * v["contact_modulus"] / v["stiffness_ratio"]};
+  }
   /// k_n and k_t do not depend on the overlap (the solver computes √(k_t/k_n) once per step).
   static constexpr bool constant_stiffness = true;
 
@@ -115,9 +123,13 @@ struct HertzMindlin {
   static constexpr const char* name = "hertz";
   static constexpr const char* summary =
       "Hertz-Mindlin no-slip, spheres of the disc diameter per metre (Tsuji et al. 1992)";
-  double youngs = 20e9;              ///< particle Young's modulus E (Pa)
-  double poisson = 0.25;             ///< Poisson's ratio ν
-  double reference_overlap = 0.005;  ///< δ/R used for the time step of a disc with no contact yet
+  static constexpr std::array<ParamSpec, 2> parameters{
+      {{"youngs_modulus", 20e9, Range::positive(), "Pa", "particle Young's modulus"},
+       {"poisson_ratio", 0.25, Range::closed_open(0.0, 0.5), "1", "particle Poisson's ratio"}}};
+  double youngs = parameters[0].def;   ///< particle Young's modulus E (Pa)
+  double poisson = parameters[1].def;  ///< Poisson's ratio ν
+  double reference_overlap = 0.005;    ///< δ/R used for the time step of a disc with no contact yet
+  bool set(std::size_t j, double v) noexcept { return (j == 0 ? youngs : poisson) = v, true; }
   /// S_n and S_t grow with the contact radius √(R*δ).
   static constexpr bool constant_stiffness = false;
 
@@ -151,6 +163,8 @@ struct HertzMindlin {
 /// What the solver requires of a contact law. Every member is used by the solver; a law that
 /// lacks one does not compile (no default stands in for it).
 ///   name, summary          config name (`material.contact_law`) and a sentence for --help-config;
+///   parameters             its material.<key> coefficients (ParamSpec: default, range, unit,
+///                          meaning), landing in the struct by `set(j, v)` or `from_parameters`;
 ///   evaluate(δ, m*, R*, l, z)  elastic normal force, normal and tangential stiffness, dashpot
 ///                          coefficient from the damping parameter z;
 ///   pair_damping(e), wall_damping(e)  z giving restitution e for a disc–disc (unclamped) and a
@@ -164,6 +178,7 @@ concept DemContactLaw = requires(const L& l, double x) {
   { L::name } -> std::convertible_to<const char*>;
   { L::constant_stiffness } -> std::convertible_to<bool>;
   { L::summary } -> std::convertible_to<const char*>;
+  L::parameters.size();
   { l.evaluate(x, x, x, x, x) } -> std::same_as<ContactResponse>;
   { L::pair_damping(x) } -> std::same_as<double>;
   { L::wall_damping(x) } -> std::same_as<double>;
@@ -173,9 +188,9 @@ concept DemContactLaw = requires(const L& l, double x) {
 };
 
 /// The contact law chosen by the configuration (visited once per step), and the one name table
-/// of the laws: its alternatives' `name`s are the values of `material.contact_law`. A law is
-/// added here and nowhere else in the solver; the app's exhaustive visit (which sets the law's
-/// parameters) then fails to compile until it has a case for it.
+/// of the laws: its alternatives' `name`s are the values of `material.contact_law` and their
+/// `parameters` (core/law_parameters.hpp) the material.<key> keys, read, checked, described and
+/// labelled from there. A law is added here and in its own struct only.
 using ContactLaw = std::variant<LinearSpringCoulomb, HertzMindlin>;
 
 template <class... L>
@@ -185,6 +200,8 @@ constexpr bool every_law_is_a_contact_law(std::type_identity<std::variant<L...>>
 static_assert(every_law_is_a_contact_law(std::type_identity<ContactLaw>{}),
               "every alternative of ContactLaw is a DemContactLaw");
 using ContactLawNames = NameTable<ContactLaw>;
+using ContactLawParameters = LawParameters<ContactLaw>;
+static_assert(ContactLawParameters::consistent(), "two contact laws declare the same key differently");
 
 /// Config names of the contact laws, in the order of ContactLaw.
 inline constexpr auto contact_law_names = ContactLawNames::names;

@@ -19,13 +19,15 @@
 #include <variant>
 #include <vector>
 
+#include "geohaz/core/law_parameters.hpp"
 #include "geohaz/core/vec.hpp"
 #include "geohaz/runout/basal_friction.hpp"
 #include "geohaz/runout/surface.hpp"
 
 namespace geohaz::runout {
 
-/// The coefficients a friction field can set (each law reads those it has).
+/// The coefficients a friction field can set (each law reads those it has): the zone slots, by
+/// the key a law declares in its `parameters` (friction_terms.hpp), which gives range and unit.
 enum FrictionParameter : int {
   kManningN,
   kCriticalSlope,
@@ -41,55 +43,40 @@ enum FrictionParameter : int {
   kDelta2,
   kFrictionParameters
 };
-/// Config names of the coefficients, as in model.<name>.
+/// Config names of the coefficients, as in model.<name> (zones.<name>, attributes <name>).
 inline constexpr std::array<const char*, kFrictionParameters> kFrictionParameterNames{
     "n", "icr", "m", "mu", "xi", "cohesion", "tau_y", "viscosity", "consistency", "flow_index", "delta1", "delta2"};
 
-/// Set coefficient k of a law from a field value; false (and nothing set) when the law has no such
-/// coefficient (the config refuses a field for it).
-inline bool set_parameter(ModifiedManningFriction& l, int k, double v) noexcept {
-  if (k == kManningN) return l.n = v, true;
-  if (k == kCriticalSlope) return l.i_cr = v, true;
-  if (k == kYieldExponent) return l.m = v, true;
-  return false;
+/// For each zone slot, the index of that key in Law::parameters (-1: the law has none).
+template <class Law>
+inline constexpr std::array<int, kFrictionParameters> kZoneParameterIndex = [] {
+  std::array<int, kFrictionParameters> j{};
+  for (std::size_t k = 0; k < j.size(); ++k) j[k] = parameter_index<Law>(kFrictionParameterNames[k]);
+  return j;
+}();
+
+/// The declaration of zone slot k (the first law's that reads it; laws sharing a key share it).
+inline const ParamSpec& zone_parameter(int k) noexcept {
+  static const std::array<ParamSpec, kFrictionParameters> specs = [] {
+    std::array<ParamSpec, kFrictionParameters> out{};
+    const auto keys = BasalFrictionParameters::keys();
+    for (std::size_t i = 0; i < out.size(); ++i)
+      for (const auto& key : keys)
+        if (key.spec.key == kFrictionParameterNames[i]) {
+          out[i] = key.spec;
+          break;
+        }
+    return out;
+  }();
+  return specs[static_cast<std::size_t>(k)];
 }
-inline bool set_parameter(VoellmyFriction& l, int k, double v) noexcept {
-  if (k == kCoulombMu) return l.mu = v, true;
-  if (k == kVoellmyXi) return l.xi = v, true;
-  return false;
-}
-inline bool set_parameter(CoulombFriction& l, int k, double v) noexcept {
-  if (k == kCoulombMu) return l.mu = v, true;
-  return false;
-}
-inline bool set_parameter(VoellmyCohesionFriction& l, int k, double v) noexcept {
-  if (k == kCoulombMu) return l.mu = v, true;
-  if (k == kVoellmyXi) return l.xi = v, true;
-  if (k == kCohesion) return l.cohesion = v, true;
-  return false;
-}
-inline bool set_parameter(BinghamFriction& l, int k, double v) noexcept {
-  if (k == kYieldStress) return l.tau_y = v, true;
-  if (k == kViscosity) return l.viscosity = v, true;
-  return false;
-}
-inline bool set_parameter(HerschelBulkleyFriction& l, int k, double v) noexcept {
-  if (k == kYieldStress) return l.tau_y = v, true;
-  if (k == kConsistency) return l.consistency = v, true;
-  if (k == kFlowIndex) return l.flow_index = v, true;
-  return false;
-}
-inline bool set_parameter(OBrienJulienFriction& l, int k, double v) noexcept {
-  if (k == kYieldStress) return l.tau_y = v, true;
-  if (k == kViscosity) return l.viscosity = v, true;
-  if (k == kManningN) return l.n_td = v, true;
-  return false;
-}
-/// δ₁, δ₂ are given in degrees (as model.delta1, model.delta2); the law holds their tangents.
-inline bool set_parameter(PouliquenForterreFriction& l, int k, double v) noexcept {
-  if (k == kDelta1) return l.tan_delta1 = std::tan(v * 3.14159265358979323846 / 180.0), true;
-  if (k == kDelta2) return l.tan_delta2 = std::tan(v * 3.14159265358979323846 / 180.0), true;
-  return false;
+
+/// Set coefficient k of a law from a field value (in the unit of its declaration: δ in degrees);
+/// false (and nothing set) when the law has no such coefficient (the config refuses a field for it).
+template <class Law>
+inline bool set_parameter(Law& l, int k, double v) noexcept {
+  const int j = kZoneParameterIndex<Law>[static_cast<std::size_t>(k)];
+  return j >= 0 && l.set(static_cast<std::size_t>(j), v);
 }
 /// Whether the law held by f has coefficient k.
 inline bool has_parameter(const BasalFriction& f, int k) noexcept {

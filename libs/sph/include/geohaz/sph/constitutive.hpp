@@ -28,6 +28,10 @@
 /// visited once per step, so the particle loop has no dispatch — that declares everything the
 /// solver needs to know about it (the solver has no special case for any model):
 ///   name, summary              config name (`model.constitutive`) and a sentence for --help-config;
+///   parameters, set(p, j, v)   the [[material]] keys the model reads besides density, young and
+///                              poisson (ParamSpec: default, range, unit, meaning; angles in
+///                              degrees), and where value j lands in MaterialParams; `check(v)`
+///                              (optional) its rules between them (core/law_parameters.hpp);
 ///   InternalVariables          FieldList of the per-particle fields the model evolves, e.g.
 ///                              FieldList<PlasticStrain>; each is a field of the store (fields.hpp),
 ///                              so it is reordered, written to snapshots and restored on restart
@@ -51,15 +55,17 @@
 /// A model without them (an elastic solid, a fluid) has nothing to reduce: the strength reduction
 /// and the limit-equilibrium checks refuse it by name.
 /// A new model (say Drucker–Prager with c and φ softening over a plastic-strain range) is a struct
-/// like DruckerPrager below, with update reading its PlasticStrain argument, plus its entry in
-/// ConstitutiveModel (the name table); parameters it adds go into MaterialParams and the app's
-/// [[material]] table. docs/sph.md, "Adding a constitutive model".
+/// like DruckerPrager below, with update reading its PlasticStrain argument and its `parameters`,
+/// plus its entry in ConstitutiveModel (the name table); a parameter it adds is a member of
+/// MaterialParams. docs/sph.md, "Adding a constitutive model".
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <concepts>
+#include <cstddef>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -69,6 +75,7 @@
 #include <variant>
 #include <vector>
 
+#include "geohaz/core/law_parameters.hpp"
 #include "geohaz/core/name_table.hpp"
 #include "geohaz/core/vec.hpp"
 #include "geohaz/sph/fields.hpp"
@@ -231,10 +238,20 @@ inline double drucker_prager_yield(const Mat3& sigma, double alpha_phi, double k
   return alpha_phi * I1 + std::sqrt(0.5 * s.squaredNorm()) - kc;
 }
 
+/// The [[material]] keys of the Mohr–Coulomb strength, shared by the Drucker–Prager models.
+inline constexpr ParamSpec kCohesionParameter{"cohesion", 0.0, Range::non_negative(), "Pa", "cohesion c"};
+inline constexpr ParamSpec kFrictionAngleParameter{"friction", 30.0, Range::closed_open(0.0, 90.0), "deg",
+                                                   "friction angle phi"};
+inline constexpr ParamSpec kDilatancyParameter{"dilatancy",           0.0,     Range::closed_open(0.0, 90.0), "deg",
+                                               "dilatancy angle psi", "<= phi"};
+inline constexpr double kDegree = std::numbers::pi / 180.0;  ///< one degree in radians
+
 /// Linear elasticity with the Jaumann rate (Hooke's law, K and G from E and ν).
 struct LinearElastic {
   static constexpr const char* name = "linear_elastic";
   static constexpr const char* summary = "linear elasticity (E, nu), Jaumann rate";
+  static constexpr std::array<ParamSpec, 0> parameters{};
+  static void set(MaterialParams& /*p*/, std::size_t /*j*/, double /*v*/) noexcept {}
   using InternalVariables = FieldList<>;
   static double update(Mat3& sigma, const Mat3& L, double dt, double /*rho*/, const MaterialParams& p) noexcept {
     sigma = elastic_trial(sigma, L, dt, p.bulk, p.shear);
@@ -254,6 +271,9 @@ struct LinearElastic {
 struct VonMises {
   static constexpr const char* name = "von_mises";
   static constexpr const char* summary = "elastic-perfectly plastic von Mises (E, nu, yield_stress)";
+  static constexpr std::array<ParamSpec, 1> parameters{
+      {{"yield_stress", 1e5, Range::positive(), "Pa", "uniaxial yield stress"}}};
+  static void set(MaterialParams& p, std::size_t /*j*/, double v) noexcept { p.yield_stress = v; }
   using InternalVariables = FieldList<PlasticStrain>;
   static double update(Mat3& sigma, const Mat3& L, double dt, double /*rho*/, const MaterialParams& p,
                        double& plastic_strain) noexcept {
@@ -285,6 +305,20 @@ struct DruckerPrager {
   static constexpr const char* name = "drucker_prager";
   static constexpr const char* summary =
       "elastic-perfectly plastic Drucker-Prager (E, nu, cohesion, friction, dilatancy), Bui et al. 2008";
+  static constexpr std::array<ParamSpec, 3> parameters{
+      {kCohesionParameter, kFrictionAngleParameter, kDilatancyParameter}};
+  /// c (Pa), φ and ψ (read in degrees, held in radians).
+  static void set(MaterialParams& p, std::size_t j, double v) noexcept {
+    if (j == 0) p.cohesion = v;
+    if (j == 1) p.friction = kDegree * v;
+    if (j == 2) p.dilatancy = kDegree * v;
+  }
+  /// ψ ≤ φ.
+  static std::optional<ParamProblem> check(const ParamValues& v) {
+    if (kDegree * v["dilatancy"] > kDegree * v["friction"] + 1e-12)
+      return ParamProblem{"dilatancy", "dilatancy must not exceed the friction angle", std::to_string(v["dilatancy"])};
+    return std::nullopt;
+  }
   using InternalVariables = FieldList<PlasticStrain>;
   static double update(Mat3& sigma, const Mat3& L, double dt, double /*rho*/, const MaterialParams& p,
                        double& plastic_strain) noexcept {
@@ -330,6 +364,36 @@ struct DruckerPragerSoftening {
   static constexpr const char* summary =
       "Drucker-Prager with cohesion and friction softening linearly from peak (cohesion, friction) to residual "
       "(residual_cohesion, residual_friction) over the plastic strain softening_strain";
+  static constexpr std::array<ParamSpec, 6> parameters{
+      {kCohesionParameter,
+       kFrictionAngleParameter,
+       kDilatancyParameter,
+       {"residual_cohesion", 0.0, Range::non_negative(), "Pa", "residual cohesion c_r <= cohesion", "default: cohesion",
+        "cohesion"},
+       {"residual_friction", 30.0, Range::closed_open(0.0, 90.0), "deg", "residual friction angle phi_r <= friction",
+        "default: friction", "friction"},
+       {"softening_strain", 0.05, Range::positive(), "1",
+        "plastic strain (sum of plastic multipliers) over which c and phi fall to residual"}}};
+  static void set(MaterialParams& p, std::size_t j, double v) noexcept {
+    if (j < 3) DruckerPrager::set(p, j, v);
+    if (j == 3) p.residual_cohesion = v;
+    if (j == 4) p.residual_friction = kDegree * v;
+    if (j == 5) p.softening_strain = v;
+  }
+  /// Residual strength at most the peak one, and ψ ≤ φ.
+  static std::optional<ParamProblem> check(const ParamValues& v) {
+    if (v["residual_cohesion"] > v["cohesion"])
+      return ParamProblem{
+          "residual_cohesion",
+          "residual cohesion must not exceed the peak cohesion (" + std::to_string(v["cohesion"]) + " Pa)",
+          std::to_string(v["residual_cohesion"])};
+    if (kDegree * v["residual_friction"] > kDegree * v["friction"] + 1e-12)
+      return ParamProblem{
+          "residual_friction",
+          "residual friction must not exceed the peak friction angle (" + std::to_string(v["friction"]) + " deg)",
+          std::to_string(v["residual_friction"])};
+    return DruckerPrager::check(v);
+  }
   using InternalVariables = FieldList<PlasticStrain>;
   /// c (Pa) and φ (rad) at the accumulated plastic multiplier κ.
   static std::pair<double, double> strength(const MaterialParams& p, double kappa) noexcept {
@@ -368,6 +432,9 @@ struct DruckerPragerSoftening {
 struct NewtonianFluid {
   static constexpr const char* name = "newtonian_fluid";
   static constexpr const char* summary = "weakly compressible Newtonian fluid (viscosity; bulk modulus from E, nu)";
+  static constexpr std::array<ParamSpec, 1> parameters{
+      {{"viscosity", 1e-3, Range::non_negative(), "Pa s", "dynamic viscosity"}}};
+  static void set(MaterialParams& p, std::size_t /*j*/, double v) noexcept { p.viscosity = v; }
   using InternalVariables = FieldList<>;
   static double update(Mat3& sigma, const Mat3& L, double /*dt*/, double rho, const MaterialParams& p) noexcept {
     const Mat3 D = 0.5 * (L + L.transpose());
@@ -394,6 +461,7 @@ template <class M>
 concept ConstitutiveLaw = requires(const MaterialParams& p, double h) {
   { M::name } -> std::convertible_to<const char*>;
   { M::summary } -> std::convertible_to<const char*>;
+  M::parameters.size();
   typename M::InternalVariables;
   { M::wave_speed(p) } -> std::same_as<double>;
   { M::time_step_limit(p, h) } -> std::same_as<double>;
@@ -420,6 +488,19 @@ constexpr bool every_model_is_a_law(std::type_identity<std::variant<M...>>) {
 static_assert(every_model_is_a_law(std::type_identity<ConstitutiveModel>{}),
               "every alternative of ConstitutiveModel is a ConstitutiveLaw");
 using ConstitutiveModelNames = NameTable<ConstitutiveModel>;
+/// The models' [[material]] keys (law_parameters.hpp): reader, help text and labels.
+using ConstitutiveModelParameters = LawParameters<ConstitutiveModel>;
+static_assert(ConstitutiveModelParameters::consistent(), "two models declare the same material key differently");
+
+/// Put the values of the model's own keys (as read: angles in degrees) into a material.
+inline void set_model_parameters(const ConstitutiveModel& m, MaterialParams& p, const ParamValues& v) {
+  std::visit(
+      [&](const auto& law) {
+        using M = std::decay_t<decltype(law)>;
+        for (std::size_t j = 0; j < v.value.size(); ++j) M::set(p, j, v.value[j]);
+      },
+      m);
+}
 
 /// Config names of the models, in the order of ConstitutiveModel.
 inline constexpr auto constitutive_model_names = ConstitutiveModelNames::names;

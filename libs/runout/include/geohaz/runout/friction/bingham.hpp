@@ -25,7 +25,9 @@
 /// as a second implicit drag step (operator splitting, first order in Δt; it cannot move a particle).
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstddef>
 
 #include "geohaz/runout/friction/friction_terms.hpp"
 
@@ -119,11 +121,13 @@ inline double speed_after_friction(double s_star, double dt, const BinghamTerms&
 }
 
 struct BinghamFriction {
-  double tau_y = 100.0;     ///< yield stress τ_y (Pa)
-  double viscosity = 10.0;  ///< plastic viscosity μ_B (Pa·s)
+  static constexpr std::array<ParamSpec, 2> parameters{{kYieldStressParameter, kBinghamViscosityParameter}};
+  double tau_y = kYieldStressParameter.def;           ///< yield stress τ_y (Pa)
+  double viscosity = kBinghamViscosityParameter.def;  ///< plastic viscosity μ_B (Pa·s)
   static constexpr const char* name = "bingham";
   static constexpr const char* summary =
       "Bingham plastic, exact plug-flow cubic (tau_y, viscosity; Pastor et al. 2004)";
+  bool set(std::size_t j, double v) noexcept { return (j == 0 ? tau_y : viscosity) = v, true; }
   BinghamTerms terms(double /*g*/, double /*g_n*/, double h_n, double /*speed*/, double rho) const noexcept {
     return {tau_y / (rho * h_n),
             h_n * tau_y / (6.0 * viscosity),

@@ -23,10 +23,41 @@
 /// particle's state of its last step, which the solver points it to (the store's per-particle
 /// fields); without it (null pointers, as in the unit tests) the step starts cold. The answer is
 /// the same to the iteration's tolerance either way.
+///
+/// Each law owns its coefficients (core/law_parameters.hpp): `parameters` (key of model.<key>,
+/// default, range, unit, meaning), `set(j, v)` and, where needed, `from_parameters` and `check`.
+/// The coefficients several laws read are declared once below and shared by those laws.
 
 #include <cmath>
 
+#include "geohaz/core/law_parameters.hpp"
+
 namespace geohaz::runout {
+
+/// Manning's n: modified Manning and (as the turbulent-dispersive n_td) O'Brien–Julien.
+inline constexpr ParamSpec kManningNParameter{
+    "n",
+    0.06,
+    Range::closed(0.005, 0.5),
+    "s/m^(1/3)",
+    "Manning roughness n",
+    "for obrien_julien the turbulent-dispersive n_td; 0.02–0.1 for natural channels"};
+/// The Coulomb coefficient of Voellmy, Coulomb and Voellmy with cohesion.
+inline constexpr ParamSpec kCoulombMuParameter{"mu", 0.15, Range::closed(0.0, 2.0), "1",
+                                               "Coulomb friction coefficient μ"};
+/// Voellmy's turbulence coefficient (Voellmy and Voellmy with cohesion).
+inline constexpr ParamSpec kVoellmyXiParameter{"xi", 500.0, Range::open_closed(0.0, 1e5), "m/s^2",
+                                               "Voellmy turbulence coefficient ξ"};
+/// The yield stress of the viscoplastic laws (Bingham, Herschel–Bulkley, O'Brien–Julien).
+inline constexpr ParamSpec kYieldStressParameter{
+    "tau_y", 100.0, Range::closed(0.0, 1e6), "Pa", "yield stress τ_y", "mud matrices 0.1 Pa to a few kPa"};
+/// The Bingham (plastic) viscosity of Bingham and O'Brien–Julien.
+inline constexpr ParamSpec kBinghamViscosityParameter{"viscosity",
+                                                      10.0,
+                                                      Range::open_closed(1e-6, 1e6),
+                                                      "Pa*s",
+                                                      "Bingham (plastic) viscosity μ_B, η",
+                                                      "mud matrices 0.01–100"};
 
 /// Where an iterative law keeps a particle's state between steps (see above); null: none.
 struct StepMemory {

@@ -23,7 +23,9 @@
 /// (extra_drag) follows as a second implicit drag step (operator splitting).
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstddef>
 
 #include "geohaz/runout/friction/friction_terms.hpp"
 
@@ -155,12 +157,17 @@ inline double speed_after_friction(double s_star, double dt, const HerschelBulkl
 }
 
 struct HerschelBulkleyFriction {
-  double tau_y = 100.0;           ///< yield stress τ_y (Pa)
-  double consistency = 30.0;      ///< consistency K (Pa·sⁿ)
-  double flow_index = 1.0 / 3.0;  ///< flow index n (1): < 1 shear-thinning
+  static constexpr std::array<ParamSpec, 3> parameters{
+      {kYieldStressParameter,
+       {"consistency", 30.0, Range::open_closed(1e-6, 1e6), "Pa*s^n", "consistency K of τ = τ_y + K γ̇^n"},
+       {"flow_index", 1.0 / 3.0, Range::closed(0.1, 2.0), "1", "flow index n of τ = τ_y + K γ̇^n", "muds ≈ 1/3"}}};
+  double tau_y = kYieldStressParameter.def;  ///< yield stress τ_y (Pa)
+  double consistency = parameters[1].def;    ///< consistency K (Pa·sⁿ)
+  double flow_index = parameters[2].def;     ///< flow index n (1): < 1 shear-thinning
   static constexpr const char* name = "herschel_bulkley";
   static constexpr const char* summary =
       "Herschel-Bulkley fluid, exact depth-averaged plug flow (tau_y, consistency, flow_index; Coussot 1997)";
+  bool set(std::size_t j, double v) noexcept { return (j == 0 ? tau_y : j == 1 ? consistency : flow_index) = v, true; }
   HerschelBulkleyTerms terms(double /*g*/, double /*g_n*/, double h_n, double /*speed*/, double rho) const noexcept {
     return {tau_y / (rho * h_n), tau_y, consistency, flow_index, h_n, rho};
   }

@@ -19,20 +19,63 @@
 /// The optional parameterisation by the volumetric sediment concentration C_v (O'Brien & Julien
 /// 1988), τ_y = α₂ exp(β₂ C_v), η = α₁ exp(β₁ C_v), is resolved by the config reader.
 
+#include <array>
 #include <cmath>
+#include <cstddef>
+#include <optional>
+#include <string>
 
 #include "geohaz/runout/friction/friction_terms.hpp"
 
 namespace geohaz::runout {
 
 struct OBrienJulienFriction {
-  double tau_y = 100.0;     ///< yield stress τ_y (Pa)
-  double viscosity = 10.0;  ///< Bingham viscosity η (Pa·s)
-  double laminar_k = 24.0;  ///< laminar resistance parameter K (1)
-  double n_td = 0.06;       ///< turbulent-dispersive Manning coefficient (s/m^{1/3})
+  /// The yield stress and viscosity given directly, or (cv > 0) from the sediment concentration;
+  /// the defaults of α, β: Aspen Pit 1 of O'Brien & Julien (1988), 0.181 dyn/cm² and 0.036 P in SI.
+  static constexpr std::array<ParamSpec, 9> parameters{
+      {kYieldStressParameter,
+       kBinghamViscosityParameter,
+       {"laminar_k", 24.0, Range::closed(1.0, 1e5), "1", "laminar resistance K of the viscous slope Kη U/(8ρ g h²)",
+        "24 smooth plane"},
+       kManningNParameter,
+       {"cv", 0.0, Range::closed(0.0, 0.65), "1", "volumetric sediment concentration C_v",
+        "τ_y = yield_alpha·exp(yield_beta·C_v), η = viscosity_alpha·exp(viscosity_beta·C_v), O'Brien & Julien 1988; "
+        "0: model.tau_y and model.viscosity"},
+       {"yield_alpha", 0.0181, Range::open_closed(0.0, 1e6), "Pa", "α₂ of τ_y = α₂ exp(β₂ C_v)", "with model.cv"},
+       {"yield_beta", 25.7, Range::closed(0.0, 100.0), "1", "β₂ of τ_y = α₂ exp(β₂ C_v)", "with model.cv"},
+       {"viscosity_alpha", 0.0036, Range::open_closed(0.0, 1e6), "Pa*s", "α₁ of η = α₁ exp(β₁ C_v)", "with model.cv"},
+       {"viscosity_beta", 22.1, Range::closed(0.0, 100.0), "1", "β₁ of η = α₁ exp(β₁ C_v)", "with model.cv"}}};
+  double tau_y = kYieldStressParameter.def;           ///< yield stress τ_y (Pa)
+  double viscosity = kBinghamViscosityParameter.def;  ///< Bingham viscosity η (Pa·s)
+  double laminar_k = parameters[2].def;               ///< laminar resistance parameter K (1)
+  double n_td = kManningNParameter.def;               ///< turbulent-dispersive Manning coefficient (s/m^{1/3})
   static constexpr const char* name = "obrien_julien";
   static constexpr const char* summary =
       "O'Brien-Julien quadratic, yield + viscous + turbulent (tau_y, viscosity, laminar_k, n; or cv; FLO-2D)";
+  /// One coefficient (a friction zone's): τ_y, η, K or n_td; the concentration group only as a whole.
+  bool set(std::size_t j, double v) noexcept {
+    if (j > 3) return false;
+    return (j == 0 ? tau_y : j == 1 ? viscosity : j == 2 ? laminar_k : n_td) = v, true;
+  }
+  static OBrienJulienFriction from_parameters(const ParamValues& v) {
+    const double cv = v["cv"];
+    if (cv > 0.0)
+      return {v["yield_alpha"] * std::exp(v["yield_beta"] * cv),
+              v["viscosity_alpha"] * std::exp(v["viscosity_beta"] * cv), v["laminar_k"], v["n"]};
+    return {v["tau_y"], v["viscosity"], v["laminar_k"], v["n"]};
+  }
+  /// With a concentration, τ_y and η come from it: giving them as well is a contradiction.
+  static std::optional<ParamProblem> check(const ParamValues& v) {
+    if (v["cv"] > 0.0)
+      for (const char* k : {"tau_y", "viscosity"})
+        if (v.is_given(k))
+          return ParamProblem{k,
+                              "model." + std::string(k) +
+                                  " and model.cv both set: with model.cv the yield stress and viscosity come "
+                                  "from the concentration (give one or the other)",
+                              ""};
+    return std::nullopt;
+  }
   FrictionTerms terms(double g, double /*g_n*/, double h_n, double /*speed*/, double rho) const noexcept {
     const double rh = rho * h_n;
     return {tau_y / rh, g * n_td * n_td / (h_n * std::cbrt(h_n)), laminar_k * viscosity / (8.0 * rh * h_n)};

@@ -25,7 +25,12 @@
 /// step (operator splitting).
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstddef>
+#include <numbers>
+#include <optional>
+#include <string>
 
 #include "geohaz/runout/friction/friction_terms.hpp"
 
@@ -63,16 +68,37 @@ inline double speed_after_friction(double s_star, double dt, const PouliquenFort
 
 struct PouliquenForterreFriction {
   // Defaults: 0.5 mm glass beads on a rough bed (Forterre & Pouliquen 2003): δ₁ = 20.9°,
-  // δ₂ = 32.76°, L = 0.65 mm, β = 0.136, γ = 0.
-  double tan_delta1 = 0.38186;  ///< tan δ₁ (1): below δ₁ no layer flows
-  double tan_delta2 = 0.64347;  ///< tan δ₂ (1): above δ₂ no layer stops
-  double length = 6.5e-4;       ///< L (m), the h_stop length scale (about a grain diameter)
-  double beta = 0.136;          ///< β of the flow rule (1)
-  double gamma = 0.0;           ///< γ of the flow rule (1)
+  // δ₂ = 32.76°, L = 0.65 mm, β = 0.136, γ = 0. The angles are read in degrees and held as their
+  // tangents (the struct's tangents are the published ones, which round to the degrees to 0.01°:
+  // a test checks it).
+  static constexpr std::array<ParamSpec, 5> parameters{
+      {{"delta1", 20.9, Range::open_closed(0.0, 60.0), "deg", "δ₁: slope below which no layer flows"},
+       {"delta2", 32.76, Range::open_closed(0.0, 80.0), "deg", "δ₂ > δ₁: slope above which no layer stops"},
+       {"hstop_length", 6.5e-4, Range::open_closed(0.0, 100.0), "m",
+        "L of h_stop(θ) = L (tan δ₂ − tan θ)/(tan θ − tan δ₁)", "a few grain diameters"},
+       {"flow_rule_beta", 0.136, Range::open_closed(0.0, 10.0), "1",
+        "β of the flow rule u/√(g h cos θ) = β h/h_stop − γ"},
+       {"flow_rule_gamma", 0.0, Range::closed(0.0, 10.0), "1", "γ of the flow rule u/√(g h cos θ) = β h/h_stop − γ"}}};
+  double tan_delta1 = 0.38186;        ///< tan δ₁ (1): below δ₁ no layer flows
+  double tan_delta2 = 0.64347;        ///< tan δ₂ (1): above δ₂ no layer stops
+  double length = parameters[2].def;  ///< L (m), the h_stop length scale (about a grain diameter)
+  double beta = parameters[3].def;    ///< β of the flow rule (1)
+  double gamma = parameters[4].def;   ///< γ of the flow rule (1)
   static constexpr const char* name = "pouliquen";
   static constexpr const char* summary =
       "Pouliquen-Forterre mu(Fr, h) with h_stop (delta1, delta2, hstop_length, flow_rule_beta, flow_rule_gamma; P&F "
       "2002)";
+  /// δ₁, δ₂ in degrees (as model.delta1, model.delta2); the law holds their tangents.
+  bool set(std::size_t j, double v) noexcept {
+    if (j < 2) return (j == 0 ? tan_delta1 : tan_delta2) = std::tan(v * std::numbers::pi / 180.0), true;
+    return (j == 2 ? length : j == 3 ? beta : gamma) = v, true;
+  }
+  static std::optional<ParamProblem> check(const ParamValues& v) {
+    if (!(v["delta2"] > v["delta1"]))
+      return ParamProblem{"delta2", "model.delta2 must exceed model.delta1 (" + std::to_string(v["delta1"]) + " deg)",
+                          std::to_string(v["delta2"])};
+    return std::nullopt;
+  }
   /// h_stop(θ) (m) on a slope tan θ (infinite at or below δ₁, 0 at or above δ₂).
   double h_stop(double tan_theta) const noexcept {
     const double t1 = tan_delta1, t2 = tan_delta2;

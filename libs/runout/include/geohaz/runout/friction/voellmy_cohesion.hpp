@@ -15,7 +15,11 @@
 /// s = √(ξ h_n (sin θ − a_rest/g)); the layer holds at rest while g sin θ ≤ a_rest.
 /// C = 0 is Voellmy. (For μ > 1 the cohesive part would be negative; the reader keeps μ ≤ 1.)
 
+#include <array>
 #include <cmath>
+#include <cstddef>
+#include <optional>
+#include <string>
 
 #include "geohaz/runout/friction/friction_terms.hpp"
 
@@ -30,12 +34,27 @@ inline double one_minus_exp_ratio(double x) noexcept {
 }
 
 struct VoellmyCohesionFriction {
-  double mu = 0.15;       ///< Coulomb coefficient μ (1)
-  double xi = 500.0;      ///< turbulence coefficient ξ (m/s²)
-  double cohesion = 0.0;  ///< C (Pa)
+  static constexpr std::array<ParamSpec, 3> parameters{
+      {kCoulombMuParameter,
+       kVoellmyXiParameter,
+       {"cohesion", 0.0, Range::closed(0.0, 1e6), "Pa", "cohesion C of the RAMMS form",
+        "no published range for debris, docs/runout.md"}}};
+  double mu = kCoulombMuParameter.def;  ///< Coulomb coefficient μ (1)
+  double xi = kVoellmyXiParameter.def;  ///< turbulence coefficient ξ (m/s²)
+  double cohesion = parameters[2].def;  ///< C (Pa)
   static constexpr const char* name = "voellmy_cohesion";
   static constexpr const char* summary =
       "Voellmy with cohesion, S = muN + rho g v^2/xi + (1-mu)C(1-exp(-N/C)) (mu, xi, cohesion; RAMMS)";
+  bool set(std::size_t j, double v) noexcept { return (j == 0 ? mu : j == 1 ? xi : cohesion) = v, true; }
+  /// μ ≤ 1 with a cohesion: the RAMMS term (1 − μ) C must not be negative.
+  static std::optional<ParamProblem> check(const ParamValues& v) {
+    if (v["cohesion"] > 0.0 && v["mu"] > 1.0)
+      return ParamProblem{"mu",
+                          "voellmy_cohesion needs model.mu ≤ 1 with a cohesion (the RAMMS term (1 − μ) C would be "
+                          "negative)",
+                          std::to_string(v["mu"])};
+    return std::nullopt;
+  }
   FrictionTerms terms(double g, double g_n, double h_n, double /*speed*/, double rho) const noexcept {
     if (cohesion <= 0.0) return {g_n * mu, g / (xi * h_n)};
     // a_rest = g_n (μ + (1 − μ) φ(x)), φ(x) = (1 − e^{−x})/x, x = N/C.
