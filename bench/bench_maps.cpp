@@ -29,8 +29,8 @@
 
 #include "geohaz/core/config.hpp"
 #include "geohaz/core/output.hpp"
+#include "geohaz/report/report.hpp"
 #include "geohaz/runout/run.hpp"
-#include "report.hpp"
 
 namespace fs = std::filesystem;
 using namespace geohaz;

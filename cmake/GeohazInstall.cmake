@@ -1,7 +1,8 @@
-# Install rules and the CMake package of geohaz (issue 20): headers, the four libraries, the apps,
+# Install rules and the CMake package of geohaz (issue 20): headers, the five libraries, the apps,
 # geohazConfig.cmake / geohazConfigVersion.cmake exporting geohaz::core, geohaz::sph,
-# geohaz::runout and geohaz::dem, and the README, docs and example data under share/geohaz with
-# the layout of the source tree (so every relative link keeps working).
+# geohaz::runout, geohaz::dem and the report layer above them (geohaz::report), and the README,
+# docs and example data under share/geohaz with the layout of the source tree (so every relative
+# link keeps working).
 #
 # Included from the top-level CMakeLists.txt after the libraries and apps exist; the libraries'
 # own CMakeLists.txt stay free of install details.
@@ -13,7 +14,7 @@ set(GEOHAZ_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/geohaz CACHE STRING
 set(GEOHAZ_INSTALL_DATADIR ${CMAKE_INSTALL_DATADIR}/geohaz CACHE STRING
     "Where README.md, docs/ and data/ are installed (relative to the prefix)")
 
-set(_geohaz_libs core sph runout dem)
+set(_geohaz_libs core sph runout dem report)
 foreach(lib IN LISTS _geohaz_libs)
   set(t geohaz_${lib})
   # The libraries name their include folder by absolute source path: usable in the build tree
@@ -44,7 +45,7 @@ foreach(lib IN LISTS _geohaz_libs)
 endforeach()
 set_target_properties(geohaz_options PROPERTIES EXPORT_NAME options)
 
-install(TARGETS geohaz_options geohaz_core geohaz_sph geohaz_runout geohaz_dem
+install(TARGETS geohaz_options geohaz_core geohaz_sph geohaz_runout geohaz_dem geohaz_report
         EXPORT geohazTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT libs

@@ -179,9 +179,10 @@ particles and series as NumPy arrays; geohaz.read_run reads any output folder
 back.")
 set(CPACK_DEBIAN_DEV_DESCRIPTION "landslide models: development files
 Headers, static libraries and the CMake package of geohaz (find_package:
-geohaz::core, geohaz::sph, geohaz::runout, geohaz::dem).")
+geohaz::core, geohaz::sph, geohaz::runout, geohaz::dem,
+geohaz::report).")
 set(CPACK_DEBIAN_LIBS_DESCRIPTION "landslide models: shared libraries
-The shared libraries of geohaz (core, sph, runout, dem).")
+The shared libraries of geohaz (core, sph, runout, dem, report).")
 include(CPack)
 
 # The QGIS plugin (qgis/geohaz_provider, docs/qgis.md) as the zip QGIS's plugin manager installs

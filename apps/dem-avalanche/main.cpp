@@ -31,10 +31,9 @@ int main(int argc, char** argv) {
     RunConfig cfg = read_config(reader, false);
     reader.finish();
     cfg.resolved = reader.resolved();
-    DemSimulation sim(std::move(cfg));
-    // Everything is validated before the output directory is created.
+    // Everything is validated (read_config) before the output directory is created.
     return run_in_output_dir(opts.out, "dem-avalanche", {}, [&] {
-      run_case(sim, opts.out, opts.quiet);
+      run_case(std::move(cfg), {opts.out, opts.quiet});
       return kExitOk;
     });
   };

@@ -11,7 +11,7 @@
 
 #include "geohaz/core/app.hpp"
 #include "geohaz/core/errors.hpp"
-#include "report.hpp"
+#include "geohaz/report/report.hpp"
 
 int main(int argc, char** argv) {
   return geohaz::run_main("geohaz-report", [&]() -> int {

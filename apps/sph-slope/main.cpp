@@ -58,14 +58,16 @@ int main(int argc, char** argv) {
       if (comm->rank() != 0) {
         comm->max_all(refused);
         if (refused[0] > 0.0) return kExitInputError;
-        return run_case(cfg, opts.out, true, comm);
+        run_case(cfg, {opts.out, true, comm});
+        return kExitOk;
       }
       bool started = false;
       try {
         return run_in_output_dir(opts.out, "sph-slope", {cfg.restart}, [&] {
           started = true;
           comm->max_all(refused);
-          return run_case(cfg, opts.out, opts.quiet, comm);
+          run_case(cfg, {opts.out, opts.quiet, comm});
+          return kExitOk;
         });
       } catch (const InputError&) {
         if (!started) {
@@ -76,7 +78,10 @@ int main(int argc, char** argv) {
       }
     }
 #endif
-    return run_in_output_dir(opts.out, "sph-slope", {cfg.restart}, [&] { return run_case(cfg, opts.out, opts.quiet); });
+    return run_in_output_dir(opts.out, "sph-slope", {cfg.restart}, [&] {
+      run_case(cfg, {opts.out, opts.quiet, nullptr});
+      return kExitOk;
+    });
   };
 #ifdef GEOHAZ_SPH_MPI
   const int code = run_config_app(argc, argv, app);

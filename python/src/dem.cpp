@@ -139,18 +139,21 @@ py::dict dem_run(const std::string& config, const std::vector<std::string>& over
   RunConfig c = read_config(cfg, false);
   cfg.finish();
   c.resolved = cfg.resolved();
-  DemSimulation sim(std::move(c));
   PythonDemObserver obs(progress, progress_every, !quiet && out.empty());
+  CaseRun run;
   {
     py::gil_scoped_release nogil;
+    // The app's run (run.hpp); with an output folder under the apps' --out policy (app.hpp).
+    const auto body = [&] {
+      run = run_case(std::move(c), {out, quiet}, &obs);
+      return kExitOk;
+    };
     if (out.empty())
-      sim.run(&obs);
+      body();
     else
-      run_in_output_dir(out, "dem-avalanche", {}, [&] {
-        run_case(sim, out, quiet, &obs);
-        return kExitOk;
-      });
+      run_in_output_dir(out, "dem-avalanche", {}, body);
   }
+  const DemSimulation& sim = *run.simulation;
 
   py::dict discs;
   if (sim.is_lab())

@@ -1,7 +1,7 @@
-// geohaz._geohaz's report part: the report page of geohaz-report (apps/geohaz-report, report.hpp)
+// geohaz._geohaz's report part: the report page of geohaz-report (libs/report, geohaz/report/report.hpp)
 // written from Python, from the same library as the app, so a notebook hands on the same page
 // (python/geohaz/report.py documents the Python signature).
-#include "report.hpp"
+#include "geohaz/report/report.hpp"
 
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>

@@ -129,14 +129,14 @@ py::dict sph_run(const std::string& config, const std::vector<std::string>& over
   reader.finish();
   cfg.resolved_config = reader.resolved();
 
-  std::unique_ptr<SphSimulation> sim;
+  CaseRun run;
   PythonObserver obs(progress, progress_every);
   {
     py::gil_scoped_release nogil;
     validate(cfg);  // everything checked before anything is written
-    sim = std::make_unique<SphSimulation>(cfg, quiet);
+    // The app's run (run.hpp); with an output folder under the apps' --out policy (app.hpp).
     const auto body = [&] {
-      run_with_outputs(*sim, out, quiet, &obs);
+      run = run_case(cfg, {out, quiet, nullptr}, &obs);
       return 0;
     };
     if (out.empty())
@@ -144,6 +144,7 @@ py::dict sph_run(const std::string& config, const std::vector<std::string>& over
     else
       run_in_output_dir(out, "sph-slope", {cfg.restart}, body);
   }
+  const SphSimulation* sim = run.simulation.get();
   py::dict r;
   r["summary"] = py::module_::import("json").attr("loads")(sim->summary_json());
   r["tables"] = table_arrays(sim->tables());

@@ -1,13 +1,14 @@
 #pragma once
 // A bare line plot for the validation pages (no text: the axes ranges and ticks are given in the
 // docs that show the picture): frame, grid lines at every tick, curves as lines, measurements as
-// dots. Shared by the validation tests of the models.
+// dots, on core's plotter (geohaz/core/plot.hpp). Shared by the validation tests of the models.
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <vector>
 
+#include "geohaz/core/plot.hpp"
 #include "geohaz/core/raster.hpp"
 
 namespace geohaz::testing {
@@ -22,22 +23,18 @@ inline void plot(const std::filesystem::path& path, const std::vector<Curve>& cu
                  double y1, double xtick, double ytick) {
   const int W = 640, H = 420, m = 40;
   geohaz::Image img(W, H);
-  auto px = [&](double x) { return m + (x - x0) / (x1 - x0) * (W - 2 * m); };
-  auto py = [&](double y) { return H - m - (y - y0) / (y1 - y0) * (H - 2 * m); };
+  const geohaz::PlotPanel f{x0, x1, y0, y1, m, m, W - 2 * m, H - 2 * m};  // core's plotter (plot.hpp)
   const std::array<std::uint8_t, 3> grid{220, 220, 220}, black{0, 0, 0};
-  for (double x = x0; x <= x1 + 1e-9; x += xtick) img.line(px(x), py(y0), px(x), py(y1), grid);
-  for (double y = y0; y <= y1 + 1e-9; y += ytick) img.line(px(x0), py(y), px(x1), py(y), grid);
-  img.line(px(x0), py(y0), px(x1), py(y0), black);
-  img.line(px(x0), py(y0), px(x0), py(y1), black);
-  img.line(px(x1), py(y0), px(x1), py(y1), black);
-  img.line(px(x0), py(y1), px(x1), py(y1), black);
-  for (const auto& c : curves)
-    for (std::size_t i = 0; i < c.x.size(); ++i) {
-      if (c.dots)
-        img.fill_circle(px(c.x[i]), py(c.y[i]), 5, c.colour);
-      else if (i)
-        img.line(px(c.x[i - 1]), py(c.y[i - 1]), px(c.x[i]), py(c.y[i]), c.colour);
+  for (double x = x0; x <= x1 + 1e-9; x += xtick) img.line(f.px(x), f.py(y0), f.px(x), f.py(y1), grid);
+  for (double y = y0; y <= y1 + 1e-9; y += ytick) img.line(f.px(x0), f.py(y), f.px(x1), f.py(y), grid);
+  geohaz::draw_frame(img, f, black);
+  for (const auto& c : curves) {
+    if (!c.dots) {
+      geohaz::draw_polyline(img, f, c.x, c.y, c.colour);
+      continue;
     }
+    for (std::size_t i = 0; i < c.x.size(); ++i) img.fill_circle(f.px(c.x[i]), f.py(c.y[i]), 5, c.colour);
+  }
   std::filesystem::create_directories(path.parent_path());
   geohaz::write_png(path, img);
 }

@@ -13,14 +13,14 @@ prefix=$tmp/prefix
 cmake --install "$build" --prefix "$prefix" >"$tmp/install.log"
 fail() { echo "test_consumer: $*" >&2; exit 1; }
 for f in include/geohaz/core/config.hpp include/geohaz/runout/run.hpp include/geohaz/sph/run.hpp \
-         include/geohaz/dem/experiments.hpp lib/cmake/geohaz/geohazConfig.cmake \
+         include/geohaz/dem/experiments.hpp include/geohaz/report/report.hpp lib/cmake/geohaz/geohazConfig.cmake \
          lib/cmake/geohaz/geohazConfigVersion.cmake lib/cmake/geohaz/geohazTargets.cmake \
          bin/debris-runout bin/sph-slope bin/dem-avalanche bin/geohaz-report \
          share/geohaz/README.md share/geohaz/docs/getting-started.md share/geohaz/data/runout/valley_small.tif \
          share/bash-completion/completions/debris-runout; do
   [ -e "$prefix/$f" ] || fail "not installed: $f"
 done
-ls "$prefix"/lib/libgeohaz_{core,sph,runout,dem}.* >/dev/null || fail "libraries not installed"
+ls "$prefix"/lib/libgeohaz_{core,sph,runout,dem,report}.* >/dev/null || fail "libraries not installed"
 if [ -e "$build/man/debris-runout.1" ]; then
   # Installed gzipped (Debian policy 12.3), with SEE ALSO naming this prefix's data folder.
   page="$prefix/share/man/man1/debris-runout.1.gz"

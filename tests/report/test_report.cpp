@@ -1,4 +1,4 @@
-// geohaz-report's pieces (apps/geohaz-report/report.hpp, docs/report.md): names and units read
+// geohaz-report's pieces (libs/report/include/geohaz/report/report.hpp, docs/report.md): names and units read
 // from keys and columns, numbers formatted with units, SVG plots whose points sit where the axes
 // say, the grouping of summary.json (unknown keys kept), the input parameters in the user's terms,
 // the back-analysis part of a geohaz-calibrate folder.
@@ -12,9 +12,9 @@
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/summary_keys.hpp"
 #include "geohaz/dem/summary_keys.hpp"
+#include "geohaz/report/report.hpp"
 #include "geohaz/runout/summary_keys.hpp"
 #include "geohaz/sph/summary_keys.hpp"
-#include "report.hpp"
 #include "summary_keys_check.hpp"
 
 namespace fs = std::filesystem;

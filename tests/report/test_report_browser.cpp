@@ -29,8 +29,8 @@
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
 #include "geohaz/core/raster_extra.hpp"
+#include "geohaz/report/report.hpp"
 #include "geohaz/runout/run.hpp"
-#include "report.hpp"
 #include "run_command.hpp"
 
 namespace fs = std::filesystem;

@@ -1,4 +1,4 @@
-// The ensemble part of geohaz-report (apps/geohaz-report/report_ensemble.cpp, docs/report.md "An
+// The ensemble part of geohaz-report (libs/report/src/report_ensemble.cpp, docs/report.md "An
 // ensemble"): parameter labels and units are the runout config reader's declarations; the
 // histogram counts every member once, in the bin its edges say; the part's pieces in reading
 // order from a geohaz-ensemble folder made here (summary.json and members.csv as the app writes
@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "geohaz/core/config.hpp"
+#include "geohaz/report/report.hpp"
 #include "geohaz/runout/run.hpp"
-#include "report.hpp"
 
 namespace fs = std::filesystem;
 using namespace geohaz::report;

@@ -1,5 +1,5 @@
 // A dem-avalanche run (run.hpp): the simulation object running the lab tests or the avalanche,
-// the one summary builder, the tables and the outputs, and run_case as the app runs it.
+// the one summary builder, the tables and the outputs, and run_case as the app and Python run it.
 #include "geohaz/dem/run.hpp"
 
 #include <cmath>
@@ -387,12 +387,21 @@ void write_outputs(const DemSimulation& sim, const fs::path& out) {
   write_text_file(out / "summary.json", summary_json(sim));
 }
 
-void run_case(DemSimulation& sim, const fs::path& out, bool quiet, RunObserver* extra) {
+CaseRun run_case(RunConfig config, const RunOptions& options, RunObserver* observer) {
+  CaseRun run;
+  run.simulation = std::make_unique<DemSimulation>(std::move(config));
+  DemSimulation& sim = *run.simulation;
+  if (options.out.empty()) {
+    sim.run(observer);
+    return run;
+  }
+  const fs::path& out = options.out;
+  const bool quiet = options.quiet;
   make_output_dir(out);
   write_text_file(out / "config.resolved.toml", sim.config().resolved);
   if (!quiet && sim.is_lab()) std::cerr << kModel << ": building the bonded sample\n";
   OutputObserver files(out, quiet);
-  RunObservers observers({&files, extra});
+  RunObservers observers({&files, observer});
   try {
     sim.run(&observers);
   } catch (const SimulationError&) {
@@ -408,6 +417,7 @@ void run_case(DemSimulation& sim, const fs::path& out, bool quiet, RunObserver* 
     std::cerr << kModel << ": run-out L = " << r.runout << " m, H = " << r.fall_height << " m, H/L = " << r.h_over_l
               << " (Scheidegger 1973: " << r.scheidegger_h_over_l << " for V = " << r.volume << " m^3)\n";
   }
+  return run;
 }
 
 }  // namespace geohaz::dem

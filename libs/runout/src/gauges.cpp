@@ -12,7 +12,7 @@
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
-#include "plot_support.hpp"
+#include "geohaz/core/plot.hpp"
 
 namespace geohaz::runout {
 
@@ -220,7 +220,6 @@ void write_gauges_csv(const std::filesystem::path& path, const GaugeRecorder& g)
 }
 
 void write_gauges_png(const std::filesystem::path& path, const GaugeRecorder& g) {
-  using detail::Panel;
   static constexpr std::array<std::array<std::uint8_t, 3>, 8> kColours{{{31, 119, 180},
                                                                         {255, 127, 14},
                                                                         {44, 160, 44},
@@ -252,15 +251,15 @@ void write_gauges_png(const std::filesystem::path& path, const GaugeRecorder& g)
   const int panels = any_line ? 3 : 2;
   Image img(W, top0 + panels * (panel_h + gap) + 20);
   const auto range = [](double lo, double hi) { return hi > lo ? hi + 0.1 * (hi - lo) : lo + 1.0; };
-  const Panel depth{t0, t1, 0.0, range(0.0, hmax), 170, top0, W - 230, panel_h};
-  const Panel speed{t0, t1, 0.0, range(0.0, vmax), 170, top0 + panel_h + gap, W - 230, panel_h};
+  const PlotPanel depth{t0, t1, 0.0, range(0.0, hmax), 170, top0, W - 230, panel_h};
+  const PlotPanel speed{t0, t1, 0.0, range(0.0, vmax), 170, top0 + panel_h + gap, W - 230, panel_h};
   const double qpad = 0.1 * std::max(qhi - qlo, 1e-9);
-  const Panel discharge{
+  const PlotPanel discharge{
       t0,      t1,     qlo < 0.0 ? qlo - qpad : 0.0, qhi > qlo ? qhi + qpad : 1.0, 170, top0 + 2 * (panel_h + gap),
       W - 230, panel_h};
-  detail::axes(img, depth, "time (s)", "flow depth (m)", s);
-  detail::axes(img, speed, "time (s)", "speed (m/s)", s);
-  if (any_line) detail::axes(img, discharge, "time (s)", "discharge across the line (m^3/s)", s);
+  draw_axes(img, depth, "time (s)", "flow depth (m)", s);
+  draw_axes(img, speed, "time (s)", "speed (m/s)", s);
+  if (any_line) draw_axes(img, discharge, "time (s)", "discharge across the line (m^3/s)", s);
   int legend_x = 170, legend_y = 22;
   for (std::size_t k = 0; k < g.gauges().size(); ++k) {
     const auto c = kColours[k % kColours.size()];
@@ -271,9 +270,9 @@ void write_gauges_png(const std::filesystem::path& path, const GaugeRecorder& g)
       v.push_back(r.speed);
       q.push_back(r.discharge);
     }
-    detail::thick_polyline(img, depth, t, h, c, 3);
-    detail::thick_polyline(img, speed, t, v, c, 3);
-    if (g.gauges()[k].is_line()) detail::thick_polyline(img, discharge, t, q, c, 3);
+    draw_polyline(img, depth, t, h, c, 3);
+    draw_polyline(img, speed, t, v, c, 3);
+    if (g.gauges()[k].is_line()) draw_polyline(img, discharge, t, q, c, 3);
     // Legend along the top: a swatch and the name (line gauges marked).
     const std::string label = g.gauges()[k].name + (g.gauges()[k].is_line() ? " (line)" : " (point)");
     if (legend_x > 170 && legend_x + 50 + text_width(label, 2) > W - 60) {

@@ -11,7 +11,7 @@
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
-#include "plot_support.hpp"
+#include "geohaz/core/plot.hpp"
 
 namespace geohaz::runout {
 
@@ -185,8 +185,6 @@ void write_profile_csv(const std::filesystem::path& path, const ThalwegProfile& 
   csv.commit();
 }
 
-using detail::Panel;
-
 ProfileReach profile_reach(const ThalwegProfile& p) noexcept {
   ProfileReach r;
   if (!p.reached) return r;
@@ -199,14 +197,13 @@ ProfileReach profile_reach(const ThalwegProfile& p) noexcept {
 namespace {
 
 /// A straight line from (s0, z0) to (s1, z1) drawn in dashes of about 24 px.
-void dashed(Image& img, const Panel& f, double s0, double z0, double s1, double z1, std::array<std::uint8_t, 3> c,
+void dashed(Image& img, const PlotPanel& f, double s0, double z0, double s1, double z1, std::array<std::uint8_t, 3> c,
             int width) {
   const double px = std::hypot(f.px(s1) - f.px(s0), f.py(z1) - f.py(z0));
   const int n = std::max(1, static_cast<int>(px / 24.0));
   for (int k = 0; k < n; k += 2) {
     const double a = double(k) / n, b = double(k + 1) / n;
-    detail::thick_polyline(img, f, {s0 + a * (s1 - s0), s0 + b * (s1 - s0)}, {z0 + a * (z1 - z0), z0 + b * (z1 - z0)},
-                           c, width);
+    draw_polyline(img, f, {s0 + a * (s1 - s0), s0 + b * (s1 - s0)}, {z0 + a * (z1 - z0), z0 + b * (z1 - z0)}, c, width);
   }
 }
 
@@ -239,16 +236,16 @@ void write_profile_png(const std::filesystem::path& path, const ThalwegProfile& 
     speed.push_back(r.speed);
   }
   const double pad = 0.05 * std::max(1.0, zhi - zlo);
-  const Panel upper{sv.front(), sv.back(), zlo - pad, zhi + pad, 170, 90, W - 230, 700};
-  const Panel lower{sv.front(), sv.back(), 0.0, vmax > 0.0 ? 1.1 * vmax : 1.0, 170, 960, W - 230, 200};
+  const PlotPanel upper{sv.front(), sv.back(), zlo - pad, zhi + pad, 170, 90, W - 230, 700};
+  const PlotPanel lower{sv.front(), sv.back(), 0.0, vmax > 0.0 ? 1.1 * vmax : 1.0, 170, 960, W - 230, 200};
   const std::array<std::uint8_t, 3> red{200, 40, 40}, orange{230, 140, 20};
   if (!f.title.empty()) draw_text(img, upper.left, 12, f.title, s);
   // The flow (depth above the terrain) filled, then the terrain, the α line, the run-out point.
   for (std::size_t k = 0; k < sv.size(); ++k)
     if (top[k] > z[k]) img.line(upper.px(sv[k]), upper.py(z[k]), upper.px(sv[k]), upper.py(top[k]), {70, 130, 200});
-  detail::axes(img, upper, "horizontal distance along the path (m)", "elevation (m)", s);
-  detail::thick_polyline(img, upper, sv, top, {40, 90, 170}, 2);
-  detail::thick_polyline(img, upper, sv, z, {30, 30, 30}, 3);
+  draw_axes(img, upper, "horizontal distance along the path (m)", "elevation (m)", s);
+  draw_polyline(img, upper, sv, top, {40, 90, 170}, 2);
+  draw_polyline(img, upper, sv, z, {30, 30, 30}, 3);
   // Legend lines right-aligned at the top of the panel, where the terrain has fallen away.
   int ly = upper.top + 20;
   const auto legend = [&](const std::string& text, std::array<std::uint8_t, 3> c) {
@@ -268,7 +265,7 @@ void write_profile_png(const std::filesystem::path& path, const ThalwegProfile& 
       const double s_end = std::min(sv.back(), p.s_top + (p.z_top - upper.y0) / t);
       dashed(img, upper, p.s_top, p.z_top, s_end, p.z_top - t * (s_end - p.s_top), orange, 3);
     }
-    detail::thick_polyline(img, upper, {p.s_top, p.s_runout}, {p.z_top, p.z_runout}, red, 2);
+    draw_polyline(img, upper, {p.s_top, p.s_runout}, {p.z_top, p.z_runout}, red, 2);
     img.fill_circle(upper.px(p.s_runout), upper.py(p.z_runout), 9, red);
     img.fill_circle(upper.px(p.s_top), upper.py(p.z_top), 7, red);
     std::snprintf(buf, sizeof buf,
@@ -294,8 +291,8 @@ void write_profile_png(const std::filesystem::path& path, const ThalwegProfile& 
     }
     legend(m.label, m.colour);
   }
-  detail::axes(img, lower, "horizontal distance along the path (m)", "peak speed (m/s)", s);
-  detail::thick_polyline(img, lower, sv, speed, {150, 60, 150}, 2);
+  draw_axes(img, lower, "horizontal distance along the path (m)", "peak speed (m/s)", s);
+  draw_polyline(img, lower, sv, speed, {150, 60, 150}, 2);
   write_png(path, img);
 }
 

@@ -154,11 +154,11 @@ void run_with_outputs(SphSimulation& sim, const std::filesystem::path& out, bool
   if (writes) write_outputs(sim, out);
 }
 
-int run_case(const RunConfig& cfg, const std::filesystem::path& out, bool quiet,
-             std::shared_ptr<const Communicator> comm) {
-  SphSimulation sim(cfg, quiet, std::move(comm));
-  run_with_outputs(sim, out, quiet);
-  return 0;
+CaseRun run_case(const RunConfig& cfg, const RunOptions& options, RunObserver* observer) {
+  CaseRun run;
+  run.simulation = std::make_unique<SphSimulation>(cfg, options.quiet, options.comm);
+  run_with_outputs(*run.simulation, options.out, options.quiet, observer);
+  return run;
 }
 
 }  // namespace geohaz::sph

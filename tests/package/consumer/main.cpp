@@ -1,6 +1,6 @@
 // A program built against an installed geohaz (find_package(geohaz)): reads the installed example
 // case of the synthetic valley through the runout library (config keys, GDAL rasters, release),
-// and checks a few figures from each library. Exit code 0 when every check holds.
+// and checks a few figures from each library (the report layer's too). Exit code 0 when every check holds.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -9,6 +9,7 @@
 #include "geohaz/core/config.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/dem/experiments.hpp"
+#include "geohaz/report/report.hpp"
 #include "geohaz/runout/run.hpp"
 #include "geohaz/sph/constitutive.hpp"
 
@@ -57,5 +58,9 @@ int main(int argc, char** argv) {
   // sph: the constitutive models by name.
   check(sph::constitutive_model_from_name(sph::constitutive_model_name(sph::ConstitutiveModel{})).has_value(),
         "the default constitutive model round-trips through its name");
+
+  // report: the output layer's names and units (libs/report).
+  const report::Quantity q = report::quantity_from_name("mean_speed_m_per_s");
+  check(q.label == "mean speed" && q.unit == "m/s", "report reads mean_speed_m_per_s as mean speed in m/s");
   return failures == 0 ? 0 : 1;
 }

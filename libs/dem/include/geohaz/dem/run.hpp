@@ -13,8 +13,10 @@
 ///     existing directory. The summary and the tables come from `summary_json` and `csv_tables`,
 ///     which the Python module returns as they are.
 ///
-/// `run_case(sim, out, quiet)` chains 2 and 3 the way `dem-avalanche` does (output folder and
-/// resolved config created only now; snapshots and progress during the run).
+/// `run_case(config, options, observer)` chains 2 and 3 the way `dem-avalanche` does (output folder
+/// and resolved config created only now; snapshots and progress during the run) and returns the
+/// run: the app and the Python module call only it. The same front end as runout's and sph's
+/// run.hpp: `RunOptions`, `RunObserver`, `CaseRun run_case(config, options, observer)`.
 
 #include <filesystem>
 #include <memory>
@@ -115,10 +117,24 @@ std::vector<std::pair<std::string, std::string>> csv_tables(const DemSimulation&
 /// existing directory `out`.
 void write_outputs(const DemSimulation& sim, const std::filesystem::path& out);
 
-/// The whole `dem-avalanche` run of a checked config: create `out`, write config.resolved.toml,
-/// run with snapshots (snapshots[_<test>].h5) and progress on stderr (unless quiet; the warnings
-/// always), call `extra` too (may be null), and write the outputs. On a SimulationError the lab
-/// tests finished so far still get their tables and pictures (no summary), then it goes on.
-void run_case(DemSimulation& sim, const std::filesystem::path& out, bool quiet, RunObserver* extra = nullptr);
+/// How run_case runs (the fields of runout's RunOptions but its thread count, which only the runout
+/// summary records).
+struct RunOptions {
+  std::filesystem::path out;  ///< folder of the outputs (created by run_case); empty: none (the run only)
+  bool quiet = false;         ///< no progress, sample or result lines on stderr (the warnings still)
+};
+
+/// A run that has ended: the discs, bonds, tests and figures in their final state.
+struct CaseRun {
+  std::unique_ptr<DemSimulation> simulation;
+};
+
+/// The whole `dem-avalanche` run of a checked config (read_config). With `options.out`: create it,
+/// write config.resolved.toml, run with snapshots (snapshots[_<test>].h5) and progress on stderr
+/// (unless quiet; the warnings always), call `observer` too (may be null), and write the outputs;
+/// on a SimulationError the lab tests finished so far still get their tables and pictures (no
+/// summary), then it goes on. Without: the run only, `observer` its only witness (nothing written
+/// or printed; the Python module's in-memory run). Returns the run.
+CaseRun run_case(RunConfig config, const RunOptions& options, RunObserver* observer = nullptr);
 
 }  // namespace geohaz::dem

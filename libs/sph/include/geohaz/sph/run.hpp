@@ -13,8 +13,11 @@
 ///     snapshots, quick-look PNGs). SimulationError on a blow-up, with the state so far kept.
 ///  3. `write_outputs(sim, out)`: the series, surfaces, pictures, release file and summary.json.
 ///
-/// `run_case(cfg, out, quiet)` chains them the way `sph-slope` does (the output folder, the
-/// resolved config and the snapshots during the run, progress on stderr, then the outputs).
+/// `run_case(cfg, options, observer)` chains them the way `sph-slope` does (the output folder, the
+/// resolved config and the snapshots during the run, progress on stderr, then the outputs) and
+/// returns the run: the apps (sph-slope, sph-slope-mpi) and the Python module call only it. The
+/// same front end as runout's and dem's run.hpp: `RunOptions`, `RunObserver`,
+/// `CaseRun run_case(config, options, observer)`.
 
 #include <cstdint>
 #include <filesystem>
@@ -318,13 +321,28 @@ void write_outputs(const SphSimulation& sim, const std::filesystem::path& out);
 void run_with_outputs(SphSimulation& sim, const std::filesystem::path& out, bool quiet,
                       RunObserver* observer = nullptr);
 
-/// The whole `sph-slope` run of a validated config: build, run with outputs into `out` (created).
-/// Returns the process exit code (0). With `comm`, over its ranks (SphSimulation): every rank calls
-/// it with the same `out`; rank 0 makes the folder and writes the outputs, every rank its part of
-/// the snapshots (core SnapshotWriter over several processes; the folder must be on a file system
-/// every rank sees).
-int run_case(const RunConfig& cfg, const std::filesystem::path& out, bool quiet,
-             std::shared_ptr<const Communicator> comm = nullptr);
+/// How run_case runs (the fields of runout's RunOptions but its thread count, which only the runout
+/// summary records, and the ranks of a distributed run).
+struct RunOptions {
+  std::filesystem::path out;  ///< folder of the outputs (created by run_case); empty: none
+  bool quiet = false;         ///< no particle counts or progress on stderr
+  /// The ranks of a run over several processes (sph-slope-mpi; SphSimulation); null: one process.
+  std::shared_ptr<const Communicator> comm;
+};
+
+/// A run that has ended: the particles, tables and figures in their final state. The simulation
+/// refers to the config given to run_case, which must outlive it.
+struct CaseRun {
+  std::unique_ptr<SphSimulation> simulation;
+};
+
+/// The whole `sph-slope` run of a validated config (validate): build, then run_with_outputs into
+/// `options.out` (created; empty: nothing written), `observer` (may be null) called too. Returns the
+/// run. With `options.comm`, over its ranks (SphSimulation): every rank calls it with the same
+/// `out`; rank 0 makes the folder and writes the outputs, every rank its part of the snapshots
+/// (core SnapshotWriter over several processes; the folder must be on a file system every rank
+/// sees).
+CaseRun run_case(const RunConfig& cfg, const RunOptions& options, RunObserver* observer = nullptr);
 
 /// What a run over several ranks cannot do yet (issue #36; docs/sph.md, "Domain decomposition"):
 /// InputError naming the key for the total-Lagrangian formulation (numerics.formulation). Every

@@ -46,11 +46,8 @@ Csv read_csv(const std::filesystem::path& path);
 /// lists with a text column, such as the acoustic-emission files, are left to the files).
 bool is_plottable(const Csv& csv);
 
-/// Tick values at a nice step (1, 2, 5 × 10^k) within [lo, hi], about n of them (report_plots.cpp).
-std::vector<double> nice_ticks(double lo, double hi, int n);
-/// [lo, hi] rounded out to nice ticks (widened first when empty).
-void nice_range(double& lo, double& hi);
-/// A tick's number (6 significant digits; 0 when within 1e-12 of the span).
+/// The ticks and ranges of the SVG plots are core's (nice_ticks in raster.hpp, nice_range in plot.hpp), as
+/// in the PNG figures. A tick's number (6 significant digits; 0 when within 1e-12 of the span).
 std::string tick_text(double v, double span);
 
 /// An SVG plot of a plottable CSV: one panel per unit of the other columns (columns sharing a unit

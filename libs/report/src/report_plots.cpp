@@ -9,7 +9,8 @@
 #include <sstream>
 
 #include "geohaz/core/errors.hpp"
-#include "report.hpp"
+#include "geohaz/core/plot.hpp"
+#include "geohaz/report/report.hpp"
 
 namespace fs = std::filesystem;
 
@@ -68,34 +69,6 @@ bool is_plottable(const Csv& csv) {
   static const char* kAbscissae[] = {"time_s", "x_m", "s_m", "distance_m"};
   if (std::find(std::begin(kAbscissae), std::end(kAbscissae), csv.names.front()) == std::end(kAbscissae)) return false;
   return std::all_of(csv.numeric.begin(), csv.numeric.end(), [](bool b) { return b; });
-}
-
-std::vector<double> nice_ticks(double lo, double hi, int n) {
-  std::vector<double> t;
-  if (!(hi > lo)) return t;
-  const double raw = (hi - lo) / n, p = std::pow(10.0, std::floor(std::log10(raw)));
-  double step = 10 * p;
-  for (double m : {1.0, 2.0, 5.0})
-    if (m * p >= raw) {
-      step = m * p;
-      break;
-    }
-  for (double k = std::ceil(lo / step - 1e-9); k * step <= hi + 1e-9 * step; k += 1) t.push_back(k * step);
-  return t;
-}
-
-void nice_range(double& lo, double& hi) {
-  if (!(hi > lo)) {
-    const double d = std::max(1e-9, std::abs(lo) * 0.05 + (lo == 0 ? 1 : 0));
-    lo -= d;
-    hi += d;
-  }
-  const auto t = nice_ticks(lo, hi, 5);
-  if (t.size() >= 2) {
-    const double step = t[1] - t[0];
-    lo = std::floor(lo / step + 1e-9) * step;
-    hi = std::ceil(hi / step - 1e-9) * step;
-  }
 }
 
 std::string tick_text(double v, double span) {

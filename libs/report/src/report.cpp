@@ -1,7 +1,7 @@
 /// \file report.cpp
 /// geohaz-report's page (see report.hpp and docs/report.md).
 
-#include "report.hpp"
+#include "geohaz/report/report.hpp"
 
 #include <unistd.h>
 

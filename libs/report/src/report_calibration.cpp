@@ -13,7 +13,7 @@
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
-#include "report.hpp"
+#include "geohaz/report/report.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;

@@ -14,8 +14,9 @@
 #include <vector>
 
 #include "geohaz/core/errors.hpp"
+#include "geohaz/core/plot.hpp"
+#include "geohaz/report/report.hpp"
 #include "geohaz/runout/summary_keys.hpp"
-#include "report.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;

@@ -13,10 +13,10 @@
 #include "geohaz/core/config.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/dem/config.hpp"
+#include "geohaz/report/report.hpp"
 #include "geohaz/runout/ensemble.hpp"
 #include "geohaz/runout/run.hpp"
 #include "geohaz/sph/config.hpp"
-#include "report.hpp"
 
 namespace fs = std::filesystem;
 
