@@ -7,8 +7,10 @@
 /// i (OpenMP) and lets the body write only to particle i, so no atomics are needed (the tests and
 /// bench_neighbours use it). The models' hot pair loops read the CSR arrays (`offsets()`,
 /// `indices()`) themselves, read only: SPH's gradient correction, velocity gradient, momentum and
-/// structure loads (libs/sph/src/solver_passes.cpp) and DEM's pair forces and contact diagnostics
-/// (libs/dem/src/solver.cpp, solver_diagnostics.cpp). They evaluate each pair once, from the lower
+/// structure loads (libs/sph/src/solver_passes.cpp, solver_pair_passes.hpp), its total-Lagrangian
+/// reference pairs (solver_total_lagrangian.cpp) and the cost of a particle (its neighbour count)
+/// in the domain decomposition's partition (solver_distributed.cpp); DEM's pair forces and contact diagnostics
+/// (libs/dem/src/solver_pairs.cpp, solver_diagnostics.cpp). They evaluate each pair once, from the lower
 /// index, and add the partner's share to a block buffer (PairBlocks below), which a callback that
 /// may write only to i cannot express; and a shared lambda for the neighbour loop's header cost 20 %
 /// of the SPH 2D speed (solver_passes.cpp).
