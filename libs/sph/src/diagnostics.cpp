@@ -28,7 +28,7 @@ void reduce_bins(const OverRanks& over, std::map<long, double>& bins, bool take_
   const auto* p = reinterpret_cast<const std::byte*>(mine.data());
   const std::vector<std::byte> all = over.comm->all_gather_bytes({p, mine.size() * sizeof(double)});
   std::vector<double> v(all.size() / sizeof(double));
-  std::memcpy(v.data(), all.data(), v.size() * sizeof(double));
+  if (!v.empty()) std::memcpy(v.data(), all.data(), v.size() * sizeof(double));  // no bins on any rank: nothing
   for (std::size_t k = 0; k + 1 < v.size(); k += 2) {
     auto [it, inserted] = bins.emplace(static_cast<long>(v[k]), v[k + 1]);
     if (!inserted) it->second = take_max ? std::max(it->second, v[k + 1]) : std::min(it->second, v[k + 1]);
@@ -37,7 +37,7 @@ void reduce_bins(const OverRanks& over, std::map<long, double>& bins, bool take_
 
 /// Sums of every rank's partial sums, added in rank order (collective).
 void sum_in_rank_order(const OverRanks& over, std::vector<double>& sums) {
-  if (!over.comm) return;
+  if (!over.comm || sums.empty()) return;
   const std::vector<double> all = over.comm->all_gather(sums);
   std::fill(sums.begin(), sums.end(), 0.0);
   for (std::size_t r = 0; r < all.size() / sums.size(); ++r)

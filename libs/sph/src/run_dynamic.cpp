@@ -332,7 +332,7 @@ void DynamicRun<Dim>::mark_free_end() {
   if (const auto* d = solver_.domain()) {
     const auto all = d->comm().all_gather_bytes(std::as_bytes(std::span<const std::int64_t>(mine)));
     mine.resize(all.size() / sizeof(std::int64_t));
-    std::memcpy(mine.data(), all.data(), all.size());
+    if (!all.empty()) std::memcpy(mine.data(), all.data(), all.size());
   }
   free_end_.assign(static_cast<std::size_t>(idmax) + 1, 0);
   for (const std::int64_t k : mine) free_end_[static_cast<std::size_t>(k)] = 1;
