@@ -470,17 +470,12 @@ void DemSolver::wall_forces(const Law& law) {
       if (!near[i] || kinematic[i]) continue;
       const Vec2 xi = position[i];
       const bool had = history[i](0, 0) >= 0.0;  // slots are filled from the first one
-      // Most discs are far from every wall and terrain segment and had no wall contact: nothing
-      // to do (decided before the contact table is set up; the same result as the full pass).
       const auto in_box = [=](std::size_t k) {
         return xi.x() >= boxes[k][0] && xi.y() >= boxes[k][1] && xi.x() <= boxes[k][2] && xi.y() <= boxes[k][3];
       };
       const auto [tb, te] = terrain.size() > 0
                                 ? terrain.candidates(xi.x())
                                 : std::pair<const std::uint32_t*, const std::uint32_t*>{nullptr, nullptr};
-      bool candidate = had || tb != te;
-      for (std::size_t k = 0; k < nw && !candidate; ++k) candidate = in_box(k);
-      if (!candidate) continue;
       const double Ri = R[i];
       const WallContacts::type& old = WC[i];
       WallContacts::type now;

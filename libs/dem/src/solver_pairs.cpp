@@ -55,19 +55,11 @@ void DemSolver::pair_forces(const Law& law_in) {
   Vec2* const F = discs.get<Force>().data();
   double* const T = discs.get<Torque>().data();
   auto* const K = discs.get<StiffnessSum>().data();
-  const auto offsets = nb_.list().offsets();
-  const std::uint32_t* const off = offsets.data();
+  const std::uint32_t* const off = nb_.list().offsets().data();
   const std::uint32_t* const nbr = nb_.list().indices().data();
-  const std::size_t npairs = nb_.list().indices().size();
   const std::size_t n = discs.size();
   const bool same_layout = same_layout_ && hist_.offsets.size() == n + 1;
-  PairHistory& out = same_layout ? hist_ : hist_next_;
-  if (!same_layout) {
-    out.offsets.assign(offsets.begin(), offsets.end());
-    out.partner.resize(npairs);
-    out.shear.resize(npairs);
-    out.roll.resize(npairs);
-  }
+  PairHistory& out = pair_history_out(same_layout);
   std::int64_t* const h_partner = out.partner.data();
   double* const h_shear = out.shear.data();
   double* const h_roll = out.roll.data();
@@ -88,13 +80,7 @@ void DemSolver::pair_forces(const Law& law_in) {
   reactions_.resize(pb.slots());
   PairReaction* const reactions = reactions_.data();
   const auto nblocks = static_cast<std::int64_t>(pb.count());
-  // Without rolling resistance (μ_r ≤ 0: every contact's μ_r is 0, a joint's too), joints and
-  // kinematic discs, a second version of the loop: its μ_r is the constant 0, so the compiler drops
-  // the rolling branch of the friction update (roll = 0 there as before) and what only it reads (R*
-  // of the linear law, ω_i − ω_j), and the joint test; every m* is the two-body one.
-  std::uint8_t any_kinematic = 0;
-  for (std::size_t i = 0; i < n; ++i) any_kinematic |= kin[i];
-  const bool plain = !(mu_r > 0.0) && !any_joints && !any_kinematic;
+  const bool plain = plain_pair_loop();
   const auto block = [=, this](std::size_t b, auto layout, auto general_tag) {
     constexpr bool same = decltype(layout)::value;
     constexpr bool general = decltype(general_tag)::value;
@@ -200,6 +186,28 @@ void DemSolver::pair_forces(const Law& law_in) {
     std::swap(hist_, hist_next_);
     same_layout_ = true;
   }
+}
+
+DemSolver::PairHistory& DemSolver::pair_history_out(bool same_layout) {
+  if (same_layout) return hist_;  // the list is the one the history was written with: in place
+  const auto offsets = nb_.list().offsets();
+  const std::size_t npairs = nb_.list().indices().size();
+  hist_next_.offsets.assign(offsets.begin(), offsets.end());
+  hist_next_.partner.resize(npairs);
+  hist_next_.shear.resize(npairs);
+  hist_next_.roll.resize(npairs);
+  return hist_next_;
+}
+
+// Without rolling resistance (μ_r ≤ 0: every contact's μ_r is 0, a joint's too), joints and
+// kinematic discs, a second version of the loop: its μ_r is the constant 0, so the compiler drops
+// the rolling branch of the friction update (roll = 0 there as before) and what only it reads (R*
+// of the linear law, ω_i − ω_j), and the joint test; every m* is the two-body one.
+bool DemSolver::plain_pair_loop() const {
+  if (contact.rolling_friction > 0.0 || !joints_.empty()) return false;
+  std::uint8_t any_kinematic = 0;
+  for (const std::uint8_t k : discs.get<Kinematic>()) any_kinematic |= k;
+  return !any_kinematic;
 }
 
 void DemSolver::gather_pair_reactions() {

@@ -140,6 +140,11 @@ class DemSolver {
   bool same_layout_ = false;  ///< hist_ was written with the current neighbour list
   /// The history (F_s, M_r as seen from i) of the contact of discs i < j after a list rebuild.
   void lookup_history(std::size_t i, std::size_t j, double& fs, double& mr) const;
+  /// The history the pair pass writes: hist_ in place while the list is the one it was written
+  /// with (same_layout), else hist_next_ laid out like the new list (swapped in after the pass).
+  PairHistory& pair_history_out(bool same_layout);
+  /// Whether the pair pass can take its plain loop: no rolling resistance, joints or kinematic disc.
+  bool plain_pair_loop() const;
   /// Add the reactions of the half-pair pass to F, T and K in fixed block order.
   void gather_pair_reactions();
   /// The joint between discs id_a and id_b, or nullptr.
