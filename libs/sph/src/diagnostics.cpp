@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <map>
 
 namespace geohaz::sph {
@@ -25,10 +24,7 @@ void reduce_bins(const OverRanks& over, std::map<long, double>& bins, bool take_
     mine.push_back(static_cast<double>(b));
     mine.push_back(v);
   }
-  const auto* p = reinterpret_cast<const std::byte*>(mine.data());
-  const std::vector<std::byte> all = over.comm->all_gather_bytes({p, mine.size() * sizeof(double)});
-  std::vector<double> v(all.size() / sizeof(double));
-  if (!v.empty()) std::memcpy(v.data(), all.data(), v.size() * sizeof(double));  // no bins on any rank: nothing
+  const std::vector<double> v = all_gather_values(*over.comm, std::span<const double>(mine));
   for (std::size_t k = 0; k + 1 < v.size(); k += 2) {
     auto [it, inserted] = bins.emplace(static_cast<long>(v[k]), v[k + 1]);
     if (!inserted) it->second = take_max ? std::max(it->second, v[k + 1]) : std::min(it->second, v[k + 1]);

@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <iomanip>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -329,11 +328,7 @@ void DynamicRun<Dim>::mark_free_end() {
     if (S.template get<ParticleKind>()[i] == kSoil && !S.template get<Clamped>()[i] &&
         x[i][0] - u[i][0] >= xmax - 0.5 * c_.numerics.spacing)
       mine.push_back(id[i]);
-  if (const auto* d = solver_.domain()) {
-    const auto all = d->comm().all_gather_bytes(std::as_bytes(std::span<const std::int64_t>(mine)));
-    mine.resize(all.size() / sizeof(std::int64_t));
-    if (!all.empty()) std::memcpy(mine.data(), all.data(), all.size());
-  }
+  if (const auto* d = solver_.domain()) mine = all_gather_values(d->comm(), std::span<const std::int64_t>(mine));
   free_end_.assign(static_cast<std::size_t>(idmax) + 1, 0);
   for (const std::int64_t k : mine) free_end_[static_cast<std::size_t>(k)] = 1;
 }

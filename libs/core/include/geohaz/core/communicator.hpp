@@ -13,7 +13,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 namespace geohaz {
@@ -44,5 +46,16 @@ class Communicator {
   virtual void exchange(std::span<const std::byte> send, std::span<const std::int64_t> send_bytes,
                         std::span<std::byte> recv, std::span<const std::int64_t> recv_bytes) const = 0;
 };
+
+/// Every rank's `values` of a plain type (counts may differ), concatenated in rank order, on every
+/// rank: `all_gather_bytes` typed. Empty on every rank gives an empty vector.
+template <class T>
+std::vector<T> all_gather_values(const Communicator& comm, std::span<const T> values) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  const std::vector<std::byte> all = comm.all_gather_bytes(std::as_bytes(values));
+  std::vector<T> out(all.size() / sizeof(T));
+  if (!out.empty()) std::memcpy(out.data(), all.data(), out.size() * sizeof(T));
+  return out;
+}
 
 }  // namespace geohaz
