@@ -77,6 +77,16 @@ int page_mark(const std::string& dom, const std::string& name) {
 }
 
 /// A small results folder with what the apps write.
+/// A north-up grid of nx × ny cells of 5 m in UTM (the maps of the report's test folders), all 0.
+geohaz::Raster grid_5m(int nx, int ny) {
+  geohaz::Raster g;
+  g.nx = nx;
+  g.ny = ny;
+  g.geotransform = {600000.0, 5.0, 0.0, 5100000.0, 0.0, -5.0};
+  g.data.resize(static_cast<std::size_t>(nx) * ny);
+  return g;
+}
+
 void make_results(const fs::path& root) {
   const fs::path run = root / "1-runout", lab = root / "2-rock-biaxial";
   fs::create_directories(run);
@@ -92,11 +102,7 @@ void make_results(const fs::path& root) {
              "0,0,0,0,100,0\n10,5,150,12,80,20\n20,9,260,8,30,70\n30,12,300,1,0,100\n");
   write_file(run / "barrier_forces.csv", "time_s,force_N\n0,0\n10,1.2e5\n20,4e4\n30,0\n");
   // A map as debris-runout draws it: a cone with a flow over one flank.
-  geohaz::Raster dem;
-  dem.nx = 120;
-  dem.ny = 90;
-  dem.geotransform = {600000.0, 5.0, 0.0, 5100000.0, 0.0, -5.0};
-  dem.data.resize(static_cast<std::size_t>(dem.nx) * dem.ny);
+  geohaz::Raster dem = grid_5m(120, 90);
   geohaz::Raster depth = dem;
   for (int r = 0; r < dem.ny; ++r)
     for (int c = 0; c < dem.nx; ++c) {
@@ -341,11 +347,7 @@ void write_wide_table(const fs::path& summary) {
 // A map taller than wide, as a valley running north-south gives (the demo's run-out): printed at
 // the page's width it would be taller than A4.
 void write_tall_map(const fs::path& png) {
-  geohaz::Raster tall;
-  tall.nx = 40;
-  tall.ny = 160;
-  tall.geotransform = {600000.0, 5.0, 0.0, 5100000.0, 0.0, -5.0};
-  tall.data.resize(static_cast<std::size_t>(tall.nx) * tall.ny);
+  geohaz::Raster tall = grid_5m(40, 160);
   geohaz::Raster speed = tall;
   for (int r = 0; r < tall.ny; ++r)
     for (int c = 0; c < tall.nx; ++c) {
