@@ -49,6 +49,7 @@ TEST(CheckPlotPng, AxesNumberedAndTitledPass) {
   const fs::path p = temp_file("axes.png");
   write_plot_png(p, img, {kPanel}, 2);
   EXPECT_TRUE(check_plot_png(p).empty()) << check_plot_png(p).front();
+  fs::remove_all(p.parent_path());
 }
 
 TEST(CheckPlotPng, FigureThatLostItsAxesIsFlagged) {
@@ -68,6 +69,7 @@ TEST(CheckPlotPng, FigureThatLostItsAxesIsFlagged) {
   EXPECT_EQ(check_plot_png(p).front(), "panel 1: no frame");
   write_png(p, img);
   EXPECT_EQ(check_plot_png(p).front(), "records no plot layout (not written by write_plot_png)");
+  fs::remove_all(p.parent_path());
 }
 
 TEST(DrawLegend, RowsWrapAtTheGivenWidth) {
