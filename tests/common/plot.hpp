@@ -29,11 +29,10 @@ inline void plot(const std::filesystem::path& path, const std::vector<Curve>& cu
   for (double y = y0; y <= y1 + 1e-9; y += ytick) img.line(f.px(x0), f.py(y), f.px(x1), f.py(y), grid);
   geohaz::draw_frame(img, f, black);
   for (const auto& c : curves) {
-    if (!c.dots) {
+    if (c.dots)
+      geohaz::draw_markers(img, f, c.x, c.y, c.colour, 5);
+    else
       geohaz::draw_polyline(img, f, c.x, c.y, c.colour);
-      continue;
-    }
-    for (std::size_t i = 0; i < c.x.size(); ++i) img.fill_circle(f.px(c.x[i]), f.py(c.y[i]), 5, c.colour);
   }
   std::filesystem::create_directories(path.parent_path());
   geohaz::write_png(path, img);

@@ -14,6 +14,7 @@
 
 #include "bonded_lab_spec.hpp"
 #include "column_collapse.hpp"
+#include "geohaz/core/plot.hpp"
 #include "geohaz/core/raster.hpp"
 #include "geohaz/core/snapshot.hpp"
 #include "geohaz/dem/experiments.hpp"
@@ -260,6 +261,8 @@ TEST(DemApp, BiaxialCompressionTinyConfig) {
                         "ae_sigma3_10MPa.csv", "cracks_sigma3_10MPa.png", "snapshots_sigma3_10MPa.h5",
                         "snapshots_sigma3_10MPa.xmf", "sample_cells.vtk", "sample_triangulation.vtk"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
+  // The crack picture is framed by numbered axes in metres with their titles (core's plotter).
+  EXPECT_EQ(geohaz::check_plot_png(out / "cracks_sigma3_10MPa.png"), std::vector<std::string>{});
   const auto j = read_json(out / "summary.json");
   ASSERT_EQ(j["tests"].size(), 2u);
   const double p0 = j["tests"][0]["peak_stress_Pa"], p1 = j["tests"][1]["peak_stress_Pa"];
@@ -319,6 +322,8 @@ TEST(DemApp, AvalancheTinyConfig) {
   for (const char* f : {"summary.json", "runout.csv", "ae.csv", "deposit.csv", "fragments.csv", "deposit.png",
                         "snapshots.h5", "snapshots.xmf"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
+  for (const char* f : {"deposit.png", "deposit_thickness.png"})  // numbered, titled axes
+    EXPECT_EQ(geohaz::check_plot_png(out / f), std::vector<std::string>{}) << f;
   const auto j = read_json(out / "summary.json");
   std::printf("tiny avalanche: %d discs, toe x = %.1f m\n", j["discs"].get<int>(), j["toe"][0].get<double>());
   // After 4 s on a 35° slope the mass has moved down-slope: the toe is beyond the source.

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "geohaz/core/plot.hpp"
 #include "geohaz/core/snapshot.hpp"
 #include "geohaz/sph/constitutive.hpp"
 #include "geohaz/sph/summary_keys.hpp"
@@ -72,6 +73,7 @@ TEST(SphSlopeApp, TinySlopeWritesAllOutputs) {
                         "snapshots.xmf", "final_displacement.png", "velocity_t0.050.png", "config.resolved.toml",
                         "structure_forces.csv", "structure_forces.png"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
+  EXPECT_EQ(geohaz::check_plot_png(out / "structure_forces.png"), std::vector<std::string>{});  // numbered axes
   const auto s = summary(out);
   EXPECT_EQ(s["dimension"], 2);
   EXPECT_EQ(s["model"], "drucker_prager");
@@ -421,6 +423,7 @@ TEST(SphSlopeApp, StrengthReductionBracketsTheAcadsFactor) {
   for (const char* f :
        {"srm_curve.csv", "srm_curve.png", "mechanism.png", "slip_surface.csv", "bishop_circle.csv", "snapshots.h5"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
+  EXPECT_EQ(geohaz::check_plot_png(out / "srm_curve.png"), std::vector<std::string>{});  // numbered axes
   // The mechanism: the failed trial's slip surface leaves the slope near the toe (x = 45 m), as
   // Bishop's circle does.
   EXPECT_NEAR(s["bishop"]["exit_x_m"].get<double>(), 45.0, 2.0);

@@ -146,4 +146,13 @@ Image read_image(const std::filesystem::path& path) {
   return img;
 }
 
+std::string read_png_text(const std::filesystem::path& path, const std::string& key) {
+  detail::ensure_gdal_registered();
+  detail::QuietGdalErrors quiet;
+  std::unique_ptr<GDALDataset> ds(GDALDataset::Open(path.string().c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
+  if (!ds) return "";
+  const char* v = ds->GetMetadataItem(key.c_str());
+  return v ? v : "";
+}
+
 }  // namespace geohaz

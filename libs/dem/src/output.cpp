@@ -8,6 +8,7 @@
 #include <string>
 
 #include "geohaz/core/output.hpp"
+#include "geohaz/core/plot.hpp"
 #include "geohaz/core/raster.hpp"
 
 namespace geohaz::dem {
@@ -114,68 +115,28 @@ Frame make_frame(Vec2 lo, Vec2 hi, int width_px) {
   return f;
 }
 
-/// One entry of a picture's legend: a colour swatch and its text.
-struct LegendEntry {
-  std::array<std::uint8_t, 3> colour;
-  std::string text;
-};
-
-/// The picture `plot` drawn in `f` framed with numbered axes in metres (`x_title`, `y_title`), a
-/// title above and a legend below.
-Image with_axes(const Image& plot, const Frame& f, const std::string& title, const std::string& x_title,
-                const std::string& y_title, const std::vector<LegendEntry>& legend) {
+/// The picture `plot` drawn in `f` as a panel of core's plotter (plot.hpp), numbered in metres
+/// (`x_title`, `y_title`), a title above and a legend below; written with its panel recorded.
+void write_framed_png(const std::filesystem::path& path, const Image& plot, const Frame& f, const std::string& title,
+                      const std::string& x_title, const std::string& y_title, const std::vector<LegendEntry>& legend) {
   constexpr int s = 2, ml = 110, mr = 30, mt = 56, mb = 70;
-  const int th = 7 * s;
-  // Legend rows.
   const int W = plot.width + ml + mr;
-  std::vector<std::pair<int, int>> pos;
-  int lx = ml, ly = mt + plot.height + mb;
-  for (const auto& e : legend) {
-    const int w = 14 * s + text_width(e.text, s);
-    if (lx > ml && lx + w > W - mr) {
-      lx = ml;
-      ly += th + 8;
-    }
-    pos.emplace_back(lx, ly);
-    lx += w + 20;
-  }
-  const int H = (legend.empty() ? mt + plot.height + mb : ly + th + 10);
+  const int H = mt + plot.height + mb + (legend.empty() ? 0 : legend_height(legend, plot.width, s) + 10);
   Image img(W, H);
-  for (int y = 0; y < plot.height; ++y)
-    for (int x = 0; x < plot.width; ++x) {
-      const std::size_t i = (static_cast<std::size_t>(y) * plot.width + x) * 3;
-      img.set(ml + x, mt + y, {plot.rgb[i], plot.rgb[i + 1], plot.rgb[i + 2]});
-    }
-  const std::array<std::uint8_t, 3> black{0, 0, 0};
-  const int x0 = ml, x1 = ml + plot.width - 1, y0 = mt, y1 = mt + plot.height - 1;
-  img.line(x0, y0, x1, y0, black);
-  img.line(x0, y1, x1, y1, black);
-  img.line(x0, y0, x0, y1, black);
-  img.line(x1, y0, x1, y1, black);
-  const double xlo = f.lo.x(), xhi = f.lo.x() + (plot.width - 1) / f.scale;
-  const double ylo = f.lo.y(), yhi = f.lo.y() + (plot.height - 1) / f.scale;
-  for (double v : nice_ticks(xlo, xhi, std::max(2, plot.width / 140))) {
-    const int px = ml + static_cast<int>(std::lround(f.px(v)));
-    img.line(px, y1, px, y1 + 6, black);
-    const std::string t = format_tick(v);
-    draw_text(img, px - text_width(t, s) / 2, y1 + 10, t, s);
-  }
-  for (double v : nice_ticks(ylo, yhi, std::max(2, plot.height / 90))) {
-    const int py = mt + static_cast<int>(std::lround(f.py(v)));
-    img.line(x0 - 6, py, x0, py, black);
-    const std::string t = format_tick(v);
-    draw_text(img, x0 - 10 - text_width(t, s), py - th / 2, t, s);
-  }
-  draw_text(img, ml + (plot.width - text_width(x_title, s)) / 2, y1 + 16 + th, x_title, s);
-  draw_text(img, 8, mt - th - 8, y_title, s);
+  draw_picture(img, plot, ml, mt);
+  // The panel spans the picture's pixel centres: column 0 is f.lo.x(), column w − 1 is f.lo.x() + (w − 1)/scale.
+  const PlotPanel panel{f.lo.x(),
+                        f.lo.x() + (plot.width - 1) / f.scale,
+                        f.lo.y(),
+                        f.lo.y() + (plot.height - 1) / f.scale,
+                        ml,
+                        mt,
+                        plot.width - 1,
+                        plot.height - 1};
+  draw_axes(img, panel, x_title, y_title, s, {std::max(2, plot.width / 140), std::max(2, plot.height / 90), false});
   draw_text(img, ml + (plot.width - text_width(title, s)) / 2, 8, title, s);
-  for (std::size_t k = 0; k < legend.size(); ++k) {
-    const auto [x, y] = pos[k];
-    for (int a = 0; a < th; ++a)
-      for (int b = 0; b < th; ++b) img.set(x + b, y + a, legend[k].colour);
-    draw_text(img, x + th + 8, y, legend[k].text, s);
-  }
-  return img;
+  draw_legend(img, ml, mt + plot.height + mb, plot.width, legend, s);
+  write_plot_png(path, img, {panel}, s);
 }
 
 }  // namespace
@@ -219,11 +180,11 @@ void write_sample_png(const std::filesystem::path& path, const DemSolver& s, con
       img.fill_circle(f.px(m.x()), f.py(m.y()), std::max(1.5, 0.4 * s.bonds.radius[b] * f.scale), c);
     }
   }
-  write_png(path, with_axes(img, f, title, "x (m)", "y (m)",
-                            {{{40, 90, 200}, "intact bond"},
-                             {{220, 30, 30}, "tensile crack"},
-                             {{250, 150, 0}, "shear crack"},
-                             {{20, 160, 60}, "cut by a joint"}}));
+  write_framed_png(path, img, f, title, "x (m)", "y (m)",
+                   {{{40, 90, 200}, "intact bond"},
+                    {{220, 30, 30}, "tensile crack"},
+                    {{250, 150, 0}, "shear crack"},
+                    {{20, 160, 60}, "cut by a joint"}});
 }
 
 void write_avalanche_png(const std::filesystem::path& path, const DemSolver& s, const std::vector<Vec2>& terrain,
@@ -256,66 +217,32 @@ void write_avalanche_png(const std::filesystem::path& path, const DemSolver& s, 
     const double t = frag[i] <= 0 ? 0.0 : 0.15 + 0.85 * std::fmod(0.618034 * frag[i], 1.0);
     img.fill_circle(f.px(x[i].x()), f.py(x[i].y()), std::max(0.8, R[i] * f.scale), ramp_colour(ColourRamp::Viridis, t));
   }
-  write_png(path, with_axes(img, f, "rock avalanche at the end (discs coloured by fragment)",
-                            "distance along the section (m)", "elevation (m)",
-                            {{{60, 40, 20}, "terrain"}, {{150, 150, 150}, "source outline"}}));
+  write_framed_png(path, img, f, "rock avalanche at the end (discs coloured by fragment)",
+                   "distance along the section (m)", "elevation (m)",
+                   {{{60, 40, 20}, "terrain"}, {{150, 150, 150}, "source outline"}});
 }
-
-namespace {
-
-/// A "nice" tick step (1, 2 or 5 × 10^k) giving about n ticks over span.
-double nice_step(double span, int n) {
-  const double raw = span / n, p = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (m * p >= raw) return m * p;
-  return 10 * p;
-}
-
-std::string tick_label(double v, double step) {
-  std::ostringstream o;
-  o << std::fixed << std::setprecision(step >= 1 ? 0 : static_cast<int>(std::ceil(-std::log10(step)))) << v;
-  return o.str();
-}
-
-}  // namespace
 
 void write_deposit_png(const std::filesystem::path& path, const std::vector<std::pair<double, double>>& deposit) {
-  const int W = 900, H = 380, ml = 90, mr = 20, mt = 30, mb = 56;
-  Image img(W, H);
-  double x0 = 0, x1 = 1, hmax = 0;
-  if (!deposit.empty()) {
-    x0 = deposit.front().first;
-    x1 = deposit.back().first;
-    for (const auto& d : deposit) hmax = std::max(hmax, d.second);
+  constexpr int W = 900, H = 380, ml = 90, mr = 20, mt = 36, mb = 56, s = 2;
+  std::vector<double> x, h;
+  for (const auto& [xk, hk] : deposit) {
+    x.push_back(xk);
+    h.push_back(hk);
   }
+  double x0 = x.empty() ? 0.0 : x.front(), x1 = x.empty() ? 1.0 : x.back();
+  double y0 = 0.0, y1 = std::max(1e-3, h.empty() ? 0.0 : *std::max_element(h.begin(), h.end()));
   if (!(x1 > x0)) x1 = x0 + 1;
-  const double xs = nice_step(x1 - x0, 8), ys = nice_step(std::max(hmax, 1e-3), 5);
-  x0 = std::floor(x0 / xs) * xs;
-  x1 = std::ceil(x1 / xs) * xs;
-  const double y1 = std::ceil(std::max(hmax, 1e-3) / ys) * ys;
-  auto px = [&](double x) { return ml + (x - x0) / (x1 - x0) * (W - ml - mr); };
-  auto py = [&](double y) { return H - mb - y / y1 * (H - mt - mb); };
-  const std::array<std::uint8_t, 3> grid{225, 225, 225}, black{0, 0, 0}, fill{160, 120, 70};
-  for (const auto& [x, h] : deposit)  // thickness as filled columns
-    if (h > 0) img.line(px(x), py(0), px(x), py(h), fill);
-  for (double x = x0; x <= x1 + 1e-9 * xs; x += xs) {
-    img.line(px(x), py(0), px(x), py(y1), grid);
-    const std::string l = tick_label(x, xs);
-    draw_text(img, static_cast<int>(px(x)) - text_width(l, 2) / 2, H - mb + 8, l, 2);
-  }
-  for (double y = 0; y <= y1 + 1e-9 * ys; y += ys) {
-    img.line(px(x0), py(y), px(x1), py(y), grid);
-    const std::string l = tick_label(y, ys);
-    draw_text(img, ml - 8 - text_width(l, 2), static_cast<int>(py(y)) - 7, l, 2);
-  }
-  for (std::size_t k = 1; k < deposit.size(); ++k)  // deposit surface
-    img.line(px(deposit[k - 1].first), py(deposit[k - 1].second), px(deposit[k].first), py(deposit[k].second), black);
-  img.line(px(x0), py(0), px(x1), py(0), black);
-  img.line(px(x0), py(0), px(x0), py(y1), black);
-  const std::string xt = "distance along the profile (m)";
-  draw_text(img, ml + (W - ml - mr - text_width(xt, 2)) / 2, H - 22, xt, 2);
-  draw_text(img, 8, 6, "deposit thickness (m)", 2);
-  write_png(path, img);
+  nice_range(x0, x1);
+  nice_range(y0, y1);
+  const PlotPanel f{x0, x1, y0, y1, ml, mt, W - ml - mr, H - mt - mb};
+  Image img(W, H);
+  draw_axes(img, f, "distance along the profile (m)", "deposit thickness (m)", s);
+  // Thickness as filled columns, one sample's spacing wide.
+  const int bar = x.size() >= 2 ? std::max(1, static_cast<int>(std::lround(f.px(x[1]) - f.px(x[0]))) - 1) : 1;
+  draw_bars(img, f, x, h, {190, 150, 100}, bar);
+  draw_polyline(img, f, x, h, {0, 0, 0});  // deposit surface
+  draw_frame(img, f);                      // over the columns' feet
+  write_plot_png(path, img, {f}, s);
 }
 
 }  // namespace geohaz::dem

@@ -15,6 +15,7 @@
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/plot.hpp"
+#include "geohaz/core/svg.hpp"
 #include "geohaz/report/report.hpp"
 #include "geohaz/runout/summary_keys.hpp"
 
@@ -399,60 +400,85 @@ std::string svg_distribution(std::vector<double> v, const Quantity& q, const std
   const auto px = [&](double x) { return ml + (x - lo) / (hi - lo) * pw; };
   const auto py_count = [&](double c) { return top + ph - c / cmax * ph; };
   const auto py_frac = [&](double f) { return top + ph - f * ph; };
-  std::ostringstream s;
-  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H << "\" viewBox=\"0 0 " << W
-    << ' ' << H << "\" font-family=\"sans-serif\" font-size=\"12\" data-members=\"" << n << "\">\n"
-    << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"" << W / 2
-    << "\" y=\"20\" text-anchor=\"middle\" font-size=\"15\">" << xml_escape(title) << " (N = " << n << ")</text>\n";
-  for (double t : nice_ticks(lo, hi, 8))
-    s << "<line x1=\"" << px(t) << "\" y1=\"" << top << "\" x2=\"" << px(t) << "\" y2=\"" << top + ph
-      << "\" stroke=\"#e4e4e4\"/><text x=\"" << px(t) << "\" y=\"" << top + ph + 15 << "\" text-anchor=\"middle\">"
-      << tick_text(t, hi - lo) << "</text>\n";
+  SvgDocument s(W, H,
+                {{"viewBox", "0 0 " + std::to_string(W) + ' ' + std::to_string(H)},
+                 {"font-family", "sans-serif"},
+                 {"font-size", 12},
+                 {"data-members", n}});
+  s.background("white");
+  s.text(W / 2, 20, title + " (N = " + std::to_string(n) + ")", {{"text-anchor", "middle"}, {"font-size", 15}})
+      .newline();
+  const std::initializer_list<SvgAttr> grid{{"stroke", "#e4e4e4"}};
+  for (double t : nice_ticks(lo, hi, 8)) {
+    s.line(px(t), top, px(t), top + ph, grid);
+    s.text(px(t), top + ph + 15, tick_text(t, hi - lo), {{"text-anchor", "middle"}}).newline();
+  }
   for (double t : nice_ticks(0.0, cmax, 5))
-    if (t == std::round(t))
-      s << "<text x=\"" << ml - 6 << "\" y=\"" << py_count(t) + 4 << "\" text-anchor=\"end\">" << tick_text(t, cmax)
-        << "</text>\n";
-  for (int k = 0; k <= 4; ++k)
-    s << "<line x1=\"" << ml << "\" y1=\"" << py_frac(k / 4.0) << "\" x2=\"" << ml + pw << "\" y2=\""
-      << py_frac(k / 4.0) << "\" stroke=\"#e4e4e4\"/><text x=\"" << ml + pw + 6 << "\" y=\"" << py_frac(k / 4.0) + 4
-      << "\">" << tick_text(k / 4.0, 1.0) << "</text>\n";
+    if (t == std::round(t)) s.text(ml - 6, py_count(t) + 4, tick_text(t, cmax), {{"text-anchor", "end"}}).newline();
+  for (int k = 0; k <= 4; ++k) {
+    s.line(ml, py_frac(k / 4.0), ml + pw, py_frac(k / 4.0), grid);
+    s.text(ml + pw + 6, py_frac(k / 4.0) + 4, tick_text(k / 4.0, 1.0)).newline();
+  }
   const double bw = static_cast<double>(pw) / bins;
   for (int b = 0; b < bins; ++b) {
     const int c = count[static_cast<std::size_t>(b)];
-    s << "<rect class=\"bin\" data-count=\"" << c << "\" data-lo=\"" << lo + b * (hi - lo) / bins << "\" x=\""
-      << ml + b * bw + 1 << "\" y=\"" << py_count(c) << "\" width=\"" << bw - 2 << "\" height=\""
-      << ph - (py_count(c) - top) << "\" fill=\"#9ecae1\" stroke=\"#3182bd\"/>\n";
+    s.element("rect", {{"class", "bin"},
+                       {"data-count", c},
+                       {"data-lo", lo + b * (hi - lo) / bins},
+                       {"x", ml + b * bw + 1},
+                       {"y", py_count(c)},
+                       {"width", bw - 2},
+                       {"height", ph - (py_count(c) - top)},
+                       {"fill", "#9ecae1"},
+                       {"stroke", "#3182bd"}})
+        .newline();
   }
   // Empirical CDF: F(x) = (members ≤ x)/N, a step at each member.
-  s << "<polyline fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\" points=\"" << px(lo) << ',' << py_frac(0);
-  for (std::size_t k = 0; k < n; ++k)
-    s << ' ' << px(v[k]) << ',' << py_frac(static_cast<double>(k) / n) << ' ' << px(v[k]) << ','
-      << py_frac(static_cast<double>(k + 1) / n);
-  s << ' ' << px(hi) << ',' << py_frac(n ? 1.0 : 0.0) << "\"/>\n";
+  std::vector<std::array<double, 2>> cdf{{px(lo), py_frac(0)}};
+  for (std::size_t k = 0; k < n; ++k) {
+    cdf.push_back({px(v[k]), py_frac(static_cast<double>(k) / n)});
+    cdf.push_back({px(v[k]), py_frac(static_cast<double>(k + 1) / n)});
+  }
+  cdf.push_back({px(hi), py_frac(n ? 1.0 : 0.0)});
+  s.polyline(cdf, {{"fill", "none"}, {"stroke", "#d62728"}, {"stroke-width", 2}}).newline();
   for (std::size_t m = 0; m < markers.size(); ++m) {
     const double x = px(markers[m].value);
     const bool right = x > ml + 0.75 * pw;  // labels of markers near the right edge to the left of the line
-    s << "<line class=\"marker\" x1=\"" << x << "\" y1=\"" << top << "\" x2=\"" << x << "\" y2=\"" << top + ph
-      << "\" stroke=\"#333\" stroke-dasharray=\"5,3\"/><text x=\"" << (right ? x - 3 : x + 3) << "\" y=\""
-      << top + 14 + 14 * (m % 3) << "\" text-anchor=\"" << (right ? "end" : "start")
-      << "\" font-size=\"11\" stroke=\"white\" stroke-width=\"3\" paint-order=\"stroke\">"
-      << xml_escape(markers[m].name) << " " << xml_escape(format_quantity(markers[m].value, q.unit)) << "</text>\n";
+    s.element("line", {{"class", "marker"},
+                       {"x1", x},
+                       {"y1", top},
+                       {"x2", x},
+                       {"y2", top + ph},
+                       {"stroke", "#333"},
+                       {"stroke-dasharray", "5,3"}});
+    s.text(right ? x - 3 : x + 3, top + 14 + 14 * (m % 3),
+           markers[m].name + " " + format_quantity(markers[m].value, q.unit),
+           {{"text-anchor", right ? "end" : "start"},
+            {"font-size", 11},
+            {"stroke", "white"},
+            {"stroke-width", 3},
+            {"paint-order", "stroke"}})
+        .newline();
   }
-  s << "<rect x=\"" << ml << "\" y=\"" << top << "\" width=\"" << pw << "\" height=\"" << ph
-    << "\" fill=\"none\" stroke=\"black\"/>\n<text x=\"" << ml + pw / 2 << "\" y=\"" << top + ph + 34
-    << "\" text-anchor=\"middle\">" << xml_escape(q.label) << (q.unit.empty() ? "" : " (" + q.unit + ")")
-    << "</text>\n<text transform=\"translate(18," << top + ph / 2
-    << ") rotate(-90)\" text-anchor=\"middle\">members per bin</text>\n<text transform=\"translate(" << W - 12 << ','
-    << top + ph / 2 << ") rotate(90)\" text-anchor=\"middle\">fraction of members ≤ value</text>\n"
-    << "<rect x=\"" << ml << "\" y=\"" << H - 26
-    << "\" width=\"14\" height=\"10\" fill=\"#9ecae1\" stroke=\"#3182bd\"/>"
-    << "<text x=\"" << ml + 18 << "\" y=\"" << H - 17 << "\">members per bin</text><line x1=\"" << ml + 150
-    << "\" y1=\"" << H - 21 << "\" x2=\"" << ml + 170 << "\" y2=\"" << H - 21
-    << "\" stroke=\"#d62728\" stroke-width=\"2\"/><text x=\"" << ml + 174 << "\" y=\"" << H - 17
-    << "\">empirical CDF</text><line x1=\"" << ml + 290 << "\" y1=\"" << H - 21 << "\" x2=\"" << ml + 310 << "\" y2=\""
-    << H - 21 << "\" stroke=\"#333\" stroke-dasharray=\"5,3\"/><text x=\"" << ml + 314 << "\" y=\"" << H - 17
-    << "\">P10, P50, P90 (nearest rank)</text>\n</svg>\n";
-  return s.str();
+  s.rect(ml, top, pw, ph, {{"fill", "none"}, {"stroke", "black"}}).newline();
+  s.text(ml + pw / 2, top + ph + 34, q.unit.empty() ? q.label : q.label + " (" + q.unit + ")",
+         {{"text-anchor", "middle"}})
+      .newline();
+  s.text({{"transform", "translate(18," + std::to_string(top + ph / 2) + ") rotate(-90)"}, {"text-anchor", "middle"}},
+         "members per bin")
+      .newline();
+  s.text({{"transform", "translate(" + std::to_string(W - 12) + ',' + std::to_string(top + ph / 2) + ") rotate(90)"},
+          {"text-anchor", "middle"}},
+         "fraction of members ≤ value")
+      .newline();
+  // Legend.
+  s.rect(ml, H - 26, 14, 10, {{"fill", "#9ecae1"}, {"stroke", "#3182bd"}});
+  s.text(ml + 18, H - 17, "members per bin");
+  s.line(ml + 150, H - 21, ml + 170, H - 21, {{"stroke", "#d62728"}, {"stroke-width", 2}});
+  s.text(ml + 174, H - 17, "empirical CDF");
+  s.line(ml + 290, H - 21, ml + 310, H - 21, {{"stroke", "#333"}, {"stroke-dasharray", "5,3"}});
+  s.text(ml + 314, H - 17, "P10, P50, P90 (nearest rank)").newline();
+  return s.finish();
 }
 
 }  // namespace geohaz::report

@@ -10,6 +10,7 @@
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/plot.hpp"
+#include "geohaz/core/svg.hpp"
 #include "geohaz/report/report.hpp"
 
 namespace fs = std::filesystem;
@@ -123,13 +124,14 @@ std::string svg_plot(const Csv& csv, const std::string& title) {
   const auto& x = csv.columns.front();
   double x0 = *std::min_element(x.begin(), x.end()), x1 = *std::max_element(x.begin(), x.end());
   nice_range(x0, x1);
-  std::ostringstream s;
-  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H << "\" viewBox=\"0 0 " << W
-    << ' ' << H << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
-    << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-    << "<text x=\"" << W / 2 << "\" y=\"20\" text-anchor=\"middle\" font-size=\"15\">" << xml_escape(title)
-    << "</text>\n";
+  SvgDocument s(W, H,
+                {{"viewBox", "0 0 " + std::to_string(W) + ' ' + std::to_string(H)},
+                 {"font-family", "sans-serif"},
+                 {"font-size", 12}});
+  s.background("white");
+  s.text(W / 2, 20, title, {{"text-anchor", "middle"}, {"font-size", 15}}).newline();
   const int pw = W - ml - mr;
+  const std::initializer_list<SvgAttr> grid{{"stroke", "#e4e4e4"}};
   for (std::size_t p = 0; p < panels.size(); ++p) {
     const int y0 = top + static_cast<int>(p) * (ph + gap);  // panel top
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
@@ -143,21 +145,16 @@ std::string svg_plot(const Csv& csv, const std::string& title) {
     nice_range(lo, hi);
     auto px = [&](double v) { return ml + (v - x0) / (x1 - x0) * pw; };
     auto py = [&](double v) { return y0 + ph - (v - lo) / (hi - lo) * ph; };
-    s << "<g>\n";
+    s.begin_group().newline();
     for (double t : nice_ticks(x0, x1, 8)) {
-      s << "<line x1=\"" << px(t) << "\" y1=\"" << y0 << "\" x2=\"" << px(t) << "\" y2=\"" << y0 + ph
-        << "\" stroke=\"#e4e4e4\"/>";
-      s << "<text x=\"" << px(t) << "\" y=\"" << y0 + ph + 15 << "\" text-anchor=\"middle\">" << tick_text(t, x1 - x0)
-        << "</text>\n";
+      s.line(px(t), y0, px(t), y0 + ph, grid);
+      s.text(px(t), y0 + ph + 15, tick_text(t, x1 - x0), {{"text-anchor", "middle"}}).newline();
     }
     for (double t : nice_ticks(lo, hi, 5)) {
-      s << "<line x1=\"" << ml << "\" y1=\"" << py(t) << "\" x2=\"" << ml + pw << "\" y2=\"" << py(t)
-        << "\" stroke=\"#e4e4e4\"/>";
-      s << "<text x=\"" << ml - 6 << "\" y=\"" << py(t) + 4 << "\" text-anchor=\"end\">" << tick_text(t, hi - lo)
-        << "</text>\n";
+      s.line(ml, py(t), ml + pw, py(t), grid);
+      s.text(ml - 6, py(t) + 4, tick_text(t, hi - lo), {{"text-anchor", "end"}}).newline();
     }
-    s << "<rect x=\"" << ml << "\" y=\"" << y0 << "\" width=\"" << pw << "\" height=\"" << ph
-      << "\" fill=\"none\" stroke=\"black\"/>\n";
+    s.rect(ml, y0, pw, ph, {{"fill", "none"}, {"stroke", "black"}}).newline();
     // Axis titles: y from the panel's unit (and the quantity when alone), x from the abscissa.
     const std::string& u = panels[p].unit;
     std::string ytitle =
@@ -168,26 +165,26 @@ std::string svg_plot(const Csv& csv, const std::string& title) {
       ytitle += u;
       ytitle += ')';
     }
-    s << "<text transform=\"translate(" << 18 << ',' << y0 + ph / 2 << ") rotate(-90)\" text-anchor=\"middle\">"
-      << xml_escape(ytitle) << "</text>\n";
-    s << "<text x=\"" << ml + pw / 2 << "\" y=\"" << y0 + ph + 32 << "\" text-anchor=\"middle\">"
-      << xml_escape(xq.label) << (xq.unit.empty() ? "" : " (" + xq.unit + ")") << "</text>\n";
+    s.text({{"transform", "translate(18," + std::to_string(y0 + ph / 2) + ") rotate(-90)"}, {"text-anchor", "middle"}},
+           ytitle)
+        .newline();
+    s.text(ml + pw / 2, y0 + ph + 32, xq.unit.empty() ? xq.label : xq.label + " (" + xq.unit + ")",
+           {{"text-anchor", "middle"}})
+        .newline();
     for (std::size_t c = 0; c < panels[p].cols.size(); ++c) {
       const auto& y = csv.columns[panels[p].cols[c]];
       const char* colour = kLineColours[c % std::size(kLineColours)];
-      s << "<polyline fill=\"none\" stroke=\"" << colour << "\" stroke-width=\"1.6\" points=\"";
+      std::vector<std::array<double, 2>> points;
       for (std::size_t i = 0; i < y.size(); ++i)
-        if (std::isfinite(x[i]) && std::isfinite(y[i])) s << px(x[i]) << ',' << py(y[i]) << ' ';
-      s << "\"/>\n";
+        if (std::isfinite(x[i]) && std::isfinite(y[i])) points.push_back({px(x[i]), py(y[i])});
+      s.polyline(points, {{"fill", "none"}, {"stroke", colour}, {"stroke-width", 1.6}}).newline();
       const int ly = y0 + 12 + static_cast<int>(c) * 16;
-      s << "<line x1=\"" << ml + pw + 10 << "\" y1=\"" << ly - 4 << "\" x2=\"" << ml + pw + 30 << "\" y2=\"" << ly - 4
-        << "\" stroke=\"" << colour << "\" stroke-width=\"2\"/><text x=\"" << ml + pw + 34 << "\" y=\"" << ly << "\">"
-        << xml_escape(quantity_from_name(csv.names[panels[p].cols[c]]).label) << "</text>\n";
+      s.line(ml + pw + 10, ly - 4, ml + pw + 30, ly - 4, {{"stroke", colour}, {"stroke-width", 2}});
+      s.text(ml + pw + 34, ly, quantity_from_name(csv.names[panels[p].cols[c]]).label).newline();
     }
-    s << "</g>\n";
+    s.end_group().newline();
   }
-  s << "</svg>\n";
-  return s.str();
+  return s.finish();
 }
 
 }  // namespace geohaz::report

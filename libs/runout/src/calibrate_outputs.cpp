@@ -17,6 +17,7 @@
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
 #include "geohaz/core/raster.hpp"
+#include "geohaz/core/svg.hpp"
 #include "geohaz/runout/calibrate.hpp"
 #include "geohaz/runout/profile.hpp"
 #include "geohaz/runout/run.hpp"
@@ -73,12 +74,13 @@ void write_acceptable_svg(const fs::path& path, const CalibrationSetup& s, const
   double smax = 0.0;
   for (const auto& e : r.evaluations)
     if (e.ok) smax = std::max(smax, e.misfit.score);
-  std::ostringstream o;
-  o << std::setprecision(6);
-  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H
-    << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  o << "<text x=\"" << W / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"14\">Members (grey) and the acceptable "
-    << "set (score within " << fmt(tol) << " of the best " << fmt(j_best, 4) << ", coloured; red ring: best)</text>\n";
+  SvgDocument o(W, H, {{"font-family", "sans-serif"}, {"font-size", 12}});
+  o.background("white");
+  o.text(W / 2, 22,
+         "Members (grey) and the acceptable set (score within " + fmt(tol) + " of the best " + fmt(j_best, 4) +
+             ", coloured; red ring: best)",
+         {{"text-anchor", "middle"}, {"font-size", 14}})
+      .newline();
   for (std::size_t k = 0; k < panels.size(); ++k) {
     const auto [a, b] = panels[k];
     const double x0 = ml + static_cast<double>(k % cols) * (pw + gap),
@@ -91,12 +93,12 @@ void write_acceptable_svg(const fs::path& path, const CalibrationSetup& s, const
                                   s.parameters[static_cast<std::size_t>(b)].unit(e.values[static_cast<std::size_t>(b)]),
                                   0.0, 1.0));
     };
-    o << "<rect x=\"" << x0 << "\" y=\"" << y0 << "\" width=\"" << pw << "\" height=\"" << ph
-      << "\" fill=\"none\" stroke=\"black\"/>\n";
+    o.rect(x0, y0, pw, ph, {{"fill", "none"}, {"stroke", "black"}}).newline();
     for (const auto& e : r.evaluations) {
       if (!e.ok) {
-        o << "<text x=\"" << X(e.values[static_cast<std::size_t>(a)]) << "\" y=\"" << y0 + ph - 2
-          << "\" fill=\"#d62728\" text-anchor=\"middle\">x</text>\n";
+        o.text(X(e.values[static_cast<std::size_t>(a)]), y0 + ph - 2, "x",
+               {{"fill", "#d62728"}, {"text-anchor", "middle"}})
+            .newline();
         continue;
       }
       const bool acc = e.misfit.score <= j_best + tol;
@@ -108,30 +110,34 @@ void write_acceptable_svg(const fs::path& path, const CalibrationSetup& s, const
         h << "rgb(" << int(c[0]) << ',' << int(c[1]) << ',' << int(c[2]) << ')';
         fill = h.str();
       }
-      o << "<circle cx=\"" << X(e.values[static_cast<std::size_t>(a)]) << "\" cy=\"" << Y(e) << "\" r=\""
-        << (acc ? 4 : 3) << "\" fill=\"" << fill << "\"/>\n";
+      o.element("circle",
+                {{"cx", X(e.values[static_cast<std::size_t>(a)])}, {"cy", Y(e)}, {"r", acc ? 4 : 3}, {"fill", fill}})
+          .newline();
     }
     if (r.best >= 0) {
       const Evaluation& e = r.evaluations[static_cast<std::size_t>(r.best)];
-      o << "<circle cx=\"" << X(e.values[static_cast<std::size_t>(a)]) << "\" cy=\"" << Y(e)
-        << "\" r=\"7\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\"/>\n";
+      o.element("circle", {{"cx", X(e.values[static_cast<std::size_t>(a)])},
+                           {"cy", Y(e)},
+                           {"r", 7},
+                           {"fill", "none"},
+                           {"stroke", "#d62728"},
+                           {"stroke-width", 2}})
+          .newline();
     }
     for (int t = 0; t <= 4; ++t) {
       const double v = pa.value(t / 4.0);
-      o << "<text x=\"" << x0 + t * pw / 4 << "\" y=\"" << y0 + ph + 16 << "\" text-anchor=\"middle\">" << fmt(v, 3)
-        << "</text>\n";
+      o.text(x0 + t * pw / 4, y0 + ph + 16, fmt(v, 3), {{"text-anchor", "middle"}}).newline();
       const double yv = b < 0 ? smax * t / 4.0 : s.parameters[static_cast<std::size_t>(b)].value(t / 4.0);
-      o << "<text x=\"" << x0 - 6 << "\" y=\"" << y0 + ph * (1 - t / 4.0) + 4 << "\" text-anchor=\"end\">" << fmt(yv, 3)
-        << "</text>\n";
+      o.text(x0 - 6, y0 + ph * (1 - t / 4.0) + 4, fmt(yv, 3), {{"text-anchor", "end"}}).newline();
     }
-    o << "<text x=\"" << x0 + pw / 2 << "\" y=\"" << y0 + ph + 34 << "\" text-anchor=\"middle\">" << xml_escape(pa.key)
-      << (pa.log_scale ? " (log scale)" : "") << "</text>\n";
+    o.text(x0 + pw / 2, y0 + ph + 34, pa.log_scale ? pa.key + " (log scale)" : pa.key, {{"text-anchor", "middle"}})
+        .newline();
     const std::string ylabel = b < 0 ? "score J" : s.parameters[static_cast<std::size_t>(b)].key;
-    o << "<text x=\"" << x0 - 50 << "\" y=\"" << y0 + ph / 2 << "\" transform=\"rotate(-90 " << x0 - 50 << ' '
-      << y0 + ph / 2 << ")\" text-anchor=\"middle\">" << xml_escape(ylabel) << "</text>\n";
+    std::ostringstream rotate;
+    rotate << "rotate(-90 " << x0 - 50 << ' ' << y0 + ph / 2 << ')';
+    o.text(x0 - 50, y0 + ph / 2, ylabel, {{"transform", rotate.str()}, {"text-anchor", "middle"}}).newline();
   }
-  o << "</svg>\n";
-  write_text_file(path, o.str());
+  write_text_file(path, o.finish());
 }
 
 /// Morris elementary effects from the trajectories' members (a step touching a failed member is

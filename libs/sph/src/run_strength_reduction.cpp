@@ -11,6 +11,7 @@
 
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/output.hpp"
+#include "geohaz/core/plot.hpp"
 #include "run_support.hpp"
 
 namespace geohaz::sph {
@@ -300,33 +301,35 @@ std::vector<NamedTable> StrengthReductionRun<Dim>::tables() const {
   return t;
 }
 
-/// Plot: F on x (f_min … f_max), displacement on y (log10, 4 decades below the largest), stable
-/// trials blue, failed red, the bracket as two grey verticals.
+/// Plot: F on x (f_min … f_max), displacement on y (logarithmic, 4 decades below the largest),
+/// stable trials blue, failed red, the bracket as two grey verticals.
 template <int Dim>
 void StrengthReductionRun<Dim>::plot_curve(const std::filesystem::path& path) const {
   const Table t = curve();
-  const int W = 800, H = 500, m = 40;
-  Image img(W, H);
+  constexpr int W = 800, H = 500, ml = 90, mr = 30, mt = 40, mb = 84, s = 2;
   double umax = 0.0;
   for (const auto& r : t.rows) umax = std::max(umax, r[1]);
-  const double ly1 = std::log10(std::max(umax, 1e-12)), ly0 = ly1 - 4.0;
-  auto px = [&](double F) { return m + (F - c_.srm.f_min) / (c_.srm.f_max - c_.srm.f_min) * (W - 2 * m); };
-  auto py = [&](double u) {
-    const double l = std::clamp(std::log10(std::max(u, 1e-300)), ly0, ly1);
-    return H - m - (l - ly0) / (ly1 - ly0) * (H - 2 * m);
-  };
-  img.line(m, H - m, W - m, H - m, {0, 0, 0});
-  img.line(m, m, m, H - m, {0, 0, 0});
-  for (int d = 0; d <= 4; ++d)
-    img.line(m - 5, py(umax * std::pow(10.0, -d)), m, py(umax * std::pow(10.0, -d)), {0, 0, 0});
-  img.line(px(lo_), m, px(lo_), H - m, {170, 170, 170});
-  img.line(px(hi_), m, px(hi_), H - m, {170, 170, 170});
-  for (std::size_t k = 1; k < t.rows.size(); ++k)
-    img.line(px(t.rows[k - 1][0]), py(t.rows[k - 1][1]), px(t.rows[k][0]), py(t.rows[k][1]), {90, 90, 90});
-  for (const auto& r : t.rows)
-    img.fill_circle(px(r[0]), py(r[1]), 5.0,
-                    r[2] != 0.0 ? std::array<std::uint8_t, 3>{210, 40, 40} : std::array<std::uint8_t, 3>{40, 80, 210});
-  write_png(path, img);
+  const double u1 = std::max(umax, 1e-12);
+  const PlotPanel f{c_.srm.f_min, c_.srm.f_max, 1e-4 * u1, u1, ml, mt, W - ml - mr, H - mt - mb, true};
+  Image img(W, H);
+  draw_axes(img, f, "strength reduction factor F", "largest displacement of a trial (m)", s);
+  const std::array<std::uint8_t, 3> grey{170, 170, 170}, stable{40, 80, 210}, failed{210, 40, 40};
+  for (const double F : {lo_, hi_})
+    if (std::isfinite(F)) draw_polyline(img, f, {F, F}, {f.y0, f.y1}, grey);
+  std::vector<double> F, u, Fs, us, Ff, uf;
+  for (const auto& r : t.rows) {
+    F.push_back(r[0]);
+    u.push_back(r[1]);
+    (r[2] != 0.0 ? Ff : Fs).push_back(r[0]);
+    (r[2] != 0.0 ? uf : us).push_back(r[1]);
+  }
+  draw_polyline(img, f, F, u, {90, 90, 90});
+  draw_markers(img, f, Fs, us, stable);
+  draw_markers(img, f, Ff, uf, failed);
+  draw_frame(img, f);  // over markers on an edge
+  draw_legend(img, ml, H - 7 * s - 8, W - ml - mr,
+              {{stable, "stable trial"}, {failed, "failed trial"}, {grey, "bracket of the factor of safety"}}, s);
+  write_plot_png(path, img, {f}, s);
 }
 
 /// The mechanism drawn where the particles started (with the Bishop circle) and deformed.

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "geohaz/core/output.hpp"
+#include "geohaz/core/plot.hpp"
 #include "geohaz/sph/run.hpp"
 
 namespace geohaz::sph {
@@ -91,32 +92,35 @@ class StructureReport {
     return a;
   }
   /// Quick-look plot of the normal force F·n of each reported structure against time (one colour
-  /// per structure in the order of the CSV columns; grey: zero).
+  /// per structure in the order of the CSV columns, named in the legend; grey: zero).
   void plot(const std::filesystem::path& path) const {
     if (times_.size() < 2) return;
-    const int W = 900, H = 500, m = 40;
-    Image img(W, H);
+    constexpr int W = 900, ml = 110, mr = 30, mt = 40, mb = 62, ph = 376, s = 2;
     double lo = 0.0, hi = 0.0;
-    for (const auto& s : normal_)
-      for (const double v : s) lo = std::min(lo, v), hi = std::max(hi, v);
-    if (hi - lo <= 0.0) hi = lo + 1.0;
+    for (const auto& q : normal_)
+      for (const double v : q) lo = std::min(lo, v), hi = std::max(hi, v);
+    nice_range(lo, hi);
     const double t0 = times_.front(), t1 = std::max(times_.back(), t0 + 1e-12);
-    auto px = [&](double t) { return m + (t - t0) / (t1 - t0) * (W - 2 * m); };
-    auto py = [&](double v) { return H - m - (v - lo) / (hi - lo) * (H - 2 * m); };
-    img.line(m, H - m, W - m, H - m, {0, 0, 0});
-    img.line(m, m, m, H - m, {0, 0, 0});
-    img.line(m, py(0.0), W - m, py(0.0), {170, 170, 170});
-    static constexpr std::array<std::array<std::uint8_t, 3>, 6> colours{
-        {{31, 119, 180}, {214, 39, 40}, {44, 160, 44}, {255, 127, 14}, {148, 103, 189}, {140, 86, 75}}};
-    for (std::size_t q = 0; q < normal_.size(); ++q)
-      for (std::size_t k = 1; k < times_.size(); ++k)
-        for (int d = 0; d <= 1; ++d)
-          img.line(px(times_[k - 1]), py(normal_[q][k - 1]) + d, px(times_[k]), py(normal_[q][k]) + d,
-                   colours[q % colours.size()]);
-    write_png(path, img);
+    std::vector<LegendEntry> legend;
+    for (std::size_t q = 0; q < normal_.size(); ++q) legend.push_back({colour(q), table_[shown_[q]].name});
+    const int legend_y = mt + ph + mb, H = legend_y + legend_height(legend, W - ml - mr, s) + 10;
+    const PlotPanel f{t0, t1, lo, hi, ml, mt, W - ml - mr, ph};
+    Image img(W, H);
+    draw_axes(img, f, "time (s)", Dim == 2 ? "normal force F·n (N/m)" : "normal force F·n (N)", s);
+    draw_polyline(img, f, {t0, t1}, {0.0, 0.0}, {170, 170, 170});
+    for (std::size_t q = 0; q < normal_.size(); ++q) draw_polyline(img, f, times_, normal_[q], colour(q), 2);
+    draw_frame(img, f);  // over curves lying on an edge (a structure without load)
+    draw_legend(img, ml, legend_y, W - ml - mr, legend, s);
+    write_plot_png(path, img, {f}, s);
   }
 
  private:
+  /// The colour of the q-th reported structure (matplotlib's first six).
+  static std::array<std::uint8_t, 3> colour(std::size_t q) {
+    static constexpr std::array<std::array<std::uint8_t, 3>, 6> colours{
+        {{31, 119, 180}, {214, 39, 40}, {44, 160, 44}, {255, 127, 14}, {148, 103, 189}, {140, 86, 75}}};
+    return colours[q % colours.size()];
+  }
   struct Peak {
     bool seen = false;
     double resultant = 0.0, t_resultant = 0.0, normal = 0.0, t_normal = 0.0, moment = 0.0, t_moment = 0.0;

@@ -21,6 +21,10 @@ std::string crs_to_wkt(const std::string& definition);
 /// file when it cannot be read.
 Image read_image(const std::filesystem::path& path);
 
+/// The text chunk `key` of a PNG written by write_png (as GDAL reads it back), "" when it has none
+/// or the file cannot be read.
+std::string read_png_text(const std::filesystem::path& path, const std::string& key);
+
 /// Elevation and gradient of a Terrain's bilinear surface in one cell look-up (BilinearGrid::sample,
 /// the same surface as Terrain::elevation / gradient). False (and `out` untouched) where
 /// Terrain::valid is false: outside the closed cell-centre hull or next to nodata.
