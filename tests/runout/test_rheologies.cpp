@@ -348,6 +348,57 @@ TEST(RheologyStep, HerschelBulkleyWarmStartGivesTheColdAnswer) {
   }
 }
 
+TEST(RheologyStep, HerschelBulkleySeriesStepIsWithin1e12OfALongDoubleBisection) {
+  // The one-evaluation warm step (series_step) in accelerating flow: from the root of a step,
+  // the next step's b is 0–25 % larger (bench_runout's plane accelerates by 6–16 % per step).
+  // Where the step accepts, its speed must be the root of U(ζ) + cζ = b to 1e-12 relative, against
+  // a 200-step long-double bisection in ln ζ (the 1e-13 in ln ζ it proves, times ρ < 1, and
+  // round-off), and ζ to 1e-13 in ln ζ plus round-off; it must accept most of bench_runout's
+  // steps (n = 0.4), else it is dead code.
+  std::mt19937 rng(3436);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (const HerschelBulkleyFriction& law :
+       {kHerschel, HerschelBulkleyFriction{1000.0, 100.0, 0.4}, HerschelBulkleyFriction{0.0, 20.0, 0.5},
+        HerschelBulkleyFriction{200.0, 5.0, 1.6}, HerschelBulkleyFriction{50.0, 0.5, 0.25}}) {
+    int accepted = 0;
+    double worst = 0.0;
+    const int draws = 400;
+    for (int k = 0; k < draws; ++k) {
+      const double h = 0.2 + 3.0 * u(rng), dt = 1e-3 * std::pow(100.0, u(rng)), b0 = 0.3 + 8.0 * u(rng);
+      const HerschelBulkleyTerms t = law.terms(kG, kG, h, b0, kRho);
+      const double c = dt / (kRho * h), b = b0 * (1.0 + 0.25 * u(rng));
+      const auto root = t.excess_stress(b0, c);  // the last step's state (cold start)
+      double zeta = root.zeta, q = root.rate, s = 0.0;
+      if (!t.series_step(b, c, zeta, q, s)) continue;
+      ++accepted;
+      long double lo = std::log(static_cast<long double>(root.zeta)) - 5.0L, hi = lo + 10.0L;
+      const long double n = law.flow_index, K = law.consistency, ty = law.tau_y;
+      const auto excess = [&](long double y) {
+        const long double z = std::exp(y), tau = ty + z;
+        const long double speed = n * h / (n + 1.0L) * std::pow(z / K, 1.0L / n) * z *
+                                  ((n + 1.0L) / (2.0L * n + 1.0L) * z + ty) / (tau * tau);
+        return speed + c * z - b;
+      };
+      for (int i = 0; i < 200; ++i) {
+        const long double m = 0.5L * (lo + hi);
+        (excess(m) > 0.0L ? hi : lo) = m;
+      }
+      const long double y_ref = 0.5L * (lo + hi), s_ref = b - c * std::exp(y_ref);
+      EXPECT_NEAR(std::log(zeta), static_cast<double>(y_ref), 2e-13 * std::max(1.0, std::abs(std::log(zeta))))
+          << "n " << law.flow_index << " draw " << k;
+      const double e = std::abs(static_cast<double>(s / s_ref - 1.0L));
+      EXPECT_LT(e, 1e-12) << "n " << law.flow_index << " draw " << k;
+      EXPECT_NEAR(zeta, law.consistency * std::pow(q, law.flow_index), 1e-11 * zeta);
+      worst = std::max(worst, e);
+    }
+    std::printf("HB series step, n %.2f: accepted %d of %d, largest relative speed error %.2e\n", law.flow_index,
+                accepted, draws, worst);
+    if (law.tau_y == 1000.0 && law.consistency == 100.0) {
+      EXPECT_GT(accepted, draws / 2);
+    }
+  }
+}
+
 TEST(RheologyZones, AConsistencyOrFlowIndexFieldSwitchesTheHerschelBulkleyMemoryOff) {
   // (ζ, γ̇_b) kept under one K would be inconsistent after a particle crosses into a field of
   // another K or n; a field of τ_y leaves it valid (ζ = K γ̇_b^n does not involve τ_y).
