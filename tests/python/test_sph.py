@@ -86,7 +86,7 @@ def test_the_pore_pressure_is_a_particle_field(data):
 @pytest.mark.parametrize("bad", [
     {"no.such_key": 1},                                   # unknown key
     {"run.end_time": -1.0},                               # out of range
-    {"material[0].residual_cohesion": 1e3},              # above the peak cohesion (read_config)
+    {"material[0].residual_cohesion": 1e3},              # a key of another model (read_config)
     {"output.structures": "pile_9"},                     # no such structure (validate)
 ])
 def test_bad_input_raises_the_apps_message_and_writes_nothing(tmp_path, data, bad):

@@ -53,6 +53,50 @@ nlohmann::json summary(const fs::path& dir) {
   return j;
 }
 
+/// The example data/sph/<name>.toml as a file for the constitutive model `model`:
+/// model.constitutive = model, the [[material]] keys of the other models (the keys some model
+/// declares and `model` does not read) removed, and material_keys[i] (TOML lines) added to the i-th
+/// [[material]]. A material names the keys of its model only (the reader refuses another model's,
+/// exit 2), so a test that runs one soil under several models writes a file per model.
+fs::path config_for_model(const std::string& name, const std::string& model,
+                          const std::vector<std::vector<std::string>>& material_keys = {}) {
+  const auto own = geohaz::sph::ConstitutiveModelParameters::parameters_of(model);
+  const auto other_models_key = [&](const std::string& key) {
+    for (const auto& k : geohaz::sph::ConstitutiveModelParameters::keys())
+      if (k.spec.key == key)
+        return std::none_of(own.begin(), own.end(), [&](const geohaz::ParamSpec& p) { return p.key == key; });
+    return false;
+  };
+  std::ifstream in(kData / (name + ".toml"));
+  std::ostringstream o;
+  std::string line, table;
+  std::size_t materials = 0;
+  while (std::getline(in, line)) {
+    const auto first = line.find_first_not_of(" \t");
+    const std::string text = first == std::string::npos ? "" : line.substr(first);
+    const auto eq = text.find('=');
+    std::string key = eq == std::string::npos ? "" : text.substr(0, eq);
+    key.erase(key.find_last_not_of(" \t") + 1);
+    if (text.starts_with("["))
+      table = text.starts_with("[[material]]") ? "material" : (text.starts_with("[model]") ? "model" : "");
+    if (table == "material" && other_models_key(key)) continue;
+    if (table == "model" && key == "constitutive") {
+      o << "constitutive = \"" << model << "\"\n";
+      continue;
+    }
+    o << line << '\n';
+    if (text.starts_with("[[material]]")) {
+      if (materials < material_keys.size())
+        for (const std::string& k : material_keys[materials]) o << k << '\n';
+      ++materials;
+    }
+  }
+  fs::create_directories(kWork);
+  const fs::path file = kWork / (name + "_" + model + ".toml");
+  std::ofstream(file) << o.str();
+  return file;
+}
+
 std::size_t csv_rows(const fs::path& p) {
   std::ifstream in(p);
   std::string line;
@@ -458,13 +502,13 @@ TEST(SphSlopeApp, StrengthReductionOfAVonMisesSlopeReducesTheYieldStress) {
   const fs::path out = kWork / "srm_von_mises";
   fs::remove_all(out);
   const double root3 = std::sqrt(3.0);
-  const auto r =
-      run("--config " + (kData / "griffiths_lane_two_layer_srm.toml").string() + " --out " + out.string() +
-              " --set model.constitutive=von_mises --set 'material[0].yield_stress=" + std::to_string(30e3 * root3) +
-              "' --set 'material[1].yield_stress=" + std::to_string(50e3 * root3) +
-              "' --set strength_reduction.f_min=0.85 --set strength_reduction.f_max=1.1"
-              " --set strength_reduction.tolerance=0.04 --quiet",
-          "srm_von_mises");
+  const fs::path cfg = config_for_model(
+      "griffiths_lane_two_layer_srm", "von_mises",
+      {{"yield_stress = " + std::to_string(30e3 * root3)}, {"yield_stress = " + std::to_string(50e3 * root3)}});
+  const auto r = run("--config " + cfg.string() + " --out " + out.string() +
+                         " --set strength_reduction.f_min=0.85 --set strength_reduction.f_max=1.1"
+                         " --set strength_reduction.tolerance=0.04 --quiet",
+                     "srm_von_mises");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto s = summary(out);
   EXPECT_EQ(s["outcome"], "bracketed");
@@ -479,14 +523,38 @@ TEST(SphSlopeApp, StrengthReductionRefusesAModelWithoutStrength) {
   const fs::path out = kWork / "srm_elastic";
   fs::remove_all(out);
   for (const char* model : {"linear_elastic", "newtonian_fluid"}) {
-    const auto r = run("--config " + (kData / "acads_1a_srm.toml").string() + " --out " + out.string() +
-                           " --set model.constitutive=" + model,
-                       "srm_elastic");
+    const auto r =
+        run("--config " + config_for_model("acads_1a_srm", model).string() + " --out " + out.string(), "srm_elastic");
     EXPECT_EQ(r.code, 2) << model << ": " << r.err;
     EXPECT_NE(r.err.find("model.constitutive"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("von_mises, drucker_prager, drucker_prager_softening"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out));
   }
+}
+
+// A [[material]] key of a constitutive model that is not chosen is a mistake (a Drucker–Prager
+// soil run as von Mises would silently drop its c and φ): exit 2 naming the file, the key, the
+// chosen model and the keys it reads; nothing written. As the runout and DEM readers do.
+TEST(SphSlopeApp, AnotherModelsMaterialKeyExitsTwo) {
+  const fs::path out = kWork / "other_models_key";
+  fs::remove_all(out);
+  auto r = run("--config " + (kData / "acads_1a_srm.toml").string() + " --out " + out.string() +
+                   " --set model.constitutive=von_mises",
+               "other_models_key");
+  EXPECT_EQ(r.code, 2) << r.err;
+  for (const char* part : {"acads_1a_srm.toml", "material.cohesion", "model.constitutive = von_mises",
+                           "drucker_prager or drucker_prager_softening", "von_mises reads material.yield_stress"})
+    EXPECT_NE(r.err.find(part), std::string::npos) << part << "\n" << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  r = run("--config " + (kData / "slope_softening.toml").string() + " --out " + out.string() +
+              " --set model.constitutive=drucker_prager",
+          "other_models_key");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("material.residual_cohesion"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("drucker_prager reads material.cohesion, material.friction, material.dilatancy"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(SphSlopeApp, StrengthReductionBadRangeExitsTwoNamingTheKey) {
@@ -692,9 +760,8 @@ TEST(SphSlopeApp, BadFormulationExitsTwoNamingTheKey) {
   EXPECT_NE(hg.err.find("cantilever.toml"), std::string::npos) << hg.err;
   EXPECT_NE(hg.err.find("at most 1"), std::string::npos) << hg.err;
   EXPECT_FALSE(fs::exists(out));
-  const auto r = run("--config " + (kData / "slope_2d_granular.toml").string() + " --out " + out.string() +
-                         " --set numerics.formulation=total_lagrangian --set model.constitutive=linear_elastic"
-                         " --set geostatic.enabled=false",
+  const auto r = run("--config " + config_for_model("slope_2d_granular", "linear_elastic").string() + " --out " +
+                         out.string() + " --set numerics.formulation=total_lagrangian --set geostatic.enabled=false",
                      "bad_formulation_walls");
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("numerics.formulation"), std::string::npos) << r.err;
@@ -767,11 +834,13 @@ TEST(SphSlopeApp, SofteningSlopeFailsProgressivelyWherePeakStrengthStands) {
   for (const auto& p : {soft, peak, resid}) fs::remove_all(p);
   auto r = run(base + " --out " + soft.string(), "softening_slope");
   ASSERT_EQ(r.code, 0) << r.err;
-  r = run(base + " --out " + peak.string() + " --set model.constitutive=drucker_prager", "softening_slope_peak");
+  // The peak and the residual slope: the same soil as a drucker_prager material (its file without
+  // the softening keys), at the peak strength and at the residual one.
+  const std::string plain = "--config " + config_for_model("slope_softening", "drucker_prager").string() +
+                            " --set run.end_time=3 --set run.snapshot_interval=0.1 --quiet";
+  r = run(plain + " --out " + peak.string(), "softening_slope_peak");
   ASSERT_EQ(r.code, 0) << r.err;
-  r = run(base + " --out " + resid.string() +
-              " --set model.constitutive=drucker_prager --set material[0].cohesion=2400"
-              " --set material[0].friction=15.90",
+  r = run(plain + " --out " + resid.string() + " --set material[0].cohesion=2400 --set material[0].friction=15.90",
           "softening_slope_residual");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto sp = summary(peak), sr = summary(resid), ss = summary(soft);

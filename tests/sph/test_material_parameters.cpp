@@ -6,12 +6,14 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "geohaz/core/config.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/sph/config.hpp"
 #include "geohaz/sph/constitutive.hpp"
 #include "geohaz/sph/run.hpp"
+#include "geohaz/sph/summary_keys.hpp"
 
 using namespace geohaz;
 using namespace geohaz::sph;
@@ -57,6 +59,54 @@ TEST(MaterialParameters, TheModelsRulesNameTheKey) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.key(), "material.residual_cohesion");
   }
+}
+
+// A key of a model that is not chosen is refused (as the runout and DEM readers do), naming the
+// key, the chosen model and the keys it reads; the shared keys of the chosen model are accepted.
+TEST(MaterialParameters, AnotherModelsKeyIsRefused) {
+  try {
+    (void)read("[model]\nconstitutive = \"drucker_prager\"\n[[material]]\ncohesion = 1e3\nyield_stress = 2e5\n");
+    FAIL() << "a von_mises key accepted for drucker_prager";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "material.yield_stress");
+    EXPECT_EQ(e.file(), "case.toml");
+    const std::string m = e.what();
+    EXPECT_NE(m.find("model.constitutive = drucker_prager"), std::string::npos) << m;
+    EXPECT_NE(m.find("it belongs to von_mises"), std::string::npos) << m;
+    EXPECT_NE(m.find("drucker_prager reads material.cohesion, material.friction, material.dilatancy"),
+              std::string::npos)
+        << m;
+  }
+  try {
+    (void)read("[model]\nconstitutive = \"linear_elastic\"\n[[material]]\nfriction = 30\n");
+    FAIL() << "a friction angle accepted for linear_elastic";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "material.friction");
+    EXPECT_NE(std::string(e.what()).find("linear_elastic reads none of these keys"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW((void)read("[model]\nconstitutive = \"von_mises\"\n[[material]]\nyield_stress = 2e5\n"));
+}
+
+// The figures summary.json reports per material are the models' declarations: the same keys as the
+// hand-written cases before (in the same column order), a parameter's label and unit from its ParamSpec.
+TEST(MaterialParameters, TheSummaryFiguresComeFromTheModels) {
+  std::vector<std::string> keys;
+  for (const MaterialFigure& f : all_material_figures()) keys.emplace_back(f.key);
+  EXPECT_EQ(keys, (std::vector<std::string>{"K_Pa", "G_Pa", "yield_stress_Pa", "alpha_phi", "k_c_Pa", "alpha_psi",
+                                            "residual_alpha_phi", "residual_k_c_Pa", "softening_strain",
+                                            "min_density_kg_per_m3", "viscosity_Pa_s"}));
+  const SummaryKey* k = find_summary_key(summary_keys(), "materials[].yield_stress_Pa");
+  ASSERT_NE(k, nullptr);
+  EXPECT_EQ(k->label, VonMises::parameters[0].meaning);
+  EXPECT_EQ(k->unit, "Pa");
+  MaterialParams p;
+  p.yield_stress = 2e5;
+  p.finalise();
+  std::vector<std::string> vm;
+  for (const MaterialFigure& f : material_figures(VonMises{})) vm.emplace_back(f.key);
+  EXPECT_EQ(vm, (std::vector<std::string>{"K_Pa", "G_Pa", "yield_stress_Pa"}));
+  EXPECT_EQ(material_figures(VonMises{})[2].value(p), 2e5);
+  EXPECT_EQ(material_figures(DruckerPrager{})[0].value(p), p.bulk);
 }
 
 TEST(MaterialParameters, TheHelpListsTheModelsThatReadAKey) {

@@ -1,5 +1,5 @@
 // The sph-slope configuration keys: declared once here (unit, default, range, help), read into
-// RunConfig. Defaults come from the structs (solver.hpp, constitutive.hpp, run.hpp) where they have one.
+// RunConfig. Defaults come from the structs (solver.hpp, constitutive.hpp, config.hpp) where they have one.
 #include "geohaz/sph/config.hpp"
 
 #include <cmath>
@@ -129,11 +129,12 @@ void read_model_and_materials(ConfigReader& r, RunConfig& c) {
                       {"kg/m^3", "density rho0 (soils 1500-2300, water 1000, rock 2500-3000)"});
     p.young = m.get("young", p.young, Range::positive(), {"Pa", "Young's modulus E"});
     p.poisson = m.get("poisson", p.poisson, Range::closed_open(0.0, 0.5), {"1", "Poisson's ratio"});
-    // The models' own keys (constitutive.hpp, `parameters`). A [[material]] describes a soil that
-    // several models may be run on (the tests switch model.constitutive over one file), so every
-    // model's keys are read, land in p and are checked by their model's rules, whichever runs.
+    // The models' own keys (constitutive.hpp, `parameters`): every model's keys are read (so
+    // --help-config and the resolved config list them); a key of a model that is not chosen is
+    // refused (exit 2), as in the runout and DEM families. The other models' values are their
+    // defaults (the shared keys: the values read); they land in p and pass their rules as before.
     const auto all = ConstitutiveModelParameters::read_all(
-        m, {"", "model.constitutive", "set model.constitutive", false, "material."}, constitutive_model_name(c.model));
+        m, {"", "model.constitutive", "set model.constitutive", true, "material."}, constitutive_model_name(c.model));
     for (const std::string_view name : ConstitutiveModelNames::names) {
       const ParamValues v = ConstitutiveModelParameters::values_of(all, name);
       ConstitutiveModelParameters::check(name, v, r.source(), "material.");

@@ -24,42 +24,12 @@ namespace geohaz::sph {
 
 namespace {
 
-/// What a material means under the model of the run, for summary.json and the log. One case per
-/// model and no generic fallback: a model added to ConstitutiveModel without its case here fails to
-/// compile.
+/// What a material means under the model of the run, for summary.json and the log: the model's
+/// declared figures (constitutive.hpp, MaterialFigure), key and value.
 nlohmann::json model_parameters(const ConstitutiveModel& model, const MaterialParams& m) {
-  using nlohmann::json;
-  return std::visit(Overloaded{[&](const LinearElastic&) {
-                                 return json{{"K_Pa", m.bulk}, {"G_Pa", m.shear}};
-                               },
-                               [&](const VonMises&) {
-                                 return json{{"K_Pa", m.bulk}, {"G_Pa", m.shear}, {"yield_stress_Pa", m.yield_stress}};
-                               },
-                               [&](const DruckerPrager&) {
-                                 return json{{"K_Pa", m.bulk},
-                                             {"G_Pa", m.shear},
-                                             {"alpha_phi", m.dp.alpha_phi},
-                                             {"k_c_Pa", m.dp.kc},
-                                             {"alpha_psi", m.dp.alpha_psi},
-                                             {"min_density_kg_per_m3", DruckerPrager::min_density(m)}};
-                               },
-                               [&](const DruckerPragerSoftening&) {
-                                 const auto r = drucker_prager_constants(m.residual_cohesion, m.residual_friction,
-                                                                         m.dilatancy, m.fit);
-                                 return json{{"K_Pa", m.bulk},
-                                             {"G_Pa", m.shear},
-                                             {"alpha_phi", m.dp.alpha_phi},
-                                             {"k_c_Pa", m.dp.kc},
-                                             {"alpha_psi", m.dp.alpha_psi},
-                                             {"residual_alpha_phi", r.alpha_phi},
-                                             {"residual_k_c_Pa", r.kc},
-                                             {"softening_strain", m.softening_strain},
-                                             {"min_density_kg_per_m3", DruckerPragerSoftening::min_density(m)}};
-                               },
-                               [&](const NewtonianFluid&) {
-                                 return json{{"K_Pa", m.bulk}, {"viscosity_Pa_s", m.viscosity}};
-                               }},
-                    model);
+  nlohmann::json j = nlohmann::json::object();
+  for (const MaterialFigure& f : material_figures(model)) j[std::string(f.key)] = f.value(m);
+  return j;
 }
 
 /// The initial velocity of the main phase (initial_velocity.*); clamped particles stay at rest.

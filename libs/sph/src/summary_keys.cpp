@@ -4,8 +4,16 @@
 /// slope-stability (stability_map.cpp) write into summary.json (summary_keys.hpp). A key written
 /// without a line here fails the apps' tests (tests/common/summary_keys_check.hpp). A 2D run
 /// stands for one metre of width: its areas, forces and moments are per metre (m²/m, N/m, N·m/m).
+/// The figures of each material (materials[].K_Pa, ...) are not listed here: they come from the
+/// constitutive models' declarations (constitutive.hpp, MaterialFigure).
 
 #include "geohaz/sph/summary_keys.hpp"
+
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "geohaz/sph/constitutive.hpp"
 
 namespace geohaz::sph {
 
@@ -203,23 +211,25 @@ constexpr SummaryKey kKeys[] = {
     {"materials[].name", "material", ""},
     {"materials[].dp_fit", "Drucker–Prager fit", ""},
     {"materials[].p_wave_speed_m_per_s", "P-wave speed", "m/s"},
-    {"materials[].K_Pa", "bulk modulus K", "Pa"},
-    {"materials[].G_Pa", "shear modulus G", "Pa"},
-    {"materials[].yield_stress_Pa", "yield stress σ_y", "Pa"},
-    {"materials[].alpha_phi", "Drucker–Prager α_φ", "1"},
-    {"materials[].k_c_Pa", "Drucker–Prager k_c", "Pa"},
-    {"materials[].alpha_psi", "Drucker–Prager α_ψ", "1"},
-    {"materials[].residual_alpha_phi", "residual α_φ", "1"},
-    {"materials[].residual_k_c_Pa", "residual k_c", "Pa"},
-    {"materials[].softening_strain", "softening strain", "1"},
-    {"materials[].min_density_kg_per_m3", "density floor", "kg/m^3"},
-    {"materials[].viscosity_Pa_s", "viscosity", "Pa*s"},
+    // materials[].<figure>: the constitutive models' declared figures (constitutive.hpp), added below
 };
 
 }  // namespace
 
 std::span<const SummaryKey> summary_keys() noexcept {
-  return kKeys;
+  // kKeys, then materials[].<key> of every model's figures (label and unit as the model declares them).
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const MaterialFigure& f : all_material_figures()) n.push_back("materials[]." + std::string(f.key));
+    return n;
+  }();
+  static const std::vector<SummaryKey> keys = [] {
+    std::vector<SummaryKey> all(std::begin(kKeys), std::end(kKeys));
+    const std::vector<MaterialFigure> figures = all_material_figures();
+    for (std::size_t i = 0; i < figures.size(); ++i) all.push_back({names[i], figures[i].label, figures[i].unit});
+    return all;
+  }();
+  return keys;
 }
 
 }  // namespace geohaz::sph

@@ -82,8 +82,8 @@ struct LawKeys {
   std::string_view prefix;         ///< the keys are read below this ("model."; "" in a table's reader)
   std::string_view selector;       ///< the key that chooses the law ("model.friction")
   std::string_view how_to_choose;  ///< the hint of the message refusing another law's key
-  /// Whether a key of a law that is not chosen is an error (true) or read and ignored (false: the
-  /// SPH [[material]] tables describe a soil that several models may be run on).
+  /// Whether a key of a law that is not chosen is an error (true, every family of the libraries)
+  /// or read and ignored (false).
   bool refuse_other_laws_keys = true;
   std::string_view shown_prefix{};  ///< how messages name the keys, when not `prefix` ("material.")
 };
@@ -189,7 +189,8 @@ struct LawParameters<std::variant<L...>> {
 
   /// Read every key of the family below k.prefix (so --help-config and the resolved configuration
   /// list them all, with their defaults). A key given for a law other than `law` is an InputError
-  /// naming it, the laws it belongs to and k.selector, unless k.refuse_other_laws_keys is false.
+  /// naming it, the laws it belongs to, k.selector and the keys `law` reads, unless
+  /// k.refuse_other_laws_keys is false.
   static AllValues read_all(ConfigReader& cfg, const LawKeys& k, std::string_view law) {
     const std::string where = cfg.source().empty() ? "command line" : cfg.source();
     const std::string shown(k.shown_prefix.empty() ? k.prefix : k.shown_prefix);
@@ -205,11 +206,14 @@ struct LawParameters<std::variant<L...>> {
     for (std::size_t i = 0; i < a.keys.size() && k.refuse_other_laws_keys; ++i) {
       const Key& e = a.keys[i];
       if (!a.given[i] || std::find(e.laws.begin(), e.laws.end(), law) != e.laws.end()) continue;
-      std::string names;
+      std::string names, accepted;
       for (std::string_view l : e.laws) (names += names.empty() ? "" : " or ") += l;
+      for (const ParamSpec& s : parameters_of(law)) ((accepted += accepted.empty() ? "" : ", ") += shown) += s.key;
       const std::string key = shown + std::string(e.spec.key);
       throw InputError(key + " is given but " + std::string(k.selector) + " = " + std::string(law) +
-                           " does not use it (it belongs to " + names + "; " + std::string(k.how_to_choose) + ")",
+                           " does not use it (it belongs to " + names + "; " + std::string(law) + " reads " +
+                           (accepted.empty() ? std::string("none of these keys") : accepted) + "; " +
+                           std::string(k.how_to_choose) + ")",
                        where, key);
     }
     return a;

@@ -67,6 +67,7 @@
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -246,6 +247,37 @@ inline constexpr ParamSpec kDilatancyParameter{"dilatancy",           0.0,     R
                                                "dilatancy angle psi", "<= phi"};
 inline constexpr double kDegree = std::numbers::pi / 180.0;  ///< one degree in radians
 
+/// A number summary.json reports for each material under a model (`materials[].<key>`, also
+/// printed in the log): the key (with its unit's suffix, as every summary key), what a reader
+/// calls it, its unit as the config declarations write it, and its value for a material. A figure
+/// that is one of the model's own parameters takes its label and unit from that parameter's
+/// declaration (ParamSpec), so they are stated once; the summary's key list (summary_keys.cpp) is
+/// built from the models' figures.
+struct MaterialFigure {
+  std::string_view key;
+  std::string_view label;
+  std::string_view unit;
+  double (*value)(const MaterialParams&);
+  constexpr MaterialFigure(std::string_view k, std::string_view l, std::string_view u,
+                           double (*v)(const MaterialParams&)) noexcept
+      : key(k), label(l), unit(u), value(v) {}
+  /// The figure of a declared parameter: its label is the parameter's meaning, its unit the parameter's.
+  constexpr MaterialFigure(std::string_view k, const ParamSpec& parameter, double (*v)(const MaterialParams&)) noexcept
+      : key(k), label(parameter.meaning), unit(parameter.unit), value(v) {}
+};
+
+/// The figures several models report.
+inline constexpr MaterialFigure kBulkModulusFigure{"K_Pa", "bulk modulus K", "Pa",
+                                                   [](const MaterialParams& m) { return m.bulk; }};
+inline constexpr MaterialFigure kShearModulusFigure{"G_Pa", "shear modulus G", "Pa",
+                                                    [](const MaterialParams& m) { return m.shear; }};
+inline constexpr MaterialFigure kAlphaPhiFigure{"alpha_phi", "Drucker–Prager α_φ", "1",
+                                                [](const MaterialParams& m) { return m.dp.alpha_phi; }};
+inline constexpr MaterialFigure kKcFigure{"k_c_Pa", "Drucker–Prager k_c", "Pa",
+                                          [](const MaterialParams& m) { return m.dp.kc; }};
+inline constexpr MaterialFigure kAlphaPsiFigure{"alpha_psi", "Drucker–Prager α_ψ", "1",
+                                                [](const MaterialParams& m) { return m.dp.alpha_psi; }};
+
 /// Linear elasticity with the Jaumann rate (Hooke's law, K and G from E and ν).
 struct LinearElastic {
   static constexpr const char* name = "linear_elastic";
@@ -265,6 +297,7 @@ struct LinearElastic {
   /// No floor: an elastic solid carries any tension.
   static double min_density(const MaterialParams& /*p*/) noexcept { return 0.0; }
   static constexpr bool elastic_loading = true;
+  static constexpr std::array<MaterialFigure, 2> figures{{kBulkModulusFigure, kShearModulusFigure}};
 };
 
 /// Elastic–perfectly plastic von Mises: f = √J2 − σ_y/√3, associated flow, radial return.
@@ -296,6 +329,10 @@ struct VonMises {
   static std::pair<double, double> plane_strain_strength(const MaterialParams& p, bool /*residual*/) noexcept {
     return {p.yield_stress / std::sqrt(3.0), 0.0};
   }
+  static constexpr std::array<MaterialFigure, 3> figures{
+      {kBulkModulusFigure, kShearModulusFigure, {"yield_stress_Pa", parameters[0], [](const MaterialParams& m) {
+                                                   return m.yield_stress;
+                                                 }}}};
 };
 
 /// Elastic–perfectly plastic Drucker–Prager, non-associated (dilatancy ψ), Jaumann rate,
@@ -347,6 +384,14 @@ struct DruckerPrager {
   static std::pair<double, double> plane_strain_strength(const MaterialParams& p, bool /*residual*/) noexcept {
     return {p.cohesion, p.friction};
   }
+  static constexpr std::array<MaterialFigure, 6> figures{
+      {kBulkModulusFigure,
+       kShearModulusFigure,
+       kAlphaPhiFigure,
+       kKcFigure,
+       kAlphaPsiFigure,
+       {"min_density_kg_per_m3", "density floor", "kg/m^3",
+        [](const MaterialParams& m) { return DruckerPrager::min_density(m); }}}};
 };
 
 /// Drucker–Prager with strain softening: as DruckerPrager, but cohesion and friction fall linearly
@@ -425,6 +470,23 @@ struct DruckerPragerSoftening {
   static std::pair<double, double> plane_strain_strength(const MaterialParams& p, bool residual) noexcept {
     return residual ? std::pair{p.residual_cohesion, p.residual_friction} : std::pair{p.cohesion, p.friction};
   }
+  /// The Drucker–Prager constants of the residual strength.
+  static DruckerPragerConstants residual_constants(const MaterialParams& p) noexcept {
+    return drucker_prager_constants(p.residual_cohesion, p.residual_friction, p.dilatancy, p.fit);
+  }
+  static constexpr std::array<MaterialFigure, 9> figures{
+      {kBulkModulusFigure,
+       kShearModulusFigure,
+       kAlphaPhiFigure,
+       kKcFigure,
+       kAlphaPsiFigure,
+       {"residual_alpha_phi", "residual α_φ", "1",
+        [](const MaterialParams& m) { return DruckerPragerSoftening::residual_constants(m).alpha_phi; }},
+       {"residual_k_c_Pa", "residual k_c", "Pa",
+        [](const MaterialParams& m) { return DruckerPragerSoftening::residual_constants(m).kc; }},
+       {"softening_strain", parameters[5], [](const MaterialParams& m) { return m.softening_strain; }},
+       {"min_density_kg_per_m3", "density floor", "kg/m^3",
+        [](const MaterialParams& m) { return DruckerPragerSoftening::min_density(m); }}}};
 };
 
 /// Weakly compressible Newtonian fluid: σ = −p I + 2μ ė, p = K (ρ/ρ0 − 1) (linear equation of
@@ -454,6 +516,8 @@ struct NewtonianFluid {
   /// No floor: the equation of state reacts to ρ < ρ0 itself.
   static double min_density(const MaterialParams& /*p*/) noexcept { return 0.0; }
   static constexpr bool elastic_loading = false;
+  static constexpr std::array<MaterialFigure, 2> figures{
+      {kBulkModulusFigure, {"viscosity_Pa_s", parameters[0], [](const MaterialParams& m) { return m.viscosity; }}}};
 };
 
 /// What the solver requires of a constitutive model (see the file comment).
@@ -467,6 +531,7 @@ concept ConstitutiveLaw = requires(const MaterialParams& p, double h) {
   { M::time_step_limit(p, h) } -> std::same_as<double>;
   { M::min_density(p) } -> std::same_as<double>;
   { M::elastic_loading } -> std::convertible_to<bool>;
+  { M::figures[0] } -> std::convertible_to<const MaterialFigure&>;
 };
 
 /// A model with a shear strength to reduce and to use in Bishop's method (see the file comment).
@@ -501,6 +566,54 @@ inline void set_model_parameters(const ConstitutiveModel& m, MaterialParams& p, 
       },
       m);
 }
+
+/// The figures summary.json reports for a material under the run's model (its `figures`).
+inline std::span<const MaterialFigure> material_figures(const ConstitutiveModel& m) noexcept {
+  return std::visit(
+      [](const auto& law) { return std::span<const MaterialFigure>(std::decay_t<decltype(law)>::figures); }, m);
+}
+
+/// Every model's figures, each key once: a key first met in a later model goes before the next key
+/// of that model already listed, so each model's figures keep their declared order (the column
+/// order of the report's material table).
+inline std::vector<MaterialFigure> all_material_figures() {
+  std::vector<MaterialFigure> out;
+  const auto listed = [&](std::string_view key) {
+    return std::find_if(out.begin(), out.end(), [&](const MaterialFigure& f) { return f.key == key; });
+  };
+  const auto add = [&]<class M>(std::type_identity<M>) {
+    for (std::size_t i = 0; i < M::figures.size(); ++i) {
+      if (listed(M::figures[i].key) != out.end()) continue;
+      auto at = out.end();
+      for (std::size_t j = i + 1; j < M::figures.size() && at == out.end(); ++j) at = listed(M::figures[j].key);
+      out.insert(at, M::figures[i]);
+    }
+  };
+  [&]<class... M>(std::type_identity<std::variant<M...>>) {
+    (add(std::type_identity<M>{}), ...);
+  }(std::type_identity<ConstitutiveModel>{});
+  return out;
+}
+
+/// Whether every figure key reported by several models has one label and unit (compile-time check).
+constexpr bool material_figures_consistent() noexcept {
+  bool ok = true;
+  const auto against = [&]<class... M>(std::type_identity<std::variant<M...>>, const MaterialFigure& f) {
+    const auto one = [&]<class N>(std::type_identity<N>) {
+      for (const MaterialFigure& g : N::figures)
+        if (g.key == f.key && (g.label != f.label || g.unit != f.unit)) ok = false;
+    };
+    (one(std::type_identity<M>{}), ...);
+  };
+  [&]<class... M>(std::type_identity<std::variant<M...>> v) {
+    const auto each = [&]<class N>(std::type_identity<N>) {
+      for (const MaterialFigure& f : N::figures) against(v, f);
+    };
+    (each(std::type_identity<M>{}), ...);
+  }(std::type_identity<ConstitutiveModel>{});
+  return ok;
+}
+static_assert(material_figures_consistent(), "two models report one figure key with different labels or units");
 
 /// Config names of the models, in the order of ConstitutiveModel.
 inline constexpr auto constitutive_model_names = ConstitutiveModelNames::names;
