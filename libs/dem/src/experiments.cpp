@@ -74,16 +74,6 @@ double principal_inclination(const std::vector<Vec2>& p) {
   return a > 90 ? 180 - a : a;
 }
 
-double polygon_area(const std::vector<Vec2>& p) {
-  double a = 0;
-  for (std::size_t k = 0; k < p.size(); ++k) {
-    const Vec2& u = p[k];
-    const Vec2& v = p[(k + 1) % p.size()];
-    a += u.x() * v.y() - v.x() * u.y();
-  }
-  return 0.5 * std::abs(a);
-}
-
 bool inside_polygon(const std::vector<Vec2>& poly, const Vec2& q) {
   bool in = false;
   for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {

@@ -42,16 +42,6 @@ std::vector<Vec2> clip(const std::vector<Vec2>& poly, const Vec2& o, const Vec2&
   return out;
 }
 
-double polygon_area(const std::vector<Vec2>& p) {
-  double a = 0;
-  for (std::size_t k = 0; k < p.size(); ++k) {
-    const Vec2& u = p[k];
-    const Vec2& v = p[(k + 1) % p.size()];
-    a += u.x() * v.y() - v.x() * u.y();
-  }
-  return 0.5 * a;
-}
-
 }  // namespace
 
 Tessellation tessellate(std::span<const Vec2> x, std::span<const double> r, const Vec2& lo, const Vec2& hi) {
@@ -107,7 +97,7 @@ Tessellation tessellate(std::span<const Vec2> x, std::span<const double> r, cons
     poly = clip(poly, lo, Vec2(0, 1));
     poly = clip(poly, hi, Vec2(-1, 0));
     poly = clip(poly, hi, Vec2(0, -1));
-    const double area = std::abs(polygon_area(poly));
+    const double area = polygon_area(poly);
     t.cells[i] = std::move(poly);
     t.cell_area[i] = area;
     t.local_porosity[i] = area > 0 ? 1.0 - std::numbers::pi * r[i] * r[i] / area : 1.0;
@@ -156,6 +146,16 @@ void write_tessellation_vtk(const std::filesystem::path& stem, const Tessellatio
     for (const auto& [a, b] : t.edges) s << "2 " << a << ' ' << b << '\n';
     write_text_file(stem.string() + "_triangulation.vtk", s.str());
   }
+}
+
+double polygon_area(std::span<const Vec2> p) {
+  double a = 0;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const Vec2& u = p[k];
+    const Vec2& v = p[(k + 1) % p.size()];
+    a += u.x() * v.y() - v.x() * u.y();
+  }
+  return 0.5 * std::abs(a);
 }
 
 }  // namespace geohaz::dem

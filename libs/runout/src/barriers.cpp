@@ -8,6 +8,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "case_support.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/kernels.hpp"
 #include "geohaz/core/raster.hpp"
@@ -19,12 +20,6 @@ namespace {
 
 double cross(const Vec2& a, const Vec2& b) noexcept {
   return a.x() * b.y() - a.y() * b.x();
-}
-
-std::string num(double v) {
-  std::ostringstream o;
-  o << v;
-  return o.str();
 }
 
 /// F(s) on s = k/kTable·2, k = 0..kTable: ½ + ∫₀ˢ m(x) dx with m(x) = ∫ w(√(x² + y²)) dy the
@@ -279,8 +274,8 @@ std::vector<Barrier> load_barriers(const BarrierSpec& s, const Raster& dsm, cons
     b.height = std::isfinite(l.attribute) ? l.attribute : s.height;
     const std::string hkey = std::isfinite(l.attribute) ? s.height_attribute : "barriers.height";
     if (!(b.height > 0.0 && b.height <= 100.0))
-      throw InputError(feature + ": the crest height must be in (0, 100] m (found " + num(b.height) + " m)", s.file,
-                       hkey, num(b.height));
+      throw InputError(feature + ": the crest height must be in (0, 100] m (found " + detail::fmt(b.height) + " m)",
+                       s.file, hkey, detail::fmt(b.height));
     b.permeability = s.permeability;
     std::string pkey = "barriers.permeability";
     if (perm_attr && std::isfinite(perm[k].attribute)) {
@@ -288,8 +283,8 @@ std::vector<Barrier> load_barriers(const BarrierSpec& s, const Raster& dsm, cons
       pkey = s.permeability_attribute;
     }
     if (!(b.permeability >= 0.0 && b.permeability < 1.0))
-      throw InputError(feature + ": the permeability must be in [0, 1) (found " + num(b.permeability) + ")", s.file,
-                       pkey, num(b.permeability));
+      throw InputError(feature + ": the permeability must be in [0, 1) (found " + detail::fmt(b.permeability) + ")",
+                       s.file, pkey, detail::fmt(b.permeability));
     // The whole line on the terrain: the vertices and points every half cell between them.
     const double step = 0.5 * std::min(g.dx, g.dy);
     for (std::size_t v = 0; v + 1 < b.vertices.size(); ++v) {

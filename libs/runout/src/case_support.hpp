@@ -1,7 +1,8 @@
 #pragma once
 /// \file case_support.hpp
-/// Small helpers that the ensemble and the calibration share when they build members from a
-/// debris-runout case (internal to libs/runout; not installed).
+/// Small helpers of libs/runout's sources: number formatting for messages and CSV cells, and what the
+/// ensemble and the calibration share when they build members from a debris-runout case (internal
+/// to libs/runout; not installed).
 
 #include <set>
 #include <string>

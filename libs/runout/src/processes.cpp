@@ -9,6 +9,7 @@
 #include <limits>
 #include <sstream>
 
+#include "case_support.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/raster.hpp"
 #include "geohaz/runout/run.hpp"
@@ -32,12 +33,6 @@ const char* to_string(EntrainmentLaw law) noexcept {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-std::string num(double v) {
-  std::ostringstream o;
-  o << v;
-  return o.str();
-}
 
 bool is_vector(const std::string& path) {
   const std::string ext = fs::path(path).extension().string();
@@ -112,8 +107,9 @@ void check_range(const std::vector<double>& f, double lo, double hi, const std::
                  const std::string& unit) {
   for (double v : f)
     if (std::isfinite(v) && !(v >= lo && v <= hi))
-      throw InputError(key + " must be in [" + num(lo) + ", " + num(hi) + "] " + unit + " (found " + num(v) + ")", file,
-                       key, num(v));
+      throw InputError(key + " must be in [" + detail::fmt(lo) + ", " + detail::fmt(hi) + "] " + unit + " (found " +
+                           detail::fmt(v) + ")",
+                       file, key, detail::fmt(v));
 }
 
 /// The same against a law coefficient's declared range (friction zones).
@@ -121,8 +117,8 @@ void check_range(const std::vector<double>& f, const ParamSpec& spec, const std:
   const std::string unit = spec.unit == "1" ? "" : std::string(spec.unit);
   for (double v : f)
     if (std::isfinite(v) && !spec.range.contains(v))
-      throw InputError(key + " must be in " + spec.range.str() + " " + unit + " (found " + num(v) + ")", file, key,
-                       num(v));
+      throw InputError(key + " must be in " + spec.range.str() + " " + unit + " (found " + detail::fmt(v) + ")", file,
+                       key, detail::fmt(v));
 }
 
 /// The CSV table of an inflow hydrograph: time (s), discharge (m³/s), one row per line, an optional
@@ -154,12 +150,15 @@ void read_hydrograph_table(const std::string& file, Hydrograph& q) {
     }
     const std::string where = "line " + std::to_string(lineno) + ": ";
     if (!std::isfinite(t) || !std::isfinite(d)) throw InputError(where + "time and discharge must be finite", file);
-    if (d < 0.0) throw InputError(where + "negative discharge " + num(d) + " m^3/s (must be ≥ 0)", file, "", num(d));
-    if (t < 0.0) throw InputError(where + "negative time " + num(t) + " s (must be ≥ 0)", file, "", num(t));
+    if (d < 0.0)
+      throw InputError(where + "negative discharge " + detail::fmt(d) + " m^3/s (must be ≥ 0)", file, "",
+                       detail::fmt(d));
+    if (t < 0.0)
+      throw InputError(where + "negative time " + detail::fmt(t) + " s (must be ≥ 0)", file, "", detail::fmt(t));
     if (!q.time.empty() && !(t > q.time.back()))
-      throw InputError(where + "time " + num(t) + " s is not after the previous row's " + num(q.time.back()) +
-                           " s (times must increase)",
-                       file, "", num(t));
+      throw InputError(where + "time " + detail::fmt(t) + " s is not after the previous row's " +
+                           detail::fmt(q.time.back()) + " s (times must increase)",
+                       file, "", detail::fmt(t));
     q.time.push_back(t);
     q.discharge.push_back(d);
   }
@@ -319,14 +318,15 @@ void load_inflow(const ProcessSpec& s, const RunoutParameters& p, const GridSurf
     for (const Vec2& e : {q.a, q.b}) {
       SurfaceSample smp;
       if (!surface.sample(e, smp))
-        throw InputError("the inflow point (" + num(e.x()) + ", " + num(e.y()) +
-                             ") is outside the DSM or on nodata (the DSM extent is " + num(g.x0) + " … " +
-                             num(g.x0 + g.nx * g.dx) + " × " + num(g.y0 - g.ny * g.dy) + " … " + num(g.y0) + ")",
+        throw InputError("the inflow point (" + detail::fmt(e.x()) + ", " + detail::fmt(e.y()) +
+                             ") is outside the DSM or on nodata (the DSM extent is " + detail::fmt(g.x0) + " … " +
+                             detail::fmt(g.x0 + g.nx * g.dx) + " × " + detail::fmt(g.y0 - g.ny * g.dy) + " … " +
+                             detail::fmt(g.y0) + ")",
                          "config", "inflow.points");
     }
     if ((q.b - q.a).norm() > 20.0 * p.d0)
-      throw InputError("the inflow line is " + num((q.b - q.a).norm()) +
-                           " m long: a short line (≤ 20 d0 = " + num(20.0 * p.d0) + " m) is expected",
+      throw InputError("the inflow line is " + detail::fmt((q.b - q.a).norm()) +
+                           " m long: a short line (≤ 20 d0 = " + detail::fmt(20.0 * p.d0) + " m) is expected",
                        "config", "inflow.points");
     if (s.inflow_azimuth >= 0.0) {
       const double az = s.inflow_azimuth * 3.14159265358979323846 / 180.0;  // clockwise from north

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "case_support.hpp"
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/handoff.hpp"
 #include "geohaz/core/output.hpp"
@@ -22,15 +23,11 @@ namespace fs = std::filesystem;
 
 namespace geohaz::runout {
 
+using detail::fmt;
+
 namespace {
 
 constexpr const char* kModel = "debris-runout";
-
-std::string fmt(double v, int prec = 6) {
-  std::ostringstream o;
-  o << std::setprecision(prec) << v;
-  return o.str();
-}
 
 void check_inside(const Raster& dsm, const std::vector<Vec2>& pts, const std::string& file, const char* what) {
   const auto ext = dsm.extent();

@@ -7,7 +7,6 @@
 namespace geohaz::sph {
 
 namespace {
-constexpr std::uint8_t kSoil = static_cast<std::uint8_t>(Kind::Soil);
 
 /// The particles a diagnostic loops over: the whole store, or this rank's owned ones.
 template <int Dim>

@@ -27,8 +27,6 @@
 
 namespace geohaz::sph {
 
-constexpr std::uint8_t kSoil = static_cast<std::uint8_t>(Kind::Soil);
-
 // ---- run_scenario.cpp ------------------------------------------------------------------------
 
 /// The name of a scenario in run.scenario ("slope", "column", ...).

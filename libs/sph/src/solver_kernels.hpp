@@ -14,7 +14,6 @@
 
 namespace geohaz::sph {
 
-constexpr std::uint8_t kSoil = static_cast<std::uint8_t>(Kind::Soil);
 constexpr std::uint8_t kRoller = static_cast<std::uint8_t>(Kind::RollerWall);
 
 /// Minimum-image displacement a − b: the core's (Periodicity::min_image, the one Neighbours uses).

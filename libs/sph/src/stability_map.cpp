@@ -15,6 +15,7 @@
 #include "geohaz/core/output.hpp"
 #include "geohaz/core/parallel.hpp"
 #include "geohaz/core/progress.hpp"
+#include "geohaz/sph/constitutive.hpp"
 
 namespace geohaz::sph {
 
@@ -23,7 +24,6 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kApp = "slope-stability";
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
 constexpr double kNodata = -9999.0;
 /// FS values above this are written as it (TRIGRS's cap of the same value): flat cells have FS → ∞.
 constexpr double kFsCap = 10.0;
@@ -70,15 +70,15 @@ StabilityMapCase read_stability_map_case(ConfigReader& cfg) {
                          {"m", "vertical depth Z of the failure plane (soil-bedrock contact); the release thickness"});
   c.soil_depth_raster = resolve(
       cfg, cfg.get_string("soil.depth_raster", "", {"", "raster of Z (m) on the DSM's grid; overrides soil.depth"}));
-  c.min_slope = kDeg * cfg.get("soil.min_slope", c.min_slope / kDeg, Range::closed_open(0.0, 90.0),
-                               {"deg", "cells flatter than this carry no soil cover (no result)"});
-  c.max_slope = kDeg * cfg.get("soil.max_slope", c.max_slope / kDeg, Range::open_closed(0.0, 90.0),
-                               {"deg", "cells steeper than this carry no soil cover (rock faces; no result)"});
+  c.min_slope = kDegree * cfg.get("soil.min_slope", c.min_slope / kDegree, Range::closed_open(0.0, 90.0),
+                                  {"deg", "cells flatter than this carry no soil cover (no result)"});
+  c.max_slope = kDegree * cfg.get("soil.max_slope", c.max_slope / kDegree, Range::open_closed(0.0, 90.0),
+                                  {"deg", "cells steeper than this carry no soil cover (rock faces; no result)"});
   auto& s = c.soil;
   s.cohesion =
       cfg.get("soil.cohesion", s.cohesion, Range::non_negative(), {"Pa", "effective cohesion c' (soil and roots)"});
-  s.friction = kDeg * cfg.get("soil.friction_angle", s.friction / kDeg, Range::open_closed(0.0, 89.0),
-                              {"deg", "effective friction angle phi'"});
+  s.friction = kDegree * cfg.get("soil.friction_angle", s.friction / kDegree, Range::open_closed(0.0, 89.0),
+                                 {"deg", "effective friction angle phi'"});
   s.unit_weight_moist = cfg.get("soil.unit_weight_moist", s.unit_weight_moist, Range::closed(1e3, 5e4),
                                 {"N/m^3", "unit weight gamma_m of the soil above the water table"});
   s.unit_weight_saturated = cfg.get("soil.unit_weight_saturated", s.unit_weight_saturated, Range::closed(1e3, 5e4),
@@ -116,8 +116,8 @@ StabilityMapCase read_stability_map_case(ConfigReader& cfg) {
     throw InputError("the saturated unit weight must exceed that of water (" + fmt(s.unit_weight_water) + " N/m^3)",
                      cfg.source(), "soil.unit_weight_saturated", fmt(s.unit_weight_saturated));
   if (!(c.min_slope < c.max_slope))
-    throw InputError("soil.min_slope must be below soil.max_slope (" + fmt(c.max_slope / kDeg) + " deg)", cfg.source(),
-                     "soil.min_slope", fmt(c.min_slope / kDeg));
+    throw InputError("soil.min_slope must be below soil.max_slope (" + fmt(c.max_slope / kDegree) + " deg)",
+                     cfg.source(), "soil.min_slope", fmt(c.min_slope / kDegree));
   if (c.duration == 0.0) c.duration = c.rain.end();
   return c;
 }
@@ -180,9 +180,9 @@ StabilityMapInputs load_stability_map_inputs(const StabilityMapCase& c) {
     }
   if (in.cells.empty())
     throw InputError("no cell carries a soil cover: every slope is outside [soil.min_slope, soil.max_slope] (" +
-                         fmt(c.min_slope / kDeg) + ", " + fmt(c.max_slope / kDeg) +
+                         fmt(c.min_slope / kDegree) + ", " + fmt(c.max_slope / kDegree) +
                          " deg), on the border or next to nodata, or the soil depth is 0",
-                     c.dsm, "soil.max_slope", fmt(c.max_slope / kDeg));
+                     c.dsm, "soil.max_slope", fmt(c.max_slope / kDegree));
   return in;
 }
 
@@ -331,7 +331,7 @@ StabilityMapResult run_stability_map(const StabilityMapCase& c, const fs::path& 
                 to_raster(r.psi_max, "largest pressure head on the failure plane", "m", 1e300));
   write_qgis_ramp_style(out / "max_pressure_head.qml", ColourRamp::Viridis, 0.0, c.soil_depth, "m", -1e300);
   std::vector<double> slope_deg(in.slope);
-  for (double& v : slope_deg) v /= kDeg;
+  for (double& v : slope_deg) v /= kDegree;
   write_geotiff(out / "slope.tif", to_raster(slope_deg, "slope angle", "deg", 90.0));
   write_qgis_ramp_style(out / "slope.qml", ColourRamp::Magma, 0.0, 60.0, "deg", -1.0);
   const Raster thick = release_thickness(in, r);

@@ -29,6 +29,9 @@ struct Tessellation {
 /// Tessellate discs (centres x, radii r) clipped to the box [lo, hi]; discs outside are ignored.
 Tessellation tessellate(std::span<const Vec2> x, std::span<const double> r, const Vec2& lo, const Vec2& hi);
 
+/// Area of a simple polygon by the shoelace formula, m², whatever its orientation.
+double polygon_area(std::span<const Vec2> p);
+
 /// Legacy VTK polydata files: `<stem>_cells.vtk` (power cells with local porosity) and
 /// `<stem>_triangulation.vtk` (triangulation edges). Written atomically.
 void write_tessellation_vtk(const std::filesystem::path& stem, const Tessellation& t, std::span<const Vec2> x);

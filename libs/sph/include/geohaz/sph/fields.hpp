@@ -24,6 +24,9 @@ enum class Kind : std::uint8_t {
   Pile = 3         ///< rigid pile: treated as full fixity
 };
 
+/// Kind::Soil as the byte the store's kind array holds (the pair loops compare against it).
+inline constexpr std::uint8_t kSoil = static_cast<std::uint8_t>(Kind::Soil);
+
 /// Displacement since the start of the main phase (after geostatic loading), m.
 template <int Dim>
 struct Displacement {
