@@ -145,6 +145,16 @@ class DemSolver {
   PairHistory& pair_history_out(bool same_layout);
   /// Whether the pair pass can take its plain loop: no rolling resistance, joints or kinematic disc.
   bool plain_pair_loop() const;
+  /// The plain loop over one block's listed pairs in two flat passes (solver_pairs.cpp): the
+  /// contacts first, then their forces. PlainPass: the arrays and constants of the pass.
+  struct PlainPass;
+  template <class Law>
+  void plain_pair_pass(const Law& law, PairHistory& out, bool same_layout, double zeta, double kt_kn_root);
+  template <bool same, class Law>
+  void plain_pair_block(const Law& law, const PlainPass& p, std::size_t b);
+  std::vector<std::uint32_t> pair_owner_;     ///< per listed pair, its lower index i (plain loop)
+  std::vector<std::uint32_t> contact_slots_;  ///< per listed pair: a block's contacts, in list order
+  bool owner_valid_ = false;                  ///< pair_owner_ was written for the current list
   /// Add the reactions of the half-pair pass to F, T and K in fixed block order.
   void gather_pair_reactions();
   /// The joint between discs id_a and id_b, or nullptr.
