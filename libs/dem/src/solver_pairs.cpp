@@ -175,12 +175,7 @@ void DemSolver::pair_forces(const Law& law_in) {
           tq += -li * shear + roll;
           ktr += k_tr;
           krot += c.kt * Ri * Ri + fr.kr;
-          PairReaction& rj = react[j];
-          rj.f.x() -= fcx;
-          rj.f.y() -= fcy;
-          rj.tq += -lj * shear - roll;
-          rj.ktr += k_tr;
-          rj.krot += c.kt * Rj * Rj + fr.kr;
+          react[j].add_reaction(fcx, fcy, -lj * shear - roll, k_tr, c.kt * Rj * Rj + fr.kr);
           h_partner[k] = pj;
           h_shear[k] = fs;
           h_roll[k] = mr;
@@ -289,12 +284,7 @@ void DemSolver::plain_pair_block(const Law& law_in, const PlainPass& p_in, std::
     p.T[i] += -li * shear + roll;
     p.K[i].x() += k_tr;
     p.K[i].y() += c.kt * Ri * Ri + fr.kr;
-    PairReaction& rj = react[j];
-    rj.f.x() -= fcx;
-    rj.f.y() -= fcy;
-    rj.tq += -lj * shear - roll;
-    rj.ktr += k_tr;
-    rj.krot += c.kt * Rj * Rj + fr.kr;
+    react[j].add_reaction(fcx, fcy, -lj * shear - roll, k_tr, c.kt * Rj * Rj + fr.kr);
     p.h_partner[k] = pj;
     p.h_shear[k] = fs;
     p.h_roll[k] = mr;

@@ -163,6 +163,14 @@ class DemSolver {
   struct PairReaction {
     Vec2 f = Vec2::Zero();
     double tq = 0.0, ktr = 0.0, krot = 0.0;
+    /// The partner's side of one contact: minus the force on i, its own torque and stiffnesses.
+    void add_reaction(double fcx, double fcy, double torque, double k_tr, double k_rot) {
+      f.x() -= fcx;
+      f.y() -= fcy;
+      tq += torque;
+      ktr += k_tr;
+      krot += k_rot;
+    }
   };
   std::vector<PairReaction> reactions_;
   PairBlocks pair_blocks_;  ///< block layout of the reactions, chosen at each list build
