@@ -53,8 +53,7 @@ void draw_particles(const std::filesystem::path& path, const SphStore<Dim>& s, c
   constexpr int kBar = 64, kBelow = kBar + 36 * ts + 8;
   const PlotPanel f = equal_scale_panel(x0 - dx, x1 + dx, z0 - dx, z1 + dx, ml, mt, kMaxW, kMaxH);
   const std::string title =
-      pic.title +
-      (Dim == 3 ? " (3D: every particle projected along y, soil over walls and piles, low y in front)" : "");
+      pic.title + (Dim == 3 ? " (3D: all particles projected along y, soil over walls, low y in front)" : "");
   const int bar_w = std::max(f.width, 400);
   const int W = std::max({ml + bar_w + mr, text_width(title, ts) + 20, 600});
   Image img(W, mt + f.height + kBelow);
