@@ -117,7 +117,10 @@ TEST(SphSlopeApp, TinySlopeWritesAllOutputs) {
                         "snapshots.xmf", "final_displacement.png", "velocity_t0.050.png", "config.resolved.toml",
                         "structure_forces.csv", "structure_forces.png"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
-  EXPECT_EQ(geohaz::check_plot_png(out / "structure_forces.png"), std::vector<std::string>{});  // numbered axes
+  // Every picture in a frame numbered and titled (the particles on x and z axes in metres).
+  for (const char* f :
+       {"structure_forces.png", "final_displacement.png", "final_plastic_strain.png", "velocity_t0.050.png"})
+    EXPECT_EQ(geohaz::check_plot_png(out / f), std::vector<std::string>{}) << f;
   const auto s = summary(out);
   EXPECT_EQ(s["dimension"], 2);
   EXPECT_EQ(s["model"], "drucker_prager");
@@ -308,6 +311,8 @@ TEST(SphSlopeApp, SectionReleaseConservesFailedVolume) {
   ASSERT_EQ(r.code, 0) << r.err;
   const auto s = summary(out);
   ASSERT_TRUE(s.contains("release")) << s.dump();
+  // The section drawn on its own axes (distance along the polyline, elevation), numbered and titled.
+  EXPECT_EQ(geohaz::check_plot_png(out / "final_displacement.png"), std::vector<std::string>{});
   geohaz::SnapshotReader rel(out / "release.h5");
   EXPECT_EQ(rel.model(), "sph-slope-release");
   EXPECT_EQ(rel.dimension(), 2);
@@ -369,6 +374,7 @@ TEST(SphSlopeApp, Tiny3DPeriodicSlopeWithPiles) {
   ASSERT_EQ(r.code, 0) << r.err;
   const auto s = summary(out);
   EXPECT_EQ(s["dimension"], 3);
+  EXPECT_EQ(geohaz::check_plot_png(out / "final_displacement.png"), std::vector<std::string>{});  // x–z projection
   EXPECT_EQ(s["materials"][0]["dp_fit"], "compression_3d");
   EXPECT_TRUE(s.contains("failed_volume_m3"));
   EXPECT_LT(s["bytes_per_particle"].get<double>(), 2048.0);
@@ -467,7 +473,8 @@ TEST(SphSlopeApp, StrengthReductionBracketsTheAcadsFactor) {
   for (const char* f :
        {"srm_curve.csv", "srm_curve.png", "mechanism.png", "slip_surface.csv", "bishop_circle.csv", "snapshots.h5"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
-  EXPECT_EQ(geohaz::check_plot_png(out / "srm_curve.png"), std::vector<std::string>{});  // numbered axes
+  for (const char* f : {"srm_curve.png", "mechanism.png", "mechanism_deformed.png"})  // numbered axes
+    EXPECT_EQ(geohaz::check_plot_png(out / f), std::vector<std::string>{}) << f;
   // The mechanism: the failed trial's slip surface leaves the slope near the toe (x = 45 m), as
   // Bishop's circle does.
   EXPECT_NEAR(s["bishop"]["exit_x_m"].get<double>(), 45.0, 2.0);

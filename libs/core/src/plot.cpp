@@ -54,17 +54,29 @@ std::vector<double> y_ticks(const PlotPanel& f, int n) {
 
 }  // namespace
 
+std::array<std::vector<double>, 2> axes_ticks(const PlotPanel& f, const AxesStyle& style) {
+  std::array<std::vector<double>, 2> t{nice_ticks(f.x0, f.x1, style.x_ticks), y_ticks(f, style.y_ticks)};
+  if (style.same_step && !f.log_y && t[0].size() >= 2) {
+    const double step = t[0][1] - t[0][0], eps = 1e-9 * step;
+    std::vector<double> y;
+    for (double k = std::ceil((f.y0 - eps) / step); k * step <= f.y1 + eps; k += 1.0) y.push_back(k * step);
+    if (y.size() >= 2) t[1] = std::move(y);
+  }
+  return t;
+}
+
 void draw_axes(Image& img, const PlotPanel& f, const std::string& x_title, const std::string& y_title, int s,
                const AxesStyle& style) {
   const std::array<std::uint8_t, 3> black{0, 0, 0}, grid{225, 225, 225};
-  for (double v : nice_ticks(f.x0, f.x1, style.x_ticks)) {
+  const auto ticks = axes_ticks(f, style);
+  for (double v : ticks[0]) {
     const double x = f.px(v);
     if (style.grid) img.line(x, f.top, x, f.top + f.height, grid);
     img.line(x, f.top + f.height, x, f.top + f.height + 6, black);
     const std::string t = format_tick(v);
     draw_text(img, static_cast<int>(x) - text_width(t, s) / 2, f.top + f.height + 10, t, s);
   }
-  for (double v : y_ticks(f, style.y_ticks)) {
+  for (double v : ticks[1]) {
     const double y = f.py(v);
     if (style.grid) img.line(f.left, y, f.left + f.width, y, grid);
     img.line(f.left - 6, y, f.left, y, black);
@@ -101,6 +113,23 @@ void draw_markers(Image& img, const PlotPanel& f, const std::vector<double>& x, 
                   std::array<std::uint8_t, 3> c, double radius) {
   for (std::size_t k = 0; k < x.size() && k < y.size(); ++k)
     if (std::isfinite(x[k]) && std::isfinite(y[k])) img.fill_circle(f.px(x[k]), f.py(y[k]), radius, c);
+}
+
+PlotPanel equal_scale_panel(double x0, double x1, double y0, double y1, int left, int top, int max_width,
+                            int max_height) {
+  const double wx = std::max(x1 - x0, 1e-12), wy = std::max(y1 - y0, 1e-12);
+  // Pixels per data unit, one less than the box so that rounding the sides up stays inside it.
+  const double scale = std::min(std::max(1, max_width - 1) / wx, std::max(1, max_height - 1) / wy);
+  const int w = std::max(1, static_cast<int>(std::ceil(wx * scale - 1e-9)));
+  const int h = std::max(1, static_cast<int>(std::ceil(wy * scale - 1e-9)));
+  return {x0, x0 + w / scale, y0, y0 + h / scale, left, top, w, h};
+}
+
+void draw_discs(Image& img, const PlotPanel& f, const std::vector<double>& x, const std::vector<double>& y,
+                const std::vector<std::array<std::uint8_t, 3>>& colours, double radius) {
+  const double r = std::max(1.0, radius * f.width / (f.x1 - f.x0));
+  for (std::size_t k = 0; k < x.size() && k < y.size() && k < colours.size(); ++k)
+    if (std::isfinite(x[k]) && std::isfinite(y[k])) img.fill_circle(f.px(x[k]), f.py(y[k]), r, colours[k]);
 }
 
 void draw_picture(Image& img, const Image& picture, int x0, int y0) {

@@ -347,7 +347,9 @@ const Caption kCaptions[] = {
     {"deposit", "Final deposit thickness."},
     {"arrival_time", "Time of first arrival of the flow."},
     {"erosion_depth", "Depth eroded from the bed."},
-    {"final_displacement", "Displacement at the end of the run (particles in the section plane)."},
+    {"final_displacement",
+     "Displacement at the end of the run (particles on x and z axes in metres at equal scale; in 3D projected "
+     "along y)."},
     {"final_plastic_strain", "Accumulated plastic strain at the end of the run."},
     {"mechanism", "Failure mechanism: displacement with the critical slip circle."},
     {"mechanism_deformed", "Failure mechanism on the deformed configuration."},

@@ -17,6 +17,7 @@
 #include "geohaz/core/errors.hpp"
 #include "geohaz/core/handoff.hpp"
 #include "geohaz/core/output.hpp"
+#include "geohaz/core/raster.hpp"
 #include "run_support.hpp"
 #include "structure_report.hpp"
 
@@ -494,7 +495,9 @@ void DynamicRun<Dim>::draw_due_pngs(const std::filesystem::path& out) {
       const double vm = v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
       std::ostringstream name;
       name << "velocity_t" << std::fixed << std::setprecision(3) << png_times_[next_png_] << ".png";
-      draw_particles<Dim>(out / name.str(), S, v, vm, c_.numerics.spacing, "speed (m/s)");
+      draw_particles<Dim>(
+          out / name.str(), S, v, vm, c_.numerics.spacing,
+          particle_picture(c_, "speed at t = " + format_tick(png_times_[next_png_]) + " s", "speed (m/s)"));
     }
     ++next_png_;
   }
@@ -544,11 +547,13 @@ void DynamicRun<Dim>::write_pictures(const std::filesystem::path& out) const {
     u[i] = S.template get<Displacement<Dim>>()[i].norm();
     if (S.template get<ParticleKind>()[i] == kSoil) umax = std::max(umax, u[i]);
   }
-  draw_particles<Dim>(out / "final_displacement.png", S, u, umax, c_.numerics.spacing, "displacement (m)");
+  const std::string at = " at t = " + format_tick(solver_.time()) + " s (end of the run)";
+  draw_particles<Dim>(out / "final_displacement.png", S, u, umax, c_.numerics.spacing,
+                      particle_picture(c_, "displacement" + at, "displacement (m)"));
   const auto& ep = S.template get<PlasticStrain>();
   const double epmax = ep.empty() ? 0.0 : *std::max_element(ep.begin(), ep.end());
   draw_particles<Dim>(out / "final_plastic_strain.png", S, ep, epmax, c_.numerics.spacing,
-                      "accumulated plastic strain (1)");
+                      particle_picture(c_, "accumulated plastic strain" + at, "accumulated plastic strain (1)"));
 }
 
 /// Failed mass for debris-runout (docs/handoff.md): only when the section is georeferenced.

@@ -121,6 +121,8 @@ class StrengthReductionRun final : public SimulationModel {
   std::vector<SrmTrial> trials_;
   std::int64_t trial_steps_ = 0;
   std::optional<SphStore<Dim>> mechanism_;  // the store of the failed trial at the upper end of the bracket
+  double mechanism_factor_ = 0.0;           // F of that trial (the last that failed)
+  double mechanism_time_ = 0.0;             // s: the time that trial reached (T, or its stop)
   double lo_ = 0.0, hi_ = 0.0;
   std::string outcome_ = "bracketed";
   BishopResult bishop_;
@@ -227,7 +229,11 @@ bool StrengthReductionRun<Dim>::trial(double F, const SphSimulation& self, RunOb
     std::fprintf(stderr, "sph-slope: trial F = %.4f: max displacement %.4g m, last-quarter growth %.3g m -> %s\n", F,
                  t.displacement, t.growth, t.failed ? "fails" : "stable");
   trials_.push_back(t);
-  if (t.failed) mechanism_ = s.domain() ? s.gathered_store(true) : s.store();  // rank 0's outputs
+  if (t.failed) {
+    mechanism_ = s.domain() ? s.gathered_store(true) : s.store();  // rank 0's outputs
+    mechanism_factor_ = F;
+    mechanism_time_ = s.time();
+  }
   return t.failed;
 }
 
@@ -343,9 +349,13 @@ void StrengthReductionRun<Dim>::write_mechanism(const std::filesystem::path& out
     reference.template get<Position<Dim>>()[i] -= mechanism_->template get<Displacement<Dim>>()[i];
     if (mechanism_->template get<ParticleKind>()[i] == kSoil) umax = std::max(umax, u[i]);
   }
-  draw_particles<Dim>(out / "mechanism.png", reference, u, umax, c_.numerics.spacing, "displacement (m)", circle_);
-  draw_particles<Dim>(out / "mechanism_deformed.png", *mechanism_, u, umax, c_.numerics.spacing, "displacement (m)",
-                      circle_);
+  const std::string trial = "displacement in the failed trial F = " + format_tick(mechanism_factor_) +
+                            " at t = " + format_tick(mechanism_time_) + " s, on the ";
+  const std::string red = circle_.empty() ? "" : "; red: Bishop's critical circle";
+  draw_particles<Dim>(out / "mechanism.png", reference, u, umax, c_.numerics.spacing,
+                      particle_picture(c_, trial + "initial positions" + red, "displacement (m)", circle_));
+  draw_particles<Dim>(out / "mechanism_deformed.png", *mechanism_, u, umax, c_.numerics.spacing,
+                      particle_picture(c_, trial + "deformed positions" + red, "displacement (m)", circle_));
 }
 
 template <int Dim>

@@ -127,13 +127,27 @@ GeostaticReport geostatic_with_progress(SphSolver<Dim>& solver, double dur, cons
 /// A number as the CSV files and the error messages write it (9 significant digits).
 std::string csv_number(double v);
 
-/// Quick-look picture: particles in the x–z plane coloured by `value` (soil) on a ramp, boundary grey,
-/// with a colour bar numbered from 0 to vmax and titled `title` ("displacement (m)").
-/// `overlay` (optional): a polyline in (x, z) drawn in red over the particles (a slip circle).
+/// What a particle picture shows (draw_particles).
+struct ParticlePicture {
+  std::string title;                                 ///< above the frame: the field and the time
+  std::string bar;                                   ///< the colour bar's title with its unit: "displacement (m)"
+  std::vector<std::array<double, 2>> overlay = {};   ///< a polyline in (x, z) drawn in red (a slip circle)
+  std::string x_title = "x (m)", z_title = "z (m)";  ///< the axes' titles (particle_picture names them)
+};
+
+/// A picture of the run's particles: `title`, `bar` and `overlay` as given, the axes titled for the
+/// scenario (a section: distance along its polyline and elevation; otherwise x and z).
+ParticlePicture particle_picture(const RunConfig& c, std::string title, std::string bar,
+                                 std::vector<std::array<double, 2>> overlay = {});
+
+/// Quick-look picture in a frame of core's plotter (plot.hpp): the particles in the x–z plane as
+/// discs Δx across at equal scale (1 m in x = 1 m in z), soil coloured by `value` on viridis,
+/// boundary grey; x and z axes numbered in metres (titled pic.x_title, pic.z_title), `pic.title` above (in 3D followed
+/// by the projection: every particle projected along y, the lowest y in front), a colour bar numbered from 0 to vmax
+/// below, titled `pic.bar`; written with its panel recorded (check_plot_png).
 template <int Dim>
 void draw_particles(const std::filesystem::path& path, const SphStore<Dim>& s, const std::vector<double>& value,
-                    double vmax, double dx, const std::string& title,
-                    const std::vector<std::array<double, 2>>& overlay = {});
+                    double vmax, double dx, const ParticlePicture& pic);
 
 /// The table of a list of (x, z) points ("x_m,z_m": a surface or a circle).
 Table xz_table(const std::vector<std::array<double, 2>>& points);

@@ -3,9 +3,11 @@
 /// The one plotter of geohaz's PNG figures, on core's Image (raster.hpp) with its Pango text: a
 /// panel that maps data to pixels (linear, or logarithmic in y), its frame, its axes numbered at
 /// nice_ticks with their titles, curves, bars, markers, a legend, a picture drawn to scale inside a
-/// panel, and the PNG written with its panels recorded so check_plot_png can tell a figure that lost
-/// its axes. The runout figures (profile.png, gauges.png), the DEM figures (cracks_*.png,
-/// deposit.png, deposit_thickness.png), the SPH curves (srm_curve.png, structure_forces.png) and the
+/// panel, a panel at equal scale with a layer of coloured discs in data coordinates (particles;
+/// draw_colour_bar in raster.hpp gives their colour bar), and the PNG written with its panels recorded so
+/// check_plot_png can tell a figure that lost its axes. The runout figures (profile.png, gauges.png), the DEM figures
+/// (cracks_*.png, deposit.png, deposit_thickness.png), the SPH curves (srm_curve.png, structure_forces.png) and
+/// particle pictures (final_displacement.png, mechanism.png, velocity_t*.png, ...) and the
 /// validation plots of the tests draw with it; the SVG plots (svg.hpp) take their ticks from the
 /// same nice_ticks and nice_range.
 
@@ -30,11 +32,16 @@ struct PlotPanel {
 };
 
 /// How draw_axes numbers a panel: about x_ticks and y_ticks nice ticks, grid lines across the
-/// panel at them or not (not over a picture).
+/// panel at them or not (not over a picture). With same_step (a panel at equal scale) the y axis is
+/// numbered at the x axis's step, when that puts at least two ticks on it.
 struct AxesStyle {
   int x_ticks = 8, y_ticks = 5;
   bool grid = true;
+  bool same_step = false;
 };
+
+/// The tick values draw_axes numbers on a panel: {x ticks, y ticks}.
+std::array<std::vector<double>, 2> axes_ticks(const PlotPanel& f, const AxesStyle& style);
 
 /// One entry of a legend: a colour swatch and its text.
 struct LegendEntry {
@@ -68,6 +75,18 @@ void draw_bars(Image& img, const PlotPanel& f, const std::vector<double>& x, con
 /// are left out.
 void draw_markers(Image& img, const PlotPanel& f, const std::vector<double>& x, const std::vector<double>& y,
                   std::array<std::uint8_t, 3> colour, double radius = 5.0);
+
+/// A panel holding [x0, x1] × [y0, y1] at equal scale (as many pixels per data unit on y as on x:
+/// a circle stays a circle), as large as fits in `max_width` × `max_height` pixels from (left, top).
+/// The range is widened at x1 or y1 (by less than a pixel) so that both axes share the scale exactly.
+PlotPanel equal_scale_panel(double x0, double x1, double y0, double y1, int left, int top, int max_width,
+                            int max_height);
+
+/// Filled discs of data radius `radius` (on the x scale, at least one pixel) centred on the points,
+/// disc k in colours[k], drawn in order (a later disc covers an earlier one): particles coloured by
+/// a field. Non-finite points are left out.
+void draw_discs(Image& img, const PlotPanel& f, const std::vector<double>& x, const std::vector<double>& y,
+                const std::vector<std::array<std::uint8_t, 3>>& colours, double radius);
 
 /// `picture` copied into `img` with its top-left corner at (x, y) (a scene drawn to scale, framed
 /// by draw_axes over a panel of the picture's size).
