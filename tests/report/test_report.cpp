@@ -6,7 +6,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <span>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "calibration_results.hpp"
 #include "geohaz/core/errors.hpp"
@@ -195,6 +198,67 @@ TEST(SummaryKeys, ANumberWithoutADeclarationIsNamedAndPatternsMatch) {
       EXPECT_FALSE(k.label.empty()) << k.key;
       EXPECT_EQ(display_unit(std::string(k.unit)).find('_'), std::string::npos) << k.key;
     }
+}
+
+// The keys of the three libraries that echo a config value (config_echo) take label and unit from
+// that key's declaration: every referenced key exists, has a short label, and its unit is the one
+// the summary key's name promises (issue #30 item 4).
+TEST(SummaryKeys, ConfigEchoesTakeLabelAndUnitFromTheirDeclarations) {
+  using geohaz::testing::config_echo_problems;
+  const std::pair<std::span<const geohaz::SummaryKey>, std::span<const geohaz::KeyReference>> libs[] = {
+      {geohaz::runout::summary_keys(), geohaz::runout::summary_config_declarations()},
+      {geohaz::sph::summary_keys(), geohaz::sph::summary_config_declarations()},
+      {geohaz::dem::summary_keys(), geohaz::dem::summary_config_declarations()}};
+  for (const auto& [keys, refs] : libs) {
+    const auto problems = config_echo_problems(keys, refs);
+    std::string list;
+    for (const auto& p : problems) list += "\n  " + p;
+    EXPECT_TRUE(problems.empty()) << list;
+  }
+  // As the declarations say: run.stop_energy_fraction and the SPH particle spacing.
+  const auto* stop = geohaz::find_summary_key(geohaz::runout::summary_keys(), "stop_energy_fraction");
+  ASSERT_NE(stop, nullptr);
+  EXPECT_EQ(stop->config_key, "run.stop_energy_fraction");
+  EXPECT_EQ(stop->label, "kinetic energy fraction that ends the run");
+  EXPECT_EQ(stop->unit, "1");
+  const auto* dx = geohaz::find_summary_key(geohaz::sph::summary_keys(), "spacing_m");
+  ASSERT_NE(dx, nullptr);
+  EXPECT_EQ(dx->label, "particle spacing");
+  EXPECT_EQ(dx->unit, "m");
+  // A label of the entry's own is kept; the unit is still the declaration's.
+  const auto* sigma3 = geohaz::find_summary_key(geohaz::dem::summary_keys(), "tests[].confining_stress_Pa");
+  ASSERT_NE(sigma3, nullptr);
+  EXPECT_EQ(sigma3->label, "confining stress σ3");
+  EXPECT_EQ(sigma3->unit, "Pa");
+}
+
+// The check fails, naming the key, on each way an echo can drift from its declaration.
+TEST(SummaryKeys, AnEchoThatDriftsFromItsDeclarationIsNamed) {
+  using geohaz::config_echo;
+  const std::vector<geohaz::KeyReference> refs = {
+      {"a.depth", "number", "m", "1", "[0, inf)", "flow depth above which ...", "depth threshold"},
+      {"a.count", "integer", "1", "3", "[1, 9]", "how many", ""}};
+  const geohaz::SummaryKey table[] = {config_echo("depth_m", "a.depth"),             // fine
+                                      config_echo("gone_m", "a.no_such_key"),        // not declared
+                                      config_echo("depth_s", "a.depth"),             // the name promises seconds
+                                      config_echo("depth", "a.depth"),               // no unit suffix, declared in m
+                                      config_echo("count", "a.count"),               // no label anywhere
+                                      config_echo("count2", "counted", "a.count")};  // its own label: fine
+  const auto keys = geohaz::with_config_declarations(table, refs);
+  EXPECT_EQ(keys[0].label, "depth threshold");
+  EXPECT_EQ(keys[0].unit, "m");
+  EXPECT_EQ(keys[1].unit, "");  // left empty for the check to name
+  const auto problems = geohaz::testing::config_echo_problems(keys, refs);
+  ASSERT_EQ(problems.size(), 4u);
+  EXPECT_NE(problems[0].find("gone_m (echoes a.no_such_key): no such config key"), std::string::npos);
+  EXPECT_NE(problems[1].find("depth_s (echoes a.depth): the key's name promises 's', declared 'm'"), std::string::npos);
+  EXPECT_NE(problems[2].find("depth (echoes a.depth): the key's name has no unit suffix"), std::string::npos);
+  EXPECT_NE(problems[3].find("count (echoes a.count): no label"), std::string::npos);
+  // A unit written on the entry that differs from the declaration's is named too.
+  geohaz::SummaryKey hand = keys[0];
+  hand.unit = "km";
+  EXPECT_EQ(geohaz::testing::config_echo_problems(std::span(&hand, 1), refs),
+            (std::vector<std::string>{"depth_m (echoes a.depth): unit 'km', declared 'm'"}));
 }
 
 TEST(ReportInputs, ParametersInTheUsersTermsForTheChosenLawOnly) {

@@ -181,11 +181,11 @@ struct ConfigReader::State {
     return source;
   }
 
-  void record(const std::string& full, std::string type, std::string_view unit, std::string def, std::string range,
-              std::string_view help) {
+  void record(const std::string& full, std::string type, const KeyDoc& doc, std::string def, std::string range) {
     const std::string k = describe_path(full);
     if (ref_keys.insert(k).second)
-      refs.push_back({k, std::move(type), std::string(unit), std::move(def), std::move(range), std::string(help)});
+      refs.push_back({k, std::move(type), std::string(doc.unit), std::move(def), std::move(range),
+                      std::string(doc.help), std::string(doc.label)});
   }
 };
 
@@ -266,7 +266,7 @@ namespace {
 
 double ConfigReader::get(std::string_view key, double def, Range range, KeyDoc doc) {
   const std::string full = full_key(key);
-  state_->record(full, "number", doc.unit, num(def), range.str(), doc.help);
+  state_->record(full, "number", doc, num(def), range.str());
   state_->accessed.insert(full);
   double v = def;
   if (!state_->describe) {
@@ -290,7 +290,7 @@ double ConfigReader::get(std::string_view key, double def, Range range, KeyDoc d
 double ConfigReader::require(std::string_view key, Range range, KeyDoc doc) {
   const std::string full = full_key(key);
   if (state_->describe) {
-    state_->record(full, "number", doc.unit, "(required)", range.str(), doc.help);
+    state_->record(full, "number", doc, "(required)", range.str());
     state_->accessed.insert(full);
     double placeholder = std::isfinite(range.min) ? range.min + (range.min_open ? 1.0 : 0.0) : 1.0;
     if (!range.contains(placeholder)) placeholder = std::isfinite(range.max) ? range.max : 0.0;
@@ -307,7 +307,7 @@ double ConfigReader::require(std::string_view key, Range range, KeyDoc doc) {
 
 std::int64_t ConfigReader::get_int(std::string_view key, std::int64_t def, Range range, KeyDoc doc) {
   const std::string full = full_key(key);
-  state_->record(full, "integer", doc.unit, std::to_string(def), range.str(), doc.help);
+  state_->record(full, "integer", doc, std::to_string(def), range.str());
   state_->accessed.insert(full);
   std::int64_t v = def;
   if (!state_->describe) {
@@ -325,7 +325,7 @@ std::int64_t ConfigReader::get_int(std::string_view key, std::int64_t def, Range
 
 bool ConfigReader::get_bool(std::string_view key, bool def, KeyDoc doc) {
   const std::string full = full_key(key);
-  state_->record(full, "boolean", doc.unit, def ? "true" : "false", "true|false", doc.help);
+  state_->record(full, "boolean", doc, def ? "true" : "false", "true|false");
   state_->accessed.insert(full);
   bool v = def;
   if (!state_->describe) {
@@ -341,7 +341,7 @@ bool ConfigReader::get_bool(std::string_view key, bool def, KeyDoc doc) {
 
 std::string ConfigReader::get_string(std::string_view key, std::string_view def, KeyDoc doc) {
   const std::string full = full_key(key);
-  state_->record(full, "string", doc.unit, "\"" + std::string(def) + "\"", "", doc.help);
+  state_->record(full, "string", doc, "\"" + std::string(def) + "\"", "");
   state_->accessed.insert(full);
   std::string v(def);
   if (!state_->describe) {
@@ -383,8 +383,8 @@ std::vector<double> ConfigReader::get_array(std::string_view key, const std::vec
   std::string deftext = "[";
   for (std::size_t i = 0; i < def.size(); ++i) deftext += (i ? ", " : "") + num(def[i]);
   deftext += "]";
-  state_->record(full, expected_size ? "array[" + std::to_string(expected_size) + "]" : "array", doc.unit, deftext,
-                 range.str(), doc.help);
+  state_->record(full, expected_size ? "array[" + std::to_string(expected_size) + "]" : "array", doc, deftext,
+                 range.str());
   state_->accessed.insert(full);
   std::vector<double> v = def;
   if (!state_->describe) {
@@ -439,7 +439,7 @@ bool ConfigReader::has(std::string_view key) const {
 
 std::vector<ConfigReader> ConfigReader::tables(std::string_view key, KeyDoc doc) {
   const std::string full = full_key(key);
-  state_->record(full, "array of tables", "", "[]", "", doc.help);
+  state_->record(full, "array of tables", {"", doc.help, doc.label}, "[]", "");
   state_->accessed.insert(full);
   std::vector<ConfigReader> out;
   if (state_->describe) {

@@ -3,6 +3,8 @@
 
 #include "geohaz/core/summary_keys.hpp"
 
+#include <algorithm>
+
 namespace geohaz {
 
 namespace {
@@ -29,6 +31,18 @@ const SummaryKey* find_summary_key(std::span<const SummaryKey> keys, std::string
   for (const SummaryKey& k : keys)
     if (k.key.find('*') != std::string_view::npos && matches(k.key, key)) return &k;
   return nullptr;
+}
+
+std::vector<SummaryKey> with_config_declarations(std::span<const SummaryKey> keys, std::span<const KeyReference> refs) {
+  std::vector<SummaryKey> out(keys.begin(), keys.end());
+  for (SummaryKey& k : out) {
+    if (k.config_key.empty()) continue;
+    const auto r = std::find_if(refs.begin(), refs.end(), [&](const KeyReference& d) { return d.key == k.config_key; });
+    if (r == refs.end()) continue;  // left empty: named by the tests
+    k.unit = r->unit;
+    if (k.label.empty()) k.label = r->label;
+  }
+  return out;
 }
 
 }  // namespace geohaz

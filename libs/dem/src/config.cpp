@@ -347,7 +347,8 @@ RunConfig read_config(ConfigReader& r, bool describe) {
   const auto test = r.get_choice("test", "biaxial-compression", {"biaxial-compression", "biaxial-tension", "avalanche"},
                                  {"",
                                   "what to run: biaxial compression at one or more confining stresses, direct "
-                                  "(biaxial) tension, or a rock avalanche on a terrain profile"});
+                                  "(biaxial) tension, or a rock avalanche on a terrain profile",
+                                  "test"});
   c.kind = test == "biaxial-compression" ? TestKind::Compression
            : test == "biaxial-tension"   ? TestKind::Tension
                                          : TestKind::Avalanche;

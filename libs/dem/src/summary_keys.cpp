@@ -2,9 +2,16 @@
 /// Label, unit and group of every key dem-avalanche writes into summary.json (run.cpp
 /// lab_summary, avalanche_summary; summary_keys.hpp). A key written without a line here fails
 /// the app's tests (tests/common/summary_keys_check.hpp). Stresses and moduli of the biaxial
-/// tests are 2D values on discs 1 m thick (Pa); energies per metre of that thickness (J/m).
+/// tests are 2D values on discs 1 m thick (Pa); energies per metre of that thickness (J/m). A key
+/// whose value is a config value (config_echo) names the config key: label and unit are its
+/// declaration's (config.cpp).
 
 #include "geohaz/dem/summary_keys.hpp"
+
+#include <vector>
+
+#include "geohaz/core/config.hpp"
+#include "geohaz/dem/config.hpp"
 
 namespace geohaz::dem {
 
@@ -29,7 +36,7 @@ constexpr SummaryKey kKeys[] = {
     {"sample.locked_in_stress_Pa", "locked-in stress (x, y) after bonding", "Pa"},
     {"tests[]", "results per confining stress", "", G::Strength},
     {"tests[].name", "test", ""},
-    {"tests[].confining_stress_Pa", "confining stress σ3", "Pa", G::Strength},
+    config_echo("tests[].confining_stress_Pa", "confining stress σ3", "biaxial.confining_stresses", G::Strength),
     {"tests[].peak_stress_Pa", "peak axial stress σ1", "Pa", G::Strength},
     {"tests[].deviator_at_peak_Pa", "deviator at peak σ1 − σ3", "Pa", G::Strength},
     {"tests[].youngs_modulus_Pa", "Young's modulus E", "Pa", G::Strength},
@@ -92,14 +99,24 @@ constexpr SummaryKey kKeys[] = {
     {"steps", "time steps", "1"},
     {"model", "model", ""},
     {"version", "geohaz version", ""},
-    {"test", "test", ""},
+    config_echo("test", "test"),
     {"warnings", "warnings", ""},
 };
 
 }  // namespace
 
+std::span<const KeyReference> summary_config_declarations() {
+  static const std::vector<KeyReference> refs = [] {
+    ConfigReader d = ConfigReader::describe();
+    (void)read_config(d, true);
+    return d.reference();
+  }();
+  return refs;
+}
+
 std::span<const SummaryKey> summary_keys() noexcept {
-  return kKeys;
+  static const std::vector<SummaryKey> keys = with_config_declarations(kKeys, summary_config_declarations());
+  return keys;
 }
 
 }  // namespace geohaz::dem

@@ -24,7 +24,7 @@ namespace {
 /// not chosen is an error.
 BasalFriction read_friction(ConfigReader& cfg) {
   const std::string law = cfg.get_choice("model.friction", ModifiedManningFriction::name, BasalFrictionNames::choices(),
-                                         {"", BasalFrictionNames::help("basal shear law")});
+                                         {"", BasalFrictionNames::help("basal shear law"), "basal friction law"});
   return BasalFrictionParameters::read(cfg, {"model.", "model.friction", "set model.friction or --friction"}, law);
 }
 
@@ -45,20 +45,25 @@ void read_processes(ConfigReader& cfg, RunConfig& c) {
   const std::string law = cfg.get_choice("entrainment.law", to_string(e.law), {"none", "growth", "shear"},
                                          {"",
                                           "bed erosion: none, growth (dV/ds = E_s V, McDougall & Hungr 2005) or "
-                                          "shear (rate k_e (τ_b − τ_c) where τ_b > τ_c)"});
+                                          "shear (rate k_e (τ_b − τ_c) where τ_b > τ_c)",
+                                          "entrainment law"});
   e.law = law == "growth"  ? EntrainmentLaw::GrowthRate
           : law == "shear" ? EntrainmentLaw::ShearStress
                            : EntrainmentLaw::None;
   e.growth_rate = cfg.get("entrainment.growth_rate", e.growth_rate, Range::closed(0.0, 1.0),
-                          {"1/m", "E_s of the growth law: volume growth per metre of path inside the erodible area"});
+                          {"1/m", "E_s of the growth law: volume growth per metre of path inside the erodible area",
+                           "entrainment growth rate E_s"});
   e.critical_shear = cfg.get("entrainment.critical_shear", e.critical_shear, Range::closed(0.0, 1e7),
-                             {"Pa", "τ_c of the shear law: no erosion below this basal shear stress"});
+                             {"Pa", "τ_c of the shear law: no erosion below this basal shear stress",
+                              "entrainment critical basal shear stress"});
   e.erosion_coefficient =
       cfg.get("entrainment.coefficient", e.erosion_coefficient, Range::closed(0.0, 1.0),
-              {"m/(s*Pa)", "k_e of the shear law: erosion rate (m/s of bed depth) per Pa of excess shear"});
+              {"m/(s*Pa)", "k_e of the shear law: erosion rate (m/s of bed depth) per Pa of excess shear",
+               "entrainment erosion coefficient"});
   s.erodible =
       resolve(cfg, "entrainment.file",
-              cfg.get_string("entrainment.file", "", {"", "erodible layer: depth raster (m, vertical) or polygons"}));
+              cfg.get_string("entrainment.file", "",
+                             {"", "erodible layer: depth raster (m, vertical) or polygons", "erodible layer file"}));
   s.erodible_attribute = cfg.get_string("entrainment.attribute", s.erodible_attribute,
                                         {"", "polygon attribute holding the erodible depth (m)"});
   s.erodible_depth = cfg.get("entrainment.depth", s.erodible_depth, Range::closed(0.0, 100.0),
@@ -72,11 +77,12 @@ void read_processes(ConfigReader& cfg, RunConfig& c) {
 
   std::string zone_names;
   for (const char* n : kFrictionParameterNames) (zone_names += zone_names.empty() ? "" : ", ") += n;
-  s.zones =
-      resolve(cfg, "zones.file",
-              cfg.get_string("zones.file", "",
-                             {"", "friction zones: polygons whose attributes (the law's coefficients: " + zone_names +
-                                      ") override the global coefficients inside them"}));
+  s.zones = resolve(cfg, "zones.file",
+                    cfg.get_string("zones.file", "",
+                                   {"",
+                                    "friction zones: polygons whose attributes (the law's coefficients: " + zone_names +
+                                        ") override the global coefficients inside them",
+                                    "friction zones file"}));
   for (int k = 0; k < kFrictionParameters; ++k) {
     const std::string name = kFrictionParameterNames[static_cast<std::size_t>(k)];
     s.zone_rasters[static_cast<std::size_t>(k)] =
@@ -89,23 +95,26 @@ void read_processes(ConfigReader& cfg, RunConfig& c) {
                      cfg.get_string("forest.file", "",
                                     {"",
                                      "forest: polygons (attributes stem_density, stem_diameter) or a "
-                                     "stem-density raster (1/m^2)"}));
+                                     "stem-density raster (1/m^2)",
+                                     "forest file"}));
   s.stem_density = cfg.get("forest.stem_density", s.stem_density, Range::closed(0.0, 10.0),
                            {"1/m^2", "stems per square metre where the polygons carry none"});
   s.stem_diameter = cfg.get("forest.stem_diameter", s.stem_diameter, Range::open_closed(0.0, 5.0),
                             {"m", "stem diameter at breast height where the polygons carry none"});
-  s.drag_coefficient = cfg.get("forest.drag_coefficient", s.drag_coefficient, Range::open_closed(0.0, 10.0),
-                               {"1", "drag coefficient C_D of a stem (k_f = ½ C_D n d)"});
+  s.drag_coefficient =
+      cfg.get("forest.drag_coefficient", s.drag_coefficient, Range::open_closed(0.0, 10.0),
+              {"1", "drag coefficient C_D of a stem (k_f = ½ C_D n d)", "forest drag coefficient C_D"});
 
   s.hydrograph =
       resolve(cfg, "inflow.hydrograph",
-              cfg.get_string("inflow.hydrograph", "", {"", "inflow hydrograph table: CSV time_s,discharge_m3_per_s"}));
+              cfg.get_string("inflow.hydrograph", "",
+                             {"", "inflow hydrograph table: CSV time_s,discharge_m3_per_s", "inflow hydrograph"}));
   s.inflow_points = cfg.get_array("inflow.points", s.inflow_points, Range::closed(-1e8, 1e8),
                                   {"m", "inflow point [x, y] or short line [x1, y1, x2, y2] in the DSM's CRS"});
   s.inflow_azimuth = cfg.get("inflow.azimuth", s.inflow_azimuth, Range::closed_open(-1.0, 360.0),
                              {"deg", "inflow direction clockwise from north; -1: down the steepest slope"});
   s.inflow_speed = cfg.get("inflow.speed", s.inflow_speed, Range::open_closed(0.0, 100.0),
-                           {"m/s", "surface speed of the inflowing material"});
+                           {"m/s", "surface speed of the inflowing material", "inflow: speed"});
   if (!s.hydrograph.empty() && s.inflow_points.empty())
     throw InputError("inflow.hydrograph needs inflow.points ([x, y] or [x1, y1, x2, y2], m)", cfg.source(),
                      "inflow.points");
@@ -127,13 +136,16 @@ void read_barriers(ConfigReader& cfg, BarrierSpec& b) {
                      {"", "line attribute holding the open fraction of a slit or net barrier (1)"});
   b.permeability = cfg.get("barriers.permeability", b.permeability, Range::closed_open(0.0, 1.0),
                            {"1", "fraction of the arriving particles an open barrier lets through; 0: closed wall"});
-  b.law.restitution = cfg.get("barriers.restitution", b.law.restitution, Range::closed(0.0, 1.0),
-                              {"1", "restitution e: normal speed after hitting the wall over before (0: stopped)"});
-  b.law.friction = cfg.get("barriers.wall_friction", b.law.friction, Range::closed(0.0, 2.0),
-                           {"1", "Coulomb friction μ_w along the wall on the normal impulse"});
+  b.law.restitution = cfg.get(
+      "barriers.restitution", b.law.restitution, Range::closed(0.0, 1.0),
+      {"1", "restitution e: normal speed after hitting the wall over before (0: stopped)", "barrier: restitution e"});
+  b.law.friction =
+      cfg.get("barriers.wall_friction", b.law.friction, Range::closed(0.0, 2.0),
+              {"1", "Coulomb friction μ_w along the wall on the normal impulse", "barrier: wall friction μ_w"});
   b.law.retention_distance =
       cfg.get("barriers.retention_distance", b.law.retention_distance, Range::open_closed(0.0, 1e5),
-              {"m", "retained volume = volume upstream of the line within this distance at the end"});
+              {"m", "retained volume = volume upstream of the line within this distance at the end",
+               "barrier: retention distance"});
 }
 
 /// The map keys (docs/runout.md "Outputs"): class breaks of the depth and pressure maps, the
@@ -233,7 +245,8 @@ void read_gauges_and_profile(ConfigReader& cfg, OutputSettings& o) {
       cfg.get("output.profile_half_width", o.profile_half_width, Range::closed(0.0, 1e4),
               {"m",
                "the profile's peak values are the largest within this distance across the path (0: the cell "
-               "under the path only)"});
+               "under the path only)",
+               "profile: peaks taken within this distance across the path"});
 }
 
 }  // namespace
@@ -245,7 +258,8 @@ RunConfig read_config(ConfigReader& cfg) {
                   cfg.get_string("terrain.dsm", "",
                                  {"",
                                   "DSM raster (any GDAL format, projected CRS); the positional "
-                                  "argument overrides it"}));
+                                  "argument overrides it",
+                                  "terrain (DSM)"}));
   auto& r = c.release;
   r.file = resolve(
       cfg, "release.file",
@@ -259,7 +273,8 @@ RunConfig read_config(ConfigReader& cfg) {
       cfg.get_choice("release.thickness_direction", to_string(r.direction), {"normal", "vertical"},
                      {"",
                       "how release thicknesses (attribute, release.depth, raster) are measured: normal to the "
-                      "slope (com1DFA, RAMMS) or vertically"});
+                      "slope (com1DFA, RAMMS) or vertically",
+                      "release thickness measured"});
   r.direction = dir == "vertical" ? ThicknessDirection::Vertical : ThicknessDirection::Normal;
 
   auto& p = c.params;
@@ -275,7 +290,8 @@ RunConfig read_config(ConfigReader& cfg) {
                        {"s", "longest simulated time (the run may end earlier: run.stop_energy_fraction)"});
   p.stop_energy_fraction =
       cfg.get("run.stop_energy_fraction", p.stop_energy_fraction, Range::closed_open(0.0, 1.0),
-              {"1", "end the run when the kinetic energy falls below this fraction of its peak; 0: never"});
+              {"1", "end the run when the kinetic energy falls below this fraction of its peak; 0: never",
+               "kinetic energy fraction that ends the run"});
   p.curvature = cfg.get_bool("model.curvature", p.curvature,
                              {"", "bed curvature along the velocity in the normal force and the bed constraint"});
   p.cfl = cfg.get("numerics.cfl", p.cfl, Range::open_closed(0.0, 1.0), {"1", "Courant number on d0 with |v|+√(gh)"});
@@ -317,14 +333,17 @@ RunConfig read_config(ConfigReader& cfg) {
       cfg.get_choice("intensity.scheme", to_string(it.scheme), {"depth_speed", "pressure"},
                      {"",
                       "intensity classes: depth_speed (Swiss debris-flow guideline: strong where peak depth > "
-                      "strong_depth and peak speed > strong_speed, medium elsewhere reached) or pressure"});
+                      "strong_depth and peak speed > strong_speed, medium elsewhere reached) or pressure",
+                      "intensity scheme"});
   it.scheme = scheme == "pressure" ? IntensityScheme::Pressure : IntensityScheme::DepthSpeed;
   it.min_depth = cfg.get("intensity.min_depth", it.min_depth, Range::closed(0.0, 100.0),
                          {"m", "a cell counts as reached when its peak depth exceeds this"});
   it.strong_depth = cfg.get("intensity.strong_depth", it.strong_depth, Range::open_closed(0.0, 100.0),
-                            {"m", "depth_speed: peak depth above which (with the speed) a cell is strong"});
+                            {"m", "depth_speed: peak depth above which (with the speed) a cell is strong",
+                             "intensity: strong above the depth"});
   it.strong_speed = cfg.get("intensity.strong_speed", it.strong_speed, Range::open_closed(0.0, 200.0),
-                            {"m/s", "depth_speed: peak speed above which (with the depth) a cell is strong"});
+                            {"m/s", "depth_speed: peak speed above which (with the depth) a cell is strong",
+                             "intensity: strong above the speed"});
   const std::vector<double> classes = cfg.get_array(
       "intensity.pressure_classes", {it.medium_pressure, it.strong_pressure}, Range::open_closed(0.0, 1e9),
       {"Pa", "pressure: [medium, strong] lower bounds of peak ρv², increasing"}, 2);

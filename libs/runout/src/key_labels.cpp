@@ -35,6 +35,7 @@ std::optional<FrictionKey> case_key(std::string_view key) {
   const auto& refs = case_reference();
   const auto r = std::find_if(refs.begin(), refs.end(), [&](const KeyReference& k) { return k.key == key; });
   if (r == refs.end()) return std::nullopt;
+  if (!r->label.empty()) return FrictionKey{r->key, r->label, r->unit};  // the declared short label
   std::string label = r->help;
   std::size_t cut = label.size();
   for (const char* sep : {" (", ": ", "; ", ", "}) cut = std::min(cut, label.find(sep));

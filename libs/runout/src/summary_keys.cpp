@@ -2,9 +2,18 @@
 /// Label, unit and group of every key debris-runout (run.cpp summary_json, run_outputs.cpp),
 /// geohaz-ensemble (ensemble.cpp) and geohaz-calibrate (calibrate_outputs.cpp) write into
 /// summary.json (summary_keys.hpp). A key written without a line here fails the apps' tests
-/// (tests/common/summary_keys_check.hpp).
+/// (tests/common/summary_keys_check.hpp). A key whose value is a config value (config_echo) names
+/// the config key: label and unit are its declaration's (config.cpp, ensemble.cpp, calibrate.cpp).
 
 #include "geohaz/runout/summary_keys.hpp"
+
+#include <utility>
+#include <vector>
+
+#include "geohaz/core/config.hpp"
+#include "geohaz/runout/calibrate.hpp"
+#include "geohaz/runout/config.hpp"
+#include "geohaz/runout/ensemble.hpp"
 
 namespace geohaz::runout {
 
@@ -46,7 +55,7 @@ constexpr SummaryKey kKeys[] = {
     {"profile.top_elevation_m", "profile: elevation of the top", "m", G::Reach},
     {"profile.runout_elevation_m", "profile: elevation of the run-out point", "m", G::Reach},
     {"profile.runout_xy_m", "profile: run-out point (x, y)", "m", G::Reach},
-    {"profile.half_width_m", "profile: peaks taken within this distance across the path", "m", G::Reach},
+    config_echo("profile.half_width_m", "output.profile_half_width", G::Reach),
     {"profile.path", "profile path", "", G::Reach},
     {"profile.reached", "the flow reached the profile path", "", G::Reach},
     {"centre_of_mass.travel_m", "centre of mass: horizontal travel", "m", G::Reach},
@@ -70,15 +79,15 @@ constexpr SummaryKey kKeys[] = {
     {"steps", "time steps", "1"},
     {"wall_time_s", "wall-clock time", "s"},
     {"threads", "threads", "1"},
-    {"stop_energy_fraction", "kinetic energy fraction that ends the run", "1"},
+    config_echo("stop_energy_fraction", "run.stop_energy_fraction"),
     {"mass_balance_error_relative", "relative mass-balance error", "1"},
     {"mobile_at_end.in_deposit_raster", "the moving mass is in the deposit raster", ""},
-    {"release_thickness_direction", "release thickness measured", ""},
-    {"intensity.scheme", "intensity scheme", ""},
-    {"intensity.strong_depth_m", "intensity: strong above the depth", "m"},
-    {"intensity.strong_speed_m_per_s", "intensity: strong above the speed", "m/s"},
-    {"intensity.medium_pressure_pa", "intensity: medium from the pressure", "Pa"},
-    {"intensity.strong_pressure_pa", "intensity: strong from the pressure", "Pa"},
+    config_echo("release_thickness_direction", "release.thickness_direction"),
+    config_echo("intensity.scheme", "intensity.scheme"),
+    config_echo("intensity.strong_depth_m", "intensity.strong_depth"),
+    config_echo("intensity.strong_speed_m_per_s", "intensity.strong_speed"),
+    config_echo("intensity.medium_pressure_pa", "intensity: medium from the pressure", "intensity.pressure_classes"),
+    config_echo("intensity.strong_pressure_pa", "intensity: strong from the pressure", "intensity.pressure_classes"),
     {"detached.volume_m3", "detached particles: volume", "m^3"},
     {"detached.particles", "detached particles", "1"},
     {"detached.on_raster_at_end_m3", "detached particles: volume on the raster at the end", "m^3"},
@@ -97,25 +106,25 @@ constexpr SummaryKey kKeys[] = {
     {"left_raster.last_seen[].volume_m3", "last seen: volume", "m^3"},
     {"left_raster.last_seen[].detached", "last seen: detached", ""},
     {"left_raster.last_seen[].where", "last seen: where", ""},
-    {"processes.entrainment.law", "entrainment law", ""},
-    {"processes.entrainment.growth_rate_per_m", "entrainment growth rate E_s", "1/m"},
-    {"processes.entrainment.critical_shear_pa", "entrainment critical basal shear stress", "Pa"},
-    {"processes.entrainment.coefficient_m_per_s_pa", "entrainment erosion coefficient", "m/(s*Pa)"},
+    config_echo("processes.entrainment.law", "entrainment.law"),
+    config_echo("processes.entrainment.growth_rate_per_m", "entrainment.growth_rate"),
+    config_echo("processes.entrainment.critical_shear_pa", "entrainment.critical_shear"),
+    config_echo("processes.entrainment.coefficient_m_per_s_pa", "entrainment.coefficient"),
     {"processes.entrainment.entrained_volume_m3", "volume entrained", "m^3"},
     {"processes.entrainment.growth_factor", "volume growth factor by entrainment", "1"},
-    {"processes.entrainment.file", "erodible layer file", ""},
+    config_echo("processes.entrainment.file", "entrainment.file"),
     {"processes.entrainment.terrain", "terrain under erosion", ""},
-    {"processes.friction_zones.file", "friction zones file", ""},
+    config_echo("processes.friction_zones.file", "zones.file"),
     {"processes.friction_zones.coefficients", "coefficients set by zones", ""},
-    {"processes.forest.file", "forest file", ""},
+    config_echo("processes.forest.file", "forest.file"),
     {"processes.forest.area_m2", "forest area", "m^2"},
     {"processes.forest.max_drag_per_m", "largest forest drag k_f", "1/m"},
-    {"processes.forest.drag_coefficient", "forest drag coefficient C_D", "1"},
-    {"processes.inflow.hydrograph", "inflow hydrograph", ""},
+    config_echo("processes.forest.drag_coefficient", "forest.drag_coefficient"),
+    config_echo("processes.inflow.hydrograph", "inflow.hydrograph"),
     {"processes.inflow.volume_of_table_m3", "inflow: volume of the hydrograph table", "m^3"},
     {"processes.inflow.injected_m3", "inflow: volume injected", "m^3"},
     {"processes.inflow.end_time_s", "inflow: end of the hydrograph", "s"},
-    {"processes.inflow.speed_m_per_s", "inflow: speed", "m/s"},
+    config_echo("processes.inflow.speed_m_per_s", "inflow.speed"),
     {"processes.inflow.direction_xy", "inflow: direction (x, y)", "1"},
     {"barriers[]", "barriers", "", G::Peak},
     {"barriers[].name", "barrier", ""},
@@ -131,10 +140,10 @@ constexpr SummaryKey kKeys[] = {
     {"barriers[].overtopped_volume_m3", "volume overtopped", "m^3"},
     {"barriers[].impulse_n_s", "impulse", "N*s"},
     {"barriers[].vertices_xy_m", "vertices (x, y)", "m"},
-    {"barrier_law.restitution", "barrier: restitution", "1"},
-    {"barrier_law.wall_friction", "barrier: wall friction", "1"},
-    {"barrier_law.retention_distance_m", "barrier: retention distance", "m"},
-    {"barrier_law.force_window_s", "barrier: force averaging window", "s"},
+    config_echo("barrier_law.restitution", "barriers.restitution"),
+    config_echo("barrier_law.wall_friction", "barriers.wall_friction"),
+    config_echo("barrier_law.retention_distance_m", "barriers.retention_distance"),
+    config_echo("barrier_law.force_window_s", "barrier: force averaging window", "output.series_interval"),
     {"gauges[]", "gauges", "", G::Peak},
     {"gauges[].name", "gauge", ""},
     {"gauges[].kind", "kind", ""},
@@ -145,17 +154,17 @@ constexpr SummaryKey kKeys[] = {
     {"gauges[].net_volume_m3", "net volume that passed", "m^3"},
     {"model", "model", ""},
     {"version", "geohaz version", ""},
-    {"dsm", "terrain (DSM)", ""},
+    config_echo("dsm", "terrain.dsm"),
     {"release", "release", ""},
-    {"friction", "basal friction law", ""},
+    config_echo("friction", "model.friction"),
     {"warnings", "warnings", ""},
 
     // geohaz-ensemble (ensemble.cpp): the statistics over the members that ran
     {"members", "members", "1"},
     {"succeeded", "members that ran to the end", "1"},
     {"unfinished_members", "members ending with mass still moving", "1"},
-    {"sampling", "sampling", ""},
-    {"seed", "seed", "1"},
+    config_echo("sampling", "ensemble.sampling"),
+    config_echo("seed", "ensemble.seed"),
     {"base_case", "base case", ""},
     {"runout_length_along_path_m.*", "run-out length along the path", "m", G::Reach},
     {"fahrboeschung_ratio_H_over_L.*", "H/L of the toe path (Fahrböschung)", "1", G::Reach},
@@ -181,7 +190,7 @@ constexpr SummaryKey kKeys[] = {
     {"release_alternatives", "alternative release files", ""},
     {"products", "products", ""},
     {"percentile_accuracy.method", "percentile maps: method", ""},
-    {"percentile_accuracy.bins", "percentile maps: histogram bins", "1"},
+    config_echo("percentile_accuracy.bins", "products.bins"),
     {"percentile_accuracy.max_relative_error_depth", "percentile maps: largest relative error of depth", "1"},
     {"percentile_accuracy.max_relative_error_speed", "percentile maps: largest relative error of speed", "1"},
     {"percentile_accuracy.max_relative_error_pressure", "percentile maps: largest relative error of pressure", "1"},
@@ -222,21 +231,21 @@ constexpr SummaryKey kKeys[] = {
     {"observation.deposit_raster", "observed deposit raster given", ""},
     {"observation.volume_m3", "observed deposit volume", "m^3", G::Volumes},
     {"score.definition", "score", ""},
-    {"score.depth_threshold_m", "affected above the peak depth", "m"},
-    {"score.tversky_alpha", "Tversky α (weight of false positives)", "1"},
-    {"score.tversky_beta", "Tversky β (weight of false negatives)", "1"},
-    {"score.w_footprint", "weight of the footprint term", "1"},
-    {"score.w_runout", "weight of the run-out term", "1"},
-    {"score.w_depth", "weight of the deposit term", "1"},
-    {"score.w_volume", "weight of the volume term", "1"},
-    {"score.failed_penalty", "score of a failed member", "1"},
-    {"score.acceptable_tolerance", "acceptable within this score of the best", "1"},
-    {"design_members", "members of the design", "1"},
+    config_echo("score.depth_threshold_m", "score.depth_threshold"),
+    config_echo("score.tversky_alpha", "score.tversky_alpha"),
+    config_echo("score.tversky_beta", "score.tversky_beta"),
+    config_echo("score.w_footprint", "score.w_footprint"),
+    config_echo("score.w_runout", "score.w_runout"),
+    config_echo("score.w_depth", "score.w_depth"),
+    config_echo("score.w_volume", "score.w_volume"),
+    config_echo("score.failed_penalty", "score.failed_penalty"),
+    config_echo("score.acceptable_tolerance", "score.acceptable_tolerance"),
+    config_echo("design_members", "calibration.global_members"),
     {"morris_members", "members of the Morris trajectories", "1"},
     {"local_members", "members of the local searches", "1"},
-    {"local_search.algorithm", "local search algorithm", ""},
-    {"local_search.starts", "local searches", "1"},
-    {"local_search.restarts", "local searches restarted when one ends", ""},
+    config_echo("local_search.algorithm", "calibration.local_algorithm"),
+    config_echo("local_search.starts", "calibration.local_starts"),
+    config_echo("local_search.restarts", "calibration.local_restarts"),
     {"local_search.searches", "local searches run", "1"},
     {"local_search.stops", "why the local searches ended", ""},
     {"acceptable_members", "acceptable members", "1"},
@@ -252,8 +261,24 @@ constexpr SummaryKey kKeys[] = {
 
 }  // namespace
 
+std::span<const KeyReference> summary_config_declarations() {
+  static const std::vector<KeyReference> refs = [] {
+    ConfigReader run = ConfigReader::describe(), ensemble = ConfigReader::describe(),
+                 calibration = ConfigReader::describe();
+    (void)read_config(run);
+    describe_ensemble(ensemble);
+    describe_calibration(calibration);
+    std::vector<KeyReference> all = run.reference();
+    for (const ConfigReader* r : {&ensemble, &calibration})
+      for (KeyReference& k : r->reference()) all.push_back(std::move(k));
+    return all;
+  }();
+  return refs;
+}
+
 std::span<const SummaryKey> summary_keys() noexcept {
-  return kKeys;
+  static const std::vector<SummaryKey> keys = with_config_declarations(kKeys, summary_config_declarations());
+  return keys;
 }
 
 }  // namespace geohaz::runout

@@ -32,13 +32,14 @@ WallType wall(ConfigReader& r, const char* key, const char* def) {
 /// [run] and [strength_reduction]: dimension, scenario, analysis, times, restart.
 void read_run(ConfigReader& r, RunConfig& c) {
   // [run]
-  c.dimension =
-      static_cast<int>(r.get_int("run.dimension", c.dimension, Range::closed(2, 3), {"1", "2 (plane strain) or 3"}));
+  c.dimension = static_cast<int>(
+      r.get_int("run.dimension", c.dimension, Range::closed(2, 3), {"1", "2 (plane strain) or 3", "dimension"}));
   const auto sc = r.get_choice("run.scenario", "slope", {"slope", "column", "biaxial", "section", "block"},
                                {"",
                                 "scenario type: parametric slope, granular column collapse, biaxial specimen, "
                                 "DSM cross-section, block (a rectangle of soil, e.g. an elastic beam with "
-                                "clamp.boxes)"});
+                                "clamp.boxes)",
+                                "scenario"});
   c.scenario = sc == "slope"     ? ScenarioType::Slope
                : sc == "column"  ? ScenarioType::Column
                : sc == "biaxial" ? ScenarioType::Biaxial
@@ -51,7 +52,8 @@ void read_run(ConfigReader& r, RunConfig& c) {
                     "strength reduction from the geostatic state, with Bishop's factor beside it "
                     "([strength_reduction]); limit_equilibrium: Bishop's method only (2D slope), with "
                     "[water] and [seismic], the yield coefficient k_y and, with an [earthquake], the Newmark "
-                    "displacement"});
+                    "displacement",
+                    "analysis"});
   c.analysis = analysis == "dynamic"              ? Analysis::Dynamic
                : analysis == "strength_reduction" ? Analysis::StrengthReduction
                                                   : Analysis::LimitEquilibrium;
@@ -62,20 +64,25 @@ void read_run(ConfigReader& r, RunConfig& c) {
         r.get("strength_reduction.f_min", d.f_min, Range::positive(), {"1", "lower end of the initial F bracket"});
     q.f_max = r.get("strength_reduction.f_max", d.f_max, Range::positive(),
                     {"1", "upper end of the initial F bracket (> f_min)"});
-    q.tolerance = r.get("strength_reduction.tolerance", d.tolerance, Range::positive(),
-                        {"1", "bisection stops when the bracket of F is narrower than this"});
-    q.damping = r.get("strength_reduction.damping", d.damping, Range::closed_open(0.0, 1.0),
-                      {"1", "Cundall local damping zeta of the quasi-static trials"});
-    q.trial_duration = r.get("strength_reduction.trial_duration", d.trial_duration, Range::non_negative(),
-                             {"s", "simulated time of each trial (0: 30 H / c_p)"});
+    q.tolerance = r.get(
+        "strength_reduction.tolerance", d.tolerance, Range::positive(),
+        {"1", "bisection stops when the bracket of F is narrower than this", "strength reduction: bracket tolerance"});
+    q.damping = r.get(
+        "strength_reduction.damping", d.damping, Range::closed_open(0.0, 1.0),
+        {"1", "Cundall local damping zeta of the quasi-static trials", "strength reduction: damping of the trials"});
+    q.trial_duration =
+        r.get("strength_reduction.trial_duration", d.trial_duration, Range::non_negative(),
+              {"s", "simulated time of each trial (0: 30 H / c_p)", "strength reduction: duration of a trial"});
     q.knee_ratio = r.get("strength_reduction.knee_ratio", d.knee_ratio, Range::open_closed(1.0, 1e6),
                          {"1",
                           "a trial fails when its largest displacement exceeds this multiple of that of the "
-                          "f_min trial (the knee of the F-displacement curve)"});
+                          "f_min trial (the knee of the F-displacement curve)",
+                          "strength reduction: knee ratio"});
     q.growth_ratio = r.get("strength_reduction.growth_ratio", d.growth_ratio, Range::open_closed(0.0, 1.0),
                            {"1",
                             "a trial fails when its largest displacement grew by more than this fraction of its "
-                            "final value over the last quarter of the trial"});
+                            "final value over the last quarter of the trial",
+                            "strength reduction: displacement growth ratio of failure"});
   }
   c.end_time = r.get("run.end_time", c.end_time, Range::positive(), {"s", "simulated time of the main phase"});
   c.output_interval = r.get("run.output_interval", c.output_interval, Range::positive(), {"s", "time-series interval"});
@@ -83,15 +90,16 @@ void read_run(ConfigReader& r, RunConfig& c) {
                               {"s", "HDF5 snapshot interval (0: first and last only)"});
   c.velocity_png_times = r.get_array("run.velocity_png_times", {}, Range::non_negative(),
                                      {"s", "times of quick-look PNGs of the speed field"});
-  c.rest_speed =
-      r.get("run.rest_speed", c.rest_speed, Range::positive(), {"m/s", "max speed below which the mass is at rest"});
+  c.rest_speed = r.get("run.rest_speed", c.rest_speed, Range::positive(),
+                       {"m/s", "max speed below which the mass is at rest", "at rest below the speed"});
   c.stop_at_rest =
       r.get_bool("run.stop_at_rest", c.stop_at_rest,
                  {"", "stop when max speed < rest_speed (after max(0.05 s, end_time/10) and any shaking)"});
   const auto restart = r.get_string("run.restart", "",
                                     {"",
                                      "snapshot file (snapshots.h5) to restart from; "
-                                     "skips the geostatic phase"});
+                                     "skips the geostatic phase",
+                                     "restarted from"});
   if (!restart.empty())
     c.restart = std::filesystem::path(restart).is_absolute() ? std::filesystem::path(restart) : r.base_dir() / restart;
 }
@@ -158,7 +166,8 @@ void read_numerics(ConfigReader& r, RunConfig& c) {
   // [numerics]
   auto& n = c.numerics;
   const NumericalSettings d;  // the defaults (solver.hpp)
-  n.spacing = r.get("numerics.spacing", d.spacing, Range::positive(), {"m", "initial particle spacing dx"});
+  n.spacing =
+      r.get("numerics.spacing", d.spacing, Range::positive(), {"m", "initial particle spacing dx", "particle spacing"});
   n.h_factor =
       r.get("numerics.h_factor", d.h_factor, Range::closed(1.0, 2.0), {"1", "smoothing length h = h_factor dx"});
   {  // from the kernels' name table (solver.hpp)
@@ -246,8 +255,8 @@ void read_geostatic_and_earthquake(ConfigReader& r, RunConfig& c) {
   auto& n = c.numerics;
   // [geostatic]
   c.geostatic = r.get_bool("geostatic.enabled", c.geostatic, {"", "apply gravity gradually before the main phase"});
-  c.geostatic_duration =
-      r.get("geostatic.duration", c.geostatic_duration, Range::non_negative(), {"s", "0: 20 H / c_p"});
+  c.geostatic_duration = r.get("geostatic.duration", c.geostatic_duration, Range::non_negative(),
+                               {"s", "0: 20 H / c_p", "geostatic phase: duration"});
   c.geostatic_damping = r.get("geostatic.damping", c.geostatic_damping, Range::closed_open(0.0, 1.0),
                               {"1", "Cundall zeta while loading"});
   c.geostatic_elastic = r.get_bool("geostatic.elastic", c.geostatic_elastic, {"", "linear-elastic soil while loading"});
@@ -291,7 +300,8 @@ void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
   const auto line = r.get_array("water.phreatic", {}, {},
                                 {"m",
                                  "phreatic surface x0, z0, x1, z1, ... (x non-decreasing, level beyond the ends); "
-                                 "u = water density g h_w below it; empty: none"});
+                                 "u = water density g h_w below it; empty: none",
+                                 "phreatic surface (x, z)"});
   if (line.size() % 2 || line.size() == 2)
     throw InputError("needs pairs x, z of at least two points", r.source(), "water.phreatic",
                      std::to_string(line.size()) + " numbers");
@@ -300,7 +310,8 @@ void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
                {"1",
                 "pore-pressure ratio r_u = u / (gamma h): u = r_u times the vertical overburden stress on Bishop's "
                 "slice bases and at every SPH particle (slope, DSM section: the column of its cover and base; 2D "
-                "and 3D; not with water.phreatic)"});
+                "and 3D; not with water.phreatic)",
+                "pore pressure ratio r_u"});
   const double rho_w = r.get("water.density", 1000.0, Range::closed(900.0, 1300.0), {"kg/m^3", "density of water"});
   w.unit_weight = rho_w * c.numerics.gravity;
   w.head_loss_correction =
@@ -308,19 +319,23 @@ void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
                    {"",
                     "vertical_head: u = gamma_w h_w (h_w the depth below the phreatic surface, hydrostatic); "
                     "head_loss_corrected: u = gamma_w h_w cos^2(theta), theta the phreatic surface's inclination "
-                    "(steady seepage parallel to it; Slide's automatic H_u)"}) == "head_loss_corrected";
+                    "(steady seepage parallel to it; Slide's automatic H_u)",
+                    "pore pressure"}) == "head_loss_corrected";
   c.water_history_times =
       r.get_array("water.history_times", {}, Range::non_negative(),
-                  {"s", "main-phase times of the water-table history (increasing; SPH runs with water.phreatic)"});
+                  {"s", "main-phase times of the water-table history (increasing; SPH runs with water.phreatic)",
+                   "water level history: times"});
   c.water_history_offsets =
       r.get_array("water.history_offsets", {}, {},
-                  {"m", "rise of the phreatic surface at those times (linear between, held after; + up)"});
+                  {"m", "rise of the phreatic surface at those times (linear between, held after; + up)",
+                   "water level history: rise of the phreatic surface"});
   {
     const auto table = r.get_string("water.table_raster", "",
                                     {"",
                                      "raster of the water table's elevation (m) in the DSM's CRS: a DSM section's "
                                      "phreatic surface, cut along the section (2D) or sampled over the strip (3D); "
-                                     "clipped to the ground; not with water.phreatic, water.ru or rain"});
+                                     "clipped to the ground; not with water.phreatic, water.ru or rain",
+                                     "water-table raster"});
     if (!table.empty())
       c.water_table_raster = std::filesystem::path(table).is_absolute() ? table : (r.base_dir() / table).string();
     const auto pore = r.get_string(
@@ -329,7 +344,8 @@ void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
          "raster of the pore pressure u_b (Pa) at the base of a DSM section's soil cover (section.soil_thickness "
          "below the ground; e.g. gamma_w times a pressure head of slope-stability) in the DSM's CRS: the "
          "piezometric level z_g - D + u_b / (rho_w g) above and below (hydrostatic in the vertical), clipped to "
-         "the ground; not with another source of pore water"});
+         "the ground; not with another source of pore water",
+         "pore-pressure raster (at the base of the cover)"});
     if (!pore.empty())
       c.pore_pressure_raster = std::filesystem::path(pore).is_absolute() ? pore : (r.base_dir() / pore).string();
   }
@@ -346,12 +362,14 @@ void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
                              {"s",
                               "the rain's time t_rain whose pore pressure the strength reduction and the "
                               "limit-equilibrium analysis take (a dynamic run follows rain.clock_times); default: "
-                              "the end of the rain"});
+                              "the end of the rain",
+                              "rain time of the pore pressure (strength reduction, limit equilibrium)"});
   const auto clock = r.get_array("rain.clock_times", {}, Range::non_negative(),
                                  {"s",
                                   "the rain's clock: pairs t, t_rain of main-phase time t and the rain's time t_rain "
                                   "there, linear between, held beyond (e.g. [0, 0, 10, 86400]: a day of rain in 10 s "
-                                  "of SPH); empty: t_rain = t"});
+                                  "of SPH); empty: t_rain = t",
+                                  "rain: clock (run time, rain time) pairs"});
   if (clock.size() % 2 || clock.size() == 2)
     throw InputError("needs pairs t, t_rain of at least two points", r.source(), "rain.clock_times",
                      std::to_string(clock.size()) + " numbers");
@@ -367,18 +385,22 @@ void read_water_and_seismic(ConfigReader& r, RunConfig& c) {
   c.seismic.kh = r.get("seismic.kh", c.seismic.kh, Range::closed_open(0.0, 1.0),
                        {"1",
                         "horizontal pseudo-static coefficient: a force k_h W in the direction of sliding "
-                        "(limit-equilibrium analysis and strength-reduction trials)"});
+                        "(limit-equilibrium analysis and strength-reduction trials)",
+                        "horizontal seismic coefficient k_h"});
   c.seismic.kv = r.get("seismic.kv", c.seismic.kv, Range::closed(-0.5, 0.5),
-                       {"1", "vertical pseudo-static coefficient, positive upward: the weight becomes (1 - k_v) W"});
+                       {"1", "vertical pseudo-static coefficient, positive upward: the weight becomes (1 - k_v) W",
+                        "vertical seismic coefficient k_v"});
 }
 
 void read_output(ConfigReader& r, RunConfig& c) {
   // [output]
   c.failed_threshold = r.get("output.failed_threshold", c.failed_threshold, Range::positive(),
-                             {"m", "displacement above which soil counts as failed (failed mass, slip surface)"});
+                             {"m", "displacement above which soil counts as failed (failed mass, slip surface)",
+                              "failed above the displacement"});
   c.front_thickness =
       r.get("output.front_thickness", c.front_thickness, Range::non_negative(),
-            {"m", "deposit thickness that defines the front (0: 2 spacings); fix it to compare resolutions"});
+            {"m", "deposit thickness that defines the front (0: 2 spacings); fix it to compare resolutions",
+             "front thickness"});
   c.bulking_factor =
       r.get("output.bulking_factor", c.bulking_factor, Range::closed(1.0, 3.0), {"1", "volume factor for release.h5"});
   c.write_release = r.get_bool("output.release", c.write_release,

@@ -114,18 +114,23 @@ InfiltrationKeys read_infiltration_keys(ConfigReader& cfg) {
   InfiltrationKeys k;
   auto& h = k.hydrology;
   h.conductivity = cfg.get("hydrology.conductivity", h.conductivity, Range::positive(),
-                           {"m/s", "saturated hydraulic conductivity K_s (rain beyond it runs off)"});
-  h.diffusivity = cfg.get("hydrology.diffusivity", h.diffusivity, Range::positive(),
-                          {"m^2/s", "maximum hydraulic diffusivity D_0 (= K_s / specific storage)"});
+                           {"m/s", "saturated hydraulic conductivity K_s (rain beyond it runs off)",
+                            "rain: saturated hydraulic conductivity K_s"});
+  h.diffusivity = cfg.get(
+      "hydrology.diffusivity", h.diffusivity, Range::positive(),
+      {"m^2/s", "maximum hydraulic diffusivity D_0 (= K_s / specific storage)", "rain: hydraulic diffusivity D_0"});
   h.steady_flux = cfg.get("hydrology.steady_infiltration", h.steady_flux, Range::non_negative(),
-                          {"m/s", "long-term infiltration rate I_ZLT before the rain (< K_s cos^2 delta)"});
+                          {"m/s", "long-term infiltration rate I_ZLT before the rain (< K_s cos^2 delta)",
+                           "rain: steady background infiltration"});
   k.water_table_depth =
       cfg.get("hydrology.water_table_depth", k.water_table_depth, Range::non_negative(),
-              {"m", "initial water table depth d below the ground, vertical (>= 0: not above the ground)"});
-  const double step = cfg.get("rain.step", 3600.0, Range::open_closed(0.0, 1e7), {"s", "length of each rain step"});
+              {"m", "initial water table depth d below the ground, vertical (>= 0: not above the ground)",
+               "rain: initial water-table depth"});
+  const double step = cfg.get("rain.step", 3600.0, Range::open_closed(0.0, 1e7),
+                              {"s", "length of each rain step", "rain: hyetograph step"});
   const std::vector<double> intensity =
       cfg.get_array("rain.intensity", {2.78e-6}, Range::closed(0.0, 1e-2),
-                    {"m/s", "intensity of each step in turn (1 mm/h = 2.778e-7 m/s); then no rain"});
+                    {"m/s", "intensity of each step in turn (1 mm/h = 2.778e-7 m/s); then no rain", "rain: intensity"});
   k.rain = RainfallHistory::uniform_steps(step, intensity);
   if (h.steady_flux >= h.conductivity)
     throw InputError("the long-term infiltration must be below K_s (" + number(h.conductivity) + " m/s)", cfg.source(),

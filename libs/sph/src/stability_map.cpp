@@ -64,7 +64,8 @@ StabilityMapCase read_stability_map_case(ConfigReader& cfg) {
   c.dsm = resolve(cfg, cfg.get_string("terrain.dsm", "",
                                       {"",
                                        "DSM raster (any GDAL format, projected CRS, m); the positional argument "
-                                       "overrides it"}));
+                                       "overrides it",
+                                       "terrain (DSM)"}));
   // Soil cover.
   c.soil_depth = cfg.get("soil.depth", c.soil_depth, Range::open_closed(0.0, 100.0),
                          {"m", "vertical depth Z of the failure plane (soil-bedrock contact); the release thickness"});
@@ -98,8 +99,8 @@ StabilityMapCase read_stability_map_case(ConfigReader& cfg) {
       resolve(cfg, cfg.get_string("hydrology.water_table_raster", "",
                                   {"", "raster of d (m) on the DSM's grid; overrides hydrology.water_table_depth"}));
   // Run and outputs.
-  c.duration =
-      cfg.get("run.duration", c.duration, Range::closed(0.0, 1e8), {"s", "simulated time; 0: the end of the rain"});
+  c.duration = cfg.get("run.duration", c.duration, Range::closed(0.0, 1e8),
+                       {"s", "simulated time; 0: the end of the rain", "simulated duration"});
   c.time_step = cfg.get("run.time_step", c.time_step, Range::open_closed(0.0, 1e7),
                         {"s", "evaluation step (failure times are refined between evaluations)"});
   c.output_every =

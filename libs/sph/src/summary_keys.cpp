@@ -5,15 +5,21 @@
 /// without a line here fails the apps' tests (tests/common/summary_keys_check.hpp). A 2D run
 /// stands for one metre of width: its areas, forces and moments are per metre (m²/m, N/m, N·m/m).
 /// The figures of each material (materials[].K_Pa, ...) are not listed here: they come from the
-/// constitutive models' declarations (constitutive.hpp, MaterialFigure).
+/// constitutive models' declarations (constitutive.hpp, MaterialFigure). A key whose value is a
+/// config value (config_echo) names the config key: label and unit are its declaration's
+/// (config.cpp, infiltration.cpp, stability_map.cpp).
 
 #include "geohaz/sph/summary_keys.hpp"
 
 #include <iterator>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "geohaz/core/config.hpp"
+#include "geohaz/sph/config.hpp"
 #include "geohaz/sph/constitutive.hpp"
+#include "geohaz/sph/stability_map.hpp"
 
 namespace geohaz::sph {
 
@@ -134,7 +140,7 @@ constexpr SummaryKey kKeys[] = {
     {"rain.end_s", "rain: end", "s"},
     {"rain.total_depth_m", "rain: total depth", "m"},
     {"rain.peak_intensity_m_per_s", "rain: peak intensity", "m/s"},
-    {"duration_s", "simulated duration", "s", G::Time},
+    config_echo("duration_s", "run.duration", G::Time),
     {"series[]", "unstable cells over time", ""},
     {"series[].time_s", "time", "s"},
     {"series[].unstable_cells", "unstable cells", "1"},
@@ -145,64 +151,63 @@ constexpr SummaryKey kKeys[] = {
     {"domain_decomposition.migrated_particles", "particles that changed rank", "1"},
     {"domain_decomposition.partitions", "partitions of the domain", "1"},
     {"domain_decomposition.rebuilds", "neighbour-list rebuilds", "1"},
-    {"scenario", "scenario", ""},
-    {"analysis", "analysis", ""},
-    {"dimension", "dimension", "1"},
+    config_echo("scenario", "run.scenario"),
+    config_echo("analysis", "run.analysis"),
+    config_echo("dimension", "run.dimension"),
     {"model", "model", ""},
     {"version", "geohaz version", ""},
     {"config", "config", ""},
-    {"dsm", "terrain (DSM)", ""},
+    config_echo("dsm", "terrain.dsm"),
     {"threads", "threads", "1"},
     {"soil_particles", "soil particles", "1"},
     {"boundary_particles", "boundary particles", "1"},
-    {"spacing_m", "particle spacing", "m"},
+    config_echo("spacing_m", "numerics.spacing"),
     {"smoothing_length_m", "smoothing length", "m"},
     {"steps", "time steps", "1"},
     {"time_step_s", "time step", "s"},
-    {"failed_threshold_m", "failed above the displacement", "m"},
-    {"front_thickness_m", "front thickness", "m"},
-    {"rest_speed_m_per_s", "at rest below the speed", "m/s"},
+    config_echo("failed_threshold_m", "output.failed_threshold"),
+    config_echo("front_thickness_m", "output.front_thickness"),
+    config_echo("rest_speed_m_per_s", "run.rest_speed"),
     {"bytes_per_particle", "memory per particle", "bytes"},
     {"wall_time_s", "wall-clock time", "s"},
-    {"seismic.kh", "horizontal seismic coefficient k_h", "1"},
-    {"seismic.kv", "vertical seismic coefficient k_v", "1"},
-    {"water.phreatic_surface", "phreatic surface (x, z)", "m"},
-    {"water.ru", "pore pressure ratio r_u", "1"},
+    config_echo("seismic.kh", "seismic.kh"),
+    config_echo("seismic.kv", "seismic.kv"),
+    config_echo("water.phreatic_surface", "water.phreatic"),
+    config_echo("water.ru", "water.ru"),
     {"water.unit_weight_N_per_m3", "unit weight of water", "N/m^3"},
-    {"water.pore_pressure", "pore pressure", ""},
+    config_echo("water.pore_pressure", "water.pore_pressure"),
     {"water.source", "pore water from", ""},
-    {"water.table_raster", "water-table raster", ""},
-    {"water.pore_pressure_raster", "pore-pressure raster (at the base of the cover)", ""},
-    {"water.history_times_s", "water level history: times", "s"},
-    {"water.history_offsets_m", "water level history: rise of the phreatic surface", "m"},
+    config_echo("water.table_raster", "water.table_raster"),
+    config_echo("water.pore_pressure_raster", "water.pore_pressure_raster"),
+    config_echo("water.history_times_s", "water.history_times"),
+    config_echo("water.history_offsets_m", "water.history_offsets"),
     {"water.max_pore_pressure_Pa", "largest pore pressure", "Pa", G::Peak},
     {"water.max_pore_pressure_time_s", "time of the largest pore pressure", "s", G::Time},
-    {"water.rain.intensity_m_per_s", "rain: intensity", "m/s"},
-    {"water.rain.step_s", "rain: hyetograph step", "s"},
+    config_echo("water.rain.intensity_m_per_s", "rain.intensity"),
+    config_echo("water.rain.step_s", "rain.step"),
     {"water.rain.end_s", "rain: end", "s"},
     {"water.rain.depth_m", "rain: soil depth of the infiltration model", "m"},
-    {"water.rain.conductivity_m_per_s", "rain: saturated hydraulic conductivity K_s", "m/s"},
-    {"water.rain.diffusivity_m2_per_s", "rain: hydraulic diffusivity D_0", "m^2/s"},
-    {"water.rain.steady_infiltration_m_per_s", "rain: steady background infiltration", "m/s"},
-    {"water.rain.water_table_depth_m", "rain: initial water-table depth", "m"},
-    {"water.rain.clock_times_s", "rain: clock (run time, rain time) pairs", "s"},
+    config_echo("water.rain.conductivity_m_per_s", "hydrology.conductivity"),
+    config_echo("water.rain.diffusivity_m2_per_s", "hydrology.diffusivity"),
+    config_echo("water.rain.steady_infiltration_m_per_s", "hydrology.steady_infiltration"),
+    config_echo("water.rain.water_table_depth_m", "hydrology.water_table_depth"),
+    config_echo("water.rain.clock_times_s", "rain.clock_times"),
     {"water.rain.rain_time_at_start_s", "rain time at the start of the run", "s"},
     {"water.rain.rain_time_at_end_s", "rain time at the end of the run", "s", G::Time},
-    {"water.rain.evaluate_at_s", "rain time of the pore pressure (strength reduction, limit equilibrium)", "s",
-     G::Time},
+    config_echo("water.rain.evaluate_at_s", "rain.evaluate_at", G::Time),
     {"water.rain.bishop_factor_at_end", "Bishop's factor of safety at the end of the rain clock", "1", G::Strength},
-    {"tolerance", "strength reduction: bracket tolerance", "1"},
-    {"trial_duration_s", "strength reduction: duration of a trial", "s"},
-    {"trial_damping", "strength reduction: damping of the trials", "1"},
-    {"growth_ratio", "strength reduction: displacement growth ratio of failure", "1"},
-    {"knee_ratio", "strength reduction: knee ratio", "1"},
+    config_echo("tolerance", "strength_reduction.tolerance"),
+    config_echo("trial_duration_s", "strength_reduction.trial_duration"),
+    config_echo("trial_damping", "strength_reduction.damping"),
+    config_echo("growth_ratio", "strength_reduction.growth_ratio"),
+    config_echo("knee_ratio", "strength_reduction.knee_ratio"),
     {"reference_displacement_m", "strength reduction: reference displacement", "m"},
     {"trials", "strength reduction: trials", "1"},
-    {"restart.file", "restarted from", ""},
+    config_echo("restart.file", "run.restart"),
     {"restart.time_s", "restart: time", "s"},
     {"restart.step", "restart: step", "1"},
     {"restart.exact", "restart: exact state", ""},
-    {"geostatic.duration_s", "geostatic phase: duration", "s"},
+    config_echo("geostatic.duration_s", "geostatic.duration"),
     {"geostatic.steps", "geostatic phase: steps", "1"},
     {"geostatic.max_speed_m_per_s", "geostatic phase: largest speed at its end", "m/s"},
     {"geostatic.rest_tolerance_m_per_s", "geostatic phase: at rest below the speed", "m/s"},
@@ -216,15 +221,28 @@ constexpr SummaryKey kKeys[] = {
 
 }  // namespace
 
+std::span<const KeyReference> summary_config_declarations() {
+  static const std::vector<KeyReference> refs = [] {
+    ConfigReader slope = ConfigReader::describe(), stability = ConfigReader::describe();
+    (void)read_config(slope, true);
+    (void)read_stability_map_case(stability);
+    std::vector<KeyReference> all = slope.reference();
+    for (KeyReference& k : stability.reference()) all.push_back(std::move(k));
+    return all;
+  }();
+  return refs;
+}
+
 std::span<const SummaryKey> summary_keys() noexcept {
-  // kKeys, then materials[].<key> of every model's figures (label and unit as the model declares them).
+  // kKeys (config echoes completed from the declarations), then materials[].<key> of every model's
+  // figures (label and unit as the model declares them).
   static const std::vector<std::string> names = [] {
     std::vector<std::string> n;
     for (const MaterialFigure& f : all_material_figures()) n.push_back("materials[]." + std::string(f.key));
     return n;
   }();
   static const std::vector<SummaryKey> keys = [] {
-    std::vector<SummaryKey> all(std::begin(kKeys), std::end(kKeys));
+    std::vector<SummaryKey> all = with_config_declarations(kKeys, summary_config_declarations());
     const std::vector<MaterialFigure> figures = all_material_figures();
     for (std::size_t i = 0; i < figures.size(); ++i) all.push_back({names[i], figures[i].label, figures[i].unit});
     return all;

@@ -40,15 +40,19 @@ struct Range {
   std::string str() const;
 };
 
-/// Documentation of a key: unit (SI, "1" for dimensionless, "" for non-numeric) and a sentence.
+/// Documentation of a key: unit (SI, "1" for dimensionless, "" for non-numeric), a sentence, and
+/// optionally a short label: what a table of results calls the value ("kinetic energy fraction
+/// that ends the run"), given where an output echoes the key (a model's summary_keys.cpp refers to
+/// the key instead of writing label and unit again). The label is not part of `--help-config`.
 struct KeyDoc {
   std::string_view unit;
   std::string_view help;
+  std::string_view label = {};
 };
 
-/// One entry of the generated key reference.
+/// One entry of the generated key reference (label: KeyDoc::label, "" when the key has none).
 struct KeyReference {
-  std::string key, type, unit, default_value, range, help;
+  std::string key, type, unit, default_value, range, help, label;
 };
 
 class ConfigReader {

@@ -11,9 +11,17 @@
 /// ("barriers[].peak_force_n"); a number array is one key ("fahrboeschung.toe_xy_m"). A segment
 /// "*" matches any one segment, and as the last segment any rest of the key
 /// ("best.parameters.*" matches "best.parameters.model.mu").
+///
+/// A key whose value is a config value written back (an echo: "stop_energy_fraction" is
+/// run.stop_energy_fraction) names that config key instead of writing its label and unit a second
+/// time (config_echo); the library completes it once from its config readers' declarations in
+/// describe mode (with_config_declarations), so the two cannot drift apart.
 
 #include <span>
 #include <string_view>
+#include <vector>
+
+#include "geohaz/core/config.hpp"
 
 namespace geohaz {
 
@@ -30,7 +38,33 @@ struct SummaryKey {
   std::string_view unit;
   SummaryGroup group = SummaryGroup::Other;
   bool headline = false;  ///< one of the few numbers for the overview of a run
+  /// The config key whose value this entry writes back ("run.stop_energy_fraction"; where the key
+  /// takes 0 for "automatic", the value used), "" for a result: its declaration gives the unit,
+  /// and the label unless the entry has one of its own.
+  std::string_view config_key = {};
 };
+
+/// An entry echoing config key `config_key`: label and unit are that key's declaration
+/// (KeyDoc::label, KeyDoc::unit), filled in by with_config_declarations.
+constexpr SummaryKey config_echo(std::string_view key, std::string_view config_key,
+                                 SummaryGroup group = SummaryGroup::Other, bool headline = false) {
+  return {key, {}, {}, group, headline, config_key};
+}
+
+/// The same with a label of its own, for a value the summary gives a narrower meaning than the
+/// config key has (the barrier force window is the series interval; one element of an array);
+/// the unit is still the declaration's.
+constexpr SummaryKey config_echo(std::string_view key, std::string_view label, std::string_view config_key,
+                                 SummaryGroup group = SummaryGroup::Other, bool headline = false) {
+  return {key, label, {}, group, headline, config_key};
+}
+
+/// `keys` with every config echo completed from `refs` (the reference of the library's config
+/// readers in describe mode): the declared unit, and the declared label where the entry has none.
+/// An echo of a key `refs` does not declare keeps an empty label and unit, so the apps' tests
+/// (EXPECT_SUMMARY_KEYS_DECLARED) and the declarations' test name it. The views point into `refs`
+/// and `keys`, which must outlive the result.
+std::vector<SummaryKey> with_config_declarations(std::span<const SummaryKey> keys, std::span<const KeyReference> refs);
 
 /// The unit of an entry that is the value of a named parameter (see SummaryKey::unit).
 inline constexpr std::string_view kUnitOfParameter = "parameter";

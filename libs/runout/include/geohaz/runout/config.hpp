@@ -118,7 +118,8 @@ struct FrictionKey {
 /// declaration order; empty for an unknown law. For tools that show a run's parameters (the report).
 std::vector<FrictionKey> friction_keys(std::string_view law);
 /// Any debris-runout key as read_config declares it (key_labels.cpp): a basal law's coefficient as
-/// friction_keys gives it, any other key labelled by its help text up to the first " (", ": ",
+/// friction_keys gives it, any other key labelled by its declared short label (KeyDoc::label) or,
+/// for a key declared without one, by its help text up to the first " (", ": ",
 /// "; " or ", " ("mixture density ρ"), with the declared unit ("kg/m^3"; "1" dimensionless, ""
 /// for a string). std::nullopt for a key read_config does not declare. For tools that show a run's
 /// or an ensemble's parameters (the report), so labels and units have one source.
