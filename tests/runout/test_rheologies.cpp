@@ -296,6 +296,48 @@ TEST(RheologyStep, BinghamRootIsWithin1e12OfALongDoubleBisection) {
               worst_warm);
 }
 
+TEST(RheologyStep, BinghamWarmStepInAcceleratingFlowIsWithin1e12OfALongDoubleBisection) {
+  // The warm step (series of order 4 and one Newton step, warm_step) from the root of the last
+  // step when s* has grown by 0–10 % (bench_runout's plane accelerates by several per cent per
+  // step): where it accepts, t and 1 − t must be the root of the cubic to 1e-13 relative and the
+  // speed K' t²(3 − t)/(1 − t) to 1e-12 (as BinghamRootIsWithin1e12OfALongDoubleBisection); and it
+  // must accept most of these steps, else it is dead code (measured: 75 % of these, and all of
+  // bench_runout's timed steps).
+  std::mt19937 rng(342);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  BinghamTerms terms = BinghamFriction{}.terms(kG, kG, 1.0, 0.0, kRho);
+  terms.rest = 1.0, terms.speed_scale = terms.inv_speed_scale = 1.0;  // K' = 1: s* = P, Δt = P − D
+  const auto bisect = [](double P, double D) {
+    long double lo = 0.0L, hi = 1.0L;
+    for (int i = 0; i < 200; ++i) {
+      const long double m = 0.5L * (lo + hi), f = (m - 3.0L) * m * m - P * m + static_cast<long double>(D);
+      (f > 0.0L ? lo : hi) = m;
+    }
+    return 0.5L * (lo + hi);
+  };
+  const auto speed = [](long double t) { return t * t * (3.0L - t) / (1.0L - t); };
+  int accepted = 0;
+  double worst = 0.0;
+  const int draws = 2000;
+  for (int k = 0; k < draws; ++k) {
+    const double P0 = std::pow(10.0, -1.0 + 2.0 * u(rng)), D0 = P0 * (0.05 + 0.9 * u(rng));
+    const double t0 = static_cast<double>(bisect(P0, D0)), zeta0 = terms.tau_y * t0 / (1.0 - t0);
+    const double P = P0 * (1.0 + 0.1 * u(rng)), D = P - (P0 - D0);  // s* grown, Δt a_rest the same
+    BinghamTerms::PlugRoot root{};
+    if (!terms.warm_step(P, D, zeta0, root)) continue;
+    ++accepted;
+    const long double t_ref = bisect(P, D);
+    EXPECT_NEAR(root.t, static_cast<double>(t_ref), 1e-13 * static_cast<double>(std::min(t_ref, 1.0L - t_ref)))
+        << "P " << P << " D " << D;
+    EXPECT_NEAR(root.inv_r, static_cast<double>(1.0L / (1.0L - t_ref)), 1e-13 * root.inv_r);
+    const double e = std::abs(static_cast<double>(speed(root.t) / speed(t_ref) - 1.0L));
+    EXPECT_LT(e, 1e-12) << "P " << P << " D " << D;
+    worst = std::max(worst, e);
+  }
+  std::printf("Bingham warm step: accepted %d of %d, largest relative speed error %.2e\n", accepted, draws, worst);
+  EXPECT_GT(accepted, draws / 2);
+}
+
 TEST(RheologyStep, BinghamWarmStartGivesTheColdAnswer) {
   // As for Herschel–Bulkley below: the solver hands the Bingham step the particle's last
   // (ζ, γ̇_b); from there, from a stale state or another particle's, the step must land on the
@@ -463,6 +505,26 @@ TEST(RheologyFlows, SteadyUniformHerschelBulkleyFlow) {
       "herschel_bulkley", l,
       plastic_profile(kHerschel.tau_y, kHerschel.consistency, kHerschel.flow_index, l.mean_depth, std::atan(tn)).mean,
       0.05);  // U ∝ h^{4.4} (n = 0.4, r = 0.28): measured spread 2.8 %
+}
+
+TEST(RheologyStep, InverseCubeRootIsWithinTwoUlpOfLongDouble) {
+  // inverse_cbrt (O'Brien–Julien's h_n^{-1/3}, no libm call) against long double over 24 decades
+  // of depth; and O'Brien–Julien's terms built from it against the direct formulas of its header.
+  std::mt19937 rng(343);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double worst = 0.0;
+  for (int k = 0; k < 100000; ++k) {
+    const double h = std::pow(10.0, -12.0 + 24.0 * u(rng));
+    const long double ref = 1.0L / std::cbrt(static_cast<long double>(h));
+    worst = std::max(worst, static_cast<double>(std::abs(inverse_cbrt(h) / ref - 1.0L)));
+  }
+  EXPECT_LT(worst, 4.5e-16);  // two units in the last place
+  for (double h : {1e-3, 0.37, 2.0, 15.0}) {
+    const FrictionTerms t = kOBrien.terms(kG, kG, h, 0.0, kRho);
+    EXPECT_NEAR(t.rest, kOBrien.tau_y / (kRho * h), 2e-15 * t.rest);
+    EXPECT_NEAR(t.visc, kOBrien.laminar_k * kOBrien.viscosity / (8.0 * kRho * h * h), 2e-15 * t.visc);
+    EXPECT_NEAR(t.drag, kG * kOBrien.n_td * kOBrien.n_td / std::pow(h, 4.0 / 3.0), 2e-15 * t.drag);
+  }
 }
 
 TEST(RheologyFlows, SteadyUniformOBrienJulienFlow) {

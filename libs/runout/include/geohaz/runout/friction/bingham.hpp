@@ -14,10 +14,11 @@
 /// The implicit step in closed form: with K' = h τ_y/(6μ_B) (m/s) and a_rest = τ_y/(ρ h), the
 /// step s = s* − Δt τ_b(s)/(ρ h) with s = K' (1 − r)²(2 + r)/r and τ_b = τ_y/r becomes the
 /// depressed cubic r³ − (3 + s*/K') r + 2 + Δt a_rest/K' = 0, whose root in (0, 1) is wanted (the
-/// middle one; one is negative, one above 1). It is solved in t = 1 − r (plug_deficit below) to
-/// 1e-13 relative in t and 1 − t: from the particle's t of its last step (kept by the solver as
-/// ζ = τ_b − τ_y in the store's BasalExcessStress) by the cubic's reversion series, one division,
-/// accepted when its residual proves the tolerance; else (cold start, or a jump) by Halley's
+/// middle one; one is negative, one above 1). It is solved in t = 1 − r (plug_root below) to
+/// 1e-13 relative in t and 1 − t: from the particle's ζ = τ_b − τ_y of its last step (kept by the
+/// solver in the store's BasalExcessStress) by the cubic's reversion series to order 4 and one
+/// Newton step, two divisions, accepted when its error bound proves the tolerance; else (cold
+/// start, or a jump) by Halley's
 /// method. Not by the trigonometric formula, whose acos is ill-conditioned near the yield
 /// (relative error in the speed up to 20 % at s*/K' = 1e-12, where this root is good to ~2e-13, as
 /// up to s*/K' = 1e5) and which costs an acos and a cos per particle-step.
@@ -38,47 +39,70 @@ struct BinghamTerms {
   double rest;              ///< τ_y/(ρ h) (m/s²)
   double speed_scale;       ///< K' = h τ_y/(6 μ_B) (m/s)
   double visc;              ///< 3 μ_B/(ρ h²) (1/s): the τ_y = 0 (Newtonian) limit
-  double inv_speed_scale;   ///< 1/K' = 6 μ_B/(h τ_y) (s/m), a division off the step's critical path
+  double inv_speed_scale;   ///< 1/K' = 6 μ_B/(h τ_y) (s/m)
   double tau_y;             ///< τ_y (Pa), to turn the kept ζ into t = ζ/(τ_y + ζ)
   double inv_viscosity;     ///< 1/μ_B (1/(Pa·s)), for the kept γ̇_b = ζ/μ_B
   double extra_drag = 0.0;  ///< forest drag (1/m)
   StepMemory memory{};      ///< the particle's last (ζ, γ̇_b), given by the solver
 
-  /// t = 1 − r = 1 − τ_y/τ_b ∈ (0, 1) after a step from s* of length Δt, s* > Δt a_rest (Δt = 0:
-  /// the steady relation at U = s*). With P = s*/K' and D = P − Δt a_rest/K' > 0 the cubic is
-  /// f(t) = t³ − 3t² − P t + D = 0: f(0) = D > 0 > f(1) = −2 − Δt a_rest/K', and f is decreasing
-  /// and concave on [0, 1], so the root is unique there. The root is wanted to 1e-13 relative in
-  /// both t and 1 − t (1 − r sets the speed near the plug limit t → 1).
+  /// t = 1 − r = 1 − τ_y/τ_b ∈ (0, 1) after a step and 1/r.
+  struct PlugRoot {
+    double t, inv_r;
+  };
+  /// The root after a step from s* of length Δt, s* > Δt a_rest (Δt = 0: the steady relation at
+  /// U = s*). With P = s*/K' and D = P − Δt a_rest/K' > 0 the cubic is f(t) = t³ − 3t² − P t + D = 0:
+  /// f(0) = D > 0 > f(1) = −2 − Δt a_rest/K', and f is decreasing and concave on [0, 1], so the root
+  /// is unique there. It is wanted to 1e-13 relative in both t and 1 − t (1 − r sets the speed near
+  /// the plug limit t → 1).
   ///
-  /// Warm start (t_warm ∈ (0, 1): the particle's t of its last step): the cubic is exact around
-  /// w = t_warm, f(w + ε) = f + f′ε + (f″/2)ε² + ε³, so its small root is the reversion series
-  /// ε = x − A x² + (2A² − B) x³ + 5A(B − A²) x⁴ + (14A⁴ − 21A²B + 3B²) x⁵ + O(x⁶),
-  /// x = −f/f′, A = f″/(2f′), B = 1/f′ (f, f′, f″ at w): one division and no iteration. It is
-  /// accepted when the residual proves it, |f(w + ε)| ≤ 1e-13 min(t, 1 − t) |f′(w)| (error in t
-  /// ≈ |f|/|f′|), which holds while the speed changes by ≲ 1 % per step; else Halley's method goes
-  /// on from there (from the cold start if w + ε left (0, 1)).
+  /// Warm start (ζ₀ > 0, the particle's τ_b − τ_y of its last step, i.e. w = ζ₀/τ₀ with
+  /// τ₀ = τ_y + ζ₀): the cubic is exact around w, f(w + ε) = f + f′ε + (f″/2)ε² + ε³, so its small
+  /// root is the reversion series
+  /// ε = x − A x² + (2A² − B) x³ + 5A(B − A²) x⁴ + O(x⁵),
+  /// x = −f/f′, A = f″/(2f′), B = 1/f′ (f, f′, f″ at w). All four of w, x, A, B come from one
+  /// division, 1/(τ₀³ f′(w)) (the numerators are polynomials in ζ₀ and τ₀). The series' terms fall
+  /// by ~4|A x| each, which in accelerating flow (|A x| ~ 0.01–0.05) leaves 1e-10 to 1e-6 in t:
+  /// one Newton step follows, t = t₄ − r/(1 + δ), where f′ being quadratic gives
+  /// f′(w + ε) = f′(w)(1 + δ), δ = 2Aε + 3Bε², exactly, and r = f(w + ε) B = ε − x + Aε² + Bε³ is
+  /// computed from ε alone (no cancellation against t). The step leaves
+  /// ((3t₄ − 3) e² − e³)/f′(t₄) with e ≈ r/(1 + δ) the error of t₄, i.e. at most
+  /// (4/3)³ (|A| + 3|B| (|ε| + |r|)) r² for |δ| ≤ 1/4: accepted when that is below
+  /// 1e-13 min(t, 1 − t), else Halley's method goes on from there (from the cold start if the
+  /// point left (0, 1)). 1/r = 1/(1 − t) is the second division.
   /// Cold start: the root of the quadratic part 3t² + P t − D (below the root: f(t₀) = t₀³ > 0).
   /// Halley's method: a step d leaves an error ≈ C d³, C = f″²/(4f′²) + 1/|f′| (f′ < 0 on
   /// [0, 1], f‴ = 6); it stops when that is below 1e-13 min(t, 1 − t), tested without a division:
   /// 1–2 iterations, no libm call but one sqrt.
-  double plug_deficit(double s_star, double dt, double t_warm = 0.0) const noexcept {
+  PlugRoot plug_root(double s_star, double dt, double zeta0) const noexcept {
     const double P = s_star * inv_speed_scale, D = (s_star - dt * rest) * inv_speed_scale;
-    const auto cold = [&] { return 2.0 * D / (P + std::sqrt(P * P + 12.0 * D)); };
-    double t;
-    if (t_warm > 0.0 && t_warm < 1.0) {
-      const double w = t_warm, w2 = w * w, f = (w - 3.0) * w2 - P * w + D, f1 = 3.0 * w2 - 6.0 * w - P;
-      const double B = 1.0 / f1, A = (3.0 * w - 3.0) * B, x = -f * B, A2 = A * A;
-      const double c4 = 5.0 * A * (B - A2), c5 = A2 * (14.0 * A2 - 21.0 * B) + 3.0 * B * B;
-      t = w + x * (1.0 + x * (-A + x * ((2.0 * A2 - B) + x * (c4 + x * c5))));
-      const double residual = ((t - 3.0) * t * t - P * t + D) * f1;  // f(t) f′(w): compared with f′(w)²
-      if (t > 0.0 && t < 1.0) {
-        if (std::abs(residual) <= 1e-13 * std::min(t, 1.0 - t) * (f1 * f1)) return t;
-      } else {
-        t = cold();
-      }
-    } else {
-      t = cold();
-    }
+    PlugRoot root{-1.0, 0.0};
+    if (zeta0 > 0.0 && warm_step(P, D, zeta0, root)) return root;
+    double t = root.t;
+    if (!(t > 0.0 && t < 1.0)) t = 2.0 * D / (P + std::sqrt(P * P + 12.0 * D));
+    t = halley(P, D, t);
+    return {t, 1.0 / (1.0 - t)};
+  }
+  /// The warm step (series and Newton step, above) of the cubic (P, D) from ζ₀ > 0: true and the
+  /// root where its error bound proves the tolerance, else false with root.t the point reached.
+  bool warm_step(double P, double D, double zeta0, PlugRoot& root) const noexcept {
+    const double z = zeta0, tau = tau_y + z, tau2 = tau * tau, tau3 = tau2 * tau;
+    const double n1 = (3.0 * z - 6.0 * tau) * z - P * tau2;             // τ₀² f′(w)
+    const double n0 = ((z - 3.0 * tau) * z - P * tau2) * z + D * tau3;  // τ₀³ f(w)
+    const double X = 1.0 / (tau * n1), x = -n0 * X, B = tau3 * X, A = -3.0 * tau_y * tau2 * X;
+    const double c3 = 2.0 * A * A - B, c4 = 5.0 * A * (B - A * A);
+    const double e = x * ((1.0 - A * x) + (x * x) * (c3 + c4 * x)), t4 = z * n1 * X + e;
+    const double r = (e - x) + e * e * (A + B * e), d = e * (2.0 * A + 3.0 * B * e);
+    const double t = t4 - r / (1.0 + d);
+    root = {t, 0.0};
+    if (!(t4 > 0.0 && t4 < 1.0 && std::abs(d) <= 0.25 &&
+          (std::abs(A) + 3.0 * std::abs(B) * (std::abs(e) + std::abs(r))) * (r * r) <=
+              4.2e-14 * std::min(t4, 1.0 - t4)))
+      return false;
+    root.inv_r = 1.0 / (1.0 - t);
+    return true;
+  }
+  /// Halley's method on the plug cubic from t (above).
+  static double halley(double P, double D, double t) noexcept {
     for (int k = 0; k < 8; ++k) {
       const double t2 = t * t, f = (t - 3.0) * t2 - P * t + D, f1 = 3.0 * t2 - 6.0 * t - P, f2 = 6.0 * t - 6.0;
       const double d = 2.0 * f * f1 / (2.0 * f1 * f1 - f * f2);
@@ -87,6 +111,11 @@ struct BinghamTerms {
       if ((0.25 * f2 * f2 - f1) * (ad * ad * ad) <= 1e-13 * std::min(t, 1.0 - t) * (f1 * f1)) break;
     }
     return t;
+  }
+  /// plug_root's t, from the particle's last t (t_warm ∈ (0, 1), i.e. ζ₀ = τ_y t/(1 − t)) or cold.
+  double plug_deficit(double s_star, double dt, double t_warm = 0.0) const noexcept {
+    const double z0 = t_warm > 0.0 && t_warm < 1.0 ? tau_y * t_warm / (1.0 - t_warm) : 0.0;
+    return plug_root(s_star, dt, z0).t;
   }
   /// τ_b(s)/(ρ h) of the steady plug flow at mean speed s.
   double acceleration(double s) const noexcept {
@@ -108,10 +137,8 @@ inline double speed_after_friction(double s_star, double dt, const BinghamTerms&
       if (zeta) *zeta = *t.memory.rate = 0.0;  // at rest: no memory
       return 0.0;
     }
-    const double z0 = zeta ? *zeta : 0.0;
-    const double u = t.plug_deficit(s_star, dt, z0 > 0.0 ? z0 / (t.tau_y + z0) : 0.0);  // 1 − r
-    const double inv_r = 1.0 / (1.0 - u);
-    s = t.speed_scale * u * u * (3.0 - u) * inv_r;  // K' (1 − r)²(2 + r)/r, exact as r → 1
+    const auto [u, inv_r] = t.plug_root(s_star, dt, zeta ? *zeta : 0.0);  // 1 − r, 1/r
+    s = t.speed_scale * u * u * (3.0 - u) * inv_r;                        // K' (1 − r)²(2 + r)/r, exact as r → 1
     if (zeta) {
       *zeta = t.tau_y * u * inv_r;  // τ_b − τ_y = τ_y (1 − r)/r
       *t.memory.rate = *zeta * t.inv_viscosity;
@@ -128,13 +155,18 @@ struct BinghamFriction {
   static constexpr const char* summary =
       "Bingham plastic, exact plug-flow cubic (tau_y, viscosity; Pastor et al. 2004)";
   bool set(std::size_t j, double v) noexcept { return (j == 0 ? tau_y : viscosity) = v, true; }
+  /// The per-particle coefficients with one division: the reciprocals of ρh, μ_B and hτ_y all
+  /// follow from 1/(ρ h τ_y μ_B) (τ_y = 0: the Newtonian film, rest = 0).
   BinghamTerms terms(double /*g*/, double /*g_n*/, double h_n, double /*speed*/, double rho) const noexcept {
-    return {tau_y / (rho * h_n),
-            h_n * tau_y / (6.0 * viscosity),
-            3.0 * viscosity / (rho * h_n * h_n),
-            6.0 * viscosity / (h_n * tau_y),
+    const double rh = rho * h_n;
+    if (!(tau_y > 0.0)) return {0.0, 0.0, 3.0 * viscosity / (rh * h_n), HUGE_VAL, tau_y, 1.0 / viscosity};
+    const double tv = tau_y * viscosity, x = 1.0 / (rh * tv), inv_rh = tv * x, inv_viscosity = rh * tau_y * x;
+    return {tau_y * inv_rh,
+            h_n * tau_y * inv_viscosity * (1.0 / 6.0),
+            3.0 * viscosity * rho * (inv_rh * inv_rh),
+            6.0 * viscosity * viscosity * rho * x,
             tau_y,
-            1.0 / viscosity};
+            inv_viscosity};
   }
 };
 

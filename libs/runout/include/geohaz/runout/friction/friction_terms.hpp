@@ -28,7 +28,9 @@
 /// default, range, unit, meaning), `set(j, v)` and, where needed, `from_parameters` and `check`.
 /// The coefficients several laws read are declared once below and shared by those laws.
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 
 #include "geohaz/core/law_parameters.hpp"
 
@@ -75,6 +77,17 @@ struct FrictionTerms {
   /// The law's basal deceleration τ_b/(ρ h_n) at speed s (without extra_drag).
   double acceleration(double s) const noexcept { return rest + (visc + drag * s) * s; }
 };
+
+/// h^{−1/3} for h > 0 (normal, finite) to ~1 ulp (measured ≤ 2e-16 relative for h = 1e-30 to
+/// 1e30) without a libm call or a division: an integer estimate of the exponent (within 3.5 %),
+/// then Newton's iteration y ← y (4 − h y³)/3 (error e → ~2e²), three times and once more in the
+/// form y + y (1 − h y³)/3, which rounds better.
+inline double inverse_cbrt(double h) noexcept {
+  double y = std::bit_cast<double>(0x553ef0ff289dd796ull - std::bit_cast<std::uint64_t>(h) / 3);
+  const double h3 = h * (1.0 / 3);
+  for (int k = 0; k < 3; ++k) y = y * (4.0 / 3 - h3 * (y * y * y));
+  return y + y * ((1.0 - h * (y * y * y)) * (1.0 / 3));
+}
 
 /// Speed after an implicit step of the drag k s² alone: root of Δt k s² + s − s₀ = 0.
 inline double speed_after_drag(double s0, double kdt) noexcept {

@@ -13,7 +13,9 @@
 ///
 ///     a = g S_f = τ_y/(ρ h_n) + (K η/(8 ρ h_n²)) s + (g n_td²/h_n^{4/3}) s²:
 ///
-/// rest, visc and drag of the closed-form implicit step. With K = 24 the viscous term is the
+/// rest, visc and drag of the closed-form implicit step, computed from y = h_n^{−1/3}
+/// (inverse_cbrt, Newton's iteration without a division; 1/h_n = y³) and 1/ρ: one division and no
+/// libm call per particle. With K = 24 the viscous term is the
 /// Newtonian laminar film (U = ρ g h² S/(3η)). Steady uniform flow on slope θ: the positive root
 /// of drag s² + visc s + rest − g sin θ = 0 (at rest while g sin θ ≤ τ_y/(ρ h_n)).
 /// The optional parameterisation by the volumetric sediment concentration C_v (O'Brien & Julien
@@ -76,9 +78,11 @@ struct OBrienJulienFriction {
                               ""};
     return std::nullopt;
   }
+  /// Without cbrt and with one division (1/ρ): y = h_n^{−1/3} (inverse_cbrt), 1/h_n = y³,
+  /// 1/h_n² = y⁶, 1/h_n^{4/3} = y⁴.
   FrictionTerms terms(double g, double /*g_n*/, double h_n, double /*speed*/, double rho) const noexcept {
-    const double rh = rho * h_n;
-    return {tau_y / rh, g * n_td * n_td / (h_n * std::cbrt(h_n)), laminar_k * viscosity / (8.0 * rh * h_n)};
+    const double inv_rho = 1.0 / rho, y = inverse_cbrt(h_n), y3 = y * y * y;
+    return {tau_y * inv_rho * y3, g * n_td * n_td * (y3 * y), laminar_k * viscosity * 0.125 * inv_rho * (y3 * y3)};
   }
 };
 
