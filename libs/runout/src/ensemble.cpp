@@ -424,15 +424,21 @@ void read_parameter_keys(ConfigReader& t, ParameterDistribution& p, bool describ
   }
 }
 
+/// The declarations of the ensemble keys whose values the summary echoes, shared by
+/// describe_ensemble and read_ensemble so that help and label are written once.
+constexpr KeyDoc kSamplingDoc{"", "sampling plan: Latin hypercube (McKay et al. 1979) or plain Monte Carlo",
+                              "sampling"};
+constexpr KeyDoc kSeedDoc{"1", "seed of the plan: member i's values depend on (seed, i)", "seed"};
+constexpr KeyDoc kBinsDoc{"1", "log-spaced histogram bins per cell and field (percentile accuracy, docs/ensemble.md)",
+                          "percentile maps: histogram bins"};
+
 }  // namespace
 
 void describe_ensemble(ConfigReader& cfg) {
   cfg.require_string("ensemble.base", {"", "the debris-runout config of the base case (DSM, release, law, numerics)"});
   cfg.get_int("ensemble.members", 10, Range::closed(1, 65535), {"1", "number of members N"});
-  cfg.get_choice("ensemble.sampling", "latin_hypercube", {"latin_hypercube", "monte_carlo"},
-                 {"", "sampling plan: Latin hypercube (McKay et al. 1979) or plain Monte Carlo", "sampling"});
-  cfg.get_int("ensemble.seed", 1, Range::closed(0, 9.0e15),
-              {"1", "seed of the plan: member i's values depend on (seed, i)", "seed"});
+  cfg.get_choice("ensemble.sampling", "latin_hypercube", {"latin_hypercube", "monte_carlo"}, kSamplingDoc);
+  cfg.get_int("ensemble.seed", 1, Range::closed(0, 9.0e15), kSeedDoc);
   cfg.get_array("ensemble.inject_failure", {}, Range::closed(0, 65535),
                 {"1", "test hook: these member indices fail on purpose (a SimulationError at their first step)"});
   for (ConfigReader& t : cfg.tables("ensemble.parameter", {"",
@@ -454,9 +460,7 @@ void describe_ensemble(ConfigReader& cfg) {
   cfg.get_array("products.intensity_classes", {2}, Range::closed(1, 3),
                 {"1", "P(intensity class ≥ k) maps, k = 1 low, 2 medium, 3 strong"});
   cfg.get_array("products.percentiles", {10, 50, 90}, Range::open_closed(0, 100), {"%", "percentile maps (0, 100]"});
-  cfg.get_int("products.bins", 96, Range::closed(8, 1024),
-              {"1", "log-spaced histogram bins per cell and field (percentile accuracy, docs/ensemble.md)",
-               "percentile maps: histogram bins"});
+  cfg.get_int("products.bins", 96, Range::closed(8, 1024), kBinsDoc);
 }
 
 EnsembleSetup read_ensemble(ConfigReader& cfg) {
@@ -468,11 +472,10 @@ EnsembleSetup read_ensemble(ConfigReader& cfg) {
   plan.members =
       static_cast<int>(cfg.get_int("ensemble.members", 10, Range::closed(1, 65535), {"1", "number of members N"}));
   plan.sampling = cfg.get_choice("ensemble.sampling", "latin_hypercube", {"latin_hypercube", "monte_carlo"},
-                                 {"", "sampling plan", "sampling"}) == "monte_carlo"
+                                 kSamplingDoc) == "monte_carlo"
                       ? SamplingMethod::MonteCarlo
                       : SamplingMethod::LatinHypercube;
-  plan.seed =
-      static_cast<std::uint64_t>(cfg.get_int("ensemble.seed", 1, Range::closed(0, 9.0e15), {"1", "seed", "seed"}));
+  plan.seed = static_cast<std::uint64_t>(cfg.get_int("ensemble.seed", 1, Range::closed(0, 9.0e15), kSeedDoc));
   for (double v : cfg.get_array("ensemble.inject_failure", {}, Range::closed(0, 65535), {"1", "test hook"}))
     s.inject_failure.push_back(static_cast<int>(v));
 
@@ -538,8 +541,7 @@ EnsembleSetup read_ensemble(ConfigReader& cfg) {
     a.intensity_classes.push_back(static_cast<int>(k));
   }
   a.percentiles = cfg.get_array("products.percentiles", {10, 50, 90}, Range::open_closed(0, 100), {"%", "percentiles"});
-  a.bins = static_cast<int>(cfg.get_int("products.bins", 96, Range::closed(8, 1024),
-                                        {"1", "histogram bins", "percentile maps: histogram bins"}));
+  a.bins = static_cast<int>(cfg.get_int("products.bins", 96, Range::closed(8, 1024), kBinsDoc));
   cfg.finish();
   s.resolved_config = cfg.resolved();
   if (!fs::exists(s.base_config))

@@ -67,6 +67,7 @@ void draw_particles(const std::filesystem::path& path, const SphStore<Dim>& s, c
   });
   std::vector<double> px, pz;
   std::vector<std::array<std::uint8_t, 3>> col;
+  px.reserve(order.size()), pz.reserve(order.size()), col.reserve(order.size());
   for (std::size_t i : order) {
     px.push_back(x[i][0]);
     pz.push_back(x[i][Dim - 1]);
