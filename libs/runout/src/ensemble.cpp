@@ -424,68 +424,95 @@ void read_parameter_keys(ConfigReader& t, ParameterDistribution& p, bool describ
   }
 }
 
-/// The declarations of the ensemble keys whose values the summary echoes, shared by
-/// describe_ensemble and read_ensemble so that help and label are written once.
-constexpr KeyDoc kSamplingDoc{"", "sampling plan: Latin hypercube (McKay et al. 1979) or plain Monte Carlo",
-                              "sampling"};
-constexpr KeyDoc kSeedDoc{"1", "seed of the plan: member i's values depend on (seed, i)", "seed"};
-constexpr KeyDoc kBinsDoc{"1", "log-spaced histogram bins per cell and field (percentile accuracy, docs/ensemble.md)",
-                          "percentile maps: histogram bins"};
+/// The ensemble keys, declared once: describe_ensemble (--help-config, the summary's labels) and
+/// read_ensemble read them through the functions below, so default, range, unit and help are
+/// written in one place.
+constexpr KeyDoc kBaseDoc{"", "the debris-runout config of the base case (DSM, release, law, numerics)"};
+constexpr KeyDoc kParameterTablesDoc{
+    "", "uncertain parameters: key (a numeric debris-runout key, release.thickness_factor) and distribution"};
+constexpr KeyDoc kParameterKeyDoc{"", "numeric debris-runout key (model.mu, model.n, ...) or release.thickness_factor"};
+constexpr KeyDoc kAlternativeTablesDoc{"",
+                                       "alternative release files: member picks one (parameter release.alternative)"};
+constexpr KeyDoc kAlternativeFileDoc{"", "release polygons or thickness raster (path relative to this file)"};
+constexpr KeyDoc kAlternativeWeightDoc{"1", "relative probability of this release"};
+
+/// ensemble.members, sampling, seed and inject_failure.
+void read_plan_keys(ConfigReader& cfg, EnsemblePlan& plan, std::vector<int>& inject_failure) {
+  plan.members =
+      static_cast<int>(cfg.get_int("ensemble.members", 10, Range::closed(1, 65535), {"1", "number of members N"}));
+  plan.sampling = cfg.get_choice("ensemble.sampling", "latin_hypercube", {"latin_hypercube", "monte_carlo"},
+                                 {"", "sampling plan: Latin hypercube (McKay et al. 1979) or plain Monte Carlo",
+                                  "sampling"}) == "monte_carlo"
+                      ? SamplingMethod::MonteCarlo
+                      : SamplingMethod::LatinHypercube;
+  plan.seed =
+      static_cast<std::uint64_t>(cfg.get_int("ensemble.seed", 1, Range::closed(0, 9.0e15),
+                                             {"1", "seed of the plan: member i's values depend on (seed, i)", "seed"}));
+  for (double v : cfg.get_array("ensemble.inject_failure", {}, Range::closed(0, 65535),
+                                {"1",
+                                 "test hook: these member indices fail on purpose (a SimulationError at their "
+                                 "first step)"}))
+    inject_failure.push_back(static_cast<int>(v));
+}
+
+/// The products.* keys: the probability, intensity and percentile maps.
+void read_product_keys(ConfigReader& cfg, AggregationSettings& a) {
+  const std::string src = origin(cfg);
+  a.depth_thresholds =
+      cfg.get_array("products.depth_thresholds", {0.5}, Range::positive(), {"m", "P(peak depth > t) maps, t > 0"});
+  a.speed_thresholds =
+      cfg.get_array("products.speed_thresholds", {}, Range::positive(), {"m/s", "P(peak speed > t) maps, t > 0"});
+  a.pressure_thresholds = cfg.get_array("products.pressure_thresholds", {30e3}, Range::positive(),
+                                        {"Pa", "P(peak pressure > t) maps, t > 0"});
+  a.intensity_classes.clear();
+  for (double k : cfg.get_array("products.intensity_classes", {2}, Range::closed(1, 3),
+                                {"1", "P(intensity class ≥ k) maps, k = 1 low, 2 medium, 3 strong"})) {
+    if (k != std::floor(k))
+      throw InputError("intensity classes are 1, 2 or 3", src, "products.intensity_classes", fmt(k));
+    a.intensity_classes.push_back(static_cast<int>(k));
+  }
+  a.percentiles = cfg.get_array("products.percentiles", {10, 50, 90}, Range::open_closed(0, 100),
+                                {"%", "percentile maps (0, 100]"});
+  a.bins = static_cast<int>(
+      cfg.get_int("products.bins", 96, Range::closed(8, 1024),
+                  {"1", "log-spaced histogram bins per cell and field (percentile accuracy, docs/ensemble.md)",
+                   "percentile maps: histogram bins"}));
+}
 
 }  // namespace
 
 void describe_ensemble(ConfigReader& cfg) {
-  cfg.require_string("ensemble.base", {"", "the debris-runout config of the base case (DSM, release, law, numerics)"});
-  cfg.get_int("ensemble.members", 10, Range::closed(1, 65535), {"1", "number of members N"});
-  cfg.get_choice("ensemble.sampling", "latin_hypercube", {"latin_hypercube", "monte_carlo"}, kSamplingDoc);
-  cfg.get_int("ensemble.seed", 1, Range::closed(0, 9.0e15), kSeedDoc);
-  cfg.get_array("ensemble.inject_failure", {}, Range::closed(0, 65535),
-                {"1", "test hook: these member indices fail on purpose (a SimulationError at their first step)"});
-  for (ConfigReader& t : cfg.tables("ensemble.parameter", {"",
-                                                           "uncertain parameters: key (a numeric debris-runout key, "
-                                                           "release.thickness_factor) and distribution"})) {
-    t.require_string("key", {"", "numeric debris-runout key (model.mu, model.n, ...) or release.thickness_factor"});
+  cfg.require_string("ensemble.base", kBaseDoc);
+  EnsemblePlan plan;
+  std::vector<int> inject;
+  read_plan_keys(cfg, plan, inject);
+  for (ConfigReader& t : cfg.tables("ensemble.parameter", kParameterTablesDoc)) {
+    t.require_string("key", kParameterKeyDoc);
     ParameterDistribution p;
     read_parameter_keys(t, p, true);
   }
-  for (ConfigReader& t :
-       cfg.tables("ensemble.release_alternative",
-                  {"", "alternative release files: member picks one (parameter release.alternative)"})) {
-    t.require_string("file", {"", "release polygons or thickness raster (path relative to this file)"});
-    t.get("weight", 1.0, Range::positive(), {"1", "relative probability of this release"});
+  for (ConfigReader& t : cfg.tables("ensemble.release_alternative", kAlternativeTablesDoc)) {
+    t.require_string("file", kAlternativeFileDoc);
+    t.get("weight", 1.0, Range::positive(), kAlternativeWeightDoc);
   }
-  cfg.get_array("products.depth_thresholds", {0.5}, Range::positive(), {"m", "P(peak depth > t) maps, t > 0"});
-  cfg.get_array("products.speed_thresholds", {}, Range::positive(), {"m/s", "P(peak speed > t) maps, t > 0"});
-  cfg.get_array("products.pressure_thresholds", {30e3}, Range::positive(), {"Pa", "P(peak pressure > t) maps, t > 0"});
-  cfg.get_array("products.intensity_classes", {2}, Range::closed(1, 3),
-                {"1", "P(intensity class ≥ k) maps, k = 1 low, 2 medium, 3 strong"});
-  cfg.get_array("products.percentiles", {10, 50, 90}, Range::open_closed(0, 100), {"%", "percentile maps (0, 100]"});
-  cfg.get_int("products.bins", 96, Range::closed(8, 1024), kBinsDoc);
+  AggregationSettings a;
+  read_product_keys(cfg, a);
 }
 
 EnsembleSetup read_ensemble(ConfigReader& cfg) {
   EnsembleSetup s;
   const std::string src = origin(cfg);
-  s.base_config =
-      resolve_path(cfg, cfg.require_string("ensemble.base", {"", "the debris-runout config of the base case"}));
+  s.base_config = resolve_path(cfg, cfg.require_string("ensemble.base", kBaseDoc));
   EnsemblePlan& plan = s.plan;
-  plan.members =
-      static_cast<int>(cfg.get_int("ensemble.members", 10, Range::closed(1, 65535), {"1", "number of members N"}));
-  plan.sampling = cfg.get_choice("ensemble.sampling", "latin_hypercube", {"latin_hypercube", "monte_carlo"},
-                                 kSamplingDoc) == "monte_carlo"
-                      ? SamplingMethod::MonteCarlo
-                      : SamplingMethod::LatinHypercube;
-  plan.seed = static_cast<std::uint64_t>(cfg.get_int("ensemble.seed", 1, Range::closed(0, 9.0e15), kSeedDoc));
-  for (double v : cfg.get_array("ensemble.inject_failure", {}, Range::closed(0, 65535), {"1", "test hook"}))
-    s.inject_failure.push_back(static_cast<int>(v));
+  read_plan_keys(cfg, plan, s.inject_failure);
 
   const std::set<std::string> numeric = numeric_case_keys();
-  auto tables = cfg.tables("ensemble.parameter", {"", "uncertain parameters"});
+  auto tables = cfg.tables("ensemble.parameter", kParameterTablesDoc);
   for (std::size_t k = 0; k < tables.size(); ++k) {
     ConfigReader& t = tables[k];
     const std::string where = "ensemble.parameter[" + std::to_string(k) + "]";
     ParameterDistribution p;
-    p.key = t.require_string("key", {"", "parameter key"});
+    p.key = t.require_string("key", kParameterKeyDoc);
     if (p.key != kThicknessFactorKey && !numeric.count(p.key)) {
       std::string list = kThicknessFactorKey;
       for (const auto& n : numeric) list += ", " + n;
@@ -512,36 +539,25 @@ EnsembleSetup read_ensemble(ConfigReader& cfg) {
     if (p.kind == DistributionKind::LogNormal && p.lower < 0.0) p.lower = 0.0;
     plan.parameters.push_back(p);
   }
-  auto alts = cfg.tables("ensemble.release_alternative", {"", "alternative release files"});
+  auto alts = cfg.tables("ensemble.release_alternative", kAlternativeTablesDoc);
   if (!alts.empty()) {
     ParameterDistribution p;
     p.key = kReleaseAlternativeKey;
     p.kind = DistributionKind::Discrete;
     for (std::size_t k = 0; k < alts.size(); ++k) {
-      const std::string file = resolve_path(cfg, alts[k].require_string("file", {"", "release file"}));
+      const std::string file = resolve_path(cfg, alts[k].require_string("file", kAlternativeFileDoc));
       if (!fs::exists(file))
         throw InputError("release file not found", src, "ensemble.release_alternative[" + std::to_string(k) + "].file",
                          file);
       plan.release_alternatives.push_back(file);
       p.values.push_back(static_cast<double>(k));
-      p.weights.push_back(alts[k].get("weight", 1.0, Range::positive(), {"1", "relative probability"}));
+      p.weights.push_back(alts[k].get("weight", 1.0, Range::positive(), kAlternativeWeightDoc));
     }
     plan.parameters.push_back(p);
   }
 
   AggregationSettings& a = s.aggregation;
-  a.depth_thresholds = cfg.get_array("products.depth_thresholds", {0.5}, Range::positive(), {"m", "P(peak depth > t)"});
-  a.speed_thresholds = cfg.get_array("products.speed_thresholds", {}, Range::positive(), {"m/s", "P(peak speed > t)"});
-  a.pressure_thresholds =
-      cfg.get_array("products.pressure_thresholds", {30e3}, Range::positive(), {"Pa", "P(peak pressure > t)"});
-  a.intensity_classes.clear();
-  for (double k : cfg.get_array("products.intensity_classes", {2}, Range::closed(1, 3), {"1", "P(class ≥ k)"})) {
-    if (k != std::floor(k))
-      throw InputError("intensity classes are 1, 2 or 3", src, "products.intensity_classes", fmt(k));
-    a.intensity_classes.push_back(static_cast<int>(k));
-  }
-  a.percentiles = cfg.get_array("products.percentiles", {10, 50, 90}, Range::open_closed(0, 100), {"%", "percentiles"});
-  a.bins = static_cast<int>(cfg.get_int("products.bins", 96, Range::closed(8, 1024), kBinsDoc));
+  read_product_keys(cfg, a);
   cfg.finish();
   s.resolved_config = cfg.resolved();
   if (!fs::exists(s.base_config))
