@@ -142,12 +142,13 @@ struct HerschelBulkleyTerms {
     speed = b - c * zeta_io;
     return true;
   }
+  /// Whether (ζ, q) is a usable start (a particle's last step, both positive and finite).
+  static bool warm(double zeta, double q) noexcept { return zeta > 0.0 && q > 0.0 && zeta < HUGE_VAL && q < HUGE_VAL; }
   /// excess_stress in place: (zeta, q) from the start to the root; returns U at the root (the
   /// series step from a warm start, else the iteration below).
   double solve(double b, double c, double& zeta_io, double& q_io) const noexcept {
     double speed;
-    if (zeta_io > 0.0 && q_io > 0.0 && zeta_io < HUGE_VAL && q_io < HUGE_VAL && series_step(b, c, zeta_io, q_io, speed))
-      return speed;
+    if (warm(zeta_io, q_io) && series_step(b, c, zeta_io, q_io, speed)) return speed;
     return iterate(b, c, zeta_io, q_io);
   }
   /// solve's iteration, from the warm start or (without one) the cold start. Out of line: the
@@ -156,7 +157,7 @@ struct HerschelBulkleyTerms {
     const double a = (n + 1.0) / (2.0 * n + 1.0), inv_n = 1.0 / n, c0 = n * h / (n + 1.0), k1 = 1.0 + inv_n;
     const double m = std::max(1.0, inv_n);  // |δ| m bounds both exponents of the updates
     double zeta = zeta_io, q = q_io;
-    if (!(zeta > 0.0 && q > 0.0 && zeta < HUGE_VAL && q < HUGE_VAL)) cold_start(b, zeta, q);
+    if (!warm(zeta, q)) cold_start(b, zeta, q);
     // Halley's method in y = ln(ζ/ζ₀) (U is close to a power of ζ at both ends). With w = aζ + τ_y,
     // τ = τ_y + ζ, f_a = aζ/w, f_z = ζ/τ and G(y) = U + cζ − b, U = c0 q f_z w/τ:
     //   G' = U p + cζ,  G'' = U (p² + f_a (1 − f_a) − 2 f_z (1 − f_z)) + cζ,  p = 1 + 1/n + f_a − 2 f_z
