@@ -56,9 +56,11 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -617,143 +619,174 @@ class RunoutSolver {
       push_depth_.resize(store_.size());
     }
     const auto& ids = store_.get<ParticleId>();
+    // The particles go in blocks of kFrictionBlock: a. and b. for the block, the friction steps of
+    // the block together (c.), then the rest for the block. The friction steps of a block are
+    // independent, so the processor overlaps them (one particle's step is a chain of dependent
+    // divisions that the rest of its own update cannot hide), and a law may step several
+    // particles in one vector instruction (speed_after_friction_block).
+    using Terms = decltype(law.terms(0.0, 0.0, 1.0, 0.0, 1.0));
+    const std::int64_t blocks = (n + kFrictionBlock - 1) / kFrictionBlock;
     int any_leaving = 0, any_non_finite = 0, any_entraining = 0, any_wall = 0;
 #pragma omp parallel for reduction(max                                                      \
                                    : any_leaving, any_non_finite, any_entraining, any_wall) \
     schedule(static) if (parallel_worth(n))
-    for (std::int64_t ii = 0; ii < n; ++ii) {
-      const auto i = static_cast<std::size_t>(ii);
-      const std::size_t cell = cells ? proc_.cell(x[i]) : SpatialProcesses::npos;
-      const Vec2 gz = grad[i];
-      const double cos_theta = cb[i];
-      const double h_n = std::max(h[i], p_.min_depth);
-      // a. Lateral mixing: implicit relaxation towards the neighbours' mean velocity at the rate
-      //    k = C_mix |ṽ − v|_s √(h_n/V) (com1DFA: C·½ρ|Δv|A_lat/m with A_lat = 2√(V h_n)).
-      Vec2 vi = v[i] + dv[i];
-      if (mix > 0.0) {
-        const Vec2 dm = vmean[i] - vi;
-        const double dmz = gz.dot(dm);
-        const double kdt = mix * std::sqrt(dm.squaredNorm() + dmz * dmz) * std::sqrt(h_n / vol[i]) * dt;
-        vi = (vi + kdt * vmean[i]) / (1.0 + kdt);
-      }
-      // b. Gravity along the bed and the head pressure: a = −g cos²θ p + a_p.
-      Vec2 a = (-g * cos_theta * cos_theta) * gz + ap[i];
-      //    Near a barrier whose crest is above the flow surface: the push of the mirror layer the
-      //    wall stands for, C g cos θ h_w M(s/d0)/d0 away from it (barriers.hpp); the wall takes it.
-      if (walls && barriers_.near(x[i])) {
-        wall_push(i, dt, a);
-        if (push_barrier_[i] >= 0) any_wall = 1;
-      }
-      const Vec2 v_star = vi + dt * a;
-      // c. Basal friction on the surface speed with the bed-normal stress ρ g_n h_n,
-      //    g_n = cos θ (g + vᵀHv)⁺: gravity plus the centripetal acceleration of the bed curvature
-      //    along the velocity, zero when the particle would leave the bed.
-      const Vec3& H = hess[i];
-      const double kv =
-          curvature ? H[0] * vi.x() * vi.x() + 2.0 * H[1] * vi.x() * vi.y() + H[2] * vi.y() * vi.y() : 0.0;
-      const double vz = gz.dot(v_star);
-      const double s_star = std::sqrt(v_star.squaredNorm() + vz * vz);
-      //    The law's coefficients of the particle's friction zone; forest drag k_f |v|² on top.
-      Law local = law;
-      if (zones) local = proc_.law_at(law, cell);
-      auto t = local.terms(g, std::max(g + kv, 0.0) * cos_theta, h_n, s_star, p_.density);
-      if (forest && cell != SpatialProcesses::npos && proc_.forest_drag[cell] > 0.0)
-        t.extra_drag = proc_.forest_drag[cell];
-      if constexpr (requires { t.memory; })
-        if (memory) t.memory = {&memory_stress[i], &memory_rate[i]};
-      double s = speed_after_friction(s_star, dt, t);
-      //    Erosion the particle asks for over the step (granted in entrain(), capped by the layer).
-      if (erode && s > 0.0 && cell != SpatialProcesses::npos && proc_.erodible_depth[cell] > 0.0) {
-        double want = 0.0;
-        if (ent.law == EntrainmentLaw::GrowthRate) {
-          want = vol[i] * std::expm1(ent.growth_rate * s * dt);  // V (exp(E_s Δs) − 1), Δs = S Δt
-        } else {
-          const double tau_b = p_.density * h_n * t.acceleration(s);  // basal shear (Pa)
-          const double rate = ent.erosion_coefficient * std::max(tau_b - ent.critical_shear, 0.0);
-          want = rate * dt * vol[i] / h_n;  // ė Δt × bed area V/h_n
+    for (std::int64_t blk = 0; blk < blocks; ++blk) {
+      const auto first = static_cast<std::size_t>(blk) * kFrictionBlock;
+      const std::size_t count = std::min<std::size_t>(kFrictionBlock, static_cast<std::size_t>(n) - first);
+      std::array<Terms, kFrictionBlock> terms;
+      std::array<Vec2, kFrictionBlock> v_stars;
+      std::array<double, kFrictionBlock> s_stars, speeds;
+      std::array<std::size_t, kFrictionBlock> block_cells;
+      for (std::size_t k = 0; k < count; ++k) {
+        const std::size_t i = first + k;
+        const std::size_t cell = cells ? proc_.cell(x[i]) : SpatialProcesses::npos;
+        const Vec2 gz = grad[i];
+        const double cos_theta = cb[i];
+        const double h_n = std::max(h[i], p_.min_depth);
+        // a. Lateral mixing: implicit relaxation towards the neighbours' mean velocity at the rate
+        //    k = C_mix |ṽ − v|_s √(h_n/V) (com1DFA: C·½ρ|Δv|A_lat/m with A_lat = 2√(V h_n)).
+        Vec2 vi = v[i] + dv[i];
+        if (mix > 0.0) {
+          const Vec2 dm = vmean[i] - vi;
+          const double dmz = gz.dot(dm);
+          const double kdt = mix * std::sqrt(dm.squaredNorm() + dmz * dmz) * std::sqrt(h_n / vol[i]) * dt;
+          vi = (vi + kdt * vmean[i]) / (1.0 + kdt);
         }
-        if (want > 0.0) {
-          demand_[i] = want;
-          demand_cell_[i] = cell;
-          any_entraining = 1;
+        // b. Gravity along the bed and the head pressure: a = −g cos²θ p + a_p.
+        Vec2 a = (-g * cos_theta * cos_theta) * gz + ap[i];
+        //    Near a barrier whose crest is above the flow surface: the push of the mirror layer the
+        //    wall stands for, C g cos θ h_w M(s/d0)/d0 away from it (barriers.hpp); the wall takes it.
+        if (walls && barriers_.near(x[i])) {
+          wall_push(i, dt, a);
+          if (push_barrier_[i] >= 0) any_wall = 1;
         }
+        const Vec2 v_star = vi + dt * a;
+        // c. Basal friction on the surface speed with the bed-normal stress ρ g_n h_n,
+        //    g_n = cos θ (g + vᵀHv)⁺: gravity plus the centripetal acceleration of the bed curvature
+        //    along the velocity, zero when the particle would leave the bed.
+        const Vec3& H = hess[i];
+        const double kv =
+            curvature ? H[0] * vi.x() * vi.x() + 2.0 * H[1] * vi.x() * vi.y() + H[2] * vi.y() * vi.y() : 0.0;
+        const double vz = gz.dot(v_star);
+        const double s_star = std::sqrt(v_star.squaredNorm() + vz * vz);
+        //    The law's coefficients of the particle's friction zone; forest drag k_f |v|² on top.
+        Law local = law;
+        if (zones) local = proc_.law_at(law, cell);
+        auto t = local.terms(g, std::max(g + kv, 0.0) * cos_theta, h_n, s_star, p_.density);
+        if (forest && cell != SpatialProcesses::npos && proc_.forest_drag[cell] > 0.0)
+          t.extra_drag = proc_.forest_drag[cell];
+        if constexpr (requires { t.memory; })
+          if (memory) t.memory = {&memory_stress[i], &memory_rate[i]};
+        terms[k] = t;
+        v_stars[k] = v_star;
+        s_stars[k] = s_star;
+        block_cells[k] = cell;
       }
-      Vec2 v_new = s > 0.0 ? Vec2(v_star * (s / s_star)) : Vec2::Zero();
-      Vec2 x_new = x[i] + dt * v_new;
-      // d. Barriers: held at the wall unless the flow surface is above the crest or the particle
-      //    passes an open barrier.
-      BarrierCrossing hit;
-      bool held = false;
-      if (walls && barriers_.first_crossing(x[i], x_new, hit)) {
-        any_wall = 1;
-        const auto b = static_cast<std::size_t>(hit.barrier);
-        const Barrier& bar = barriers_[b];
-        // Depth at the wall: the kernel sum misses the part of the support beyond the wall.
-        const double h_wall =
-            h[i] / BarrierSet::kernel_fraction(barriers_.distance_to_segment(b, hit.segment, x[i]) / p_.d0);
-        SurfaceSample at;
-        const double z_crest = (surface_.sample(hit.point, at) ? at.z : z[i]) + bar.height;
-        const bool over = z[i] + h_wall / cos_theta > z_crest;
-        wall_barrier_[i] = hit.barrier;
-        wall_bin_[i] = barriers_.bin_of(hit);
-        wall_depth_[i] = h_wall;
-        wall_cross_[i] = over || barriers_.passes(ids[i], b) ? 1 : 0;
-        if (wall_cross_[i]) {
-          wall_value_[i] = hit.from_upstream ? vol[i] : -vol[i];  // crosses: signed volume
-        } else {
-          const WallLaw& wl = barriers_.law();
-          const Vec2 nrm = hit.normal;
-          const double vn = std::max(v_new.dot(nrm), 0.0);
-          Vec2 vt = v_new - v_new.dot(nrm) * nrm;
-          const double vt_norm = vt.norm(), dvn = (1.0 + wl.restitution) * vn;
-          if (vt_norm > 0.0) vt *= std::max(0.0, 1.0 - wl.friction * dvn / vt_norm);
-          v_new = vt - wl.restitution * vn * nrm;
-          wall_value_[i] = vol[i] * dvn;  // held: the impulse per unit density (m⁴/s)
-          // Stop at the wall (a hair before it), then the rest of the step with v'.
-          const double backoff = 1e-6 * p_.d0;
-          const double to_wall = hit.t * (x_new - x[i]).dot(nrm);
-          const Vec2 xc = to_wall > 2.0 * backoff ? Vec2(x[i] + hit.t * (x_new - x[i]) - backoff * nrm) : x[i];
-          x_new = xc + ((1.0 - hit.t) * dt) * v_new;
-          BarrierCrossing again;
-          if (barriers_.first_crossing(xc, x_new, again)) x_new = xc;  // a corner: the next step resolves it
-          const double vzn = gz.dot(v_new);
-          s = std::sqrt(v_new.squaredNorm() + vzn * vzn);
-          held = true;
+      speed_after_friction_block(std::span<const double>(s_stars.data(), count), dt,
+                                 std::span<const Terms>(terms.data(), count), std::span<double>(speeds.data(), count));
+      for (std::size_t k = 0; k < count; ++k) {
+        const std::size_t i = first + k;
+        const std::size_t cell = block_cells[k];
+        const Vec2 gz = grad[i];
+        const double cos_theta = cb[i];
+        const double h_n = std::max(h[i], p_.min_depth);
+        const Vec2 v_star = v_stars[k];
+        const double s_star = s_stars[k];
+        const Terms& t = terms[k];
+        double s = speeds[k];
+        //    Erosion the particle asks for over the step (granted in entrain(), capped by the layer).
+        if (erode && s > 0.0 && cell != SpatialProcesses::npos && proc_.erodible_depth[cell] > 0.0) {
+          double want = 0.0;
+          if (ent.law == EntrainmentLaw::GrowthRate) {
+            want = vol[i] * std::expm1(ent.growth_rate * s * dt);  // V (exp(E_s Δs) − 1), Δs = S Δt
+          } else {
+            const double tau_b = p_.density * h_n * t.acceleration(s);  // basal shear (Pa)
+            const double rate = ent.erosion_coefficient * std::max(tau_b - ent.critical_shear, 0.0);
+            want = rate * dt * vol[i] / h_n;  // ė Δt × bed area V/h_n
+          }
+          if (want > 0.0) {
+            demand_[i] = want;
+            demand_cell_[i] = cell;
+            any_entraining = 1;
+          }
         }
-      }
-      const double moved = held ? (x_new - x[i]).norm() : dt * v_new.norm();
-      if (periodic) x_new = periodic_.wrap(x_new);
-      SurfaceSample smp;
-      if (!surface_.sample(x_new, smp)) {
-        leaving[i] = 1;
+        Vec2 v_new = s > 0.0 ? Vec2(v_star * (s / s_star)) : Vec2::Zero();
+        Vec2 x_new = x[i] + dt * v_new;
+        // d. Barriers: held at the wall unless the flow surface is above the crest or the particle
+        //    passes an open barrier.
+        BarrierCrossing hit;
+        bool held = false;
+        if (walls && barriers_.first_crossing(x[i], x_new, hit)) {
+          any_wall = 1;
+          const auto b = static_cast<std::size_t>(hit.barrier);
+          const Barrier& bar = barriers_[b];
+          // Depth at the wall: the kernel sum misses the part of the support beyond the wall.
+          const double h_wall =
+              h[i] / BarrierSet::kernel_fraction(barriers_.distance_to_segment(b, hit.segment, x[i]) / p_.d0);
+          SurfaceSample at;
+          const double z_crest = (surface_.sample(hit.point, at) ? at.z : z[i]) + bar.height;
+          const bool over = z[i] + h_wall / cos_theta > z_crest;
+          wall_barrier_[i] = hit.barrier;
+          wall_bin_[i] = barriers_.bin_of(hit);
+          wall_depth_[i] = h_wall;
+          wall_cross_[i] = over || barriers_.passes(ids[i], b) ? 1 : 0;
+          if (wall_cross_[i]) {
+            wall_value_[i] = hit.from_upstream ? vol[i] : -vol[i];  // crosses: signed volume
+          } else {
+            const WallLaw& wl = barriers_.law();
+            const Vec2 nrm = hit.normal;
+            const double vn = std::max(v_new.dot(nrm), 0.0);
+            Vec2 vt = v_new - v_new.dot(nrm) * nrm;
+            const double vt_norm = vt.norm(), dvn = (1.0 + wl.restitution) * vn;
+            if (vt_norm > 0.0) vt *= std::max(0.0, 1.0 - wl.friction * dvn / vt_norm);
+            v_new = vt - wl.restitution * vn * nrm;
+            wall_value_[i] = vol[i] * dvn;  // held: the impulse per unit density (m⁴/s)
+            // Stop at the wall (a hair before it), then the rest of the step with v'.
+            const double backoff = 1e-6 * p_.d0;
+            const double to_wall = hit.t * (x_new - x[i]).dot(nrm);
+            const Vec2 xc = to_wall > 2.0 * backoff ? Vec2(x[i] + hit.t * (x_new - x[i]) - backoff * nrm) : x[i];
+            x_new = xc + ((1.0 - hit.t) * dt) * v_new;
+            BarrierCrossing again;
+            if (barriers_.first_crossing(xc, x_new, again)) x_new = xc;  // a corner: the next step resolves it
+            const double vzn = gz.dot(v_new);
+            s = std::sqrt(v_new.squaredNorm() + vzn * vzn);
+            held = true;
+          }
+        }
+        const double moved = held ? (x_new - x[i]).norm() : dt * v_new.norm();
+        if (periodic) x_new = periodic_.wrap(x_new);
+        SurfaceSample smp;
+        if (!surface_.sample(x_new, smp)) {
+          leaving[i] = 1;
+          v[i] = v_new;
+          any_leaving = 1;
+          if (!(x[i].allFinite() && v_new.allFinite())) any_non_finite = 1;
+          continue;
+        }
+        // e. The bed constraint: the velocity, tangent to the bed at the old position, is turned into
+        //    the tangent plane at the new one keeping its magnitude S (the normal reaction does no
+        //    work; AvaFrame com1DFA's reprojection). In map view, with p' the new gradient:
+        //        v' ∝ v + p' ((p − p')·v)/(1 + |p'|²),   scaled so that |(v', p'·v')| = S.
+        if (s > 0.0) {
+          const Vec2 pn = smp.grad;
+          const Vec2 vt = v_new + (((gz - pn).dot(v_new)) / (1.0 + pn.squaredNorm())) * pn;
+          const double vtz = pn.dot(vt);
+          const double st = std::sqrt(vt.squaredNorm() + vtz * vtz);
+          if (st > 1e-12 * s) v_new = vt * (s / st);
+        }
+        leaving[i] = 0;
+        path[i] += moved;
+        x[i] = x_new;
         v[i] = v_new;
-        any_leaving = 1;
-        if (!(x[i].allFinite() && v_new.allFinite())) any_non_finite = 1;
-        continue;
+        z[i] = smp.z;
+        grad[i] = smp.grad;
+        hess[i] = smp.hess;
+        cb[i] = 1.0 / std::sqrt(1.0 + smp.grad.squaredNorm());
+        vzf[i] = smp.grad.dot(v_new);
+        speed[i] = s;
+        moving[i] = s > 0.0 ? 1 : 0;
+        if (!(x_new.allFinite() && v_new.allFinite())) any_non_finite = 1;
       }
-      // e. The bed constraint: the velocity, tangent to the bed at the old position, is turned into
-      //    the tangent plane at the new one keeping its magnitude S (the normal reaction does no
-      //    work; AvaFrame com1DFA's reprojection). In map view, with p' the new gradient:
-      //        v' ∝ v + p' ((p − p')·v)/(1 + |p'|²),   scaled so that |(v', p'·v')| = S.
-      if (s > 0.0) {
-        const Vec2 pn = smp.grad;
-        const Vec2 vt = v_new + (((gz - pn).dot(v_new)) / (1.0 + pn.squaredNorm())) * pn;
-        const double vtz = pn.dot(vt);
-        const double st = std::sqrt(vt.squaredNorm() + vtz * vtz);
-        if (st > 1e-12 * s) v_new = vt * (s / st);
-      }
-      leaving[i] = 0;
-      path[i] += moved;
-      x[i] = x_new;
-      v[i] = v_new;
-      z[i] = smp.z;
-      grad[i] = smp.grad;
-      hess[i] = smp.hess;
-      cb[i] = 1.0 / std::sqrt(1.0 + smp.grad.squaredNorm());
-      vzf[i] = smp.grad.dot(v_new);
-      speed[i] = s;
-      moving[i] = s > 0.0 ? 1 : 0;
-      if (!(x_new.allFinite() && v_new.allFinite())) any_non_finite = 1;
     }
     return {any_leaving != 0, any_non_finite != 0, any_entraining != 0, any_wall != 0};
   }

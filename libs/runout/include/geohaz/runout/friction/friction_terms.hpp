@@ -30,7 +30,9 @@
 
 #include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <span>
 
 #include "geohaz/core/law_parameters.hpp"
 
@@ -103,6 +105,36 @@ inline double speed_after_friction(double s_star, double dt, const FrictionTerms
   if (kdt <= 0.0) return b / c;
   // Root of kdt·s² + c·s − b = 0, written without cancellation.
   return 2.0 * b / (c + std::sqrt(c * c + 4.0 * kdt * b));
+}
+
+/// Doubles side by side in one vector register (GCC/Clang vector extension): the lanes of a law's
+/// block step. Arithmetic and comparisons act lane by lane with the IEEE rounding of the scalar
+/// operation (no fused multiply–add: the AVX2 code below is built without FMA), a comparison gives
+/// a mask of 0/−1 lanes, and `m ? a : b` selects by lane, so a step written once as a template over
+/// double and lanes gives the same bits either way. Two lanes are SSE2 (x86-64's baseline); four
+/// are AVX2, used where the processor has it (has_avx2()).
+using DoubleLanes = double __attribute__((vector_size(16)));
+using DoubleLanes4 = double __attribute__((vector_size(32)));
+/// Whether this processor runs AVX2 (tested once).
+inline bool has_avx2() noexcept {
+#if defined(__x86_64__) && defined(__GNUC__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+#else
+  return false;
+#endif
+}
+
+/// The solver steps the friction of its particles in blocks of this many (solver.hpp, integrate).
+inline constexpr std::size_t kFrictionBlock = 16;
+
+/// The friction steps of a block of particles: s[k] = speed_after_friction(s_star[k], dt, t[k]).
+/// A law whose step gains from doing several particles at once (vector instructions) overloads
+/// this for its terms type with the same results.
+template <class Terms>
+void speed_after_friction_block(std::span<const double> s_star, double dt, std::span<const Terms> t,
+                                std::span<double> s) noexcept {
+  for (std::size_t k = 0; k < s.size(); ++k) s[k] = speed_after_friction(s_star[k], dt, t[k]);
 }
 
 }  // namespace geohaz::runout

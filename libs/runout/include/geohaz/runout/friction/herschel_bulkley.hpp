@@ -17,7 +17,9 @@
 /// in ln ζ (U is close to a power of ζ at both ends), safeguarded by Newton steps and bisection, to
 /// an estimated 1e-13 in ln ζ. From the particle's (ζ, (ζ/K)^{1/n}) of its last step, kept by the
 /// solver in the store (BasalExcessStress, BasalShearRate; a warm start), one evaluation and a
-/// sixth-order series step usually prove that tolerance (series_step); where they do not, the
+/// sixth-order series step usually prove that tolerance (series_step; the solver steps its
+/// particles in blocks, several series steps side by side in vector lanes, with the same bits:
+/// speed_after_friction_block); where they do not, the
 /// iteration runs from there (one or two iterations and no libm call). Without it, it starts from
 /// the larger of the two asymptotic inverses (both below the root of U = b; three pows). ζ and
 /// (ζ/K)^{1/n} are updated by the factors e^{−δ}, e^{−δ/n} from Padé approximants while the steps
@@ -28,6 +30,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <span>
 
 #include "geohaz/runout/friction/friction_terms.hpp"
 
@@ -88,11 +91,13 @@ struct HerschelBulkleyTerms {
   }
   /// The derivatives σ^(j), j = 1..5, of the logistic function (σ' = σ(1 − σ)) as polynomials in
   /// its value f: the y-derivatives of f_a, f_z and −ρ below.
-  static std::array<double, 5> logistic_derivatives(double f) noexcept {
-    const double g = f * (1.0 - f), e = 1.0 - 2.0 * f;
+  template <class T>
+  [[gnu::always_inline]] static std::array<T, 5> logistic_derivatives(const T& f) noexcept {
+    const T g = f * (1.0 - f), e = 1.0 - 2.0 * f;
     return {g, g * e, g * (1.0 - 6.0 * g), g * e * (1.0 - 12.0 * g), g * (1.0 + g * (-30.0 + 120.0 * g))};
   }
-  /// The warm step in one evaluation. With B(y) = b − cζ₀e^y the root of G is the root of
+  /// The warm step in one evaluation (series_step for one particle, series_lanes for several side
+  /// by side). With B(y) = b − cζ₀e^y the root of G is the root of
   ///   H(y) = ln U(y) − ln B(y),   y = ln(ζ/ζ₀),
   /// which is nearly linear: H' = p + ρ (ρ = cζ/B), and since ln U = const + (1 + 1/n) y + ln w −
   /// 2 ln τ with f_a' = f_a(1 − f_a), f_z' = f_z(1 − f_z), ρ' = ρ(1 + ρ), every higher derivative is
@@ -101,46 +106,60 @@ struct HerschelBulkleyTerms {
   /// s = (U₀ − B₀)/(U₀ + B₀), by its series to s¹³ (|s| < 0.1: truncation < 2e-16). The Taylor
   /// series of H to order 6 is reverted, y = t + c₂t² + … + c₆t⁶ with t = −H(0)/H'(0), a_k =
   /// H^(k)/(k! H'). Its terms fall by a factor ~4|t a₂| each (the series of the quadratic's root);
-  /// the step is accepted when the last one times 8|t|(|a₂| + |a₃| + |a₄|), the estimate of what is
-  /// left, is below 1e-13, as the iteration below is solved to, and |t| ≤ 0.05 (the omitted a₇t⁷ <
-  /// 1e-13); else nothing is changed and the iteration runs. The speed
-  /// returned is B(y) = b − cζ, which with ρ < 1 < p carries less of the error in y than U(ζ) (ρ
-  /// against p). ζ = ζ₀e^y by the Taylor polynomial of e^y to degree 9 (|y| ≤ 0.1: truncation
-  /// < 3e-17), (ζ/K)^{1/n} by small_exp.
+  /// the step is accepted when the last one times 8|t|√(3(a₂² + a₃² + a₄²)) (≥ 8|t|(|a₂| + |a₃| +
+  /// |a₄|)), the estimate of what is left, is below 1e-13, as the iteration below is solved to, and
+  /// |t| ≤ 0.05 (the omitted a₇t⁷ < 1e-13); these tests are made on squares (no absolute values,
+  /// the same code for one or several particles); else nothing is changed and the iteration runs.
+  /// The speed returned is B(y) = b − cζ, which with ρ < 1 < p carries less of the error in y than
+  /// U(ζ) (ρ against p). ζ = ζ₀e^y by the Taylor polynomial of e^y to degree 9 (|y| ≤ 0.1:
+  /// truncation < 3e-17), (ζ/K)^{1/n} by the (5, 5) Padé approximant of small_exp (|y/n| ≤ 1/4:
+  /// < 3e-17) without its branches.
   bool series_step(double b, double c, double& zeta_io, double& q_io, double& speed) const noexcept {
-    const double a = (n + 1.0) / (2.0 * n + 1.0), inv_n = 1.0 / n, c0 = n * h / (n + 1.0);
-    const double z0 = zeta_io, az = a * z0, w = az + tau_y, tau = tau_y + z0, cz = c * z0, b0 = b - cz;
-    const double num = c0 * q_io * z0 * w, den = b0 * (tau * tau);  // U₀ = num/τ², B₀ = den/τ²
-    const double sg = (num - den) / (num + den), rho = cz / b0;
-    if (!(std::abs(sg) < 0.1 && rho >= 0.0 && rho < 1.0)) return false;
-    const double fa = az / w, fz = z0 / tau;
-    const std::array<double, 5> da = logistic_derivatives(fa), dz = logistic_derivatives(fz);
-    const std::array<double, 5> dr = logistic_derivatives(-rho);
-    const double ih1 = 1.0 / (1.0 + inv_n + fa - 2.0 * fz + rho);
+    bool ok;
+    series_lanes(tau_y, n, h, b, c, zeta_io, q_io, speed, ok);
+    return ok;
+  }
+  /// series_step for T = double, or for several particles side by side (T = DoubleLanes or
+  /// DoubleLanes4, each lane with its own law and state), written once so that both give the same
+  /// bits: every test is a mask, and where it fails the lane's (ζ, q) is left as it was (ok false
+  /// there). The start is tested here too (warm()).
+  template <class T, class Mask>
+  [[gnu::always_inline]] static void series_lanes(const T& tau_y, const T& n, const T& h, const T& b, const T& c,
+                                                  T& zeta_io, T& q_io, T& speed, Mask& ok) noexcept {
+    const T a = (n + 1.0) / (2.0 * n + 1.0), inv_n = 1.0 / n, c0 = n * h / (n + 1.0);
+    const T z0 = zeta_io, q0 = q_io, az = a * z0, w = az + tau_y, tau = tau_y + z0, cz = c * z0, b0 = b - cz;
+    const T num = c0 * q0 * z0 * w, den = b0 * (tau * tau);  // U₀ = num/τ², B₀ = den/τ²
+    const T sg = (num - den) / (num + den), rho = cz / b0, s2 = sg * sg;
+    ok = (z0 > 0.0) & (q0 > 0.0) & (z0 < HUGE_VAL) & (q0 < HUGE_VAL) & (s2 < 0.01) & (rho >= 0.0) & (rho < 1.0);
+    const T fa = az / w, fz = z0 / tau;
+    const std::array<T, 5> da = logistic_derivatives(fa), dz = logistic_derivatives(fz);
+    const std::array<T, 5> dr = logistic_derivatives(T(-rho));
+    const T ih1 = 1.0 / (1.0 + inv_n + fa - 2.0 * fz + rho);
     constexpr std::array<double, 5> inv_fact{1.0 / 2, 1.0 / 6, 1.0 / 24, 1.0 / 120, 1.0 / 720};
-    std::array<double, 5> ak;  // a_2 … a_6
+    std::array<T, 5> ak;  // a_2 … a_6
     for (std::size_t j = 0; j < 5; ++j) ak[j] = (da[j] - 2.0 * dz[j] - dr[j]) * (inv_fact[j] * ih1);
-    const double a2 = ak[0], a3 = ak[1], a4 = ak[2], a5 = ak[3], a6 = ak[4], a22 = a2 * a2;
-    const double c2 = -a2, c3 = 2.0 * a22 - a3, c4 = a2 * (5.0 * (a3 - a22)) - a4;
-    const double c5 = a22 * (14.0 * a22 - 21.0 * a3) + 6.0 * a2 * a4 + 3.0 * a3 * a3 - a5;
-    const double c6 =
+    const T a2 = ak[0], a3 = ak[1], a4 = ak[2], a5 = ak[3], a6 = ak[4], a22 = a2 * a2;
+    const T c2 = -a2, c3 = 2.0 * a22 - a3, c4 = a2 * (5.0 * (a3 - a22)) - a4;
+    const T c5 = a22 * (14.0 * a22 - 21.0 * a3) + 6.0 * a2 * a4 + 3.0 * a3 * a3 - a5;
+    const T c6 =
         a22 * (a2 * (84.0 * a3 - 42.0 * a22) - 28.0 * a4) - 28.0 * a2 * a3 * a3 + 7.0 * (a2 * a5 + a3 * a4) - a6;
-    const double s2 = sg * sg, s4 = s2 * s2;
-    const double h0 = 2.0 * sg *
-                      ((1.0 + s2 * (1.0 / 3)) +
-                       s4 * ((1.0 / 5 + s2 * (1.0 / 7)) + s4 * ((1.0 / 9 + s2 * (1.0 / 11)) + s4 * (1.0 / 13))));
-    const double t = -h0 * ih1, t2 = t * t, t3 = t2 * t;
-    const double y = t * ((1.0 + c2 * t) + t2 * (c3 + c4 * t) + t3 * t * (c5 + c6 * t));
-    const double ay = std::abs(y), at = std::abs(t), ratio = 8.0 * at * (std::abs(a2) + std::abs(a3) + std::abs(a4));
-    if (!(std::abs(c6) * t3 * t3 * ratio < 1e-13 && at <= 0.05 && ay * inv_n <= 0.25)) return false;
-    const double y2 = y * y, y4 = y2 * y2;
-    const double ey = (1.0 + y) + y2 * (1.0 / 2 + y * (1.0 / 6)) +
-                      y4 * ((1.0 / 24 + y * (1.0 / 120)) + y2 * (1.0 / 720 + y * (1.0 / 5040)) +
-                            y4 * (1.0 / 40320 + y * (1.0 / 362880)));
-    zeta_io = z0 * ey;
-    q_io *= small_exp(y * inv_n);
+    const T s4 = s2 * s2;
+    const T h0 = 2.0 * sg *
+                 ((1.0 + s2 * (1.0 / 3)) +
+                  s4 * ((1.0 / 5 + s2 * (1.0 / 7)) + s4 * ((1.0 / 9 + s2 * (1.0 / 11)) + s4 * (1.0 / 13))));
+    const T t = -h0 * ih1, t2 = t * t, t3 = t2 * t;
+    const T y = t * ((1.0 + c2 * t) + t2 * (c3 + c4 * t) + t3 * t * (c5 + c6 * t));
+    const T y2 = y * y, y4 = y2 * y2, t6 = t3 * t3;
+    ok = ok & ((c6 * c6) * (t6 * t6) * (192.0 * t2 * (a22 + a3 * a3 + a4 * a4)) < 1e-26) & (t2 <= 0.0025) &
+         (y2 * (inv_n * inv_n) <= 0.0625);
+    const T ey = (1.0 + y) + y2 * (1.0 / 2 + y * (1.0 / 6)) +
+                 y4 * ((1.0 / 24 + y * (1.0 / 120)) + y2 * (1.0 / 720 + y * (1.0 / 5040)) +
+                       y4 * (1.0 / 40320 + y * (1.0 / 362880)));
+    const T x = y * inv_n, x2 = x * x;
+    const T even = 1.0 + x2 * (1.0 / 9 + x2 * (1.0 / 1008)), odd = x * (1.0 / 2 + x2 * (1.0 / 72 + x2 * (1.0 / 30240)));
+    zeta_io = ok ? T(z0 * ey) : z0;
+    q_io = ok ? T(q0 * ((even + odd) / (even - odd))) : q0;
     speed = b - c * zeta_io;
-    return true;
   }
   /// Whether (ζ, q) is a usable start (a particle's last step, both positive and finite).
   static bool warm(double zeta, double q) noexcept { return zeta > 0.0 && q > 0.0 && zeta < HUGE_VAL && q < HUGE_VAL; }
@@ -222,6 +241,54 @@ inline double speed_after_friction(double s_star, double dt, const HerschelBulkl
   double z = 0.0, q = 0.0;
   const double s = t.solve(b, dt / (t.rho * t.h), zeta ? *zeta : z, zeta ? *rate : q);
   return speed_after_drag(std::min(s, b), t.extra_drag * dt);
+}
+
+/// The steps of a block of particles, bit for bit those of speed_after_friction: the warm series
+/// steps V's lanes side by side (series_lanes); a particle that stops, has no usable start or
+/// whose series step is not accepted takes speed_after_friction.
+template <class V>
+[[gnu::always_inline]] inline void herschel_bulkley_block(std::span<const double> s_star, double dt,
+                                                          std::span<const HerschelBulkleyTerms> t,
+                                                          std::span<double> s) noexcept {
+  constexpr std::size_t lanes = sizeof(V) / sizeof(double);
+  std::size_t k = 0;
+  for (; k + lanes <= s.size(); k += lanes) {
+    V tau_y, n, h, rho, rest, ss, zeta, q, speed;
+    for (std::size_t l = 0; l < lanes; ++l) {
+      const HerschelBulkleyTerms& tl = t[k + l];
+      tau_y[l] = tl.tau_y, n[l] = tl.n, h[l] = tl.h, rho[l] = tl.rho, rest[l] = tl.rest, ss[l] = s_star[k + l];
+      zeta[l] = tl.memory.stress ? *tl.memory.stress : 0.0;
+      q[l] = tl.memory.stress ? *tl.memory.rate : 0.0;
+    }
+    const V b = ss - dt * rest, c = dt / (rho * h);
+    decltype(b > 0.0) ok;
+    HerschelBulkleyTerms::series_lanes(tau_y, n, h, b, c, zeta, q, speed, ok);
+    ok &= b > 0.0;
+    for (std::size_t l = 0; l < lanes; ++l) {
+      const HerschelBulkleyTerms& tl = t[k + l];
+      if (!ok[l]) {
+        s[k + l] = speed_after_friction(s_star[k + l], dt, tl);
+        continue;
+      }
+      *tl.memory.stress = zeta[l], *tl.memory.rate = q[l];
+      s[k + l] = speed_after_drag(std::min(speed[l], b[l]), tl.extra_drag * dt);
+    }
+  }
+  for (; k < s.size(); ++k) s[k] = speed_after_friction(s_star[k], dt, t[k]);
+}
+#if defined(__x86_64__) && defined(__GNUC__)
+[[gnu::target("avx2")]] inline void herschel_bulkley_block_avx2(std::span<const double> s_star, double dt,
+                                                                std::span<const HerschelBulkleyTerms> t,
+                                                                std::span<double> s) noexcept {
+  herschel_bulkley_block<DoubleLanes4>(s_star, dt, t, s);
+}
+#endif
+inline void speed_after_friction_block(std::span<const double> s_star, double dt,
+                                       std::span<const HerschelBulkleyTerms> t, std::span<double> s) noexcept {
+#if defined(__x86_64__) && defined(__GNUC__)
+  if (has_avx2()) return herschel_bulkley_block_avx2(s_star, dt, t, s);
+#endif
+  herschel_bulkley_block<DoubleLanes>(s_star, dt, t, s);
 }
 
 struct HerschelBulkleyFriction {
