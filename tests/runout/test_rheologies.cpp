@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <limits>
 #include <numbers>
 #include <random>
@@ -443,133 +444,133 @@ TEST(RheologyStep, HerschelBulkleySeriesStepIsWithin1e12OfALongDoubleBisection) 
   }
 }
 
+// --- The block step (speed_after_friction_block) against one particle at a time ---
+
+namespace {
+// A block of one law's particles: the driving speed s* of each and the memory (ζ, γ̇_b) its last
+// step left (0: none, a cold start).
+template <class Terms>
+struct FrictionBlock {
+  double dt = 0.0;
+  std::vector<double> s_star, zeta, rate;
+  std::vector<Terms> terms;
+};
+template <class Terms>
+using BlockStep = void (*)(std::span<const double>, double, std::span<const Terms>, std::span<double>);
+template <class Terms>
+void dispatched_block(std::span<const double> s_star, double dt, std::span<const Terms> t, std::span<double> s) {
+  speed_after_friction_block(s_star, dt, t, s);
+}
+// The next driving of a particle whose last step was at s0: a small change (the warm step), a jump
+// (refused by it) or too little to move (a stop), forest drag on some.
+template <class Terms>
+double next_driving(std::mt19937& rng, double s0, double dt, Terms& t) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  if (u(rng) < 0.2) t.extra_drag = 0.01 * u(rng);
+  const double kind = u(rng);
+  return kind < 0.7 ? s0 * (1.0 + 0.1 * (u(rng) - 0.3)) + dt * t.rest : kind < 0.85 ? 3.0 * s0 : 0.5 * dt * t.rest;
+}
+// Every particle of the block must get from each variant the speed and the memory that
+// speed_after_friction gives it alone, bit for bit; every fifth particle has no memory.
+template <class Terms>
+void expect_block_bits(const FrictionBlock<Terms>& b, int trial,
+                       std::initializer_list<std::pair<const char*, BlockStep<Terms>>> variants) {
+  const std::size_t count = b.terms.size();
+  std::vector<double> ref_speed(count), ref_zeta = b.zeta, ref_rate = b.rate;
+  for (std::size_t k = 0; k < count; ++k) {
+    Terms tk = b.terms[k];
+    if (k % 5 != 4) tk.memory = {&ref_zeta[k], &ref_rate[k]};
+    ref_speed[k] = speed_after_friction(b.s_star[k], b.dt, tk);
+  }
+  for (const auto& [name, step] : variants) {
+    std::vector<double> speed(count, -1.0), z = b.zeta, q = b.rate;
+    std::vector<Terms> tb = b.terms;
+    for (std::size_t k = 0; k < count; ++k)
+      if (k % 5 != 4) tb[k].memory = {&z[k], &q[k]};
+    step(b.s_star, b.dt, tb, speed);
+    for (std::size_t k = 0; k < count; ++k) {
+      ASSERT_EQ(speed[k], ref_speed[k]) << name << ", trial " << trial << ", particle " << k << " of " << count;
+      ASSERT_EQ(z[k], ref_zeta[k]) << name << ", trial " << trial << ", particle " << k;
+      ASSERT_EQ(q[k], ref_rate[k]) << name << ", trial " << trial << ", particle " << k;
+    }
+  }
+}
+}  // namespace
+
 TEST(RheologyStep, HerschelBulkleyBlockStepGivesTheBitsOfOneParticleAtATime) {
   // The solver steps its particles in blocks (speed_after_friction_block), Herschel–Bulkley's warm
   // series side by side in vector lanes: two (SSE2) or four (AVX2, where the processor has it).
-  // Every particle of a block must get the speed and the memory (ζ, q) that speed_after_friction
-  // gives it alone, bit for bit, whatever its neighbours in the block do: warm starts the series
-  // accepts, warm starts it refuses (a large jump of b), cold starts, stops (b ≤ 0), no memory,
-  // forest drag, several laws (friction zones) in one block, and blocks whose size is not a
-  // multiple of the lanes.
+  // Every particle of a block must get what it gets alone, whatever its neighbours in the block
+  // do: warm starts the series accepts, warm starts it refuses (a large jump of b), cold starts,
+  // stops (b ≤ 0), no memory, forest drag, several laws (friction zones) in one block, and blocks
+  // whose size is not a multiple of the lanes.
   std::mt19937 rng(2026);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const std::array<HerschelBulkleyFriction, 3> laws{HerschelBulkleyFriction{1000.0, 100.0, 0.4}, kHerschel,
                                                     HerschelBulkleyFriction{200.0, 5.0, 1.6}};
-  using Step = void (*)(std::span<const double>, double, std::span<const HerschelBulkleyTerms>, std::span<double>);
-  const std::array<std::pair<const char*, Step>, 3> variants{
-      {{"two lanes", &herschel_bulkley_block<DoubleLanes>},
-       {"four lanes", &herschel_bulkley_block<DoubleLanes4>},
-       {"dispatched", [](std::span<const double> a, double dt, std::span<const HerschelBulkleyTerms> t,
-                         std::span<double> s) { speed_after_friction_block(a, dt, t, s); }}}};
   int series = 0, particles = 0;
   for (int trial = 0; trial < 200; ++trial) {
+    FrictionBlock<HerschelBulkleyTerms> b;
     const std::size_t count = 1 + static_cast<std::size_t>(u(rng) * kFrictionBlock);
-    const double dt = 1e-3 * std::pow(30.0, u(rng));
-    std::vector<double> s_star(count), zeta(count), rate(count);
-    std::vector<HerschelBulkleyTerms> t;
+    b.dt = 1e-3 * std::pow(30.0, u(rng));
     for (std::size_t k = 0; k < count; ++k) {
       const HerschelBulkleyFriction& law = laws[static_cast<std::size_t>(u(rng) * 3.0) % 3];
       const double h = 0.3 + 2.5 * u(rng), s0 = 0.2 + 6.0 * u(rng);
       HerschelBulkleyTerms tk = law.terms(kG, kG, h, s0, kRho);
-      // The state of a previous step at speed s0 (a warm start), or none (cold).
-      const auto root = tk.excess_stress(s0, dt / (kRho * h));
+      const auto root = tk.excess_stress(s0, b.dt / (kRho * h));  // the state of a step at s0
       const bool warm = u(rng) < 0.8;
-      zeta[k] = warm ? root.zeta : 0.0, rate[k] = warm ? root.rate : 0.0;
-      const double kind = u(rng);  // next driving: small change (series), jump, or stop
-      s_star[k] = kind < 0.7    ? s0 * (1.0 + 0.1 * (u(rng) - 0.3)) + dt * tk.rest
-                  : kind < 0.85 ? 3.0 * s0
-                                : 0.5 * dt * tk.rest;
-      if (u(rng) < 0.2) tk.extra_drag = 0.01 * u(rng);
-      t.push_back(tk);
-    }
-    // One at a time: the reference.
-    std::vector<double> ref_speed(count), ref_zeta = zeta, ref_rate = rate;
-    for (std::size_t k = 0; k < count; ++k) {
-      HerschelBulkleyTerms tk = t[k];
-      if (k % 5 != 4) tk.memory = {&ref_zeta[k], &ref_rate[k]};  // every fifth without memory
-      ref_speed[k] = speed_after_friction(s_star[k], dt, tk);
-      double z = zeta[k], q = rate[k], sp = 0.0;
-      const double b = s_star[k] - dt * tk.rest;
-      if (k % 5 != 4 && b > 0.0 && tk.series_step(b, dt / (kRho * tk.h), z, q, sp)) ++series;
+      b.zeta.push_back(warm ? root.zeta : 0.0), b.rate.push_back(warm ? root.rate : 0.0);
+      b.s_star.push_back(next_driving(rng, s0, b.dt, tk));
+      b.terms.push_back(tk);
+      double z = b.zeta[k], q = b.rate[k], sp = 0.0;
+      const double drive = b.s_star[k] - b.dt * tk.rest;
+      if (k % 5 != 4 && drive > 0.0 && tk.series_step(drive, b.dt / (kRho * h), z, q, sp)) ++series;
     }
     particles += static_cast<int>(count);
-    for (const auto& [name, step] : variants) {
-      std::vector<double> speed(count, -1.0), z = zeta, q = rate;
-      std::vector<HerschelBulkleyTerms> tb = t;
-      for (std::size_t k = 0; k < count; ++k)
-        if (k % 5 != 4) tb[k].memory = {&z[k], &q[k]};
-      step(s_star, dt, tb, speed);
-      for (std::size_t k = 0; k < count; ++k) {
-        ASSERT_EQ(speed[k], ref_speed[k]) << name << ", trial " << trial << ", particle " << k << " of " << count;
-        ASSERT_EQ(z[k], ref_zeta[k]) << name << ", trial " << trial << ", particle " << k;
-        ASSERT_EQ(q[k], ref_rate[k]) << name << ", trial " << trial << ", particle " << k;
-      }
-    }
+    expect_block_bits<HerschelBulkleyTerms>(b, trial,
+                                            {{"two lanes", &herschel_bulkley_block<DoubleLanes>},
+                                             {"four lanes", &herschel_bulkley_block<DoubleLanes4>},
+                                             {"dispatched", &dispatched_block<HerschelBulkleyTerms>}});
+    if (HasFatalFailure()) return;
   }
-  // The vector path was taken for most particles (else this test compares the fallback with itself).
+  // The vector path was taken for many particles (else this compares the fallback with itself).
   EXPECT_GT(series, particles / 3) << series << " of " << particles;
   std::printf("HB block step: %d of %d particles by the series step, all bit-identical (AVX2 here: %s)\n", series,
               particles, has_avx2() ? "yes" : "no");
 }
 
 TEST(RheologyStep, BinghamBlockStepGivesTheBitsOfOneParticleAtATime) {
-  // As for Herschel–Bulkley above: Bingham's warm step of the plug cubic side by side in vector
-  // lanes must give every particle of a block the bits of speed_after_friction alone (warm steps
-  // accepted and refused, cold starts, stops, no memory, the Newtonian film τ_y = 0, forest drag).
+  // As for Herschel–Bulkley above, Bingham's warm step of the plug cubic in vector lanes; the
+  // Newtonian film τ_y = 0 among the laws.
   std::mt19937 rng(1970);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const std::array<BinghamFriction, 4> laws{BinghamFriction{1000.0, 100.0}, kBingham, BinghamFriction{0.0, 10.0},
                                             BinghamFriction{200.0, 5.0}};
-  using Step = void (*)(std::span<const double>, double, std::span<const BinghamTerms>, std::span<double>);
-  const std::array<std::pair<const char*, Step>, 3> variants{
-      {{"two lanes", &bingham_block<DoubleLanes>},
-       {"four lanes", &bingham_block<DoubleLanes4>},
-       {"dispatched", [](std::span<const double> a, double dt, std::span<const BinghamTerms> t, std::span<double> s) {
-          speed_after_friction_block(a, dt, t, s);
-        }}}};
   int warm_steps = 0, particles = 0;
   for (int trial = 0; trial < 200; ++trial) {
+    FrictionBlock<BinghamTerms> b;
     const std::size_t count = 1 + static_cast<std::size_t>(u(rng) * kFrictionBlock);
-    const double dt = 1e-3 * std::pow(30.0, u(rng));
-    std::vector<double> s_star(count), zeta(count), rate(count);
-    std::vector<BinghamTerms> t;
+    b.dt = 1e-3 * std::pow(30.0, u(rng));
     for (std::size_t k = 0; k < count; ++k) {
       const BinghamFriction& law = laws[static_cast<std::size_t>(u(rng) * 4.0) % 4];
       const double h = 0.3 + 2.5 * u(rng), s0 = 0.2 + 6.0 * u(rng);
       BinghamTerms tk = law.terms(kG, kG, h, s0, kRho);
-      // The state of a previous step at speed s0 (a warm start), or none (cold).
-      const bool warm = law.tau_y > 0.0 && u(rng) < 0.8;
-      const BinghamTerms::PlugRoot root = warm ? tk.plug_root(s0, dt, 0.0) : BinghamTerms::PlugRoot{0.0, 0.0};
-      zeta[k] = warm ? tk.tau_y * root.t * root.inv_r : 0.0, rate[k] = zeta[k] * tk.inv_viscosity;
-      const double kind = u(rng);  // next driving: small change (warm step), jump, or stop
-      s_star[k] = kind < 0.7    ? s0 * (1.0 + 0.1 * (u(rng) - 0.3)) + dt * tk.rest
-                  : kind < 0.85 ? 3.0 * s0
-                                : 0.5 * dt * tk.rest;
-      if (u(rng) < 0.2) tk.extra_drag = 0.01 * u(rng);
-      t.push_back(tk);
-    }
-    std::vector<double> ref_speed(count), ref_zeta = zeta, ref_rate = rate;
-    for (std::size_t k = 0; k < count; ++k) {
-      BinghamTerms tk = t[k];
-      if (k % 5 != 4) tk.memory = {&ref_zeta[k], &ref_rate[k]};  // every fifth without memory
-      ref_speed[k] = speed_after_friction(s_star[k], dt, tk);
-      BinghamTerms::PlugRoot root{};
-      const double P = s_star[k] * tk.inv_speed_scale, D = (s_star[k] - dt * tk.rest) * tk.inv_speed_scale;
-      if (k % 5 != 4 && tk.rest > 0.0 && D > 0.0 && zeta[k] > 0.0 && tk.warm_step(P, D, zeta[k], root)) ++warm_steps;
+      const bool warm = law.tau_y > 0.0 && u(rng) < 0.8;  // the state of a step at s0, or none
+      const BinghamTerms::PlugRoot root = warm ? tk.plug_root(s0, b.dt, 0.0) : BinghamTerms::PlugRoot{0.0, 0.0};
+      b.zeta.push_back(warm ? tk.tau_y * root.t * root.inv_r : 0.0), b.rate.push_back(b.zeta[k] * tk.inv_viscosity);
+      b.s_star.push_back(next_driving(rng, s0, b.dt, tk));
+      b.terms.push_back(tk);
+      BinghamTerms::PlugRoot next{};
+      const double P = b.s_star[k] * tk.inv_speed_scale, D = (b.s_star[k] - b.dt * tk.rest) * tk.inv_speed_scale;
+      if (k % 5 != 4 && tk.rest > 0.0 && D > 0.0 && b.zeta[k] > 0.0 && tk.warm_step(P, D, b.zeta[k], next))
+        ++warm_steps;
     }
     particles += static_cast<int>(count);
-    for (const auto& [name, step] : variants) {
-      std::vector<double> speed(count, -1.0), z = zeta, q = rate;
-      std::vector<BinghamTerms> tb = t;
-      for (std::size_t k = 0; k < count; ++k)
-        if (k % 5 != 4) tb[k].memory = {&z[k], &q[k]};
-      step(s_star, dt, tb, speed);
-      for (std::size_t k = 0; k < count; ++k) {
-        ASSERT_EQ(speed[k], ref_speed[k]) << name << ", trial " << trial << ", particle " << k << " of " << count;
-        ASSERT_EQ(z[k], ref_zeta[k]) << name << ", trial " << trial << ", particle " << k;
-        ASSERT_EQ(q[k], ref_rate[k]) << name << ", trial " << trial << ", particle " << k;
-      }
-    }
+    expect_block_bits<BinghamTerms>(b, trial,
+                                    {{"two lanes", &bingham_block<DoubleLanes>},
+                                     {"four lanes", &bingham_block<DoubleLanes4>},
+                                     {"dispatched", &dispatched_block<BinghamTerms>}});
+    if (HasFatalFailure()) return;
   }
   EXPECT_GT(warm_steps, particles / 3) << warm_steps << " of " << particles;
   std::printf("Bingham block step: %d of %d particles by the warm step, all bit-identical\n", warm_steps, particles);
