@@ -73,54 +73,11 @@
 #include "geohaz/runout/basal_friction.hpp"
 #include "geohaz/runout/fields.hpp"
 #include "geohaz/runout/head_pressure.hpp"
+#include "geohaz/runout/parameters.hpp"
 #include "geohaz/runout/processes.hpp"
 #include "geohaz/runout/surface.hpp"
 
 namespace geohaz::runout {
-
-/// Model parameters (SI units), filled from the config by the app.
-struct RunoutParameters {
-  double gravity = 9.81;    ///< g (m/s²)
-  double density = 1800.0;  ///< ρ of the mixture (kg/m³), for pressures ρv² in the outputs
-  double d0 = 5.0;          ///< reference particle spacing (m); kernel h = d0, support 2·d0
-  double h0 = 1.0;          ///< reference depth (m): nominal particle volume V0 = h0·d0²
-  double cfl = 0.3;         ///< Courant number on d0 (1)
-  double dt_max = 1.0;      ///< largest time step (s)
-  double dt_min = 1e-7;     ///< a smaller step is a blow-up (s)
-  double duration = 600.0;  ///< simulated time (s)
-  double min_depth = 0.01;  ///< floor on the bed-normal depth in the friction law (m)
-  double smoothing = 0.0;   ///< ε of the velocity correction per step (1), 0 switches it off
-  double pressure_scale = HeadPressureForce::consistent_normalisation();  ///< C (1)
-  /// C_mix of the lateral-mixing viscosity (1), 0 switches it off. AvaFrame com1DFA's default
-  /// subgridMixingFactor, 100; the relaxation vanishes with the velocity differences at the
-  /// particle scale, so results converge as d0 shrinks (docs/validation/runout.md).
-  double lateral_mixing = 100.0;
-  /// Bed curvature in the normal force (friction) and in the bed constraint (acceleration).
-  bool curvature = true;
-  /// The run ends when the kinetic energy falls below this fraction of its peak (1); 0: never.
-  double stop_energy_fraction = 0.01;
-  int reorder_every = 25;  ///< sort the store by cell at every this-many-th neighbour rebuild (0: never)
-  double skin = 0.0;       ///< neighbour-list skin in units of d0 (list cutoff (2 + skin)·d0)
-  BasalFriction friction = ModifiedManningFriction{};
-  /// Bed erosion law and coefficients (the erodible layer is a field: SpatialProcesses).
-  EntrainmentParameters entrainment;
-
-  double nominal_volume() const noexcept { return h0 * d0 * d0; }
-};
-
-/// Volumes (m³) at a moment of the run; initial + injected + entrained = mobile + deposited + lost
-/// up to round-off.
-struct VolumeBudget {
-  double initial = 0.0, mobile = 0.0, deposited = 0.0, lost = 0.0;
-  double injected = 0.0;   ///< brought in by inflow hydrographs
-  double entrained = 0.0;  ///< eroded from the bed
-  std::size_t lost_particles = 0;
-  double kinetic_energy = 0.0;       ///< Σ ½ ρ V S² now (J)
-  double peak_kinetic_energy = 0.0;  ///< its maximum so far (J)
-  /// Everything that has entered the flow.
-  double total_in() const noexcept { return initial + injected + entrained; }
-  double balance_error() const noexcept { return mobile + deposited + lost - total_in(); }
-};
 
 template <class Surface>
 class RunoutSolver {
@@ -618,7 +575,6 @@ class RunoutSolver {
       push_bin_.resize(store_.size());
       push_depth_.resize(store_.size());
     }
-    const auto& ids = store_.get<ParticleId>();
     // The particles go in blocks of kFrictionBlock: a. and b. for the block, the friction steps of
     // the block together (c.), then the rest for the block. The friction steps of a block are
     // independent, so the processor overlaps them (one particle's step is a chain of dependent
@@ -718,40 +674,7 @@ class RunoutSolver {
         bool held = false;
         if (walls && barriers_.first_crossing(x[i], x_new, hit)) {
           any_wall = 1;
-          const auto b = static_cast<std::size_t>(hit.barrier);
-          const Barrier& bar = barriers_[b];
-          // Depth at the wall: the kernel sum misses the part of the support beyond the wall.
-          const double h_wall =
-              h[i] / BarrierSet::kernel_fraction(barriers_.distance_to_segment(b, hit.segment, x[i]) / p_.d0);
-          SurfaceSample at;
-          const double z_crest = (surface_.sample(hit.point, at) ? at.z : z[i]) + bar.height;
-          const bool over = z[i] + h_wall / cos_theta > z_crest;
-          wall_barrier_[i] = hit.barrier;
-          wall_bin_[i] = barriers_.bin_of(hit);
-          wall_depth_[i] = h_wall;
-          wall_cross_[i] = over || barriers_.passes(ids[i], b) ? 1 : 0;
-          if (wall_cross_[i]) {
-            wall_value_[i] = hit.from_upstream ? vol[i] : -vol[i];  // crosses: signed volume
-          } else {
-            const WallLaw& wl = barriers_.law();
-            const Vec2 nrm = hit.normal;
-            const double vn = std::max(v_new.dot(nrm), 0.0);
-            Vec2 vt = v_new - v_new.dot(nrm) * nrm;
-            const double vt_norm = vt.norm(), dvn = (1.0 + wl.restitution) * vn;
-            if (vt_norm > 0.0) vt *= std::max(0.0, 1.0 - wl.friction * dvn / vt_norm);
-            v_new = vt - wl.restitution * vn * nrm;
-            wall_value_[i] = vol[i] * dvn;  // held: the impulse per unit density (m⁴/s)
-            // Stop at the wall (a hair before it), then the rest of the step with v'.
-            const double backoff = 1e-6 * p_.d0;
-            const double to_wall = hit.t * (x_new - x[i]).dot(nrm);
-            const Vec2 xc = to_wall > 2.0 * backoff ? Vec2(x[i] + hit.t * (x_new - x[i]) - backoff * nrm) : x[i];
-            x_new = xc + ((1.0 - hit.t) * dt) * v_new;
-            BarrierCrossing again;
-            if (barriers_.first_crossing(xc, x_new, again)) x_new = xc;  // a corner: the next step resolves it
-            const double vzn = gz.dot(v_new);
-            s = std::sqrt(v_new.squaredNorm() + vzn * vzn);
-            held = true;
-          }
+          held = meet_wall(i, hit, dt, gz, cos_theta, v_new, x_new, s);
         }
         const double moved = held ? (x_new - x[i]).norm() : dt * v_new.norm();
         if (periodic) x_new = periodic_.wrap(x_new);
@@ -789,6 +712,54 @@ class RunoutSolver {
       }
     }
     return {any_leaving != 0, any_non_finite != 0, any_entraining != 0, any_wall != 0};
+  }
+
+  /// d. Particle i, moving from x[i] to x_new at v_new, crosses a barrier (hit): recorded for the
+  /// tally. It is held at the wall (v_new reflected by the wall law, x_new just before the wall,
+  /// then the rest of the step, s its new speed; true) unless the flow surface is above the crest
+  /// or the particle passes an open barrier (false: nothing changed).
+  bool meet_wall(std::size_t i, const BarrierCrossing& hit, double dt, const Vec2& gz, double cos_theta, Vec2& v_new,
+                 Vec2& x_new, double& s) {
+    const auto& x = store_.get<Position<2>>();
+    const auto& h = store_.get<FlowDepth>();
+    const auto& z = store_.get<Elevation>();
+    const auto& vol = store_.get<Volume>();
+    const auto& ids = store_.get<ParticleId>();
+    const auto b = static_cast<std::size_t>(hit.barrier);
+    const Barrier& bar = barriers_[b];
+    // Depth at the wall: the kernel sum misses the part of the support beyond the wall.
+    const double h_wall =
+        h[i] / BarrierSet::kernel_fraction(barriers_.distance_to_segment(b, hit.segment, x[i]) / p_.d0);
+    SurfaceSample at;
+    const double z_crest = (surface_.sample(hit.point, at) ? at.z : z[i]) + bar.height;
+    const bool over = z[i] + h_wall / cos_theta > z_crest;
+    wall_barrier_[i] = hit.barrier;
+    wall_bin_[i] = barriers_.bin_of(hit);
+    wall_depth_[i] = h_wall;
+    wall_cross_[i] = over || barriers_.passes(ids[i], b) ? 1 : 0;
+    if (wall_cross_[i]) {
+      wall_value_[i] = hit.from_upstream ? vol[i] : -vol[i];  // crosses: signed volume
+    } else {
+      const WallLaw& wl = barriers_.law();
+      const Vec2 nrm = hit.normal;
+      const double vn = std::max(v_new.dot(nrm), 0.0);
+      Vec2 vt = v_new - v_new.dot(nrm) * nrm;
+      const double vt_norm = vt.norm(), dvn = (1.0 + wl.restitution) * vn;
+      if (vt_norm > 0.0) vt *= std::max(0.0, 1.0 - wl.friction * dvn / vt_norm);
+      v_new = vt - wl.restitution * vn * nrm;
+      wall_value_[i] = vol[i] * dvn;  // held: the impulse per unit density (m⁴/s)
+      // Stop at the wall (a hair before it), then the rest of the step with v'.
+      const double backoff = 1e-6 * p_.d0;
+      const double to_wall = hit.t * (x_new - x[i]).dot(nrm);
+      const Vec2 xc = to_wall > 2.0 * backoff ? Vec2(x[i] + hit.t * (x_new - x[i]) - backoff * nrm) : x[i];
+      x_new = xc + ((1.0 - hit.t) * dt) * v_new;
+      BarrierCrossing again;
+      if (barriers_.first_crossing(xc, x_new, again)) x_new = xc;  // a corner: the next step resolves it
+      const double vzn = gz.dot(v_new);
+      s = std::sqrt(v_new.squaredNorm() + vzn * vzn);
+      return true;
+    }
+    return false;
   }
 
   /// The mirror push of the nearest barrier on particle i (added to its acceleration a), recorded
