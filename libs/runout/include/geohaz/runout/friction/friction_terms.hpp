@@ -109,7 +109,8 @@ inline double speed_after_friction(double s_star, double dt, const FrictionTerms
 
 /// Doubles side by side in one vector register (GCC/Clang vector extension): the lanes of a law's
 /// block step. Arithmetic and comparisons act lane by lane with the IEEE rounding of the scalar
-/// operation (no fused multiply–add: the AVX2 code below is built without FMA), a comparison gives
+/// operation (no fused multiply–add: the AVX2 block steps are built with target("avx2") alone, and
+/// GEOHAZ_NATIVE builds with -ffp-contract=off), a comparison gives
 /// a mask of 0/−1 lanes, and `m ? a : b` selects by lane, so a step written once as a template over
 /// double and lanes gives the same bits either way. Two lanes are SSE2 (x86-64's baseline); four
 /// are AVX2, used where the processor has it (has_avx2()).
