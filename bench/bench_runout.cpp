@@ -10,11 +10,13 @@
 // strategies).
 #include <omp.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -126,27 +128,38 @@ const std::vector<BasalFriction>& bench_laws() {
                                                CoulombFriction{0.15}};
   return laws;
 }
-/// The latency of one law's friction step alone (terms + speed_after_friction) in a dependent
-/// chain, as in the solver's particle loop, where the next particle's work cannot overlap much
-/// with this one's: ns per step, best of 5 runs of 2e6 steps. An accelerating 2 m layer
-/// (tan θ ≈ 0.3, Δt = 0.01 s) restarted every 200 steps; an iterative law keeps its memory.
-/// Small working set, CPU time: far less sensitive to a shared machine than the plane's rates.
-double law_step_ns(const BasalFriction& friction) {
+/// The cost of one law's friction step alone (terms + step), ns per step, best of 5 runs of 2e6
+/// steps, CPU time: an accelerating 2 m layer (tan θ ≈ 0.3, Δt = 0.01 s) restarted every 200 steps;
+/// an iterative law keeps its memory. Two ways: `chained`, one particle whose next step waits for
+/// this one (the latency: what a step cost when each particle's step sat inside its own update),
+/// and in blocks of kFrictionBlock independent particles through speed_after_friction_block, as
+/// the solver now steps them (the throughput). Small working set: far less sensitive to a shared
+/// machine than the plane's rates.
+double law_step_ns(const BasalFriction& friction, bool chained) {
   return std::visit(
-      [](const auto& law) {
-        const int n = 2000000;
+      [chained](const auto& law) {
+        using Terms = decltype(law.terms(0.0, 0.0, 1.0, 0.0, 1.0));
+        const std::size_t block = chained ? 1 : kFrictionBlock;
+        const int n = 2000000 / static_cast<int>(block);
         const double dt = 0.01, h = 2.0, g = 9.81;
-        double zeta = 0.0, rate = 0.0, s = 1.0, sum = 0.0, best = HUGE_VAL;
+        std::array<double, kFrictionBlock> zeta{}, rate{}, s, s_star;
+        std::array<Terms, kFrictionBlock> t;
+        s.fill(1.0);
+        double sum = 0.0, best = HUGE_VAL;
         for (int rep = 0; rep < 5; ++rep) {
           const double c0 = cpu();
           for (int k = 0; k < n; ++k) {
-            const double s_star = (k % 200 == 0 ? 0.5 : s) + dt * g * 0.287;
-            auto t = law.terms(g, g * 0.958, h + 1e-3 * (k & 7), s_star, 2000.0);
-            if constexpr (requires { t.memory; }) t.memory = {&zeta, &rate};
-            s = speed_after_friction(s_star, dt, t);
-            sum += s;
+            for (std::size_t p = 0; p < block; ++p) {
+              s_star[p] = (k % 200 == 0 ? 0.5 + 0.01 * static_cast<double>(p) : s[p]) + dt * g * 0.287;
+              t[p] = law.terms(g, g * 0.958, h + 1e-3 * static_cast<double>((k + static_cast<int>(p)) & 7), s_star[p],
+                               2000.0);
+              if constexpr (requires { t[p].memory; }) t[p].memory = {&zeta[p], &rate[p]};
+            }
+            speed_after_friction_block(std::span<const double>(s_star.data(), block), dt,
+                                       std::span<const Terms>(t.data(), block), std::span<double>(s.data(), block));
           }
-          best = std::min(best, (cpu() - c0) / n * 1e9);
+          best = std::min(best, (cpu() - c0) / (static_cast<double>(n) * static_cast<double>(block)) * 1e9);
+          for (std::size_t p = 0; p < block; ++p) sum += s[p];
         }
         return sum > 0.0 ? best : -best;  // keeps the chain
       },
@@ -184,9 +197,13 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (which == "law_steps") {
-    std::printf("bench_runout: one friction step of each law alone, dependent chain (ns, CPU, best of 5)\n");
+    std::printf(
+        "bench_runout: one friction step of each law alone (ns, CPU, best of 5): one particle in a dependent\n"
+        "  chain, and blocks of %zu independent particles as the solver steps them\n",
+        kFrictionBlock);
     for (const BasalFriction& law : bench_laws())
-      std::printf("  %-17s %.1f ns\n", friction_name(law).c_str(), law_step_ns(law));
+      std::printf("  %-17s chained %5.1f ns, in blocks %5.1f ns\n", friction_name(law).c_str(), law_step_ns(law, true),
+                  law_step_ns(law, false));
     return 0;
   }
   if (which == "laws") {
