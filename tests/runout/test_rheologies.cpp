@@ -528,8 +528,8 @@ TEST(RheologyStep, HerschelBulkleyBlockStepGivesTheBitsOfOneParticleAtATime) {
     }
     particles += static_cast<int>(count);
     expect_block_bits<HerschelBulkleyTerms>(b, trial,
-                                            {{"two lanes", &herschel_bulkley_block<DoubleLanes>},
-                                             {"four lanes", &herschel_bulkley_block<DoubleLanes4>},
+                                            {{"two lanes", &lane_block<DoubleLanes>},
+                                             {"four lanes", &lane_block<DoubleLanes4>},
                                              {"dispatched", &dispatched_block<HerschelBulkleyTerms>}});
     if (HasFatalFailure()) return;
   }
@@ -567,8 +567,8 @@ TEST(RheologyStep, BinghamBlockStepGivesTheBitsOfOneParticleAtATime) {
     }
     particles += static_cast<int>(count);
     expect_block_bits<BinghamTerms>(b, trial,
-                                    {{"two lanes", &bingham_block<DoubleLanes>},
-                                     {"four lanes", &bingham_block<DoubleLanes4>},
+                                    {{"two lanes", &lane_block<DoubleLanes>},
+                                     {"four lanes", &lane_block<DoubleLanes4>},
                                      {"dispatched", &dispatched_block<BinghamTerms>}});
     if (HasFatalFailure()) return;
   }

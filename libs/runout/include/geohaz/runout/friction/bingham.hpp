@@ -112,6 +112,14 @@ struct BinghamTerms {
          ((abs_a + 3.0 * abs_b * (abs_e + abs_r)) * (r * r) <= 4.2e-14 * near);
     inv_r = 1.0 / (1.0 - t);
   }
+  /// At u = 1 − r: the speed K' (1 − r)²(2 + r)/r (exact as r → 1) and ζ = τ_b − τ_y = τ_y (1 − r)/r,
+  /// for one particle or several side by side.
+  template <class T>
+  [[gnu::always_inline]] static void plug_state(const T& speed_scale, const T& tau_y, const T& u, const T& inv_r,
+                                                T& speed, T& zeta) noexcept {
+    speed = speed_scale * u * u * (3.0 - u) * inv_r;
+    zeta = tau_y * u * inv_r;
+  }
   /// Halley's method on the plug cubic from t (above).
   static double halley(double P, double D, double t) noexcept {
     for (int k = 0; k < 8; ++k) {
@@ -149,11 +157,9 @@ inline double speed_after_friction(double s_star, double dt, const BinghamTerms&
       return 0.0;
     }
     const auto [u, inv_r] = t.plug_root(s_star, dt, zeta ? *zeta : 0.0);  // 1 − r, 1/r
-    s = t.speed_scale * u * u * (3.0 - u) * inv_r;                        // K' (1 − r)²(2 + r)/r, exact as r → 1
-    if (zeta) {
-      *zeta = t.tau_y * u * inv_r;  // τ_b − τ_y = τ_y (1 − r)/r
-      *t.memory.rate = *zeta * t.inv_viscosity;
-    }
+    double excess;
+    BinghamTerms::plug_state(t.speed_scale, t.tau_y, u, inv_r, s, excess);
+    if (zeta) *zeta = excess, *t.memory.rate = excess * t.inv_viscosity;
   }
   return speed_after_drag(s, t.extra_drag * dt);
 }
@@ -162,8 +168,8 @@ inline double speed_after_friction(double s_star, double dt, const BinghamTerms&
 /// the plug cubic for V's lanes side by side (warm_lanes); a particle that stops, has no memory,
 /// is a Newtonian film (τ_y = 0) or whose warm step is not accepted takes speed_after_friction.
 template <class V>
-[[gnu::always_inline]] inline void bingham_block(std::span<const double> s_star, double dt,
-                                                 std::span<const BinghamTerms> t, std::span<double> s) noexcept {
+[[gnu::always_inline]] inline void lane_block(std::span<const double> s_star, double dt,
+                                              std::span<const BinghamTerms> t, std::span<double> s) noexcept {
   constexpr std::size_t lanes = sizeof(V) / sizeof(double);
   std::size_t k = 0;
   for (; k + lanes <= s.size(); k += lanes) {
@@ -179,7 +185,8 @@ template <class V>
     decltype(P > 0.0) ok;
     BinghamTerms::warm_lanes(tau_y, P, D, zeta0, u, inv_r, ok);
     ok &= (zeta0 > 0.0) & (rest != 0.0) & (ss > dt * rest);
-    const V speed = scale * u * u * (3.0 - u) * inv_r, zeta = tau_y * u * inv_r;
+    V speed, zeta;
+    BinghamTerms::plug_state(scale, tau_y, u, inv_r, speed, zeta);
     for (std::size_t l = 0; l < lanes; ++l) {
       const BinghamTerms& tl = t[k + l];
       if (!ok[l]) {
@@ -191,19 +198,6 @@ template <class V>
     }
   }
   for (; k < s.size(); ++k) s[k] = speed_after_friction(s_star[k], dt, t[k]);
-}
-#if defined(__x86_64__) && defined(__GNUC__)
-[[gnu::target("avx2")]] inline void bingham_block_avx2(std::span<const double> s_star, double dt,
-                                                       std::span<const BinghamTerms> t, std::span<double> s) noexcept {
-  bingham_block<DoubleLanes4>(s_star, dt, t, s);
-}
-#endif
-inline void speed_after_friction_block(std::span<const double> s_star, double dt, std::span<const BinghamTerms> t,
-                                       std::span<double> s) noexcept {
-#if defined(__x86_64__) && defined(__GNUC__)
-  if (has_avx2()) return bingham_block_avx2(s_star, dt, t, s);
-#endif
-  bingham_block<DoubleLanes>(s_star, dt, t, s);
 }
 
 struct BinghamFriction {

@@ -129,13 +129,37 @@ inline bool has_avx2() noexcept {
 /// The solver steps the friction of its particles in blocks of this many (solver.hpp, integrate).
 inline constexpr std::size_t kFrictionBlock = 16;
 
-/// The friction steps of a block of particles: s[k] = speed_after_friction(s_star[k], dt, t[k]).
-/// A law whose step gains from doing several particles at once (vector instructions) overloads
-/// this for its terms type with the same results.
+/// A law whose step gains from doing several particles at once defines, for its terms type,
+/// `template <class V> void lane_block(s_star, dt, span<const Terms> t, s)`: the block's steps with
+/// V's lanes side by side (V = DoubleLanes or DoubleLanes4), bit for bit those of
+/// speed_after_friction. It is found by argument-dependent lookup.
+template <class Terms>
+concept HasLaneBlock = requires(std::span<const double> a, std::span<const Terms> t, std::span<double> s) {
+  lane_block<DoubleLanes>(a, 0.0, t, s);
+};
+#if defined(__x86_64__) && defined(__GNUC__)
+/// lane_block on four lanes, built for AVX2 (without FMA).
+template <class Terms>
+[[gnu::target("avx2")]] void lane_block_avx2(std::span<const double> s_star, double dt, std::span<const Terms> t,
+                                             std::span<double> s) noexcept {
+  lane_block<DoubleLanes4>(s_star, dt, t, s);
+}
+#endif
+
+/// The friction steps of a block of particles: s[k] = speed_after_friction(s_star[k], dt, t[k]),
+/// through the law's lane_block where it has one (four lanes where the processor runs AVX2, else
+/// two), one particle at a time otherwise.
 template <class Terms>
 void speed_after_friction_block(std::span<const double> s_star, double dt, std::span<const Terms> t,
                                 std::span<double> s) noexcept {
-  for (std::size_t k = 0; k < s.size(); ++k) s[k] = speed_after_friction(s_star[k], dt, t[k]);
+  if constexpr (HasLaneBlock<Terms>) {
+#if defined(__x86_64__) && defined(__GNUC__)
+    if (has_avx2()) return lane_block_avx2(s_star, dt, t, s);
+#endif
+    lane_block<DoubleLanes>(s_star, dt, t, s);
+  } else {
+    for (std::size_t k = 0; k < s.size(); ++k) s[k] = speed_after_friction(s_star[k], dt, t[k]);
+  }
 }
 
 }  // namespace geohaz::runout

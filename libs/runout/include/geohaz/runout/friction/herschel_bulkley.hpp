@@ -247,9 +247,8 @@ inline double speed_after_friction(double s_star, double dt, const HerschelBulkl
 /// steps V's lanes side by side (series_lanes); a particle that stops, has no usable start or
 /// whose series step is not accepted takes speed_after_friction.
 template <class V>
-[[gnu::always_inline]] inline void herschel_bulkley_block(std::span<const double> s_star, double dt,
-                                                          std::span<const HerschelBulkleyTerms> t,
-                                                          std::span<double> s) noexcept {
+[[gnu::always_inline]] inline void lane_block(std::span<const double> s_star, double dt,
+                                              std::span<const HerschelBulkleyTerms> t, std::span<double> s) noexcept {
   constexpr std::size_t lanes = sizeof(V) / sizeof(double);
   std::size_t k = 0;
   for (; k + lanes <= s.size(); k += lanes) {
@@ -275,20 +274,6 @@ template <class V>
     }
   }
   for (; k < s.size(); ++k) s[k] = speed_after_friction(s_star[k], dt, t[k]);
-}
-#if defined(__x86_64__) && defined(__GNUC__)
-[[gnu::target("avx2")]] inline void herschel_bulkley_block_avx2(std::span<const double> s_star, double dt,
-                                                                std::span<const HerschelBulkleyTerms> t,
-                                                                std::span<double> s) noexcept {
-  herschel_bulkley_block<DoubleLanes4>(s_star, dt, t, s);
-}
-#endif
-inline void speed_after_friction_block(std::span<const double> s_star, double dt,
-                                       std::span<const HerschelBulkleyTerms> t, std::span<double> s) noexcept {
-#if defined(__x86_64__) && defined(__GNUC__)
-  if (has_avx2()) return herschel_bulkley_block_avx2(s_star, dt, t, s);
-#endif
-  herschel_bulkley_block<DoubleLanes>(s_star, dt, t, s);
 }
 
 struct HerschelBulkleyFriction {
